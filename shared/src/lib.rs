@@ -1,4 +1,40 @@
 //! pada-core: the learning core of pada, identical on the host and on the chip.
+//!
+//! Everything here is `no_std`, allocation-free and fixed-size: capacities are
+//! const generics or [`heapless`] types, and running out is an error that is
+//! counted, never a panic. The pieces, each in its own module:
+//!
+//! - [`fixed`]: the fixed-point formats of weights, rates and trace weights;
+//! - [`tile_coding`]: state → integer tile coordinates → feature indices
+//!   (hashed or exact layout);
+//! - [`action_space`]: discrete multi-dimensional actions and joint indices;
+//! - [`policy`]: the six action policies of Section V (SARSA, low-pass,
+//!   Markov low-pass, integrator, Markov integrator, PADA) as one concept;
+//! - [`trace`]: bounded eligibility traces;
+//! - [`agent`]: SARSA(λ) with ε-greedy selection over the policy's candidates;
+//! - [`fatigue`]: backlash re-engagements → damage J → predicted MTBF
+//!   (Section IV, Eqs. 1–7).
+//!
+//! Section and equation numbers refer to Meijdam, Plooij and Caarls,
+//! "Learning while preventing mechanical failure due to random motions".
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
+// Index loops over several parallel fixed-size arrays read more plainly than
+// zipped iterators here.
+#![allow(clippy::needless_range_loop)]
+
+pub mod action_space;
+pub mod agent;
+pub mod error;
+pub mod fatigue;
+pub mod fixed;
+pub mod policy;
+pub mod tile_coding;
+pub mod trace;
+
+/// A value the firmware references so that a link of pada-core is visible in
+/// the ELF even before the firmware runs an agent ("PADA" in ASCII).
+pub fn linked_marker() -> u32 {
+    0x5041_4441
+}

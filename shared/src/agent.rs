@@ -1,0 +1,522 @@
+//! SARSA(λ) with tile coding, ε-greedy selection over the policy's
+//! candidates, and bounded traces (Section III; reference semantics in
+//! `../shared/reference/grl-facts.md` §5).
+//!
+//! - `Q(s, a)` is the **mean** of the `TILINGS` active weights, and an update
+//!   moves every active weight by `α·δ·e`, so that `Q` itself moves by `α·δ`
+//!   for the current pair: α = 0.2 means what it means in the paper.
+//! - `δ = r + γ·Q(s', a') − Q(s, a)` on-policy: `a'` is chosen (by the
+//!   policy, among its candidates) before the update; an absorbing end has
+//!   no bootstrap term, a timeout does.
+//! - Traces: [`crate::trace`], cleared at every episode start.
+//! - ε-greedy: with probability ε a uniformly random candidate, else the
+//!   best candidate, ties broken uniformly at random. The caller's
+//!   [`RngCore`] is the only source of randomness, so a seed reproduces a
+//!   run bit for bit on any machine.
+//!
+//! Floats enter only as observations and rewards, checked for finiteness
+//! before anything changes: a NaN state is an error that changes no weight.
+
+use crate::action_space::{ActionSpace, Levels, Output, MAX_ACTION_DIMS};
+use crate::error::{check_range, ConfigError, StepError};
+use crate::fixed::{Frac, Q16};
+use crate::policy::{uniform_below, Candidates, Policy, PolicyKind};
+use crate::tile_coding::{Layout, StateCode, StateDim, TileCoder, MAX_STATE_DIMS};
+use crate::trace::{Trace, TraceKind};
+use heapless::Vec;
+use rand_core::RngCore;
+
+/// How weights start.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum WeightInit {
+    /// Every weight equal (optimistic initialisation when above the
+    /// achievable returns).
+    Constant(f32),
+    /// Independent uniform draws in `[min, max]` (GRL uses U[0, 1]).
+    Uniform {
+        /// Lower end.
+        min: f32,
+        /// Upper end.
+        max: f32,
+    },
+}
+
+/// Learning parameters. [`Default`] is the paper's (Section VII): α 0.2,
+/// γ 0.99, ε 0.05, λ 0.92, replacing traces pruned at 0.01, weights 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct SarsaParams {
+    /// Learning rate α, `0 < α ≤ 1`: Q moves by α·δ.
+    pub alpha: f32,
+    /// Discount γ per step, `0 ≤ γ ≤ 1`.
+    pub gamma: f32,
+    /// Trace decay λ per step, `0 ≤ λ ≤ 1`.
+    pub lambda: f32,
+    /// Exploration rate ε, `0 ≤ ε ≤ 1`.
+    pub epsilon: f32,
+    /// Trace entries with eligibility `(γλ)^k` below this are pruned,
+    /// `0 < threshold < 1`.
+    pub trace_threshold: f32,
+    /// Replacing (default) or accumulating traces.
+    pub trace_kind: TraceKind,
+    /// Initial weights.
+    pub init: WeightInit,
+}
+
+impl Default for SarsaParams {
+    fn default() -> Self {
+        SarsaParams {
+            alpha: 0.2,
+            gamma: 0.99,
+            lambda: 0.92,
+            epsilon: 0.05,
+            trace_threshold: 0.01,
+            trace_kind: TraceKind::Replacing,
+            init: WeightInit::Constant(0.0),
+        }
+    }
+}
+
+impl SarsaParams {
+    /// Checks every parameter's range.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        if !(self.alpha.is_finite() && self.alpha > 0.0 && self.alpha <= 1.0) {
+            return Err(ConfigError::new("alpha", self.alpha, "0 < alpha <= 1"));
+        }
+        check_range("gamma", self.gamma, 0.0, 1.0, "0 <= gamma <= 1")?;
+        check_range("lambda", self.lambda, 0.0, 1.0, "0 <= lambda <= 1")?;
+        check_range("epsilon", self.epsilon, 0.0, 1.0, "0 <= epsilon <= 1")?;
+        if !(self.trace_threshold.is_finite() && self.trace_threshold > 0.0 && self.trace_threshold < 1.0) {
+            return Err(ConfigError::new("trace_threshold", self.trace_threshold, "0 < trace_threshold < 1"));
+        }
+        match self.init {
+            WeightInit::Constant(c) => check_range("init", c, -30000.0, 30000.0, "-30000 <= init <= 30000"),
+            WeightInit::Uniform { min, max } => {
+                check_range("init.min", min, -30000.0, 30000.0, "-30000 <= init.min <= init.max <= 30000")?;
+                check_range("init.max", max, min, 30000.0, "-30000 <= init.min <= init.max <= 30000")
+            }
+        }
+    }
+}
+
+/// Learning (ε-greedy, updates) or testing (greedy, no updates: the test
+/// runs of Section VI).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Mode {
+    /// ε-greedy selection and SARSA(λ) updates.
+    Learning,
+    /// Greedy selection among the policy's candidates, no updates.
+    Testing,
+}
+
+/// What the agent decided for one step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Decision {
+    /// Joint index of the learner's action.
+    pub action: u32,
+    /// The learner's action as levels per dimension.
+    pub levels: Levels,
+    /// What to apply to each motor (torque, voltage …), after the policy.
+    pub output: Output,
+    /// Whether the action was an exploratory draw.
+    pub explored: bool,
+    /// `Q(s, a)` of the chosen action.
+    pub q: Q16,
+}
+
+/// How an episode ended.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum EpisodeEnd<'a> {
+    /// An absorbing state (a fall): no bootstrap.
+    Absorbing,
+    /// A time limit in a non-terminal state: bootstrap from this observation.
+    Timeout(&'a [f32]),
+}
+
+/// Counters for telemetry and reports.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct AgentStats {
+    /// Decisions taken (learning and testing).
+    pub steps: u64,
+    /// SARSA updates made.
+    pub updates: u64,
+    /// Exploratory decisions.
+    pub explorations: u64,
+    /// Episodes started.
+    pub episodes: u32,
+    /// Weight writes that hit the Q16 range and saturated.
+    pub saturations: u32,
+    /// Trace entries dropped for lack of capacity.
+    pub trace_drops: u32,
+    /// The last TD error δ.
+    pub last_td_error: Q16,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Current<const TILINGS: usize> {
+    /// Feature indices of the (state, action) pair being played.
+    features: [u32; TILINGS],
+}
+
+/// A SARSA(λ) agent with `TILINGS` tilings and a trace of at most `TRACE`
+/// entries, on weights stored in `W`.
+///
+/// The weights live in any `W` that lends a slice: an array owned by the
+/// agent, a `&'static mut [Q16; N]` in a chosen RAM section on the chip
+/// (compile-time size), or a boxed slice on the host. The hashed layout
+/// needs a power-of-two length.
+pub struct Agent<W, const TILINGS: usize, const TRACE: usize> {
+    coder: TileCoder<TILINGS>,
+    policy: Policy,
+    weights: W,
+    trace: Trace<TILINGS, TRACE>,
+    params: SarsaParams,
+    alpha: Frac,
+    gamma: Frac,
+    /// ε scaled to 2³²: explore when a `u32` draw is below it.
+    epsilon: u64,
+    mode: Mode,
+    obs_dims: usize,
+    current: Option<Current<TILINGS>>,
+    stats: AgentStats,
+}
+
+impl<W, const TILINGS: usize, const TRACE: usize> Agent<W, TILINGS, TRACE>
+where
+    W: AsRef<[Q16]> + AsMut<[Q16]>,
+{
+    /// Builds an agent that observes `obs` (the policy may append its own
+    /// dimensions), drives `motor` through `policy`, and learns with
+    /// `params` on `weights` laid out as `layout`. Weights are set from
+    /// `params.init` with [`reset_weights`](Self::reset_weights).
+    pub fn new(
+        obs: &[StateDim],
+        motor: ActionSpace,
+        policy: PolicyKind,
+        params: SarsaParams,
+        layout: Layout,
+        weights: W,
+    ) -> Result<Self, ConfigError> {
+        params.validate()?;
+        if TRACE == 0 {
+            return Err(ConfigError::new("trace capacity", 0.0, "at least 1 entry"));
+        }
+        let policy = Policy::new(policy, motor)?;
+        let mut dims: Vec<StateDim, MAX_STATE_DIMS> = Vec::new();
+        for d in obs {
+            dims.push(*d).map_err(|_| {
+                ConfigError::new("state dimensions", obs.len() as f32, "at most 16 including the policy's")
+            })?;
+        }
+        for i in 0..policy.extension_len() {
+            dims.push(policy.extension_dim(i)?).map_err(|_| {
+                ConfigError::new(
+                    "state dimensions",
+                    (obs.len() + policy.extension_len()) as f32,
+                    "at most 16 including the policy's",
+                )
+            })?;
+        }
+        let coder = TileCoder::new(&dims, policy.learner_space().joint_count(), layout, weights.as_ref().len())?;
+        let decay = Frac::from_f32(params.gamma).times(Frac::from_f32(params.lambda));
+        Ok(Agent {
+            coder,
+            policy,
+            weights,
+            trace: Trace::new(params.trace_kind, decay, Frac::from_f32(params.trace_threshold)),
+            alpha: Frac::from_f32(params.alpha),
+            gamma: Frac::from_f32(params.gamma),
+            epsilon: (params.epsilon as f64 * 4_294_967_296.0) as u64,
+            params,
+            mode: Mode::Learning,
+            obs_dims: obs.len(),
+            current: None,
+            stats: AgentStats::default(),
+        })
+    }
+
+    /// Sets every weight from `params.init` (draws from `rng` if uniform).
+    pub fn reset_weights<R: RngCore + ?Sized>(&mut self, rng: &mut R) {
+        match self.params.init {
+            WeightInit::Constant(c) => self.weights.as_mut().fill(Q16::from_f32(c)),
+            WeightInit::Uniform { min, max } => {
+                let (lo, hi) = (Q16::from_f32(min).0 as i64, Q16::from_f32(max).0 as i64);
+                let span = (hi - lo + 1) as u64;
+                for w in self.weights.as_mut() {
+                    let r = ((rng.next_u64() as u128 * span as u128) >> 64) as i64;
+                    *w = Q16((lo + r) as i32);
+                }
+            }
+        }
+    }
+
+    /// Starts an episode in observation `obs`: clears the trace, puts the
+    /// policy at rest, and chooses the first action.
+    pub fn start_episode<R: RngCore + ?Sized>(&mut self, obs: &[f32], rng: &mut R) -> Result<Decision, StepError> {
+        self.check_obs(obs)?;
+        self.trace.clear();
+        self.policy.reset();
+        self.stats.episodes = self.stats.episodes.wrapping_add(1);
+        let (decision, features) = self.decide(obs, rng);
+        Ok(self.commit(decision, features))
+    }
+
+    /// One step: the previous action earned `reward` and led to `obs`.
+    /// Chooses the next action and, when learning, updates the weights.
+    pub fn step<R: RngCore + ?Sized>(
+        &mut self,
+        reward: f32,
+        obs: &[f32],
+        rng: &mut R,
+    ) -> Result<Decision, StepError> {
+        let current = self.current.ok_or(StepError::NoEpisode)?;
+        self.check_obs(obs)?;
+        if !reward.is_finite() {
+            return Err(StepError::NonFiniteReward);
+        }
+        let (decision, features) = self.decide(obs, rng);
+        if self.mode == Mode::Learning {
+            self.update(&current, reward, Some(decision.q));
+        }
+        Ok(self.commit(decision, features))
+    }
+
+    /// Ends the episode: the last action earned `reward`; `end` says whether
+    /// to bootstrap. The next call must be [`start_episode`](Self::start_episode).
+    pub fn end_episode<R: RngCore + ?Sized>(
+        &mut self,
+        reward: f32,
+        end: EpisodeEnd<'_>,
+        rng: &mut R,
+    ) -> Result<(), StepError> {
+        let current = self.current.ok_or(StepError::NoEpisode)?;
+        if let EpisodeEnd::Timeout(obs) = end {
+            self.check_obs(obs)?;
+        }
+        if !reward.is_finite() {
+            return Err(StepError::NonFiniteReward);
+        }
+        if self.mode == Mode::Learning {
+            let q_next = match end {
+                EpisodeEnd::Absorbing => None,
+                EpisodeEnd::Timeout(obs) => {
+                    // The on-policy successor: the action the policy would
+                    // take in the timed-out state (not applied).
+                    let (successor, _) = self.decide(obs, rng);
+                    Some(successor.q)
+                }
+            };
+            self.update(&current, reward, q_next);
+        }
+        self.current = None;
+        self.trace.clear();
+        Ok(())
+    }
+
+    /// Learning or testing.
+    pub fn set_mode(&mut self, mode: Mode) {
+        self.mode = mode;
+    }
+
+    /// The current mode.
+    pub fn mode(&self) -> Mode {
+        self.mode
+    }
+
+    /// Changes ε (`0 ≤ ε ≤ 1`).
+    pub fn set_epsilon(&mut self, epsilon: f32) -> Result<(), ConfigError> {
+        check_range("epsilon", epsilon, 0.0, 1.0, "0 <= epsilon <= 1")?;
+        self.params.epsilon = epsilon;
+        self.epsilon = (epsilon as f64 * 4_294_967_296.0) as u64;
+        Ok(())
+    }
+
+    /// Switches PADA or the low-pass filter back to plain SARSA
+    /// (Section VIII).
+    pub fn switch_to_sarsa(&mut self) -> Result<(), StepError> {
+        self.policy.switch_to_sarsa()
+    }
+
+    /// The action policy.
+    pub fn policy(&self) -> &Policy {
+        &self.policy
+    }
+
+    /// The tile coder.
+    pub fn coder(&self) -> &TileCoder<TILINGS> {
+        &self.coder
+    }
+
+    /// The learning parameters.
+    pub fn params(&self) -> &SarsaParams {
+        &self.params
+    }
+
+    /// Counters.
+    pub fn stats(&self) -> AgentStats {
+        AgentStats { trace_drops: self.trace.drops(), ..self.stats }
+    }
+
+    /// The weights.
+    pub fn weights(&self) -> &[Q16] {
+        self.weights.as_ref()
+    }
+
+    /// The weights, mutably (loading a checkpoint).
+    pub fn weights_mut(&mut self) -> &mut [Q16] {
+        self.weights.as_mut()
+    }
+
+    /// FNV-1a over the weights' little-endian bytes: equal on every machine
+    /// for equal weights.
+    pub fn weights_checksum(&self) -> u32 {
+        let mut h: u32 = 0x811c_9dc5;
+        for w in self.weights.as_ref() {
+            for b in w.0.to_le_bytes() {
+                h = (h ^ b as u32).wrapping_mul(0x0100_0193);
+            }
+        }
+        h
+    }
+
+    /// `Q(s, a)` for an observation and a joint action of the learner, with
+    /// the policy's current extension appended (for inspection and tests).
+    pub fn q_value(&self, obs: &[f32], action: u32) -> Result<Q16, StepError> {
+        self.check_obs(obs)?;
+        let code = self.code(obs);
+        Ok(self.q_of(&self.coder.features(&code, action)))
+    }
+
+    fn check_obs(&self, obs: &[f32]) -> Result<(), StepError> {
+        if obs.len() != self.obs_dims {
+            return Err(StepError::WrongStateLength { expected: self.obs_dims as u8, got: obs.len() as u8 });
+        }
+        match obs.iter().position(|x| !x.is_finite()) {
+            Some(dim) => Err(StepError::NonFiniteState { dim: dim as u8 }),
+            None => Ok(()),
+        }
+    }
+
+    /// The state code of `obs` plus the policy's extension.
+    fn code(&self, obs: &[f32]) -> StateCode<TILINGS> {
+        let mut x = [0.0f32; MAX_STATE_DIMS];
+        x[..obs.len()].copy_from_slice(obs);
+        let ext = self.policy.extension();
+        x[obs.len()..obs.len() + ext.len()].copy_from_slice(ext);
+        self.coder.encode(&x[..obs.len() + ext.len()])
+    }
+
+    /// Sum of the active weights of (state, action): `TILINGS · Q`.
+    #[inline]
+    fn q_sum(&self, code: &StateCode<TILINGS>, action: u32) -> i64 {
+        let w = self.weights.as_ref();
+        let mut sum = 0i64;
+        for j in 0..TILINGS {
+            sum += w[self.coder.feature(code, j, action) as usize].0 as i64;
+        }
+        sum
+    }
+
+    /// `Q` of a feature set: the mean of its weights.
+    fn q_of(&self, features: &[u32; TILINGS]) -> Q16 {
+        let w = self.weights.as_ref();
+        let sum: i64 = features.iter().map(|&f| w[f as usize].0 as i64).sum();
+        Q16::from_wide(sum / TILINGS as i64)
+    }
+
+    /// ε-greedy choice among the policy's candidates. Does not change the
+    /// agent; [`commit`](Self::commit) applies the choice.
+    fn decide<R: RngCore + ?Sized>(
+        &self,
+        obs: &[f32],
+        rng: &mut R,
+    ) -> (Decision, [u32; TILINGS]) {
+        let code = self.code(obs);
+        let candidates = self.policy.candidates();
+        let space = self.policy.learner_space();
+        let explore = self.mode == Mode::Learning && (rng.next_u32() as u64) < self.epsilon;
+        let levels = if explore { candidates.random(rng) } else { self.greedy(&code, &candidates, space, rng) };
+        let action = space.encode(&levels);
+        let features = self.coder.features(&code, action);
+        let q = self.q_of(&features);
+        (Decision { action, levels, output: [0.0; MAX_ACTION_DIMS], explored: explore, q }, features)
+    }
+
+    /// The best candidate; ties broken uniformly at random (reservoir
+    /// sampling: the k-th tie replaces the choice with probability 1/k).
+    fn greedy<R: RngCore + ?Sized>(
+        &self,
+        code: &StateCode<TILINGS>,
+        candidates: &Candidates,
+        space: &ActionSpace,
+        rng: &mut R,
+    ) -> Levels {
+        let mut best = candidates.lo;
+        let mut best_sum = i64::MIN;
+        let mut ties = 0u32;
+        candidates.for_each(|levels| {
+            let sum = self.q_sum(code, space.encode(levels));
+            if sum > best_sum {
+                best_sum = sum;
+                best = *levels;
+                ties = 1;
+            } else if sum == best_sum {
+                ties += 1;
+                if uniform_below(rng, ties) == 0 {
+                    best = *levels;
+                }
+            }
+        });
+        best
+    }
+
+    fn commit(&mut self, mut decision: Decision, features: [u32; TILINGS]) -> Decision {
+        decision.output = self.policy.apply(&decision.levels);
+        self.current = Some(Current { features });
+        self.stats.steps += 1;
+        if decision.explored {
+            self.stats.explorations += 1;
+        }
+        decision
+    }
+
+    /// The SARSA(λ) update for the pair `current` that earned `reward`;
+    /// `q_next` is `Q(s', a')`, or `None` at an absorbing end.
+    fn update(&mut self, current: &Current<TILINGS>, reward: f32, q_next: Option<Q16>) {
+        let q = self.q_of(&current.features);
+        let mut delta = Q16::from_f32(reward).0 as i64 - q.0 as i64;
+        if let Some(qn) = q_next {
+            delta += qn.mul_frac(self.gamma).0 as i64;
+        }
+        let delta = Q16::from_wide(delta);
+        self.stats.last_td_error = delta;
+        let step = delta.mul_frac(self.alpha);
+        self.trace.push(&current.features);
+        let weights = self.weights.as_mut();
+        let mut saturations = 0u32;
+        self.trace.for_each_entry(|entry, eligibility| {
+            let inc = step.mul_frac(eligibility);
+            if inc == Q16::ZERO {
+                return;
+            }
+            for &f in entry {
+                // Replaced slots hold u32::MAX and are skipped here.
+                if let Some(w) = weights.get_mut(f as usize) {
+                    let next = w.saturating_add(inc);
+                    if next == Q16::MAX || next == Q16::MIN {
+                        saturations += 1;
+                    }
+                    *w = next;
+                }
+            }
+        });
+        self.stats.saturations = self.stats.saturations.saturating_add(saturations);
+        self.stats.updates += 1;
+    }
+}
