@@ -1,0 +1,44 @@
+//! Link setup, as cortex-m-rt projects do it: put the workspace's `memory.x`
+//! where `link.x` (from cortex-m-rt) can `INCLUDE` it, and link with `link.x`.
+
+use std::{env, fs, path::PathBuf};
+
+fn main() {
+    let chips: Vec<&str> = ["stm32f405", "stm32f407", "stm32f446"]
+        .into_iter()
+        .filter(|c| env::var_os(format!("CARGO_FEATURE_{}", c.to_uppercase())).is_some())
+        .collect();
+    if chips.len() != 1 {
+        panic!(
+            "pada-firmware: enable exactly one chip feature (stm32f405, stm32f407, stm32f446); \
+             got {chips:?}. For a non-default chip use --no-default-features --features <chip>."
+        );
+    }
+    if chips[0] == "stm32f446" {
+        // Still linked with the F405 layout: the STM32F446RE has only 512 KB
+        // of flash (checkpoint sectors would be 6 and 7 at 0x0804_0000) and
+        // no CCM RAM at 0x1000_0000. Fine for a build check, wrong on a chip.
+        println!(
+            "cargo:warning=stm32f446: linking with the STM32F405 memory.x \
+             (1 MB flash, CCM RAM); the F446RE has 512 KB flash and no CCM, \
+             so this image is a build check only"
+        );
+    }
+
+    let manifest_dir = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").unwrap());
+    let memory_x = manifest_dir.join("..").join("memory.x");
+    let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());
+    let contents = fs::read(&memory_x)
+        .unwrap_or_else(|e| panic!("pada-firmware: cannot read {}: {e}", memory_x.display()));
+    fs::write(out.join("memory.x"), contents).unwrap();
+    println!("cargo:rustc-link-search={}", out.display());
+    println!("cargo:rerun-if-changed={}", memory_x.display());
+    println!("cargo:rerun-if-changed=build.rs");
+
+    // Segments need no page alignment in flash (keeps images small); both
+    // rust-lld and GNU ld (arm-none-eabi-ld) accept it.
+    println!("cargo:rustc-link-arg-bins=--nmagic");
+    // cortex-m-rt's linker script; it includes memory.x. Set here rather
+    // than in .cargo/config.toml so every way of building gets it once.
+    println!("cargo:rustc-link-arg-bins=-Tlink.x");
+}
