@@ -26,6 +26,7 @@
 
 pub mod action_space;
 pub mod agent;
+pub mod dynamixel;
 pub mod error;
 pub mod fatigue;
 pub mod fixed;
