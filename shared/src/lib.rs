@@ -31,6 +31,7 @@ pub mod error;
 pub mod fatigue;
 pub mod fixed;
 pub mod policy;
+pub mod safety;
 pub mod tile_coding;
 pub mod trace;
 
