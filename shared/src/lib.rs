@@ -26,6 +26,7 @@
 
 pub mod action_space;
 pub mod agent;
+pub mod checkpoint;
 pub mod dynamixel;
 pub mod error;
 pub mod fatigue;
