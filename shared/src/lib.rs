@@ -35,6 +35,7 @@ pub mod policy;
 pub mod safety;
 pub mod tile_coding;
 pub mod trace;
+pub mod wire;
 
 /// A value the firmware references so that a link of pada-core is visible in
 /// the ELF even before the firmware runs an agent ("PADA" in ASCII).

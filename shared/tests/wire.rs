@@ -1,0 +1,586 @@
+//! The wire protocol: every message round trips, the largest fit a frame,
+//! and the decoder resynchronises and counts every loss on corrupted
+//! streams without ever panicking.
+
+use heapless::{String, Vec as HVec};
+use pada_core::checkpoint::{LoadOutcome, Saved};
+use pada_core::dynamixel::ErrorFlags;
+use pada_core::policy::PolicyKind;
+use pada_core::safety::{FaultCause, Rejection, State};
+use pada_core::wire::*;
+use proptest::prelude::*;
+
+/// The postcard bytes of a value.
+fn body<T: serde::Serialize>(v: &T) -> Vec<u8> {
+    let mut buf = [0u8; 1024];
+    postcard::to_slice(v, &mut buf).unwrap().to_vec()
+}
+
+fn text(s: &str) -> String<MAX_TEXT> {
+    String::try_from(s).unwrap()
+}
+
+fn full_step() -> Step {
+    Step {
+        step: u32::MAX,
+        time_ms: u32::MAX,
+        episode: u32::MAX,
+        mode: RunMode::Testing,
+        kind: StepKind::Timeout,
+        state: HVec::from_slice(&[-1.5e30; MAX_STATE_DIMS]).unwrap(),
+        action: u32::MAX,
+        output: HVec::from_slice(&[f32::MAX; MAX_OUTPUTS]).unwrap(),
+        reward: f32::MIN,
+        td_error: i32::MIN,
+        explored: true,
+        joints: HVec::from_slice(&[JointFatigue { damage: 1e-300, reengagements: u32::MAX }; MAX_JOINTS]).unwrap(),
+        loop_us: u32::MAX,
+    }
+}
+
+fn full_health() -> Health {
+    Health {
+        uptime_ms: u32::MAX,
+        servo_temps_c: HVec::from_slice(&[255; MAX_SERVOS]).unwrap(),
+        min_voltage_dv: 255,
+        bus_errors: u32::MAX,
+        checksum_errors: u32::MAX,
+        timeouts: u32::MAX,
+        trace_drops: u32::MAX,
+        weight_saturations: u32::MAX,
+        overruns: u32::MAX,
+        max_loop_us: u32::MAX,
+        telemetry_drops: u32::MAX,
+    }
+}
+
+/// One of every chip → host message (and variant of the nested enums).
+fn all_to_host() -> Vec<ToHost> {
+    let small_step = Step {
+        step: 3,
+        time_ms: 150,
+        episode: 0,
+        mode: RunMode::Learning,
+        kind: StepKind::Step,
+        state: HVec::from_slice(&[0.1, -0.2]).unwrap(),
+        action: 2,
+        output: HVec::from_slice(&[0.5]).unwrap(),
+        reward: -1.0,
+        td_error: -65536,
+        explored: false,
+        joints: HVec::from_slice(&[JointFatigue { damage: 3.2e-9, reengagements: 4 }]).unwrap(),
+        loop_us: 812,
+    };
+    let mut v = vec![
+        ToHost::Hello(Hello {
+            protocol: PROTOCOL_VERSION,
+            config_hash: 0xDEAD_BEEF,
+            weight_count: 1 << 16,
+            period_us: 33_333,
+            state_dims: 10,
+            joints: 3,
+        }),
+        ToHost::Step(small_step),
+        ToHost::Step(full_step()),
+        ToHost::Episode(Episode {
+            index: 7,
+            mode: RunMode::Testing,
+            total_reward: -812.5,
+            length: 300,
+            weights_checksum: 0x1234_5678,
+        }),
+        ToHost::Health(full_health()),
+        ToHost::Health(Health { servo_temps_c: HVec::new(), ..full_health() }),
+        ToHost::Log(Log { level: LogLevel::Info, text: text("booted") }),
+        ToHost::Log(Log { level: LogLevel::Error, text: text(&"é".repeat(MAX_TEXT / 2)) }),
+        ToHost::Log(Log { level: LogLevel::Warn, text: String::new() }),
+        ToHost::Warning(Warning::CheckpointIgnored(LoadOutcome::ConfigMismatch { expected: 1, found: 2 })),
+        ToHost::Warning(Warning::TelemetryDropped { frames: 12 }),
+        ToHost::Warning(Warning::Text(text(&"x".repeat(MAX_TEXT)))),
+        ToHost::Weights(WeightsChunk {
+            offset: 96,
+            total: 1 << 20,
+            weights: (0..WEIGHTS_PER_CHUNK as i32).map(|i| i32::MIN + i).collect(),
+        }),
+        ToHost::Ack(Ack { seq: 41 }),
+        ToHost::Checkpoint(CheckpointReport::Saved(Saved { generation: 3, slot: 0 })),
+        ToHost::Checkpoint(CheckpointReport::SaveFailed),
+    ];
+    for o in [
+        LoadOutcome::Loaded { generation: 9, slot: 1 },
+        LoadOutcome::NoCheckpoint,
+        LoadOutcome::ConfigMismatch { expected: 5, found: 6 },
+        LoadOutcome::SizeMismatch { expected: 5, found: 6 },
+        LoadOutcome::UnsupportedVersion { found: 2 },
+        LoadOutcome::Corrupt,
+    ] {
+        v.push(ToHost::Checkpoint(CheckpointReport::Load(o)));
+    }
+    for reason in [
+        NackReason::State(Rejection::InFault),
+        NackReason::State(Rejection::NotRunning),
+        NackReason::InvalidParameter,
+        NackReason::OutOfRange,
+        NackReason::Busy,
+        NackReason::CheckpointFailed,
+        NackReason::Unsupported,
+    ] {
+        v.push(ToHost::Nack(Nack { seq: 99, reason }));
+    }
+    let causes = [
+        FaultCause::ServoTimeout { servo: 3, attempts: 3 },
+        FaultCause::ChecksumErrors { count: 5, window_ms: 1000 },
+        FaultCause::ServoError { servo: 2, error: ErrorFlags::OVERHEATING | ErrorFlags::OVERLOAD },
+        FaultCause::SoftLimit { joint: 1, position: -2.5 },
+        FaultCause::OverrunStreak { count: 3 },
+        FaultCause::WatchdogReset,
+    ];
+    for cause in causes {
+        v.push(ToHost::Fault(Fault { step: 1000, time_ms: 33_000, cause }));
+    }
+    let states = [State::Idle, State::Learning, State::Testing, State::Paused, State::Fault(causes[3])];
+    for w in states.windows(2) {
+        v.push(ToHost::State(StateChange { step: 5, from: w[0], to: w[1] }));
+    }
+    v
+}
+
+/// One of every host → chip command.
+fn all_to_chip() -> Vec<ToChip> {
+    vec![
+        ToChip::Ping,
+        ToChip::Start(RunMode::Learning),
+        ToChip::Start(RunMode::Testing),
+        ToChip::Stop,
+        ToChip::Pause,
+        ToChip::SetPolicy(PolicySpec::Sarsa),
+        ToChip::SetPolicy(PolicySpec::LowPass(0.3)),
+        ToChip::SetPolicy(PolicySpec::MarkovLowPass(0.3)),
+        ToChip::SetPolicy(PolicySpec::Integrator(0.1)),
+        ToChip::SetPolicy(PolicySpec::MarkovIntegrator(0.1)),
+        ToChip::SetPolicy(PolicySpec::Pada(0.25)),
+        ToChip::SwitchToSarsa,
+        ToChip::SetEpsilon(0.05),
+        ToChip::SaveCheckpoint,
+        ToChip::LoadCheckpoint,
+        ToChip::ReadWeights { offset: u32::MAX, count: u32::MAX },
+        ToChip::ClearFault,
+    ]
+}
+
+fn round_trip<M: serde::Serialize + serde::de::DeserializeOwned + PartialEq + std::fmt::Debug, const N: usize>(
+    msgs: &[M],
+) {
+    let mut enc = FrameEncoder::new();
+    let mut stream = Vec::new();
+    for m in msgs {
+        let mut buf = [0u8; MAX_FRAME_LEN];
+        let frame = enc.encode(m, &mut buf).unwrap_or_else(|e| panic!("{e:?} for {m:?}"));
+        assert!(frame.len() <= N, "{} bytes for {m:?}", frame.len());
+        assert_eq!(frame.last(), Some(&0));
+        assert!(!frame[..frame.len() - 1].contains(&0));
+        stream.extend_from_slice(frame);
+    }
+    for chunk in [1, 3, 64, stream.len().max(1)] {
+        let mut dec = FrameDecoder::<M, N>::new();
+        let got: Vec<_> = stream.chunks(chunk).flat_map(|c| dec.feed(c).collect::<Vec<_>>()).collect();
+        assert_eq!(got.len(), msgs.len());
+        for (i, (g, m)) in got.into_iter().zip(msgs).enumerate() {
+            let d = g.unwrap();
+            assert_eq!((d.seq, &d.msg, d.gap), (i as u32, m, None));
+        }
+        assert!(dec.stats().is_clean());
+        assert_eq!(dec.stats().frames, msgs.len() as u32);
+        assert_eq!(dec.stats().bytes, stream.len() as u64);
+    }
+}
+
+#[test]
+fn every_chip_message_round_trips() {
+    round_trip::<ToHost, MAX_FRAME_LEN>(&all_to_host());
+}
+
+#[test]
+fn every_host_command_round_trips() {
+    // The chip's decoder holds 64 bytes: enough for every command.
+    round_trip::<ToChip, 64>(&all_to_chip());
+}
+
+#[test]
+fn the_largest_messages_fit_the_documented_limits() {
+    for m in all_to_host() {
+        let b = body(&(u32::MAX, &m));
+        assert!(b.len() <= MAX_BODY, "{} body bytes: {m:?}", b.len());
+    }
+    let step = body(&(u32::MAX, ToHost::Step(full_step())));
+    let weights = body(&(
+        u32::MAX,
+        ToHost::Weights(WeightsChunk {
+            offset: u32::MAX,
+            total: u32::MAX,
+            weights: HVec::from_slice(&[i32::MIN; WEIGHTS_PER_CHUNK]).unwrap(),
+        }),
+    ));
+    eprintln!("largest bodies: step {} B, weights {} B, frame limit {MAX_FRAME_LEN} B", step.len(), weights.len());
+    assert!(step.len() <= MAX_BODY && weights.len() <= MAX_BODY);
+}
+
+#[test]
+fn a_small_buffer_is_an_error_not_a_panic() {
+    let m = ToHost::Step(full_step());
+    for len in 0..MAX_FRAME_LEN / 2 {
+        let mut buf = vec![0u8; len];
+        assert_eq!(encode_frame(&m, 0, &mut buf), Err(WireError::BufferTooSmall), "len {len}");
+    }
+}
+
+#[test]
+fn frame_bytes_are_cobs_of_body_and_crc() {
+    // The layout of the module documentation, checked byte by byte on Ack.
+    let mut buf = [0u8; 32];
+    let frame = encode_frame(&ToHost::Ack(Ack { seq: 5 }), 300, &mut buf).unwrap().to_vec();
+    // body: seq 300 = varint AC 02, variant Ack = index 10, seq 5.
+    let body = [0xAC, 0x02, 10, 5];
+    let crc = pada_core::checkpoint::crc32(&body).to_le_bytes();
+    let mut raw = body.to_vec();
+    raw.extend_from_slice(&crc);
+    assert!(!raw.contains(&0), "this example has no zero byte, so COBS adds one code byte");
+    let mut expected = vec![raw.len() as u8 + 1];
+    expected.extend_from_slice(&raw);
+    expected.push(0);
+    assert_eq!(frame, expected);
+}
+
+#[test]
+fn sequence_gaps_are_counted() {
+    let mut enc = FrameEncoder::new();
+    let mut dec = HostDecoder::new();
+    let mut buf = [0u8; MAX_FRAME_LEN];
+    let mut send = |enc: &mut FrameEncoder, dec: &mut HostDecoder| {
+        let f = enc.encode(&ToHost::Ack(Ack { seq: 0 }), &mut buf).unwrap().to_vec();
+        dec.feed(&f).next().unwrap().unwrap()
+    };
+    assert_eq!(send(&mut enc, &mut dec).gap, None);
+    enc.skip();
+    enc.skip();
+    enc.skip();
+    let d = send(&mut enc, &mut dec);
+    assert_eq!(d.gap, Some(SeqGap { expected: 1, got: 4 }));
+    assert_eq!(d.gap.unwrap().missed(), 3);
+    assert_eq!(send(&mut enc, &mut dec).gap, None);
+    // The sender restarts: a backwards jump is a gap with nothing missed.
+    let mut enc2 = FrameEncoder::new();
+    let d = send(&mut enc2, &mut dec);
+    assert_eq!(d.gap, Some(SeqGap { expected: 6, got: 0 }));
+    let s = dec.stats();
+    assert_eq!((s.seq_gaps, s.frames_missed, s.frames), (2, 3, 4));
+    // Wrapping is not a gap.
+    let mut dec = HostDecoder::new();
+    for seq in [u32::MAX - 1, u32::MAX, 0, 1] {
+        let f = encode_frame(&ToHost::Ack(Ack { seq }), seq, &mut buf).unwrap().to_vec();
+        assert_eq!(dec.feed(&f).next().unwrap().unwrap().gap, None);
+    }
+}
+
+#[test]
+fn garbage_between_frames_costs_nothing_but_itself() {
+    let msgs = all_to_host();
+    let mut enc = FrameEncoder::new();
+    let mut stream = vec![0x13, 0x37, 0xFF]; // joined mid-frame
+    for (i, m) in msgs.iter().enumerate() {
+        let mut buf = [0u8; MAX_FRAME_LEN];
+        stream.extend_from_slice(enc.encode(m, &mut buf).unwrap());
+        if i % 3 == 0 {
+            stream.extend_from_slice(&[0x00, 0x00]); // flushes: ignored
+        }
+        if i % 5 == 0 {
+            stream.extend_from_slice(&[0x42, 0x42, 0x42, 0x00]); // garbage frame
+        }
+    }
+    let mut dec = HostDecoder::new();
+    let got: Vec<_> = dec.feed(&stream).collect();
+    let ok: Vec<ToHost> = got.iter().filter_map(|r| r.as_ref().ok().map(|d| d.msg.clone())).collect();
+    // The leading garbage has no delimiter, so it and the first frame form
+    // one bad frame; everything after arrives.
+    assert_eq!(ok, msgs[1..]);
+    let s = dec.stats();
+    let garbage_frames = 1 + msgs.len().div_ceil(5) as u32;
+    assert_eq!(s.bad_frames(), garbage_frames);
+    assert_eq!(s.seq_gaps, 0, "the first frame seen sets the expected number");
+}
+
+#[test]
+fn oversize_frames_are_dropped_and_counted() {
+    let mut dec = FrameDecoder::<ToChip, 16>::new();
+    let mut stream = vec![0x55; 40];
+    stream.push(0);
+    let mut buf = [0u8; 64];
+    stream.extend_from_slice(encode_frame(&ToChip::Stop, 0, &mut buf).unwrap());
+    let got: Vec<_> = dec.feed(&stream).collect();
+    assert_eq!(got.len(), 2);
+    assert_eq!(got[0], Err(FrameError::Oversize));
+    assert_eq!(got[1].as_ref().unwrap().msg, ToChip::Stop);
+    assert_eq!(dec.stats().oversize, 1);
+}
+
+#[test]
+fn each_loss_kind_is_typed_and_counted() {
+    let mut buf = [0u8; 64];
+    let good = encode_frame(&ToChip::Pause, 0, &mut buf).unwrap().to_vec();
+    let mut dec = ChipDecoder::new();
+    // COBS error: a code byte that runs past the end.
+    assert_eq!(dec.feed(&[9, 1, 2, 0]).collect::<Vec<_>>(), vec![Err(FrameError::Cobs)]);
+    // Too short for body + CRC.
+    assert_eq!(dec.feed(&[3, 1, 2, 0]).collect::<Vec<_>>(), vec![Err(FrameError::TooShort)]);
+    // CRC error: a valid body with a wrong CRC.
+    let mut raw = body(&(0u32, ToChip::Stop));
+    let crc = pada_core::checkpoint::crc32(&raw);
+    raw.extend_from_slice(&(crc ^ 0x0100).to_le_bytes());
+    let mut bad = cobs_reference(&raw);
+    bad.push(0);
+    assert_eq!(
+        dec.feed(&bad).collect::<Vec<_>>(),
+        vec![Err(FrameError::Crc { computed: crc, received: crc ^ 0x0100 })]
+    );
+    // Good CRC, but not a ToChip: a ToHost Hello body.
+    let mut hb = [0u8; MAX_FRAME_LEN];
+    let hello = ToHost::Hello(Hello {
+        protocol: 1,
+        config_hash: 0xFFFF_FFFF,
+        weight_count: 0xFFFF_FFFF,
+        period_us: 1,
+        state_dims: 1,
+        joints: 1,
+    });
+    let f = encode_frame(&hello, 0, &mut hb).unwrap().to_vec();
+    assert_eq!(dec.feed(&f).collect::<Vec<_>>(), vec![Err(FrameError::Decode)]);
+    // Trailing bytes after a valid body are a decode error too.
+    let mut raw = body(&(0u32, ToChip::Stop));
+    raw.push(7);
+    let crc = pada_core::checkpoint::crc32(&raw);
+    raw.extend_from_slice(&crc.to_le_bytes());
+    let mut framed = cobs_reference(&raw);
+    framed.push(0);
+    assert_eq!(dec.feed(&framed).collect::<Vec<_>>(), vec![Err(FrameError::Decode)]);
+    let s = dec.stats();
+    assert_eq!((s.cobs_errors, s.too_short, s.crc_errors, s.decode_errors), (1, 1, 1, 2));
+    assert_eq!(s.bad_frames(), 5);
+    assert!(!s.is_clean());
+    // And the decoder still works.
+    assert_eq!(dec.feed(&good).next().unwrap().unwrap().msg, ToChip::Pause);
+}
+
+/// Plain COBS for building hand-made frames in tests.
+fn cobs_reference(data: &[u8]) -> Vec<u8> {
+    let mut out = vec![0u8];
+    let mut code_at = 0;
+    for &b in data {
+        if b == 0 {
+            out[code_at] = (out.len() - code_at) as u8;
+            code_at = out.len();
+            out.push(0);
+        } else {
+            out.push(b);
+            if out.len() - code_at == 255 {
+                out[code_at] = 255;
+                code_at = out.len();
+                out.push(0);
+            }
+        }
+    }
+    out[code_at] = (out.len() - code_at) as u8;
+    out
+}
+
+#[test]
+fn floats_round_trip_bit_for_bit() {
+    let mut step = full_step();
+    step.reward = f32::from_bits(0x7FC0_1234); // a NaN with payload
+    step.state = HVec::from_slice(&[-0.0, f32::INFINITY, f32::MIN_POSITIVE / 2.0]).unwrap();
+    let mut buf = [0u8; MAX_FRAME_LEN];
+    let f = encode_frame(&ToHost::Step(step.clone()), 0, &mut buf).unwrap().to_vec();
+    let mut dec = HostDecoder::new();
+    let ToHost::Step(got) = dec.feed(&f).next().unwrap().unwrap().msg else { panic!() };
+    assert_eq!(got.reward.to_bits(), 0x7FC0_1234);
+    let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&got.state), bits(&step.state));
+}
+
+#[test]
+fn policy_spec_converts_both_ways() {
+    let kinds = [
+        PolicyKind::Sarsa,
+        PolicyKind::LowPass { alpha: 0.3 },
+        PolicyKind::MarkovLowPass { alpha: 0.4 },
+        PolicyKind::Integrator { delta: 0.1 },
+        PolicyKind::MarkovIntegrator { delta: 0.2 },
+        PolicyKind::Pada { delta: 0.25 },
+    ];
+    for k in kinds {
+        assert_eq!(PolicyKind::from(PolicySpec::from(k)), k);
+    }
+}
+
+fn xorshift(s: &mut u64) -> u64 {
+    *s ^= *s << 13;
+    *s ^= *s >> 7;
+    *s ^= *s << 17;
+    *s
+}
+
+#[test]
+fn corrupted_streams_lose_only_corrupted_frames_and_count_them() {
+    // 3000 frames; every 4th gets one byte flipped, dropped or inserted, or
+    // its delimiter lost. No wrong message is ever delivered, every intact
+    // frame whose predecessor's delimiter survived is delivered, and the
+    // sequence numbers account for every frame lost.
+    let msgs = all_to_host();
+    let mut seed = 0x9E37_79B9_7F4A_7C15u64;
+    let mut enc = FrameEncoder::new();
+    let mut stream = Vec::new();
+    let mut sent = Vec::new();
+    let mut must_arrive = Vec::new();
+    let mut prev_delimiter_lost = false;
+    for i in 0..3000u32 {
+        let m = msgs[(xorshift(&mut seed) % msgs.len() as u64) as usize].clone();
+        let mut buf = [0u8; MAX_FRAME_LEN];
+        let mut f = enc.encode(&m, &mut buf).unwrap().to_vec();
+        let corrupt = i % 4 == 3;
+        let mut delimiter_lost = false;
+        if corrupt {
+            let pos = (xorshift(&mut seed) % (f.len() as u64 - 1)) as usize;
+            match xorshift(&mut seed) % 4 {
+                0 => f[pos] ^= 1 << (xorshift(&mut seed) % 8),
+                1 => {
+                    f.remove(pos);
+                }
+                2 => f.insert(pos, xorshift(&mut seed) as u8),
+                _ => {
+                    f.pop();
+                    delimiter_lost = true;
+                }
+            }
+        } else if !prev_delimiter_lost {
+            must_arrive.push((i, m.clone()));
+        }
+        prev_delimiter_lost = delimiter_lost;
+        sent.push(m);
+        stream.extend(f);
+    }
+    let mut dec = HostDecoder::new();
+    let mut got = Vec::new();
+    for chunk in stream.chunks(13) {
+        for d in dec.feed(chunk).flatten() {
+            assert_eq!(d.msg, sent[d.seq as usize], "frame {} delivered wrong content", d.seq);
+            got.push((d.seq, d.msg));
+        }
+    }
+    for (seq, m) in &must_arrive {
+        assert!(got.contains(&(*seq, m.clone())), "intact frame {seq} lost");
+    }
+    let s = dec.stats();
+    let lost = 3000 - s.frames;
+    assert!(lost >= 1);
+    // Every lost frame that lies between two delivered frames is seen as a
+    // gap (frames lost after the last delivered one cannot be).
+    let last = got.last().unwrap().0;
+    let first = got.first().unwrap().0;
+    assert_eq!(s.frames_missed, (last - first + 1 - s.frames) as u64);
+    assert!(s.bad_frames() >= 1);
+}
+
+fn arb_step() -> impl Strategy<Value = Step> {
+    (
+        (any::<u32>(), any::<u32>(), any::<u32>(), any::<bool>(), 0u8..4),
+        proptest::collection::vec(-1e9f32..1e9, 0..=MAX_STATE_DIMS),
+        (any::<u32>(), proptest::collection::vec(-1.0f32..1.0, 0..=MAX_OUTPUTS)),
+        (-1e6f32..1e6, any::<i32>(), any::<bool>(), any::<u32>()),
+        proptest::collection::vec((0.0f64..1e3, any::<u32>()), 0..=MAX_JOINTS),
+    )
+        .prop_map(|((step, time_ms, episode, testing, kind), state, (action, output), (reward, td, ex, lus), j)| {
+            Step {
+                step,
+                time_ms,
+                episode,
+                mode: if testing { RunMode::Testing } else { RunMode::Learning },
+                kind: [StepKind::Start, StepKind::Step, StepKind::Absorbing, StepKind::Timeout][kind as usize],
+                state: HVec::from_slice(&state).unwrap(),
+                action,
+                output: HVec::from_slice(&output).unwrap(),
+                reward,
+                td_error: td,
+                explored: ex,
+                joints: j.into_iter().map(|(damage, reengagements)| JointFatigue { damage, reengagements }).collect(),
+                loop_us: lus,
+            }
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(1000))]
+
+    #[test]
+    fn arbitrary_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..2000), chunk in 1usize..100) {
+        let mut host = HostDecoder::new();
+        let mut chip = ChipDecoder::new();
+        let mut small = FrameDecoder::<ToHost, 8>::new();
+        for c in bytes.chunks(chunk) {
+            for r in host.feed(c) { let _ = r; }
+            for r in chip.feed(c) { let _ = r; }
+            for r in small.feed(c) { let _ = r; }
+        }
+        let s = host.stats();
+        prop_assert_eq!(s.bytes, bytes.len() as u64);
+    }
+
+    #[test]
+    fn arbitrary_zero_free_bodies_never_panic(frames in proptest::collection::vec(proptest::collection::vec(1u8..=255, 0..300), 0..20)) {
+        // Frames that are valid COBS-wise more often: random non-zero bytes
+        // with delimiters, so decoding reaches the CRC and postcard stages.
+        let mut dec = HostDecoder::new();
+        for f in &frames {
+            let mut bytes = f.clone();
+            bytes.push(0);
+            for r in dec.feed(&bytes) { let _ = r; }
+        }
+    }
+
+    #[test]
+    fn arbitrary_steps_round_trip(step in arb_step(), seq in any::<u32>()) {
+        let msg = ToHost::Step(step);
+        let mut buf = [0u8; MAX_FRAME_LEN];
+        let frame = encode_frame(&msg, seq, &mut buf).unwrap().to_vec();
+        let mut dec = HostDecoder::new();
+        let got: Vec<_> = dec.feed(&frame).collect();
+        prop_assert_eq!(got.len(), 1);
+        let d = got[0].as_ref().unwrap();
+        prop_assert_eq!(d.seq, seq);
+        prop_assert_eq!(&d.msg, &msg);
+    }
+
+    #[test]
+    fn arbitrary_weight_chunks_round_trip(offset in any::<u32>(), total in any::<u32>(),
+            w in proptest::collection::vec(any::<i32>(), 0..=WEIGHTS_PER_CHUNK)) {
+        let msg = ToHost::Weights(WeightsChunk { offset, total, weights: HVec::from_slice(&w).unwrap() });
+        let mut buf = [0u8; MAX_FRAME_LEN];
+        let frame = encode_frame(&msg, 1, &mut buf).unwrap().to_vec();
+        let mut dec = HostDecoder::new();
+        let d = dec.feed(&frame).next().unwrap().unwrap();
+        prop_assert_eq!(d.msg, msg);
+    }
+
+    #[test]
+    fn single_corruptions_are_never_delivered(pos in any::<prop::sample::Index>(), bit in 0u8..8, step in arb_step()) {
+        let msg = ToHost::Step(step);
+        let mut buf = [0u8; MAX_FRAME_LEN];
+        let mut frame = encode_frame(&msg, 0, &mut buf).unwrap().to_vec();
+        let i = pos.index(frame.len() - 1);
+        frame[i] ^= 1 << bit;
+        let mut dec = HostDecoder::new();
+        for r in dec.feed(&frame) {
+            prop_assert!(r.is_err(), "a corrupted frame was delivered");
+        }
+        // A flip that makes a 0x00 inside splits the frame: two errors.
+        prop_assert!(dec.stats().bad_frames() >= 1);
+    }
+}
