@@ -373,6 +373,12 @@ where
         self.weights.as_mut()
     }
 
+    /// Gives the weight storage back (to build an agent with another
+    /// policy on the same table, e.g. the firmware's `&'static mut` table).
+    pub fn into_weights(self) -> W {
+        self.weights
+    }
+
     /// FNV-1a over the weights' little-endian bytes: equal on every machine
     /// for equal weights.
     pub fn weights_checksum(&self) -> u32 {
