@@ -13,7 +13,16 @@
 //! - [`trace`]: bounded eligibility traces;
 //! - [`agent`]: SARSA(λ) with ε-greedy selection over the policy's candidates;
 //! - [`fatigue`]: backlash re-engagements → damage J → predicted MTBF
-//!   (Section IV, Eqs. 1–7).
+//!   (Section IV, Eqs. 1–7);
+//! - [`dynamixel`]: the Dynamixel Protocol 1.0 codec and the RX-28 control
+//!   table (both directions, so the host can emulate servos);
+//! - [`wire`]: the telemetry and command protocol between chip and host
+//!   (postcard + CRC-32 + COBS), so both ends decode exactly what the other
+//!   encodes;
+//! - [`checkpoint`]: learned weights in two alternating flash slots that
+//!   survive a torn write;
+//! - [`safety`]: the Idle → Learning/Testing → Fault state machine that owns
+//!   torque enable.
 //!
 //! Section and equation numbers refer to Meijdam, Plooij and Caarls,
 //! "Learning while preventing mechanical failure due to random motions".
