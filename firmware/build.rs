@@ -35,10 +35,17 @@ fn main() {
     println!("cargo:rerun-if-changed={}", memory_x.display());
     println!("cargo:rerun-if-changed=build.rs");
 
+    // The library also builds for the host (its tests); only the chip's
+    // binary is linked with these scripts.
+    if env::var("CARGO_CFG_TARGET_OS").as_deref() != Ok("none") {
+        return;
+    }
     // Segments need no page alignment in flash (keeps images small); both
     // rust-lld and GNU ld (arm-none-eabi-ld) accept it.
     println!("cargo:rustc-link-arg-bins=--nmagic");
     // cortex-m-rt's linker script; it includes memory.x. Set here rather
     // than in .cargo/config.toml so every way of building gets it once.
     println!("cargo:rustc-link-arg-bins=-Tlink.x");
+    // defmt's symbol table (the log format strings live in the ELF only).
+    println!("cargo:rustc-link-arg-bins=-Tdefmt.x");
 }

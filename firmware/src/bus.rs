@@ -1,0 +1,526 @@
+//! Dynamixel Protocol 1.0 transactions on a [`BusPort`], with bounded
+//! timeouts and retries.
+//!
+//! The packets come from `pada_core::dynamixel`; this module adds the
+//! conversation: send an instruction, listen for the status packet of the
+//! servo that was asked until a deadline, retry a bounded number of times,
+//! and report every timeout, checksum error and error bit so the safety
+//! machine can count them (`pada_core::safety`).
+//!
+//! Worst case per period with the defaults (1 Mbps, 7 servos, 2 attempts of
+//! at most 1 ms each): 14 ms of a 33 ms LEO period; a healthy read takes
+//! about 0.25 ms per servo (8-byte READ, 14-byte status, 50 µs return
+//! delay).
+
+use crate::io::{BusPort, PortError};
+use pada_core::dynamixel::{self, table, DecodeError, ErrorFlags, StatusDecoder, StatusPacket, BROADCAST_ID};
+
+/// Longest status packet the firmware reads (header to checksum).
+pub const STATUS_LEN: usize = 32;
+/// A status packet as the bus returns it.
+pub type Status = StatusPacket<STATUS_LEN>;
+
+/// Return delay the servos are set to: 25 × 2 µs = 50 µs, time for the
+/// driver-enable line to drop after the last stop bit.
+pub const RETURN_DELAY: u8 = 25;
+/// Status return level: answer READ (and PING) only, so WRITE and
+/// SYNC_WRITE never put a reply on the bus.
+pub const STATUS_RETURN_LEVEL: u8 = 1;
+
+/// Timing of the conversation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct BusConfig {
+    /// How long to wait for a status packet after the instruction \[µs\].
+    pub reply_timeout_us: u32,
+    /// Attempts per request within one control period (1 + retries).
+    pub attempts: u8,
+}
+
+impl Default for BusConfig {
+    fn default() -> Self {
+        BusConfig { reply_timeout_us: 1000, attempts: 2 }
+    }
+}
+
+/// Counters for health telemetry.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct BusStats {
+    /// Instruction packets sent.
+    pub requests: u32,
+    /// Status packets received from the servo asked.
+    pub replies: u32,
+    /// Attempts without a valid answer before the deadline.
+    pub timeouts: u32,
+    /// Status packets with a bad checksum.
+    pub checksum_errors: u32,
+    /// Status packets from another ID, or with an impossible length.
+    pub stray_packets: u32,
+    /// UART errors (overrun, framing, noise).
+    pub line_errors: u32,
+}
+
+/// What one request to one servo came to, with everything the safety
+/// machine counts.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Exchange {
+    /// The servo's answer, if one came.
+    pub status: Option<Status>,
+    /// Attempts that ended without an answer.
+    pub timeouts: u8,
+    /// Bad checksums seen (received status packets).
+    pub checksum_errors: u8,
+}
+
+impl Exchange {
+    /// The servo's error bits (empty without an answer).
+    pub fn error(&self) -> ErrorFlags {
+        self.status.as_ref().map_or(ErrorFlags::NONE, |s| s.error)
+    }
+}
+
+/// One servo's EEPROM settings that the firmware relies on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ServoSetup {
+    /// Model number (28 for an RX-28).
+    pub model: u16,
+    /// Whether anything had to be written (EEPROM writes are counted: they
+    /// wear the servo's EEPROM, so only differences are written).
+    pub wrote: bool,
+}
+
+/// Why a servo could not be set up.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SetupError {
+    /// It did not answer.
+    NoAnswer {
+        /// Dynamixel ID.
+        id: u8,
+    },
+    /// It answered with error bits.
+    Error {
+        /// Dynamixel ID.
+        id: u8,
+        /// The bits.
+        error: ErrorFlags,
+    },
+}
+
+/// The servo bus: a port, a decoder, the transmit buffer and the counters.
+pub struct ServoBus<P> {
+    port: P,
+    config: BusConfig,
+    decoder: StatusDecoder<STATUS_LEN>,
+    tx: [u8; 64],
+    rx: [u8; 64],
+    stats: BusStats,
+}
+
+impl<P: BusPort> ServoBus<P> {
+    /// A bus on `port`.
+    pub fn new(port: P, config: BusConfig) -> Self {
+        ServoBus { port, config, decoder: StatusDecoder::new(), tx: [0; 64], rx: [0; 64], stats: BusStats::default() }
+    }
+
+    /// Counters since start.
+    pub fn stats(&self) -> BusStats {
+        self.stats
+    }
+
+    /// The port (for the board's own checks).
+    pub fn port_mut(&mut self) -> &mut P {
+        &mut self.port
+    }
+
+    /// READ `len` bytes at `addr` of servo `id`, with up to
+    /// [`BusConfig::attempts`] attempts.
+    pub async fn read(&mut self, id: u8, addr: u8, len: u8) -> Exchange {
+        let mut exchange = Exchange { status: None, timeouts: 0, checksum_errors: 0 };
+        let Ok(n) = dynamixel::read_data(id, addr, len, &mut self.tx).map(|p| p.len()) else {
+            // Only an invalid ID gets here; it can never answer.
+            exchange.timeouts = 1;
+            return exchange;
+        };
+        for _ in 0..self.config.attempts.max(1) {
+            match self.request(id, n, &mut exchange.checksum_errors).await {
+                Some(status) if status.params.len() == len as usize => {
+                    exchange.status = Some(status);
+                    return exchange;
+                }
+                // A short answer is as good as none.
+                _ => exchange.timeouts = exchange.timeouts.saturating_add(1),
+            }
+        }
+        exchange
+    }
+
+    /// PING servo `id`.
+    pub async fn ping(&mut self, id: u8) -> Exchange {
+        let mut exchange = Exchange { status: None, timeouts: 0, checksum_errors: 0 };
+        let Ok(n) = dynamixel::ping(id, &mut self.tx).map(|p| p.len()) else {
+            exchange.timeouts = 1;
+            return exchange;
+        };
+        for _ in 0..self.config.attempts.max(1) {
+            if let Some(status) = self.request(id, n, &mut exchange.checksum_errors).await {
+                exchange.status = Some(status);
+                return exchange;
+            }
+            exchange.timeouts = exchange.timeouts.saturating_add(1);
+        }
+        exchange
+    }
+
+    /// Present Position, Speed, Load, Voltage and Temperature of `id` (one
+    /// 8-byte READ from address 36).
+    pub async fn read_present(&mut self, id: u8) -> (Option<table::PresentState>, Exchange) {
+        let exchange = self.read(id, table::PRESENT_BLOCK, table::PRESENT_BLOCK_LEN).await;
+        let state = exchange.status.as_ref().and_then(|s| table::PresentState::from_bytes(&s.params));
+        (state, exchange)
+    }
+
+    /// SYNC_WRITE of Moving Speed to several servos (no reply).
+    pub async fn write_speeds(&mut self, entries: &[(u8, u16)]) -> Result<(), PortError> {
+        let n = dynamixel::sync_write_u16(table::MOVING_SPEED, entries, &mut self.tx)
+            .map(|p| p.len())
+            .map_err(|_| PortError::Transmit)?;
+        self.send(n).await
+    }
+
+    /// Torque Enable of every servo at once (broadcast WRITE, no reply).
+    pub async fn torque_all(&mut self, on: bool) -> Result<(), PortError> {
+        self.write_no_reply(BROADCAST_ID, table::TORQUE_ENABLE, &[on as u8]).await
+    }
+
+    /// Moving Speed 0 on every servo at once (broadcast WRITE, no reply).
+    pub async fn stop_all(&mut self) -> Result<(), PortError> {
+        self.write_no_reply(BROADCAST_ID, table::MOVING_SPEED, &[0, 0]).await
+    }
+
+    /// WRITE without waiting for an answer (broadcast, or a servo whose
+    /// status return level is 1).
+    pub async fn write_no_reply(&mut self, id: u8, addr: u8, data: &[u8]) -> Result<(), PortError> {
+        let n = dynamixel::write_data(id, addr, data, &mut self.tx).map(|p| p.len()).map_err(|_| PortError::Transmit)?;
+        self.send(n).await
+    }
+
+    /// Prepares servo `id` for the control loop: checks that it answers,
+    /// then writes (only where different) wheel mode (both angle limits 0),
+    /// the return delay and the status return level. Torque is left as it
+    /// is (the caller switches it off for every servo first).
+    pub async fn setup(&mut self, id: u8) -> Result<ServoSetup, SetupError> {
+        // Model number.
+        let model = self.read(id, table::MODEL_NUMBER, 2).await;
+        let Some(status) = model.status else {
+            return Err(SetupError::NoAnswer { id });
+        };
+        if status.error.intersects(ErrorFlags::HARDWARE) {
+            return Err(SetupError::Error { id, error: status.error });
+        }
+        let model = status.u16_at(0).unwrap_or(0);
+        // Addresses 5..=16: return delay, CW and CCW limits, …, status
+        // return level.
+        let first = table::RETURN_DELAY_TIME;
+        let len = table::STATUS_RETURN_LEVEL - first + 1;
+        let block = self.read(id, first, len).await;
+        let Some(block) = block.status else {
+            return Err(SetupError::NoAnswer { id });
+        };
+        let at = |addr: u8| block.u8_at((addr - first) as usize).unwrap_or(0xFF);
+        let at16 = |addr: u8| block.u16_at((addr - first) as usize).unwrap_or(0xFFFF);
+        let mut wrote = false;
+        // A servo at status return level 2 answers this WRITE: listen for
+        // it, so it does not collide with the next request.
+        let answers_writes = at(table::STATUS_RETURN_LEVEL) >= 2;
+        if at(table::STATUS_RETURN_LEVEL) != STATUS_RETURN_LEVEL {
+            self.write_maybe_reply(id, table::STATUS_RETURN_LEVEL, &[STATUS_RETURN_LEVEL], answers_writes).await;
+            wrote = true;
+        }
+        if at(table::RETURN_DELAY_TIME) != RETURN_DELAY {
+            self.write_no_reply(id, table::RETURN_DELAY_TIME, &[RETURN_DELAY]).await.ok();
+            wrote = true;
+        }
+        if at16(table::CW_ANGLE_LIMIT) != 0 || at16(table::CCW_ANGLE_LIMIT) != 0 {
+            self.write_no_reply(id, table::CW_ANGLE_LIMIT, &[0, 0, 0, 0]).await.ok();
+            wrote = true;
+        }
+        Ok(ServoSetup { model, wrote })
+    }
+
+    async fn write_maybe_reply(&mut self, id: u8, addr: u8, data: &[u8], reply: bool) {
+        if reply {
+            let Ok(n) = dynamixel::write_data(id, addr, data, &mut self.tx).map(|p| p.len()) else {
+                return;
+            };
+            let mut checksum_errors = 0;
+            let _ = self.request(id, n, &mut checksum_errors).await;
+        } else {
+            self.write_no_reply(id, addr, data).await.ok();
+        }
+    }
+
+    /// Sends the first `n` bytes of the transmit buffer.
+    async fn send(&mut self, n: usize) -> Result<(), PortError> {
+        self.stats.requests = self.stats.requests.wrapping_add(1);
+        let result = self.port.send(&self.tx[..n]).await;
+        if result.is_err() {
+            self.stats.line_errors = self.stats.line_errors.wrapping_add(1);
+        }
+        result
+    }
+
+    /// One attempt: send the first `n` bytes of the transmit buffer, listen
+    /// for `id`'s status packet until the reply deadline.
+    async fn request(&mut self, id: u8, n: usize, checksum_errors: &mut u8) -> Option<Status> {
+        self.port.discard_input();
+        self.decoder.reset();
+        self.decoder.expect(Some(id));
+        self.send(n).await.ok()?;
+        let deadline = self.port.now_us() + self.config.reply_timeout_us as u64;
+        loop {
+            let got = match self.port.receive(&mut self.rx, deadline).await {
+                Ok(0) => break,
+                Ok(got) => got,
+                Err(_) => {
+                    self.stats.line_errors = self.stats.line_errors.wrapping_add(1);
+                    break;
+                }
+            };
+            let mut found = None;
+            for result in self.decoder.feed(&self.rx[..got]) {
+                match result {
+                    Ok(status) => {
+                        found = Some(status);
+                        break;
+                    }
+                    Err(DecodeError::BadChecksum { .. }) => {
+                        self.stats.checksum_errors = self.stats.checksum_errors.wrapping_add(1);
+                        *checksum_errors = checksum_errors.saturating_add(1);
+                    }
+                    Err(DecodeError::UnexpectedId { .. } | DecodeError::BadLength { .. }) => {
+                        self.stats.stray_packets = self.stats.stray_packets.wrapping_add(1);
+                    }
+                }
+            }
+            if found.is_some() {
+                self.stats.replies = self.stats.replies.wrapping_add(1);
+                return found;
+            }
+        }
+        self.stats.timeouts = self.stats.timeouts.wrapping_add(1);
+        None
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use embassy_futures::block_on;
+    use pada_core::dynamixel::{Instruction, InstructionDecoder};
+    use std::collections::VecDeque;
+
+    /// A fake bus: decodes what the firmware sends and answers as scripted
+    /// servos with a control table each; time advances only by waiting.
+    pub struct FakeBus {
+        pub tables: Vec<(u8, [u8; table::TABLE_LEN])>,
+        pub inbox: VecDeque<u8>,
+        pub sent: Vec<Vec<u8>>,
+        pub now: u64,
+        /// Answers to drop (counted down), to corrupt, and a stray prefix.
+        pub drop_next: u32,
+        pub corrupt_next: u32,
+        pub decoder: InstructionDecoder<64>,
+    }
+
+    impl FakeBus {
+        pub fn with_servos(ids: &[u8]) -> Self {
+            let tables = ids
+                .iter()
+                .map(|&id| {
+                    let mut t = [0u8; table::TABLE_LEN];
+                    t[0] = 28; // model 28
+                    t[table::ID as usize] = id;
+                    t[table::RETURN_DELAY_TIME as usize] = 250;
+                    t[table::CCW_ANGLE_LIMIT as usize] = 0xFF;
+                    t[table::CCW_ANGLE_LIMIT as usize + 1] = 0x03;
+                    t[table::STATUS_RETURN_LEVEL as usize] = 2;
+                    t[table::PRESENT_POSITION as usize] = 0x00;
+                    t[table::PRESENT_POSITION as usize + 1] = 0x02;
+                    t[table::PRESENT_VOLTAGE as usize] = 120;
+                    t[table::PRESENT_TEMPERATURE as usize] = 40;
+                    (id, t)
+                })
+                .collect();
+            FakeBus {
+                tables,
+                inbox: VecDeque::new(),
+                sent: Vec::new(),
+                now: 0,
+                drop_next: 0,
+                corrupt_next: 0,
+                decoder: InstructionDecoder::new(),
+            }
+        }
+
+        pub fn table(&self, id: u8) -> &[u8; table::TABLE_LEN] {
+            &self.tables.iter().find(|(i, _)| *i == id).unwrap().1
+        }
+
+        fn answer(&mut self, id: u8, params: &[u8]) {
+            if self.drop_next > 0 {
+                self.drop_next -= 1;
+                return;
+            }
+            let mut buf = [0u8; 64];
+            let bytes = Status::new(id, ErrorFlags::NONE, params).unwrap().encode(&mut buf).unwrap().to_vec();
+            let mut bytes = bytes;
+            if self.corrupt_next > 0 {
+                self.corrupt_next -= 1;
+                let last = bytes.len() - 1;
+                bytes[last] ^= 0x55;
+            }
+            self.inbox.extend(bytes);
+        }
+    }
+
+    impl BusPort for FakeBus {
+        fn discard_input(&mut self) {
+            self.inbox.clear();
+        }
+
+        async fn send(&mut self, bytes: &[u8]) -> Result<(), PortError> {
+            self.sent.push(bytes.to_vec());
+            self.now += bytes.len() as u64 * 10; // 10 µs per byte at 1 Mbps
+            let packets: Vec<_> = self.decoder.feed(bytes).collect();
+            for p in packets {
+                let p = p.expect("the firmware sends valid packets");
+                let id = p.id;
+                let srl = self.tables.iter().find(|(i, _)| *i == id).map(|(_, t)| t[16]);
+                match p.instruction().unwrap() {
+                    Instruction::Ping => {
+                        if srl.is_some() {
+                            self.answer(id, &[]);
+                        }
+                    }
+                    Instruction::Read { addr, len } => {
+                        if let Some((_, t)) = self.tables.iter().find(|(i, _)| *i == id) {
+                            let data = t[addr as usize..(addr + len) as usize].to_vec();
+                            self.answer(id, &data);
+                        }
+                    }
+                    Instruction::Write { addr, data } => {
+                        for (i, t) in self.tables.iter_mut() {
+                            if *i == id || id == BROADCAST_ID {
+                                t[addr as usize..addr as usize + data.len()].copy_from_slice(data);
+                            }
+                        }
+                        if id != BROADCAST_ID && srl >= Some(2) {
+                            self.answer(id, &[]);
+                        }
+                    }
+                    Instruction::SyncWrite { addr, .. } => {
+                        let entries: Vec<(u8, Vec<u8>)> =
+                            p.instruction().unwrap().sync_entries().map(|(i, d)| (i, d.to_vec())).collect();
+                        for (sid, d) in entries {
+                            if let Some((_, t)) = self.tables.iter_mut().find(|(i, _)| *i == sid) {
+                                t[addr as usize..addr as usize + d.len()].copy_from_slice(&d);
+                            }
+                        }
+                    }
+                    _ => {}
+                }
+            }
+            Ok(())
+        }
+
+        async fn receive(&mut self, buf: &mut [u8], deadline_us: u64) -> Result<usize, PortError> {
+            if self.inbox.is_empty() {
+                self.now = self.now.max(deadline_us);
+                return Ok(0);
+            }
+            let n = buf.len().min(self.inbox.len()).min(5);
+            for b in buf.iter_mut().take(n) {
+                *b = self.inbox.pop_front().unwrap();
+            }
+            self.now += n as u64 * 10;
+            Ok(n)
+        }
+
+        fn now_us(&self) -> u64 {
+            self.now
+        }
+    }
+
+    #[test]
+    fn reads_present_state() {
+        let mut bus = ServoBus::new(FakeBus::with_servos(&[1, 2]), BusConfig::default());
+        let (state, ex) = block_on(bus.read_present(2));
+        let state = state.unwrap();
+        assert_eq!(state.position, 512);
+        assert_eq!(state.voltage, 120);
+        assert_eq!(state.temperature, 40);
+        assert_eq!((ex.timeouts, ex.checksum_errors), (0, 0));
+        assert_eq!(bus.stats().replies, 1);
+    }
+
+    #[test]
+    fn a_missing_servo_times_out_within_the_attempt_budget() {
+        let mut bus = ServoBus::new(FakeBus::with_servos(&[1]), BusConfig { reply_timeout_us: 1000, attempts: 3 });
+        let before = bus.port_mut().now;
+        let (state, ex) = block_on(bus.read_present(9));
+        assert!(state.is_none());
+        assert_eq!(ex.timeouts, 3);
+        // Bounded: three attempts of one timeout each, plus the bytes sent.
+        let spent = bus.port_mut().now - before;
+        assert!((3000..3000 + 3 * 8 * 10 + 1).contains(&spent), "{spent}");
+        assert_eq!(bus.stats().timeouts, 3);
+    }
+
+    #[test]
+    fn retries_after_a_lost_or_corrupted_answer() {
+        let mut bus = ServoBus::new(FakeBus::with_servos(&[1]), BusConfig::default());
+        bus.port_mut().drop_next = 1;
+        let (state, ex) = block_on(bus.read_present(1));
+        assert!(state.is_some());
+        assert_eq!(ex.timeouts, 1);
+
+        bus.port_mut().corrupt_next = 1;
+        let (state, ex) = block_on(bus.read_present(1));
+        assert!(state.is_some());
+        assert_eq!((ex.timeouts, ex.checksum_errors), (1, 1));
+        assert_eq!(bus.stats().checksum_errors, 1);
+
+        bus.port_mut().corrupt_next = 5;
+        let (state, ex) = block_on(bus.read_present(1));
+        assert!(state.is_none());
+        assert_eq!((ex.timeouts, ex.checksum_errors), (2, 2));
+    }
+
+    #[test]
+    fn setup_writes_wheel_mode_once() {
+        let mut bus = ServoBus::new(FakeBus::with_servos(&[3]), BusConfig::default());
+        let s = block_on(bus.setup(3)).unwrap();
+        assert_eq!(s, ServoSetup { model: 28, wrote: true });
+        let t = *bus.port_mut().table(3);
+        assert_eq!(&t[6..10], &[0, 0, 0, 0]);
+        assert_eq!(t[table::STATUS_RETURN_LEVEL as usize], STATUS_RETURN_LEVEL);
+        assert_eq!(t[table::RETURN_DELAY_TIME as usize], RETURN_DELAY);
+        // Second time: nothing to write.
+        let s = block_on(bus.setup(3)).unwrap();
+        assert!(!s.wrote);
+        assert_eq!(block_on(bus.setup(4)), Err(SetupError::NoAnswer { id: 4 }));
+    }
+
+    #[test]
+    fn speeds_and_torque_reach_every_servo() {
+        let mut bus = ServoBus::new(FakeBus::with_servos(&[1, 2]), BusConfig::default());
+        block_on(bus.write_speeds(&[(1, 0x123), (2, 0x456)])).unwrap();
+        block_on(bus.torque_all(true)).unwrap();
+        let t1 = *bus.port_mut().table(1);
+        let t2 = *bus.port_mut().table(2);
+        assert_eq!(u16::from_le_bytes([t1[32], t1[33]]), 0x123);
+        assert_eq!(u16::from_le_bytes([t2[32], t2[33]]), 0x456);
+        assert_eq!((t1[24], t2[24]), (1, 1));
+        block_on(bus.stop_all()).unwrap();
+        assert_eq!(bus.port_mut().table(2)[32], 0);
+    }
+}

@@ -1,0 +1,893 @@
+//! One control period, from readings to servo commands and telemetry.
+//!
+//! [`Controller::period`] is everything the control-loop task does between
+//! reading the sensors and writing the servos:
+//!
+//! 1. the safety machine sees every servo answer, timeout, checksum error,
+//!    error bit, joint position and the last period's overrun — a fault
+//!    found here switches torque off in **this** period's output;
+//! 2. the robot's observer turns the readings into an observation and a
+//!    reward ([`crate::pendulum`], [`crate::leo`]);
+//! 3. while torque is on: between episodes the robot is brought back to
+//!    its start (pendulum hanging still, LEO set upright); in an episode the
+//!    agent takes one step (`start_episode`, `step` or `end_episode` at an
+//!    absorbing state or the time limit); every `test_interval` learning
+//!    episodes one greedy test episode is run (Section VI);
+//! 4. the learner's output and the held joints become voltages, the
+//!    voltages become Moving Speeds of each servo's measured supply;
+//! 5. the fatigue counter sees each servo's torque, estimated from voltage
+//!    and speed with the RX-28 model;
+//! 6. telemetry records: the step (everything a host replay needs: kind,
+//!    observation, reward, action, TD error), the finished episode, state
+//!    changes and faults.
+//!
+//! Randomness: the agent's generator ([`rand_pcg::Pcg32`] from a seed) is
+//! used by the agent only — weight initialisation and action choice — so a
+//! host build of the same agent, fed the reported observations and rewards,
+//! draws the same numbers and takes the same actions.
+
+use crate::config::{self, FirmwareAgent, Robot, RobotConfig, MAX_OBS, MAX_SERVOS};
+use crate::encoder::Unwrapper;
+use crate::io::CycleCounter;
+use crate::leo::{HoldGains, Leo};
+use crate::pendulum::Pendulum;
+use crate::servo::estimated_torque;
+use heapless::Vec;
+use pada_core::agent::{Decision, EpisodeEnd, Mode};
+use pada_core::dynamixel::{table::PresentState, ErrorFlags};
+use pada_core::error::ConfigError;
+use pada_core::fatigue::{FatigueCounter, GearboxParams, PAPER_WINDOW_STEPS};
+use pada_core::fixed::Q16;
+use pada_core::policy::PolicyKind;
+use pada_core::safety::{Command, Event, RunMode, Safety, SafetyConfig, State, Transition};
+use pada_core::wire::{self, NackReason, StepKind};
+use rand_core::SeedableRng;
+use rand_pcg::Pcg32;
+
+/// One servo's part of a period's readings.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ServoRead {
+    /// Present Position … Temperature, if the servo answered.
+    pub state: Option<PresentState>,
+    /// Error bits of its answer.
+    pub error: ErrorFlags,
+    /// Attempts that got no answer.
+    pub timeouts: u8,
+    /// Answers with a bad checksum.
+    pub checksum_errors: u8,
+}
+
+/// Everything the control loop read in one period.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Readings {
+    /// Per servo, in the robot's joint order.
+    pub servos: [ServoRead; MAX_SERVOS],
+    /// The encoder's counter, if it could be read.
+    pub encoder: Option<u16>,
+    /// Foot switches ([`crate::leo::contact`]).
+    pub contacts: u8,
+    /// Time since boot \[ms\].
+    pub time_ms: u32,
+    /// Whether the previous period's work overran its period.
+    pub last_period_overran: bool,
+}
+
+/// What the control loop applies and reports after one period.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PeriodOutput {
+    /// Torque Enable for every servo.
+    pub torque: bool,
+    /// Moving Speed per servo (ID, value); all zero while torque is off.
+    pub speeds: Vec<(u8, u16), MAX_SERVOS>,
+    /// The agent's step, if one was taken (`loop_us` is the caller's to
+    /// fill in).
+    pub step: Option<wire::Step>,
+    /// The episode that ended.
+    pub episode: Option<wire::Episode>,
+    /// Safety state changes of this period, in order.
+    pub transitions: Vec<Transition, 8>,
+    /// Cycles of the agent call, if there was one.
+    pub agent_cycles: Option<u32>,
+}
+
+/// A host command's result, for the `Ack`/`Nack`.
+pub type CommandResult = Result<(), NackReason>;
+
+/// The robot's observer.
+#[derive(Debug, Clone)]
+enum Plant {
+    Pendulum(Pendulum),
+    Leo(Leo),
+}
+
+/// Where the episode cycle is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Phase {
+    /// Torque off.
+    Stopped,
+    /// Bringing the robot back to its start.
+    Resetting,
+    /// In an episode of `steps` transitions so far.
+    Running {
+        /// Transitions (rewards) so far.
+        steps: u32,
+    },
+}
+
+/// The control loop's state: agent, safety machine, observer, fatigue.
+pub struct Controller<W> {
+    robot: Robot,
+    config: RobotConfig,
+    agent: Option<FirmwareAgent<W>>,
+    policy: PolicyKind,
+    config_hash: u32,
+    seed: u64,
+    rng: Pcg32,
+    safety: Safety,
+    fatigue: FatigueCounter<MAX_SERVOS>,
+    plant: Plant,
+    encoder: Unwrapper,
+    phase: Phase,
+    /// The safety state at the end of the last period.
+    last_state: State,
+    episode_mode: RunMode,
+    /// Episodes started since boot (the index of the next one).
+    episodes: u32,
+    /// Learning episodes since the last test episode.
+    since_test: u32,
+    episode_return: f32,
+    last_action: u32,
+    last_output: [f32; pada_core::action_space::MAX_ACTION_DIMS],
+    /// Voltage each servo applied during the last period.
+    applied: [f32; MAX_SERVOS],
+    /// Last supply each servo reported \[V\].
+    supply: [Option<f32>; MAX_SERVOS],
+    temps: [u8; MAX_SERVOS],
+    steps: u32,
+}
+
+impl<W> Controller<W>
+where
+    W: AsRef<[Q16]> + AsMut<[Q16]>,
+{
+    /// A controller for `robot` learning with `policy` on `weights`,
+    /// initialised from `seed` (also the generator of every action).
+    pub fn new(robot: Robot, policy: PolicyKind, weights: W, seed: u64) -> Result<Self, ConfigError> {
+        let config = robot.config();
+        let mut soft_limits = Vec::new();
+        for limit in config.soft_limits.iter().map_while(|l| *l) {
+            let _ = soft_limits.push(limit);
+        }
+        let safety = Safety::new(SafetyConfig { soft_limits, ..SafetyConfig::default() })?;
+        let fatigue = FatigueCounter::new(GearboxParams::TABLE_I, config.period_s() as f64, Some(PAPER_WINDOW_STEPS))
+            .map_err(|_| ConfigError::new("fatigue", 0.0, "Table I parameters"))?;
+        let plant = match robot {
+            Robot::Pendulum33 | Robot::Pendulum20 => Plant::Pendulum(Pendulum::new(&config)),
+            Robot::Leo => Plant::Leo(Leo::new(&config, HoldGains::default())),
+        };
+        let mut controller = Controller {
+            robot,
+            config,
+            agent: None,
+            policy,
+            config_hash: 0,
+            seed,
+            rng: Pcg32::seed_from_u64(seed),
+            safety,
+            fatigue,
+            plant,
+            encoder: Unwrapper::new(),
+            phase: Phase::Stopped,
+            last_state: State::Idle,
+            episode_mode: RunMode::Learning,
+            episodes: 0,
+            since_test: 0,
+            episode_return: 0.0,
+            last_action: 0,
+            last_output: [0.0; pada_core::action_space::MAX_ACTION_DIMS],
+            applied: [0.0; MAX_SERVOS],
+            supply: [None; MAX_SERVOS],
+            temps: [0; MAX_SERVOS],
+            steps: 0,
+        };
+        controller.build(policy, weights)?;
+        Ok(controller)
+    }
+
+    /// A fresh agent with `policy` on `weights`: the generator is reseeded
+    /// and the weights initialised, as a host build would do.
+    fn build(&mut self, policy: PolicyKind, weights: W) -> Result<(), ConfigError> {
+        let params = self.robot.params();
+        let hash = config::config_hash(self.robot, policy, &params)?;
+        let mut agent = FirmwareAgent::new(
+            &self.robot.state_dims(),
+            self.robot.action_space(),
+            policy,
+            params,
+            config::LAYOUT,
+            weights,
+        )?;
+        self.rng = Pcg32::seed_from_u64(self.seed);
+        agent.reset_weights(&mut self.rng);
+        self.agent = Some(agent);
+        self.policy = policy;
+        self.config_hash = hash;
+        Ok(())
+    }
+
+    fn agent(&self) -> &FirmwareAgent<W> {
+        // Always Some outside `set_policy`.
+        self.agent.as_ref().unwrap_or_else(|| unreachable!())
+    }
+
+    fn agent_mut(&mut self) -> &mut FirmwareAgent<W> {
+        self.agent.as_mut().unwrap_or_else(|| unreachable!())
+    }
+
+    /// The robot.
+    pub fn robot(&self) -> Robot {
+        self.robot
+    }
+
+    /// The robot's fixed description.
+    pub fn config(&self) -> &RobotConfig {
+        &self.config
+    }
+
+    /// The configuration hash of the running learner.
+    pub fn config_hash(&self) -> u32 {
+        self.config_hash
+    }
+
+    /// The policy.
+    pub fn policy(&self) -> PolicyKind {
+        self.policy
+    }
+
+    /// The safety state.
+    pub fn state(&self) -> State {
+        self.safety.state()
+    }
+
+    /// Whether torque may be on now.
+    pub fn torque_enabled(&self) -> bool {
+        self.safety.torque_enabled()
+    }
+
+    /// The weights.
+    pub fn weights(&self) -> &[Q16] {
+        self.agent().weights()
+    }
+
+    /// The weights, to load a checkpoint into (only while torque is off).
+    pub fn weights_mut(&mut self) -> Option<&mut [Q16]> {
+        if self.torque_enabled() {
+            return None;
+        }
+        Some(self.agent_mut().weights_mut())
+    }
+
+    /// The agent's counters.
+    pub fn agent_stats(&self) -> pada_core::agent::AgentStats {
+        self.agent().stats()
+    }
+
+    /// The fatigue counter (every servo, joint order).
+    pub fn fatigue(&self) -> &FatigueCounter<MAX_SERVOS> {
+        &self.fatigue
+    }
+
+    /// Joints whose fatigue goes into each `Step`: the learned ones (the
+    /// pendulum's motor; LEO's hips and knees, which take turns as stance
+    /// and swing joints).
+    pub fn reported_joints(&self) -> core::ops::Range<usize> {
+        match self.robot {
+            Robot::Pendulum33 | Robot::Pendulum20 => 0..1,
+            Robot::Leo => crate::leo::joint::HIP_R..crate::leo::joint::KNEE_L + 1,
+        }
+    }
+
+    /// The `Hello` of this configuration.
+    pub fn hello(&self) -> wire::Hello {
+        wire::Hello {
+            protocol: wire::PROTOCOL_VERSION,
+            config_hash: self.config_hash,
+            weight_count: self.weights().len() as u32,
+            period_us: self.config.period_us,
+            state_dims: self.robot.state_dims().len() as u8,
+            joints: self.reported_joints().len() as u8,
+        }
+    }
+
+    /// At boot, after a reset by the independent watchdog: a fault.
+    pub fn watchdog_reset(&mut self) -> Transition {
+        self.safety.on(Event::WatchdogReset)
+    }
+
+    /// Carries out a host command that the controller owns (start, stop,
+    /// pause, clear fault, policy, ε, switch to SARSA); the others
+    /// (checkpoints, weights, ping) are the caller's.
+    pub fn command(&mut self, cmd: &wire::ToChip) -> (CommandResult, Option<Transition>) {
+        let safety = |c| Some(Event::Command(c));
+        let event = match *cmd {
+            wire::ToChip::Start(mode) => safety(Command::Start(mode)),
+            wire::ToChip::Stop => safety(Command::Stop),
+            wire::ToChip::Pause => safety(Command::Pause),
+            wire::ToChip::ClearFault => safety(Command::ClearFault),
+            _ => None,
+        };
+        if let Some(event) = event {
+            let t = self.safety.on(event);
+            let result = match t.outcome {
+                pada_core::safety::Outcome::Rejected(r) => Err(NackReason::State(r)),
+                _ => Ok(()),
+            };
+            return (result, Some(t));
+        }
+        let result = match *cmd {
+            wire::ToChip::SetPolicy(spec) => self.set_policy(spec.into()),
+            wire::ToChip::SetEpsilon(e) => self.agent_mut().set_epsilon(e).map_err(|_| NackReason::InvalidParameter),
+            wire::ToChip::SwitchToSarsa => {
+                self.agent_mut().switch_to_sarsa().map_err(|_| NackReason::InvalidParameter)
+            }
+            _ => Err(NackReason::Unsupported),
+        };
+        (result, None)
+    }
+
+    /// A fresh learner with `policy` (generator reseeded, weights
+    /// initialised); only while torque is off. An invalid parameter leaves
+    /// the running learner as it was.
+    pub fn set_policy(&mut self, policy: PolicyKind) -> CommandResult {
+        if self.torque_enabled() {
+            return Err(NackReason::Busy);
+        }
+        let params = self.robot.params();
+        if config::config_hash(self.robot, policy, &params).is_err() {
+            return Err(NackReason::InvalidParameter);
+        }
+        let Some(agent) = self.agent.take() else {
+            return Err(NackReason::Busy);
+        };
+        let weights = agent.into_weights();
+        // Validated above, so this builds.
+        self.build(policy, weights).map_err(|_| NackReason::InvalidParameter)
+    }
+
+    /// One control period (see the module documentation). `cycles` times
+    /// the agent call.
+    pub fn period(&mut self, readings: &Readings, cycles: &impl CycleCounter, out: &mut PeriodOutput) {
+        out.step = None;
+        out.episode = None;
+        out.transitions.clear();
+        out.speeds.clear();
+        out.agent_cycles = None;
+        self.steps = self.steps.wrapping_add(1);
+        let now = readings.time_ms;
+        let joints = self.config.joints;
+        let n = joints.len();
+
+        // 1. Safety sees everything that was read.
+        fn feed(safety: &mut Safety, out: &mut Vec<Transition, 8>, event: Event) {
+            let t = safety.on(event);
+            if t.changed() {
+                let _ = out.push(t);
+            }
+        }
+        let overrun = Event::LoopTiming { overrun: readings.last_period_overran };
+        feed(&mut self.safety, &mut out.transitions, overrun);
+        let mut angles = [None; MAX_SERVOS];
+        for (i, (joint, read)) in joints.iter().zip(&readings.servos).enumerate() {
+            for _ in 0..read.checksum_errors {
+                feed(&mut self.safety, &mut out.transitions, Event::ChecksumError { at_ms: now });
+            }
+            for _ in 0..read.timeouts {
+                feed(&mut self.safety, &mut out.transitions, Event::ServoTimeout { servo: joint.id });
+            }
+            if let Some(state) = read.state {
+                let status = Event::ServoStatus { servo: joint.id, error: read.error, at_ms: now };
+                feed(&mut self.safety, &mut out.transitions, status);
+                self.supply[i] = Some(state.voltage_v());
+                self.temps[i] = state.temperature;
+                let angle = joint.angle(state.position);
+                angles[i] = Some(angle);
+                if self.config.soft_limits.get(i).is_some_and(|l| l.is_some()) {
+                    let position = Event::JointPosition { joint: i as u8, position: angle };
+                    feed(&mut self.safety, &mut out.transitions, position);
+                }
+            }
+        }
+
+        // 2. Where the episode cycle goes this period. The reset's end is
+        // judged on the last period's observation, so that an episode's
+        // first observation is taken after the observer was restarted.
+        let torque = self.safety.torque_enabled();
+        let state = self.safety.state();
+        let mut starting = false;
+        if !torque {
+            self.phase = Phase::Stopped;
+        } else {
+            if state != self.last_state {
+                // Just started, resumed or switched mode: the robot is
+                // wherever it is; bring it to its start first.
+                self.begin_reset();
+            } else if self.phase == Phase::Resetting && self.reset_done() {
+                starting = true;
+                if let Plant::Leo(l) = &mut self.plant {
+                    l.start_episode();
+                }
+            }
+        }
+        self.last_state = state;
+
+        // 3. Observe.
+        let encoder_angle = readings.encoder.map(|c| self.config.encoder.angle(self.encoder.update(c)));
+        match &mut self.plant {
+            Plant::Pendulum(p) => p.sense(encoder_angle),
+            Plant::Leo(l) => l.sense(&angles, encoder_angle, readings.contacts, &self.applied),
+        }
+
+        // 4. The agent's step, and the voltages.
+        let mut volts = [0.0f32; MAX_SERVOS];
+        if torque {
+            let mode = state.run_mode().unwrap_or(RunMode::Learning);
+            if starting {
+                self.start_episode(mode, readings, cycles, out);
+            } else if let Phase::Running { steps } = self.phase {
+                self.continue_episode(steps + 1, readings, cycles, out);
+            }
+            match self.phase {
+                Phase::Running { .. } => self.run_commands(&mut volts),
+                _ => self.reset_commands(&mut volts),
+            }
+        }
+
+        // 5. Voltages → Moving Speeds of the measured supply.
+        let nominal = self.config.supply_nominal_v;
+        for (i, joint) in joints.iter().enumerate() {
+            let v = if torque { volts[i] } else { 0.0 };
+            let supply = self.supply[i].filter(|s| *s >= 5.0).unwrap_or(nominal);
+            let speed = joint.moving_speed(v, self.supply[i], nominal);
+            self.applied[i] = joint.voltage_of(speed, supply);
+            let _ = out.speeds.push((joint.id, speed));
+        }
+
+        // 6. Fatigue from the estimated gearbox torque.
+        if torque {
+            let mut speeds = [0.0f32; MAX_SERVOS];
+            match &self.plant {
+                Plant::Pendulum(p) => p.servo_speeds(&mut speeds),
+                Plant::Leo(l) => l.servo_speeds(&mut speeds),
+            }
+            let mut torques = [0.0f32; MAX_SERVOS];
+            for i in 0..n {
+                let supply = self.supply[i].unwrap_or(nominal);
+                torques[i] = estimated_torque(self.applied[i], speeds[i], supply);
+            }
+            let _ = self.fatigue.update(&torques);
+        }
+        out.torque = torque;
+    }
+
+    fn begin_reset(&mut self) {
+        self.phase = Phase::Resetting;
+        match &mut self.plant {
+            Plant::Pendulum(p) => p.begin_reset(),
+            Plant::Leo(l) => l.begin_reset(),
+        }
+    }
+
+    fn reset_done(&mut self) -> bool {
+        match &mut self.plant {
+            Plant::Pendulum(p) => p.reset_done(),
+            Plant::Leo(l) => l.reset_done(),
+        }
+    }
+
+    fn observe(&self, obs: &mut [f32; MAX_OBS]) -> usize {
+        match &self.plant {
+            Plant::Pendulum(p) => p.observe(obs),
+            Plant::Leo(l) => l.observe(obs),
+        }
+    }
+
+    fn start_episode(&mut self, mode: RunMode, readings: &Readings, cycles: &impl CycleCounter, out: &mut PeriodOutput) {
+        // Every `test_interval` learning episodes, one greedy test episode.
+        let test = mode == RunMode::Testing || self.since_test >= self.config.test_interval;
+        self.episode_mode = if test { RunMode::Testing } else { RunMode::Learning };
+        if test {
+            if mode == RunMode::Learning {
+                self.since_test = 0;
+            }
+        } else {
+            self.since_test += 1;
+        }
+        self.agent_mut().set_mode(if test { Mode::Testing } else { Mode::Learning });
+        self.episode_return = 0.0;
+        let mut obs = [0.0; MAX_OBS];
+        let dims = self.observe(&mut obs);
+        let t0 = cycles.cycles();
+        let result = {
+            let (agent, rng) = (self.agent.as_mut(), &mut self.rng);
+            agent.map(|a| a.start_episode(&obs[..dims], rng))
+        };
+        out.agent_cycles = Some(cycles.cycles().wrapping_sub(t0));
+        match result {
+            Some(Ok(decision)) => {
+                self.phase = Phase::Running { steps: 0 };
+                self.record(StepKind::Start, &obs[..dims], 0.0, Some(decision), readings.time_ms, out);
+            }
+            // A non-finite observation (a broken sensor): try again next
+            // period.
+            _ => self.begin_reset(),
+        }
+    }
+
+    fn continue_episode(&mut self, steps: u32, readings: &Readings, cycles: &impl CycleCounter, out: &mut PeriodOutput) {
+        let mut obs = [0.0; MAX_OBS];
+        let dims = self.observe(&mut obs);
+        let (reward, absorbing) = match &self.plant {
+            Plant::Pendulum(p) => (p.reward(self.applied[0]), false),
+            Plant::Leo(l) => (l.reward(), l.doomed()),
+        };
+        let timeout = steps >= self.config.episode_steps;
+        let t0 = cycles.cycles();
+        let (kind, result) = {
+            let Some(agent) = self.agent.as_mut() else { return };
+            let rng = &mut self.rng;
+            if absorbing {
+                (StepKind::Absorbing, agent.end_episode(reward, EpisodeEnd::Absorbing, rng).map(|_| None))
+            } else if timeout {
+                (StepKind::Timeout, agent.end_episode(reward, EpisodeEnd::Timeout(&obs[..dims]), rng).map(|_| None))
+            } else {
+                (StepKind::Step, agent.step(reward, &obs[..dims], rng).map(Some))
+            }
+        };
+        out.agent_cycles = Some(cycles.cycles().wrapping_sub(t0));
+        match result {
+            Ok(decision) => {
+                self.episode_return += reward;
+                self.record(kind, &obs[..dims], reward, decision, readings.time_ms, out);
+                if decision.is_some() {
+                    self.phase = Phase::Running { steps };
+                } else {
+                    out.episode = Some(wire::Episode {
+                        index: self.episodes.wrapping_sub(1),
+                        mode: self.episode_mode,
+                        total_reward: self.episode_return,
+                        length: steps,
+                        weights_checksum: self.agent().weights_checksum(),
+                    });
+                    self.begin_reset();
+                }
+            }
+            // A non-finite observation or reward: the episode is given up
+            // (nothing learned from it) and the robot reset.
+            Err(_) => self.begin_reset(),
+        }
+    }
+
+    /// Fills the step record.
+    fn record(
+        &mut self,
+        kind: StepKind,
+        obs: &[f32],
+        reward: f32,
+        decision: Option<Decision>,
+        time_ms: u32,
+        out: &mut PeriodOutput,
+    ) {
+        if kind == StepKind::Start {
+            self.episodes = self.episodes.wrapping_add(1);
+        }
+        let outputs = self.agent().policy().motor_space().dims();
+        match decision {
+            Some(d) => {
+                self.last_action = d.action;
+                self.last_output = d.output;
+            }
+            None => self.last_output = [0.0; pada_core::action_space::MAX_ACTION_DIMS],
+        }
+        let td_error = match (kind, self.episode_mode) {
+            (StepKind::Start, _) | (_, RunMode::Testing) => 0,
+            _ => self.agent().stats().last_td_error.0,
+        };
+        let mut joints = Vec::new();
+        for j in self.reported_joints() {
+            if let Some(f) = self.fatigue.joint(j) {
+                let _ = joints.push(wire::JointFatigue {
+                    damage: f.damage(),
+                    reengagements: f.reengagements().min(u32::MAX as u64) as u32,
+                });
+            }
+        }
+        out.step = Some(wire::Step {
+            step: self.steps,
+            time_ms,
+            episode: self.episodes.wrapping_sub(1),
+            mode: self.episode_mode,
+            kind,
+            state: Vec::from_slice(obs).unwrap_or_default(),
+            action: self.last_action,
+            output: Vec::from_slice(&self.last_output[..outputs]).unwrap_or_default(),
+            reward,
+            td_error,
+            explored: decision.is_some_and(|d| d.explored),
+            joints,
+            loop_us: 0,
+        });
+    }
+
+    fn run_commands(&self, volts: &mut [f32; MAX_SERVOS]) {
+        match &self.plant {
+            Plant::Pendulum(p) => p.commands(self.last_output[0], volts),
+            Plant::Leo(l) => l.commands(&self.last_output[..3], volts),
+        }
+    }
+
+    fn reset_commands(&self, volts: &mut [f32; MAX_SERVOS]) {
+        match &self.plant {
+            Plant::Pendulum(p) => p.reset_commands(volts),
+            Plant::Leo(l) => l.reset_commands(volts),
+        }
+    }
+
+    /// Health fields the controller knows; the caller adds bus, loop and
+    /// link counters.
+    pub fn health(&self, health: &mut wire::Health) {
+        health.servo_temps_c.clear();
+        let n = self.config.joints.len();
+        for &t in &self.temps[..n] {
+            let _ = health.servo_temps_c.push(t);
+        }
+        health.min_voltage_dv =
+            self.supply[..n].iter().flatten().map(|v| (v * 10.0 + 0.5) as u8).min().unwrap_or(0);
+        let stats = self.agent().stats();
+        health.trace_drops = stats.trace_drops;
+        health.weight_saturations = stats.saturations;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::WEIGHTS;
+    use core::cell::Cell;
+    use core::f32::consts::PI;
+    use pada_core::safety::FaultCause;
+
+    struct Clock(Cell<u32>);
+    impl CycleCounter for Clock {
+        fn cycles(&self) -> u32 {
+            let c = self.0.get();
+            self.0.set(c + 1000);
+            c
+        }
+    }
+
+    fn table() -> Box<[Q16]> {
+        vec![Q16::ZERO; WEIGHTS].into_boxed_slice()
+    }
+
+    /// A healthy pendulum reading: the servo answers, the encoder at `counts`.
+    fn pendulum_readings(counts: u16, time_ms: u32) -> Readings {
+        let mut r = Readings { encoder: Some(counts), time_ms, ..Readings::default() };
+        r.servos[0].state = Some(PresentState { position: 512, speed: 0, load: 0, voltage: 120, temperature: 35 });
+        r
+    }
+
+    fn start(c: &mut Controller<Box<[Q16]>>, mode: RunMode) {
+        let (result, t) = c.command(&wire::ToChip::Start(mode));
+        assert_eq!(result, Ok(()));
+        assert!(t.unwrap().torque_enable);
+    }
+
+    #[test]
+    fn idle_means_torque_off_and_zero_speed() {
+        let mut c = Controller::new(Robot::Pendulum33, PolicyKind::Sarsa, table(), 1).unwrap();
+        let mut out = PeriodOutput::default();
+        c.period(&pendulum_readings(0, 0), &Clock(Cell::new(0)), &mut out);
+        assert!(!out.torque);
+        assert_eq!(out.speeds.as_slice(), &[(1, 0)]);
+        assert!(out.step.is_none());
+    }
+
+    #[test]
+    fn pendulum_episodes_start_after_hanging_still_and_end_by_time() {
+        let mut c = Controller::new(Robot::Pendulum33, PolicyKind::Pada { delta: 0.5 }, table(), 7).unwrap();
+        start(&mut c, RunMode::Learning);
+        let clock = Clock(Cell::new(0));
+        let mut out = PeriodOutput::default();
+        let mut kinds = std::vec::Vec::new();
+        let mut episodes = std::vec::Vec::new();
+        for k in 0..400u32 {
+            c.period(&pendulum_readings(0, k * 30), &clock, &mut out);
+            assert!(out.torque);
+            if let Some(s) = &out.step {
+                kinds.push(s.kind);
+                assert_eq!(s.state.len(), 2);
+                assert_eq!(s.output.len(), 1);
+                assert_eq!(s.joints.len(), 1);
+                assert!(out.agent_cycles.is_some());
+            }
+            if let Some(e) = out.episode {
+                episodes.push(e);
+            }
+        }
+        // 34 periods of waiting (1 s still), then Start, 99 Steps, Timeout.
+        assert_eq!(kinds[0], StepKind::Start);
+        assert_eq!(kinds.iter().filter(|k| **k == StepKind::Step).count() >= 99, true);
+        assert_eq!(kinds[100], StepKind::Timeout);
+        assert_eq!(episodes[0].length, 100);
+        assert_eq!(episodes[0].index, 0);
+        assert_eq!(episodes[0].mode, RunMode::Learning);
+        // Reward at the bottom, at rest, with the actions taken.
+        assert!(episodes[0].total_reward < 0.0);
+    }
+
+    #[test]
+    fn every_tenth_episode_is_a_test() {
+        let mut c = Controller::new(Robot::Pendulum33, PolicyKind::Sarsa, table(), 3).unwrap();
+        start(&mut c, RunMode::Learning);
+        let clock = Clock(Cell::new(0));
+        let mut out = PeriodOutput::default();
+        let mut modes = std::vec::Vec::new();
+        for k in 0..(11 * 140) {
+            c.period(&pendulum_readings(0, k * 30), &clock, &mut out);
+            if let Some(e) = out.episode {
+                modes.push(e.mode);
+            }
+        }
+        assert!(modes.len() >= 11, "{}", modes.len());
+        assert!(modes[..10].iter().all(|m| *m == RunMode::Learning));
+        assert_eq!(modes[10], RunMode::Testing);
+    }
+
+    #[test]
+    fn a_silent_servo_faults_and_torque_goes_off_in_the_same_period() {
+        let mut c = Controller::new(Robot::Pendulum33, PolicyKind::Sarsa, table(), 1).unwrap();
+        start(&mut c, RunMode::Learning);
+        let clock = Clock(Cell::new(0));
+        let mut out = PeriodOutput::default();
+        c.period(&pendulum_readings(0, 0), &clock, &mut out);
+        assert!(out.torque);
+        // Two attempts time out this period, one more the next: budget 2.
+        let mut r = pendulum_readings(0, 30);
+        r.servos[0] = ServoRead { state: None, timeouts: 2, ..ServoRead::default() };
+        c.period(&r, &clock, &mut out);
+        assert!(out.torque);
+        r.servos[0].timeouts = 1;
+        c.period(&r, &clock, &mut out);
+        assert!(!out.torque, "torque off in the period the fault is found");
+        assert_eq!(out.speeds.as_slice(), &[(1, 0)]);
+        let t = out.transitions.iter().find_map(|t| t.entered_fault()).unwrap();
+        assert_eq!(t, FaultCause::ServoTimeout { servo: 1, attempts: 3 });
+        // Start is refused until the host clears the fault.
+        let (result, _) = c.command(&wire::ToChip::Start(RunMode::Learning));
+        assert_eq!(result, Err(NackReason::State(pada_core::safety::Rejection::InFault)));
+        assert_eq!(c.command(&wire::ToChip::ClearFault).0, Ok(()));
+        start(&mut c, RunMode::Learning);
+    }
+
+    #[test]
+    fn servo_error_bits_and_overrun_streaks_fault() {
+        let mut c = Controller::new(Robot::Pendulum33, PolicyKind::Sarsa, table(), 1).unwrap();
+        start(&mut c, RunMode::Learning);
+        let clock = Clock(Cell::new(0));
+        let mut out = PeriodOutput::default();
+        let mut r = pendulum_readings(0, 0);
+        r.servos[0].error = ErrorFlags::OVERHEATING;
+        c.period(&r, &clock, &mut out);
+        assert!(!out.torque);
+        assert!(matches!(c.state(), State::Fault(FaultCause::ServoError { servo: 1, .. })));
+
+        let mut c = Controller::new(Robot::Pendulum33, PolicyKind::Sarsa, table(), 1).unwrap();
+        start(&mut c, RunMode::Learning);
+        let mut r = pendulum_readings(0, 0);
+        r.last_period_overran = true;
+        for _ in 0..2 {
+            c.period(&r, &clock, &mut out);
+            assert!(out.torque);
+        }
+        c.period(&r, &clock, &mut out);
+        assert!(!out.torque);
+        assert!(matches!(c.state(), State::Fault(FaultCause::OverrunStreak { count: 3 })));
+    }
+
+    #[test]
+    fn leo_soft_limit_faults() {
+        let mut c = Controller::new(Robot::Leo, PolicyKind::Sarsa, table(), 1).unwrap();
+        start(&mut c, RunMode::Learning);
+        let clock = Clock(Cell::new(0));
+        let mut out = PeriodOutput::default();
+        let mut r = Readings { encoder: Some(0), contacts: crate::leo::contact::LEFT, ..Readings::default() };
+        for s in r.servos.iter_mut() {
+            s.state = Some(PresentState { position: 512, speed: 0, load: 0, voltage: 140, temperature: 30 });
+        }
+        c.period(&r, &clock, &mut out);
+        assert!(out.torque);
+        assert_eq!(out.speeds.len(), 7);
+        // Right knee bent forward by 40 counts ≈ +0.2 rad: beyond +2° + margin.
+        r.servos[crate::leo::joint::KNEE_R].state.as_mut().unwrap().position = 512 + 40;
+        c.period(&r, &clock, &mut out);
+        assert!(!out.torque);
+        assert!(matches!(c.state(), State::Fault(FaultCause::SoftLimit { joint: 3, .. })));
+    }
+
+    #[test]
+    fn policy_changes_only_with_torque_off_and_reseed() {
+        let mut c = Controller::new(Robot::Pendulum33, PolicyKind::Sarsa, table(), 5).unwrap();
+        let fresh = c.agent().weights_checksum();
+        c.agent_mut().weights_mut()[0] = Q16(12345);
+        assert_eq!(c.command(&wire::ToChip::SetPolicy(wire::PolicySpec::Pada(0.5))).0, Ok(()));
+        assert_eq!(c.policy(), PolicyKind::Pada { delta: 0.5 });
+        assert_eq!(c.agent().weights_checksum(), fresh, "fresh learner, same seed, same weights");
+        assert_eq!(
+            c.command(&wire::ToChip::SetPolicy(wire::PolicySpec::Pada(-1.0))).0,
+            Err(NackReason::InvalidParameter)
+        );
+        assert_eq!(c.policy(), PolicyKind::Pada { delta: 0.5 });
+        start(&mut c, RunMode::Learning);
+        assert_eq!(c.command(&wire::ToChip::SetPolicy(wire::PolicySpec::Sarsa)).0, Err(NackReason::Busy));
+        assert!(c.weights_mut().is_none());
+        assert_eq!(c.command(&wire::ToChip::SetEpsilon(2.0)).0, Err(NackReason::InvalidParameter));
+        assert_eq!(c.command(&wire::ToChip::SetEpsilon(0.0)).0, Ok(()));
+        assert_eq!(c.command(&wire::ToChip::SwitchToSarsa).0, Ok(()));
+    }
+
+    #[test]
+    fn replaying_the_reported_steps_on_a_host_agent_gives_the_same_actions() {
+        // What issue 6 does with the firmware's telemetry, in miniature: a
+        // pendulum that moves with the commands, the Step records replayed
+        // through a plain agent with the same seed.
+        let seed = 11;
+        let mut c = Controller::new(Robot::Pendulum33, PolicyKind::Pada { delta: 0.5 }, table(), seed).unwrap();
+        start(&mut c, RunMode::Learning);
+        let clock = Clock(Cell::new(0));
+        let mut out = PeriodOutput::default();
+        let mut steps = std::vec::Vec::new();
+        let mut angle: f32 = 0.0;
+        for k in 0..1500u32 {
+            let counts = (angle / (2.0 * PI) * 4096.0).round() as i64;
+            c.period(&pendulum_readings(counts.rem_euclid(65536) as u16, k * 30), &clock, &mut out);
+            if let Some(s) = out.step.take() {
+                steps.push(s);
+            }
+            // A crude plant: the voltage turns the pendulum.
+            let u = c.applied[0];
+            angle += 0.02 * u - 0.05 * libm::sinf(angle);
+        }
+        assert!(steps.len() > 300);
+
+        let robot = Robot::Pendulum33;
+        let mut rng = Pcg32::seed_from_u64(seed);
+        let mut agent = FirmwareAgent::new(
+            &robot.state_dims(),
+            robot.action_space(),
+            PolicyKind::Pada { delta: 0.5 },
+            robot.params(),
+            config::LAYOUT,
+            table(),
+        )
+        .unwrap();
+        agent.reset_weights(&mut rng);
+        for s in &steps {
+            agent.set_mode(if s.mode == RunMode::Testing { Mode::Testing } else { Mode::Learning });
+            match s.kind {
+                StepKind::Start => {
+                    let d = agent.start_episode(&s.state, &mut rng).unwrap();
+                    assert_eq!(d.action, s.action);
+                }
+                StepKind::Step => {
+                    let d = agent.step(s.reward, &s.state, &mut rng).unwrap();
+                    assert_eq!(d.action, s.action, "step {}", s.step);
+                }
+                StepKind::Absorbing => agent.end_episode(s.reward, EpisodeEnd::Absorbing, &mut rng).unwrap(),
+                StepKind::Timeout => {
+                    agent.end_episode(s.reward, EpisodeEnd::Timeout(&s.state), &mut rng).unwrap()
+                }
+            }
+        }
+        assert_eq!(agent.weights_checksum(), c.agent().weights_checksum());
+    }
+}

@@ -1,0 +1,476 @@
+//! The firmware's tasks, one per concern, and the channels between them.
+//!
+//! ```text
+//!            BUS_REQUESTS ──▶ servo_bus ──▶ USART1 (RS-485, 1 Mbps) ──▶ RX-28 ×1…7
+//! control ◀── BUS_REPLIES ───┘
+//!    │  ▲
+//!    │  └── FROM_HOST ◀── telemetry_rx ◀── USART2 ◀── host
+//!    ├────▶ TO_HOST ────▶ telemetry_tx ──▶ USART2 ──▶ host
+//!    └────▶ WATCHDOG ───▶ watchdog ──▶ IWDG
+//! ```
+//!
+//! `control` runs the loop at the robot's rate; it alone owns the
+//! controller (agent, safety machine, fatigue counter) and the checkpoint
+//! flash, so nothing else can change the weights or the torque.
+
+use crate::board::{BoardSensors, Cycles, FlashStore, Led, ServoPort, TelemetryRx, TelemetryTx, Watchdog};
+use defmt::{info, warn};
+use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
+use embassy_sync::channel::Channel;
+use embassy_sync::signal::Signal;
+use embassy_time::{Duration, Instant, Ticker};
+use heapless::Vec;
+use pada_core::checkpoint::{self, LoadOutcome};
+use pada_core::safety::Transition;
+use pada_core::wire::{self, FrameDecoder, FrameEncoder, NackReason, ToChip, ToHost, MAX_FRAME_LEN};
+use pada_firmware::bus::{BusConfig, BusStats, ServoBus};
+use pada_firmware::config::{WeightTable, MAX_SERVOS};
+use pada_firmware::control::{Controller, PeriodOutput, Readings, ServoRead};
+use pada_firmware::io::{ByteSink, ByteSource, CycleCounter, Sensors};
+use pada_firmware::servo::Joint;
+use pada_firmware::timing::LoopTiming;
+
+type Mutex = CriticalSectionRawMutex;
+
+/// What the control loop asks of the servo bus.
+pub enum BusRequest {
+    /// Read every servo's present state.
+    Read,
+    /// Apply torque enable and Moving Speeds.
+    Write {
+        /// Torque Enable for all servos.
+        torque: bool,
+        /// (ID, Moving Speed) per servo.
+        speeds: Vec<(u8, u16), MAX_SERVOS>,
+    },
+}
+
+/// The servo bus's answer to [`BusRequest::Read`].
+pub struct BusReply {
+    /// Per servo, in joint order.
+    pub servos: [ServoRead; MAX_SERVOS],
+    /// Counters since boot.
+    pub stats: BusStats,
+}
+
+/// A message for the host, and how many were dropped before it (the
+/// telemetry task skips that many sequence numbers, so the host sees the
+/// gap).
+pub struct Outgoing {
+    msg: ToHost,
+    skipped: u32,
+}
+
+/// What the watchdog task is told.
+#[derive(Clone, Copy)]
+pub enum WatchdogRequest {
+    /// The control loop completed a period.
+    Alive,
+    /// A flash erase is about to stall the CPU: long timeout (`true`) or back.
+    Extend(bool),
+}
+
+/// Control → servo bus.
+pub static BUS_REQUESTS: Channel<Mutex, BusRequest, 1> = Channel::new();
+/// Servo bus → control.
+pub static BUS_REPLIES: Channel<Mutex, BusReply, 1> = Channel::new();
+/// Anyone → telemetry.
+pub static TO_HOST: Channel<Mutex, Outgoing, 16> = Channel::new();
+/// Telemetry → control: (sequence number, command).
+pub static FROM_HOST: Channel<Mutex, (u32, ToChip), 4> = Channel::new();
+/// Control → watchdog.
+pub static WATCHDOG: Channel<Mutex, WatchdogRequest, 2> = Channel::new();
+/// Watchdog → control: the last `Extend` is in force.
+pub static WATCHDOG_DONE: Signal<Mutex, ()> = Signal::new();
+
+/// Sends a message the host must get (waits for room).
+pub async fn send_reliable(msg: ToHost) {
+    TO_HOST.send(Outgoing { msg, skipped: 0 }).await;
+}
+
+/// The servo bus: boot-time set-up, then reads and writes on request.
+#[embassy_executor::task]
+pub async fn servo_bus(port: ServoPort, joints: &'static [Joint]) -> ! {
+    let mut bus = ServoBus::new(port, BusConfig::default());
+    // Whatever the servos did before this boot (wheel mode keeps turning
+    // at the last Moving Speed): torque off first, a few times.
+    for _ in 0..3 {
+        bus.torque_all(false).await.ok();
+        bus.stop_all().await.ok();
+    }
+    for joint in joints {
+        match bus.setup(joint.id).await {
+            Ok(s) => info!("servo {=u8}: model {=u16}, settings {}", joint.id, s.model, if s.wrote { "written" } else { "ok" }),
+            Err(e) => warn!("servo {=u8}: {}", joint.id, defmt::Debug2Format(&e)),
+        }
+    }
+    loop {
+        match BUS_REQUESTS.receive().await {
+            BusRequest::Read => {
+                let mut servos = [ServoRead::default(); MAX_SERVOS];
+                for (read, joint) in servos.iter_mut().zip(joints) {
+                    let (state, exchange) = bus.read_present(joint.id).await;
+                    *read = ServoRead {
+                        state,
+                        error: exchange.error(),
+                        timeouts: exchange.timeouts,
+                        checksum_errors: exchange.checksum_errors,
+                    };
+                }
+                BUS_REPLIES.send(BusReply { servos, stats: bus.stats() }).await;
+            }
+            BusRequest::Write { torque, speeds } => {
+                // Sent every period, so a servo that missed a packet (or
+                // browned out) gets it again one period later.
+                if torque {
+                    bus.write_speeds(&speeds).await.ok();
+                    bus.torque_all(true).await.ok();
+                } else {
+                    bus.torque_all(false).await.ok();
+                    bus.stop_all().await.ok();
+                }
+            }
+        }
+    }
+}
+
+/// Frames and sends everything for the host.
+#[embassy_executor::task]
+pub async fn telemetry_tx(mut tx: TelemetryTx) -> ! {
+    let mut encoder = FrameEncoder::new();
+    let mut frame = [0u8; MAX_FRAME_LEN];
+    loop {
+        let out = TO_HOST.receive().await;
+        for _ in 0..out.skipped {
+            encoder.skip();
+        }
+        match encoder.encode(&out.msg, &mut frame) {
+            Ok(bytes) => {
+                if tx.write_all(bytes).await.is_err() {
+                    warn!("telemetry: transmit error");
+                }
+            }
+            Err(e) => warn!("telemetry: cannot encode: {}", e),
+        }
+    }
+}
+
+/// Decodes host commands and hands them to the control loop.
+#[embassy_executor::task]
+pub async fn telemetry_rx(mut rx: TelemetryRx) -> ! {
+    let mut decoder: FrameDecoder<ToChip, 64> = FrameDecoder::new();
+    let mut buf = [0u8; 64];
+    loop {
+        let n = match rx.read(&mut buf).await {
+            Ok(n) => n,
+            Err(_) => {
+                warn!("telemetry: receive error (overrun or framing); resynchronising");
+                continue;
+            }
+        };
+        for result in decoder.feed(&buf[..n]) {
+            match result {
+                Ok(frame) => FROM_HOST.send((frame.seq, frame.msg)).await,
+                Err(e) => warn!("telemetry: bad command frame: {}", e),
+            }
+        }
+    }
+}
+
+/// Feeds the independent watchdog while the control loop is alive.
+#[embassy_executor::task]
+pub async fn watchdog(mut wd: Watchdog, mut led: Led) -> ! {
+    wd.start();
+    let mut beats = 0u32;
+    loop {
+        match WATCHDOG.receive().await {
+            WatchdogRequest::Alive => {
+                wd.feed();
+                beats = beats.wrapping_add(1);
+                // A slow blink: the loop runs.
+                led.set(beats / 16 % 2 == 0);
+            }
+            WatchdogRequest::Extend(long) => {
+                wd.extend(long);
+                WATCHDOG_DONE.signal(());
+            }
+        }
+    }
+}
+
+/// Everything the control loop owns.
+pub struct ControlLoop {
+    /// The controller on the table in CCM.
+    pub ctl: Controller<&'static mut WeightTable>,
+    /// Encoder and foot switches.
+    pub sensors: BoardSensors,
+    /// The checkpoint slots.
+    pub flash: FlashStore,
+    /// The cycle counter.
+    pub cycles: Cycles,
+    /// The CPU clock \[Hz\].
+    pub cpu_hz: u32,
+}
+
+/// A `ReadWeights` in progress: sent a few chunks per period.
+struct WeightsJob {
+    seq: u32,
+    next: u32,
+    end: u32,
+}
+
+/// The control loop at the robot's rate.
+#[embassy_executor::task]
+pub async fn control(mut cl: ControlLoop) -> ! {
+    let period_us = cl.ctl.config().period_us;
+    let mut timing = LoopTiming::new(cl.cpu_hz, period_us);
+    let mut readings = Readings::default();
+    let mut out = PeriodOutput::default();
+    let mut ticker = Ticker::every(Duration::from_micros(period_us as u64));
+    let mut skipped = 0u32;
+    let mut drops = 0u32;
+    let mut weights_job: Option<WeightsJob> = None;
+    let health_every = (1_000_000 / period_us).max(1);
+    let log_every = health_every * 10;
+    let mut period: u32 = 0;
+    info!("control loop: {} at {=u32} us, policy {}", cl.ctl.config().name, period_us, cl.ctl.policy());
+
+    // Sends without waiting; a full queue drops the message (counted, and
+    // visible to the host as a sequence gap).
+    let send = |msg: ToHost, skipped: &mut u32, drops: &mut u32| {
+        match TO_HOST.try_send(Outgoing { msg, skipped: *skipped }) {
+            Ok(()) => *skipped = 0,
+            Err(_) => {
+                *skipped += 1;
+                *drops += 1;
+            }
+        }
+    };
+
+    loop {
+        ticker.next().await;
+        let t0 = cl.cycles.cycles();
+        period = period.wrapping_add(1);
+
+        // Host commands.
+        while let Ok((seq, cmd)) = FROM_HOST.try_receive() {
+            if handle_command(&mut cl, seq, &cmd, &mut weights_job).await {
+                // A flash operation stalled the CPU: restart the schedule
+                // and do not count this period as an overrun.
+                ticker.reset();
+                readings.last_period_overran = false;
+            }
+        }
+
+        // Read.
+        BUS_REQUESTS.send(BusRequest::Read).await;
+        let reply = BUS_REPLIES.receive().await;
+        readings.servos = reply.servos;
+        let bus_stats = reply.stats;
+        readings.encoder = cl.sensors.encoder_count().await;
+        readings.contacts = cl.sensors.contacts().await;
+        readings.time_ms = Instant::now().as_millis() as u32;
+
+        // Decide.
+        let state_before = cl.ctl.state();
+        cl.ctl.period(&readings, &cl.cycles, &mut out);
+
+        // Write.
+        BUS_REQUESTS.send(BusRequest::Write { torque: out.torque, speeds: out.speeds.clone() }).await;
+
+        // Time.
+        let spent = cl.cycles.cycles().wrapping_sub(t0);
+        let overran = timing.period(spent);
+        readings.last_period_overran = overran;
+        if overran {
+            warn!("period {=u32} overran: {=u32} us of {=u32} us", period, timing.last_us, period_us);
+        }
+        if let Some(c) = out.agent_cycles {
+            timing.agent_step(c);
+        }
+
+        // Report.
+        for t in &out.transitions {
+            report_transition(t, &cl.ctl, readings.time_ms).await;
+        }
+        if state_before != cl.ctl.state() && out.transitions.is_empty() {
+            info!("state {} -> {}", state_before, cl.ctl.state());
+        }
+        if let Some(mut step) = out.step.take() {
+            step.loop_us = timing.last_us;
+            send(ToHost::Step(step), &mut skipped, &mut drops);
+        }
+        if let Some(e) = out.episode.take() {
+            info!("episode {=u32} ({}): return {=f32}, {=u32} steps", e.index, e.mode, e.total_reward, e.length);
+            send_reliable(ToHost::Episode(e)).await;
+        }
+        if let Some(job) = weights_job.as_mut() {
+            if send_weights(&cl.ctl, job) {
+                send_reliable(ToHost::Ack(wire::Ack { seq: job.seq })).await;
+                weights_job = None;
+            }
+        }
+        if period % health_every == 0 {
+            let mut health = wire::Health {
+                uptime_ms: readings.time_ms,
+                servo_temps_c: Vec::new(),
+                min_voltage_dv: 0,
+                bus_errors: bus_stats.timeouts + bus_stats.line_errors + bus_stats.stray_packets,
+                checksum_errors: bus_stats.checksum_errors,
+                timeouts: bus_stats.timeouts,
+                trace_drops: 0,
+                weight_saturations: 0,
+                overruns: timing.overruns,
+                max_loop_us: timing.max_us,
+                telemetry_drops: drops,
+            };
+            cl.ctl.health(&mut health);
+            send(ToHost::Health(health), &mut skipped, &mut drops);
+        }
+        if period % log_every == 0 && timing.agent_mean() > 0 {
+            info!(
+                "agent step: mean {=u32} cycles ({=u32} us), min {=u32}, max {=u32}; loop max {=u32} us, {=u32} overruns",
+                timing.agent_mean(),
+                timing.us(timing.agent_mean()),
+                timing.agent_min,
+                timing.agent_max,
+                timing.max_us,
+                timing.overruns
+            );
+        }
+
+        WATCHDOG.send(WatchdogRequest::Alive).await;
+    }
+}
+
+/// Sends up to four chunks of a weights read; true when done.
+fn send_weights(ctl: &Controller<&'static mut WeightTable>, job: &mut WeightsJob) -> bool {
+    let weights = ctl.weights();
+    for _ in 0..4 {
+        if job.next >= job.end {
+            return true;
+        }
+        let end = (job.next + wire::WEIGHTS_PER_CHUNK as u32).min(job.end);
+        let chunk = wire::WeightsChunk {
+            offset: job.next,
+            total: weights.len() as u32,
+            weights: weights[job.next as usize..end as usize].iter().map(|w| w.0).collect(),
+        };
+        if TO_HOST.try_send(Outgoing { msg: ToHost::Weights(chunk), skipped: 0 }).is_err() {
+            // The link is busy: the rest next period.
+            return false;
+        }
+        job.next = end;
+    }
+    job.next >= job.end
+}
+
+async fn report_transition(t: &Transition, ctl: &Controller<&'static mut WeightTable>, time_ms: u32) {
+    let step = ctl.agent_stats().steps as u32;
+    info!("state {} -> {}", t.from, t.to);
+    send_reliable(ToHost::State(wire::StateChange { step, from: t.from, to: t.to })).await;
+    if let Some(cause) = t.entered_fault() {
+        warn!("FAULT: {} — torque off", cause);
+        send_reliable(ToHost::Fault(wire::Fault { step, time_ms, cause })).await;
+    }
+}
+
+/// Carries out one host command; true if it stalled the CPU on flash.
+async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut Option<WeightsJob>) -> bool {
+    let ack = |r: Result<(), NackReason>| match r {
+        Ok(()) => ToHost::Ack(wire::Ack { seq }),
+        Err(reason) => ToHost::Nack(wire::Nack { seq, reason }),
+    };
+    let mut stalled = false;
+    let result = match *cmd {
+        ToChip::Ping => {
+            send_reliable(ToHost::Hello(cl.ctl.hello())).await;
+            Ok(())
+        }
+        ToChip::SaveCheckpoint => {
+            if cl.ctl.torque_enabled() {
+                Err(NackReason::Busy)
+            } else {
+                stalled = true;
+                let hash = cl.ctl.config_hash();
+                let result = with_long_watchdog(|| checkpoint::save(&mut cl.flash, hash, cl.ctl.weights())).await;
+                match result {
+                    Ok(saved) => {
+                        info!("checkpoint saved: generation {=u32}, slot {=u8}", saved.generation, saved.slot);
+                        send_reliable(ToHost::Checkpoint(wire::CheckpointReport::Saved(saved))).await;
+                        Ok(())
+                    }
+                    Err(e) => {
+                        warn!("checkpoint save failed: {}", defmt::Debug2Format(&e));
+                        send_reliable(ToHost::Checkpoint(wire::CheckpointReport::SaveFailed)).await;
+                        Err(NackReason::CheckpointFailed)
+                    }
+                }
+            }
+        }
+        ToChip::LoadCheckpoint => {
+            let hash = cl.ctl.config_hash();
+            match cl.ctl.weights_mut() {
+                None => Err(NackReason::Busy),
+                Some(weights) => match checkpoint::load(&cl.flash, hash, weights) {
+                    Ok(outcome) => {
+                        send_reliable(ToHost::Checkpoint(wire::CheckpointReport::Load(outcome))).await;
+                        match outcome {
+                            LoadOutcome::Loaded { .. } => Ok(()),
+                            _ => Err(NackReason::CheckpointFailed),
+                        }
+                    }
+                    Err(_) => Err(NackReason::CheckpointFailed),
+                },
+            }
+        }
+        ToChip::ReadWeights { offset, count } => {
+            let total = cl.ctl.weights().len() as u32;
+            match offset.checked_add(count) {
+                Some(end) if end <= total => {
+                    // Acknowledged once the last chunk is queued.
+                    *job = Some(WeightsJob { seq, next: offset, end });
+                    return false;
+                }
+                _ => Err(NackReason::OutOfRange),
+            }
+        }
+        _ => {
+            let (result, transition) = cl.ctl.command(cmd);
+            if let Some(t) = transition.filter(|t| t.changed()) {
+                report_transition(&t, &cl.ctl, Instant::now().as_millis() as u32).await;
+            }
+            result
+        }
+    };
+    send_reliable(ack(result)).await;
+    stalled
+}
+
+/// Runs a flash operation with the watchdog's long timeout.
+async fn with_long_watchdog<T>(op: impl FnOnce() -> T) -> T {
+    WATCHDOG_DONE.reset();
+    WATCHDOG.send(WatchdogRequest::Extend(true)).await;
+    WATCHDOG_DONE.wait().await;
+    let result = op();
+    WATCHDOG.send(WatchdogRequest::Extend(false)).await;
+    result
+}
+
+/// Loads the checkpoint at boot and tells the host what happened.
+pub async fn boot_checkpoint(ctl: &mut Controller<&'static mut WeightTable>, flash: &FlashStore) {
+    let hash = ctl.config_hash();
+    let Some(weights) = ctl.weights_mut() else { return };
+    match checkpoint::load(flash, hash, weights) {
+        Ok(outcome @ LoadOutcome::Loaded { generation, slot }) => {
+            info!("checkpoint loaded: generation {=u32} from slot {=u8}", generation, slot);
+            send_reliable(ToHost::Checkpoint(wire::CheckpointReport::Load(outcome))).await;
+        }
+        Ok(LoadOutcome::NoCheckpoint) => info!("no checkpoint in flash; fresh weights"),
+        Ok(outcome) => {
+            warn!("checkpoint ignored: {}", outcome);
+            send_reliable(ToHost::Warning(wire::Warning::CheckpointIgnored(outcome))).await;
+        }
+        Err(e) => warn!("checkpoint unreadable: {}", e),
+    }
+}
