@@ -14,19 +14,15 @@ fn main() {
              got {chips:?}. For a non-default chip use --no-default-features --features <chip>."
         );
     }
-    if chips[0] == "stm32f446" {
-        // Still linked with the F405 layout: the STM32F446RE has only 512 KB
-        // of flash (checkpoint sectors would be 6 and 7 at 0x0804_0000) and
-        // no CCM RAM at 0x1000_0000. Fine for a build check, wrong on a chip.
-        println!(
-            "cargo:warning=stm32f446: linking with the STM32F405 memory.x \
-             (1 MB flash, CCM RAM); the F446RE has 512 KB flash and no CCM, \
-             so this image is a build check only"
-        );
-    }
-
     let manifest_dir = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").unwrap());
-    let memory_x = manifest_dir.join("..").join("memory.x");
+    // The workspace's memory.x describes the STM32F405RG and the F407VG
+    // (same layout); the STM32F446RE (512 KB flash, checkpoint sectors 6
+    // and 7, no CCM RAM) has its own.
+    let memory_x = if chips[0] == "stm32f446" {
+        manifest_dir.join("memory-f446.x")
+    } else {
+        manifest_dir.join("..").join("memory.x")
+    };
     let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());
     let contents = fs::read(&memory_x)
         .unwrap_or_else(|e| panic!("pada-firmware: cannot read {}: {e}", memory_x.display()));

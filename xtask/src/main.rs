@@ -27,9 +27,16 @@ const USAGE: &str = "\
 usage: cargo xtask <task>
 
 tasks:
-  firmware [--release] [--chip f405|f407|f446]
+  firmware [--release] [--chip f405|f407|f446] [--robot pendulum|pendulum-20hz|leo]
         build the firmware ELF for thumbv7em-none-eabihf (debug unless
-        --release; chip f405 unless --chip) and print its flash/RAM use
+        --release; chip f405 unless --chip; the 33 Hz pendulum unless
+        --robot) and print its flash/RAM use
+  flash [--release] [--chip ...] [--robot ...]
+        build as `firmware`, then flash it and show its defmt log through
+        a debug probe (`probe-rs run`)
+  firmware-test
+        run the firmware library's tests on the host (controller, servo-bus
+        transactions, LEO and pendulum observers)
   help  print this message";
 
 /// A microcontroller the firmware can be built for (one cargo feature each).
@@ -59,6 +66,15 @@ impl Chip {
         }
     }
 
+    /// The linker memory layout the firmware's build script uses for this
+    /// chip, relative to the workspace root.
+    pub fn memory_x(self) -> &'static str {
+        match self {
+            Chip::F405 | Chip::F407 => "memory.x",
+            Chip::F446 => "firmware/memory-f446.x",
+        }
+    }
+
     /// The name probe-rs knows the usual package of this chip by.
     pub fn probe_rs_name(self) -> &'static str {
         match self {
@@ -69,10 +85,49 @@ impl Chip {
     }
 }
 
+/// The robot a firmware image drives (one cargo feature each, none for the
+/// default 33 Hz pendulum).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Robot {
+    Pendulum,
+    Pendulum20,
+    Leo,
+}
+
+impl Robot {
+    fn parse(s: &str) -> Option<Robot> {
+        match s.to_ascii_lowercase().as_str() {
+            "pendulum" | "pendulum-33hz" => Some(Robot::Pendulum),
+            "pendulum-20hz" => Some(Robot::Pendulum20),
+            "leo" => Some(Robot::Leo),
+            _ => None,
+        }
+    }
+
+    /// The firmware's cargo feature that selects this robot, if any.
+    pub fn feature(self) -> Option<&'static str> {
+        match self {
+            Robot::Pendulum => None,
+            Robot::Pendulum20 => Some("robot-pendulum-20hz"),
+            Robot::Leo => Some("robot-leo"),
+        }
+    }
+}
+
+/// What to build.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Build {
+    release: bool,
+    chip: Chip,
+    robot: Robot,
+}
+
 #[derive(Debug, PartialEq, Eq)]
 enum Task {
     Help,
-    Firmware { release: bool, chip: Chip },
+    Firmware(Build),
+    Flash(Build),
+    FirmwareTest,
 }
 
 fn parse_args(args: &[String]) -> Result<Task, String> {
@@ -81,31 +136,41 @@ fn parse_args(args: &[String]) -> Result<Task, String> {
     };
     match task.as_str() {
         "help" | "-h" | "--help" => Ok(Task::Help),
-        "firmware" => {
-            let mut release = false;
-            let mut chip = Chip::F405;
+        "firmware" | "flash" => {
+            let mut build = Build { release: false, chip: Chip::F405, robot: Robot::Pendulum };
             let mut rest = rest.iter();
             while let Some(arg) = rest.next() {
-                let chip_value = match arg.as_str() {
+                let (key, value) = match arg.as_str() {
                     "--release" | "-r" => {
-                        release = true;
+                        build.release = true;
                         continue;
                     }
                     "-h" | "--help" => return Ok(Task::Help),
-                    "--chip" => rest
-                        .next()
-                        .ok_or("--chip needs a value: f405, f407 or f446")?,
-                    other => match other.strip_prefix("--chip=") {
-                        Some(v) => v,
-                        None => return Err(format!("unknown argument `{other}` for `firmware`")),
+                    "--chip" => ("--chip", rest.next().ok_or("--chip needs a value: f405, f407 or f446")?.as_str()),
+                    "--robot" => (
+                        "--robot",
+                        rest.next().ok_or("--robot needs a value: pendulum, pendulum-20hz or leo")?.as_str(),
+                    ),
+                    other => match (other.strip_prefix("--chip="), other.strip_prefix("--robot=")) {
+                        (Some(v), _) => ("--chip", v),
+                        (_, Some(v)) => ("--robot", v),
+                        _ => return Err(format!("unknown argument `{other}` for `{task}`")),
                     },
                 };
-                chip = Chip::parse(chip_value).ok_or_else(|| {
-                    format!("unknown chip `{chip_value}`: expected f405, f407 or f446")
-                })?;
+                if key == "--chip" {
+                    build.chip = Chip::parse(value)
+                        .ok_or_else(|| format!("unknown chip `{value}`: expected f405, f407 or f446"))?;
+                } else {
+                    build.robot = Robot::parse(value)
+                        .ok_or_else(|| format!("unknown robot `{value}`: expected pendulum, pendulum-20hz or leo"))?;
+                }
             }
-            Ok(Task::Firmware { release, chip })
+            Ok(if task == "flash" { Task::Flash(build) } else { Task::Firmware(build) })
         }
+        "firmware-test" => match rest.first() {
+            None => Ok(Task::FirmwareTest),
+            Some(other) => Err(format!("unknown argument `{other}` for `firmware-test`")),
+        },
         other => Err(format!("unknown task `{other}`")),
     }
 }
@@ -137,7 +202,9 @@ fn main() -> ExitCode {
             println!("{USAGE}");
             Ok(())
         }
-        Task::Firmware { release, chip } => firmware(&workspace_root(), release, chip),
+        Task::Firmware(build) => firmware(&workspace_root(), build).map(|_| ()),
+        Task::Flash(build) => firmware(&workspace_root(), build).and_then(|elf| flash(&elf, build.chip)),
+        Task::FirmwareTest => firmware_test(&workspace_root()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -148,7 +215,9 @@ fn main() -> ExitCode {
     }
 }
 
-fn firmware(root: &Path, release: bool, chip: Chip) -> Result<(), String> {
+/// Builds the firmware; returns the ELF's path.
+fn firmware(root: &Path, build: Build) -> Result<PathBuf, String> {
+    let Build { release, chip, robot } = build;
     let toolchain = toolchain::detect()?;
     println!("xtask: toolchain: {}", toolchain.describe());
 
@@ -169,13 +238,20 @@ fn firmware(root: &Path, release: bool, chip: Chip) -> Result<(), String> {
     if release {
         cmd.arg("--release");
     }
+    let mut features: Vec<&str> = Vec::new();
     if chip != Chip::F405 {
-        cmd.args(["--no-default-features", "--features", chip.feature()]);
+        cmd.arg("--no-default-features");
+        features.push(chip.feature());
+    }
+    features.extend(robot.feature());
+    if !features.is_empty() {
+        cmd.args(["--features", &features.join(",")]);
     }
 
     println!(
-        "xtask: building pada-firmware ({profile}, {}) for {TARGET}",
-        chip.feature()
+        "xtask: building pada-firmware ({profile}, {}, {}) for {TARGET}",
+        chip.feature(),
+        robot.feature().unwrap_or("robot-pendulum-33hz (default)")
     );
     let started = Instant::now();
     let status = cmd
@@ -198,7 +274,7 @@ fn firmware(root: &Path, release: bool, chip: Chip) -> Result<(), String> {
     })?;
     let sizes = elf::section_sizes(&bytes)
         .map_err(|e| format!("{}: not a usable ELF: {e}", elf_path.display()))?;
-    let regions = std::fs::read_to_string(root.join("memory.x"))
+    let regions = std::fs::read_to_string(root.join(chip.memory_x()))
         .map(|text| elf::parse_memory_x(&text))
         .unwrap_or_default();
     let usage = elf::Usage::classify(&sizes, &regions);
@@ -215,12 +291,58 @@ fn firmware(root: &Path, release: bool, chip: Chip) -> Result<(), String> {
         chip.probe_rs_name(),
         elf_path.display()
     );
-    if chip == Chip::F446 {
-        println!(
-            "xtask: note: linked with the STM32F405 memory.x; the F446RE has 512 KB flash and no CCM"
-        );
+    Ok(elf_path)
+}
+
+/// Flashes `elf` and streams its defmt log (`probe-rs run`), as `cargo run`
+/// does with the runner of `.cargo/config.toml`.
+fn flash(elf: &Path, chip: Chip) -> Result<(), String> {
+    println!("xtask: probe-rs run --chip {} {}", chip.probe_rs_name(), elf.display());
+    let status = std::process::Command::new("probe-rs")
+        .args(["run", "--chip", chip.probe_rs_name()])
+        .arg(elf)
+        .status()
+        .map_err(|e| {
+            format!(
+                "cannot start probe-rs ({e}); install it (`cargo install probe-rs-tools`, \
+                 https://probe.rs) or flash {} with another tool",
+                elf.display()
+            )
+        })?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("probe-rs failed ({status})"))
     }
-    Ok(())
+}
+
+/// Runs the firmware library's tests for the host with the toolchain this
+/// xtask runs with.
+fn firmware_test(root: &Path) -> Result<(), String> {
+    let cargo = env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let host = std::process::Command::new(env::var_os("RUSTC").unwrap_or_else(|| "rustc".into()))
+        .arg("-vV")
+        .output()
+        .ok()
+        .and_then(|o| String::from_utf8(o.stdout).ok())
+        .and_then(|v| v.lines().find_map(|l| l.strip_prefix("host: ").map(str::to_owned)))
+        .ok_or("cannot ask rustc for the host target")?;
+    let mut cmd = std::process::Command::new(&cargo);
+    toolchain::clean_env(&mut cmd, false);
+    cmd.current_dir(root)
+        .arg("test")
+        .arg("--manifest-path")
+        .arg(root.join("firmware").join("Cargo.toml"))
+        .args(["--lib", "--target", &host])
+        .arg("--target-dir")
+        .arg(root.join("target").join("firmware"));
+    println!("xtask: testing the firmware library on {host}");
+    let status = cmd.status().map_err(|e| format!("cannot start cargo: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("firmware library tests failed ({status})"))
+    }
 }
 
 #[cfg(test)]
@@ -235,19 +357,13 @@ mod tests {
     fn firmware_defaults_to_debug_f405() {
         assert_eq!(
             parse_args(&args("firmware")),
-            Ok(Task::Firmware {
-                release: false,
-                chip: Chip::F405
-            })
+            Ok(Task::Firmware(Build { release: false, chip: Chip::F405, robot: Robot::Pendulum }))
         );
     }
 
     #[test]
     fn firmware_flags_in_any_order_and_both_chip_spellings() {
-        let want = Ok(Task::Firmware {
-            release: true,
-            chip: Chip::F446,
-        });
+        let want = Ok(Task::Firmware(Build { release: true, chip: Chip::F446, robot: Robot::Pendulum }));
         assert_eq!(parse_args(&args("firmware --chip f446 --release")), want);
         assert_eq!(
             parse_args(&args("firmware --release --chip=stm32F446")),
@@ -256,9 +372,24 @@ mod tests {
     }
 
     #[test]
+    fn flash_robot_and_firmware_test() {
+        assert_eq!(
+            parse_args(&args("flash --robot leo --release")),
+            Ok(Task::Flash(Build { release: true, chip: Chip::F405, robot: Robot::Leo }))
+        );
+        assert_eq!(
+            parse_args(&args("firmware --robot=pendulum-20hz --chip=f407")),
+            Ok(Task::Firmware(Build { release: false, chip: Chip::F407, robot: Robot::Pendulum20 }))
+        );
+        assert_eq!(parse_args(&args("firmware-test")), Ok(Task::FirmwareTest));
+        assert!(parse_args(&args("firmware-test --release")).is_err());
+        assert!(parse_args(&args("firmware --robot walker")).is_err());
+    }
+
+    #[test]
     fn bad_arguments_are_errors() {
         assert!(parse_args(&args("")).is_err());
-        assert!(parse_args(&args("flash")).is_err());
+        assert!(parse_args(&args("deploy")).is_err());
         assert!(parse_args(&args("firmware --chip")).is_err());
         assert!(parse_args(&args("firmware --chip f103")).is_err());
         assert!(parse_args(&args("firmware --relase")).is_err());
