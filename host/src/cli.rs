@@ -1,0 +1,221 @@
+//! The command line (clap derive) and its dispatch. Every clap error is
+//! turned into one line with exit code 2.
+
+use crate::algo::Algo;
+use crate::commands;
+use crate::error::{usage, CliError};
+use crate::tasks::TaskName;
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use std::ffi::OsString;
+use std::path::PathBuf;
+
+/// pada: reinforcement learning that does not break the robot (Meijdam,
+/// Plooij and Caarls, "Learning while preventing mechanical failure due to
+/// random motions").
+#[derive(Debug, Parser)]
+#[command(name = "pada", version, allow_negative_numbers = true)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Run trials of one algorithm on one task and summarise them.
+    #[command(allow_negative_numbers = true)]
+    Run(RunArgs),
+    /// SARSA(λ) against PADA Δ = 0.5 on the simulated pendulum, next to the
+    /// paper's numbers (about ten seconds on two cores).
+    #[command(allow_negative_numbers = true)]
+    Demo(DemoArgs),
+    /// Reproduce a section of the paper: report.md, tables and figures.
+    #[command(allow_negative_numbers = true)]
+    Paper(PaperArgs),
+    /// Predicted MTBF of a recorded torque log (Eqs. 3–7).
+    #[command(allow_negative_numbers = true)]
+    Mtbf(MtbfArgs),
+}
+
+/// Options shared by the commands that run trials.
+#[derive(Debug, Clone, Args)]
+pub struct TrialOptions {
+    /// Master seed; each trial's seed derives from it.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+}
+
+/// `pada run`.
+#[derive(Debug, Clone, Args)]
+pub struct RunArgs {
+    /// The task.
+    #[arg(long, value_enum, default_value_t = TaskName::Pendulum)]
+    pub task: TaskName,
+    /// The algorithm (Section V).
+    #[arg(long, value_enum)]
+    pub algo: Algo,
+    /// Low-pass α of Eq. 8, 0 < α ≤ 1 (lowpass, markov-lowpass; default 0.834).
+    #[arg(long)]
+    pub alpha: Option<f32>,
+    /// Δ relative to the action range, 0 < Δ ≤ 1 (integrator,
+    /// markov-integrator, pada; default 0.5).
+    #[arg(long)]
+    pub delta: Option<f32>,
+    /// Switch back to SARSA(λ) after this much learning time [s]
+    /// (lowpass, pada; Section VIII).
+    #[arg(long, value_name = "SECONDS")]
+    pub switch_at: Option<f64>,
+    /// Trials (default: the paper's count for the task, 29 or 28).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=10000))]
+    pub trials: Option<u32>,
+    /// Learning time per trial [s of simulated time] (default: the task's).
+    #[arg(long, value_name = "S")]
+    pub seconds: Option<f64>,
+    /// Output directory for summary.json, trials.csv and the learning
+    /// curves (default: pada-out/run-<task>-<algo>).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Print the summary as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub trial: TrialOptions,
+}
+
+/// `pada demo`.
+#[derive(Debug, Clone, Args)]
+pub struct DemoArgs {
+    /// Trials per algorithm.
+    #[arg(long, value_name = "N", default_value_t = 29, value_parser = clap::value_parser!(u32).range(1..=10000))]
+    pub trials: u32,
+    /// Learning time per trial [s].
+    #[arg(long, value_name = "S", default_value_t = 3000.0)]
+    pub seconds: f64,
+    /// Also write both runs' summaries and curves under this directory.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Print both summaries as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub trial: TrialOptions,
+}
+
+/// Which experiment `pada paper` reproduces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum PaperExperiment {
+    /// Section VII: the simulated pendulum sweeps and the physical pendulum.
+    Pendulum,
+}
+
+/// `pada paper`.
+#[derive(Debug, Clone, Args)]
+pub struct PaperArgs {
+    /// The experiment.
+    #[arg(value_enum)]
+    pub experiment: PaperExperiment,
+    /// Output directory for report.md, the figures and the data.
+    #[arg(long, value_name = "DIR", default_value = "pada-out/paper-pendulum")]
+    pub out: PathBuf,
+    /// Trials per configuration (default: the paper's 29 simulated, 28
+    /// physical).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=10000))]
+    pub trials: Option<u32>,
+    /// Learning time per trial on the simulated pendulum [s].
+    #[arg(long, value_name = "S", default_value_t = 3000.0)]
+    pub seconds: f64,
+    /// Learning time per trial on the physical pendulum [s].
+    #[arg(long, value_name = "S", default_value_t = 1500.0)]
+    pub physical_seconds: f64,
+    #[command(flatten)]
+    pub trial: TrialOptions,
+}
+
+/// `pada mtbf`.
+#[derive(Debug, Clone, Args)]
+pub struct MtbfArgs {
+    /// CSV torque log [N·m], one column per joint, one row per control
+    /// step; an optional header row names the joints.
+    #[arg(long, value_name = "FILE.csv")]
+    pub torques: PathBuf,
+    /// Control rate of the log [Hz].
+    #[arg(long, value_name = "HZ", default_value_t = 20.0)]
+    pub rate: f64,
+    /// MTBF window: the first N steps (the paper's 1200 actions).
+    #[arg(long, value_name = "N", default_value_t = 1200, value_parser = clap::value_parser!(u32).range(1..))]
+    pub window: u32,
+    /// Print the result as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Largest learning time accepted per trial [s].
+pub const MAX_SECONDS: f64 = 1.0e6;
+
+/// Checks a learning time given with `flag`.
+pub fn check_seconds(flag: &str, s: f64) -> Result<f64, CliError> {
+    if s.is_finite() && s > 0.0 && s <= MAX_SECONDS {
+        Ok(s)
+    } else {
+        Err(usage(format!("{flag} {s} is out of range: valid is 0 < seconds <= {MAX_SECONDS}")))
+    }
+}
+
+/// Sets the size of rayon's pool, once.
+pub fn set_threads(threads: Option<u32>) -> Result<(), CliError> {
+    if let Some(n) = threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n as usize)
+            .build_global()
+            .map_err(|e| CliError::Runtime(anyhow::anyhow!("cannot start {n} threads: {e}")))?;
+    }
+    Ok(())
+}
+
+/// One line from a clap error: its message and the valid values, without
+/// the usage block.
+fn clap_one_line(e: &clap::Error) -> String {
+    let text = e.render().to_string();
+    let line = text
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && !l.starts_with("Usage:") && !l.starts_with("For more information"))
+        .collect::<Vec<_>>()
+        .join(" ");
+    line.strip_prefix("error: ").unwrap_or(&line).to_string()
+}
+
+/// Parses `args` and runs the command. Help and version requests print and
+/// return `Ok`.
+pub fn run<I, T>(args: I) -> Result<(), CliError>
+where
+    I: IntoIterator<Item = T>,
+    T: Into<OsString> + Clone,
+{
+    let cli = match Cli::try_parse_from(args) {
+        Ok(cli) => cli,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            return match e.kind() {
+                ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
+                    let _ = e.print();
+                    Ok(())
+                }
+                ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => Err(usage(
+                    "no command given: valid commands are run, demo, paper, mtbf (see pada --help)",
+                )),
+                _ => Err(usage(clap_one_line(&e))),
+            };
+        }
+    };
+    match cli.command {
+        Command::Run(a) => commands::run::run(a),
+        Command::Demo(a) => commands::demo::run(a),
+        Command::Paper(a) => commands::paper::run(a),
+        Command::Mtbf(a) => commands::mtbf::run(a),
+    }
+}

@@ -1,0 +1,6 @@
+//! One module per subcommand of `pada`.
+
+pub mod demo;
+pub mod mtbf;
+pub mod paper;
+pub mod run;

@@ -1,0 +1,63 @@
+//! Trials in parallel: every (configuration, trial) pair is one job for
+//! rayon's pool (all cores by default), each with its own seed, so the
+//! results do not depend on scheduling.
+
+use super::trial::{run_trial, TrialResult};
+use crate::task::Task;
+use pada_core::policy::PolicyKind;
+use rayon::prelude::*;
+
+/// What to run: one algorithm with its parameter, for a number of trials.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RunConfig {
+    /// The algorithm and its α or Δ.
+    pub policy: PolicyKind,
+    /// Learning time after which PADA or the low-pass filter switches back
+    /// to SARSA(λ) (Section VIII) \[s\], if any.
+    pub switch_at_s: Option<f64>,
+    /// Learning time per trial \[s of simulated time\].
+    pub seconds: f64,
+    /// Number of trials.
+    pub trials: u32,
+    /// Master seed; trial seeds derive from it ([`crate::seed`]).
+    pub seed: u64,
+}
+
+impl RunConfig {
+    /// Environment steps one trial takes, learning and test runs (an
+    /// estimate for progress bars: exact when no episode ends early).
+    pub fn expected_steps(&self, period_s: f64, episode_steps: u32, test_interval: u32) -> u64 {
+        let learning = (self.seconds / period_s).round() as u64;
+        let episodes = learning.div_ceil(episode_steps as u64);
+        let tests = 1 + episodes.div_ceil(test_interval as u64);
+        (episodes + tests) * episode_steps as u64
+    }
+}
+
+/// Runs the trials of `cfg` in parallel; results in trial order.
+pub fn run_trials<T: Task>(
+    task: &T,
+    cfg: &RunConfig,
+    progress: &(dyn Fn(u64) + Sync),
+) -> anyhow::Result<Vec<TrialResult>> {
+    Ok(run_configs(task, std::slice::from_ref(cfg), progress)?.remove(0))
+}
+
+/// Runs every configuration's trials as one pool of jobs (good load
+/// balance across configurations); results per configuration, in trial
+/// order. The first error stops the run.
+pub fn run_configs<T: Task>(
+    task: &T,
+    cfgs: &[RunConfig],
+    progress: &(dyn Fn(u64) + Sync),
+) -> anyhow::Result<Vec<Vec<TrialResult>>> {
+    let jobs: Vec<(usize, u32)> =
+        cfgs.iter().enumerate().flat_map(|(c, cfg)| (0..cfg.trials).map(move |t| (c, t))).collect();
+    let results: Vec<TrialResult> =
+        jobs.par_iter().map(|&(c, t)| run_trial(task, &cfgs[c], t, progress)).collect::<anyhow::Result<_>>()?;
+    let mut out: Vec<Vec<TrialResult>> = cfgs.iter().map(|c| Vec::with_capacity(c.trials as usize)).collect();
+    for (&(c, _), r) in jobs.iter().zip(results) {
+        out[c].push(r);
+    }
+    Ok(out)
+}

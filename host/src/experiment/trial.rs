@@ -1,0 +1,199 @@
+//! One trial (Section VI): learning for a given simulated time, with a
+//! greedy test run before learning and after every
+//! [`TaskSpec::test_interval`](crate::task::TaskSpec) learning episodes.
+//!
+//! - The learning curve is the test-run return against learning time (the
+//!   simulated time of learning episodes only; test runs do not count).
+//! - End performance and rise time follow from it ([`super::metrics`]).
+//! - The predicted MTBF is the fatigue counter's windowed MTBF over the
+//!   first [`PAPER_WINDOW_STEPS`] learning actions (end of Section IV),
+//!   from the torques the plant applies to its gearboxes (Eqs. 3–7); the
+//!   robot's MTBF is its weakest joint's.
+
+use super::agent_setup::{build_agent, HostAgent};
+use super::metrics::{end_performance, rise_time};
+use super::runner::RunConfig;
+use crate::seed::{trial_rng, trial_seed};
+use crate::task::{Plant, Task, TaskSpec};
+use anyhow::anyhow;
+use pada_core::action_space::MAX_ACTION_DIMS;
+use pada_core::agent::{Decision, EpisodeEnd, Mode};
+use pada_core::fatigue::{FatigueCounter, GearboxParams, PAPER_WINDOW_STEPS};
+use pada_core::tile_coding::MAX_STATE_DIMS;
+use rand_pcg::Pcg64;
+use serde::Serialize;
+
+/// One point of a learning curve.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TestPoint {
+    /// Learning time before this test run \[s of simulated time\].
+    pub learning_time_s: f64,
+    /// Learning episodes before this test run.
+    pub learning_episodes: u32,
+    /// Sum of the rewards of the greedy test run.
+    pub test_return: f64,
+}
+
+/// Everything measured in one trial.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TrialResult {
+    /// Trial index within the run.
+    pub trial: u32,
+    /// The trial's seed (derived from the master seed).
+    pub seed: u64,
+    /// End performance: mean return of the last 10% of test runs.
+    pub end_performance: f64,
+    /// Rise time \[s of learning time\].
+    pub rise_time_s: f64,
+    /// Predicted MTBF from the first 1200 learning actions \[s\]
+    /// (infinite when nothing re-engaged).
+    pub mtbf_s: f64,
+    /// Backlash re-engagements within those actions (all joints).
+    pub window_reengagements: u64,
+    /// Learning steps taken.
+    pub learning_steps: u64,
+    /// Test-run steps taken.
+    pub test_steps: u64,
+    /// Weight writes that saturated the fixed-point range (should be 0).
+    pub saturations: u32,
+    /// Trace entries dropped for capacity (should be 0).
+    pub trace_drops: u32,
+    /// The learning curve.
+    #[serde(skip)]
+    pub curve: Vec<TestPoint>,
+}
+
+/// Runs trial `trial` of `cfg` on `task`. `progress` is told the number of
+/// environment steps after every episode.
+pub fn run_trial<T: Task>(
+    task: &T,
+    cfg: &RunConfig,
+    trial: u32,
+    progress: &(dyn Fn(u64) + Sync),
+) -> anyhow::Result<TrialResult> {
+    let spec = task.spec();
+    let mut rng = trial_rng(cfg.seed, trial);
+    let mut agent = build_agent(spec, cfg.policy)?;
+    agent.reset_weights(&mut rng);
+    let fatigue = FatigueCounter::new(GearboxParams::TABLE_I, spec.control_period_s, Some(PAPER_WINDOW_STEPS))
+        .map_err(|e| anyhow!("{e}"))?;
+    let mut t = Trial {
+        spec,
+        agent,
+        plant: task.plant(),
+        rng,
+        fatigue,
+        obs: [0.0; MAX_STATE_DIMS],
+        switch_step: cfg.switch_at_s.map(|s| (s / spec.control_period_s).round() as u64),
+        learning_steps: 0,
+        test_steps: 0,
+        episodes: 0,
+        curve: Vec::new(),
+    };
+
+    let budget = (cfg.seconds / spec.control_period_s).round() as u64;
+    t.test_run()?;
+    while t.learning_steps < budget {
+        let mut done = t.episode(true)?.1 as u64;
+        t.episodes += 1;
+        if t.episodes % spec.test_interval == 0 || t.learning_steps >= budget {
+            done += t.test_run()?;
+        }
+        progress(done);
+    }
+
+    let times: Vec<f64> = t.curve.iter().map(|p| p.learning_time_s).collect();
+    let returns: Vec<f64> = t.curve.iter().map(|p| p.test_return).collect();
+    let stats = t.agent.stats();
+    Ok(TrialResult {
+        trial,
+        seed: trial_seed(cfg.seed, trial),
+        end_performance: end_performance(&returns).unwrap_or(f64::NAN),
+        rise_time_s: rise_time(&times, &returns).unwrap_or(f64::NAN),
+        mtbf_s: t.fatigue.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
+        window_reengagements: t.fatigue.joints().iter().filter_map(|j| j.window_reengagements()).sum(),
+        learning_steps: t.learning_steps,
+        test_steps: t.test_steps,
+        saturations: stats.saturations,
+        trace_drops: stats.trace_drops,
+        curve: t.curve,
+    })
+}
+
+/// The state of a running trial.
+struct Trial<'a, P: Plant> {
+    spec: &'a TaskSpec,
+    agent: HostAgent,
+    plant: P,
+    rng: Pcg64,
+    fatigue: FatigueCounter<MAX_ACTION_DIMS>,
+    obs: [f32; MAX_STATE_DIMS],
+    /// Learning step at which the policy switches back to SARSA(λ).
+    switch_step: Option<u64>,
+    learning_steps: u64,
+    test_steps: u64,
+    episodes: u32,
+    curve: Vec<TestPoint>,
+}
+
+impl<P: Plant> Trial<'_, P> {
+    /// A greedy test run, recorded on the curve; returns its steps.
+    fn test_run(&mut self) -> anyhow::Result<u64> {
+        self.agent.set_mode(Mode::Testing);
+        let result = self.episode(false);
+        self.agent.set_mode(Mode::Learning);
+        let (ret, steps) = result?;
+        self.curve.push(TestPoint {
+            learning_time_s: self.learning_steps as f64 * self.spec.control_period_s,
+            learning_episodes: self.episodes,
+            test_return: ret,
+        });
+        self.test_steps += steps as u64;
+        Ok(steps as u64)
+    }
+
+    /// Switches to SARSA(λ) once the learning steps reach the switch point.
+    fn maybe_switch(&mut self) -> anyhow::Result<()> {
+        if self.switch_step.is_some_and(|s| self.learning_steps >= s) {
+            self.agent.switch_to_sarsa().map_err(|e| anyhow!("{e}"))?;
+            self.switch_step = None;
+        }
+        Ok(())
+    }
+
+    /// One episode to the time limit or an absorbing state; returns the
+    /// undiscounted return and the steps. A learning episode counts its
+    /// steps and applied torques.
+    fn episode(&mut self, learning: bool) -> anyhow::Result<(f64, u32)> {
+        let spec = self.spec;
+        let (n, motors) = (spec.state.len(), spec.motor.dims());
+        let bad = |e: pada_core::error::StepError| anyhow!("{}: {e}", spec.name);
+        if learning {
+            self.maybe_switch()?;
+        }
+        self.plant.reset(&mut self.rng, &mut self.obs[..n]);
+        let mut d: Decision = self.agent.start_episode(&self.obs[..n], &mut self.rng).map_err(bad)?;
+        let mut ret = 0.0f64;
+        for k in 1..=spec.episode_steps {
+            let command = &d.output[..motors];
+            if learning {
+                self.fatigue.update(&self.plant.gearbox_torques(command)).map_err(|e| anyhow!("{e}"))?;
+                self.learning_steps += 1;
+            }
+            let step = self.plant.step(command, &mut self.obs[..n]);
+            ret += step.reward as f64;
+            let obs = &self.obs[..n];
+            if step.terminal || k == spec.episode_steps {
+                let end = if step.terminal { EpisodeEnd::Absorbing } else { EpisodeEnd::Timeout(obs) };
+                self.agent.end_episode(step.reward, end, &mut self.rng).map_err(bad)?;
+                return Ok((ret, k));
+            }
+            if learning {
+                self.maybe_switch()?;
+            }
+            let obs = &self.obs[..n];
+            d = self.agent.step(step.reward, obs, &mut self.rng).map_err(bad)?;
+        }
+        Ok((ret, spec.episode_steps))
+    }
+}

@@ -1,0 +1,186 @@
+//! Section VII from one call: the SARSA(λ) baseline and the sweeps of α
+//! (low-pass, Markov low-pass) and Δ (integrator, Markov integrator, PADA)
+//! on the simulated pendulum, the objective check, and SARSA(λ), low-pass
+//! α = 0.834 and PADA Δ = 0.5 on the physical pendulum's model.
+//!
+//! Sweep values (the paper plots its sweeps without listing the values):
+//! α ∈ {0.1, 0.25, 0.5, 0.7, 0.834, 0.9}; integrator Δ ∈ {0.05, 0.1, 0.2,
+//! 0.3, 0.5}; PADA Δ = 0.5. With three torque levels 1.5 N·m apart
+//! (range 3 N·m), PADA's Δ < 0.5 would leave only the current torque
+//! (the motor would never leave rest) and Δ = 1 allows every level, which
+//! is SARSA(λ) itself, bit for bit (a test checks it): Δ = 0.5 is the only
+//! value that restricts.
+
+use crate::algo::{algo_of, Algo};
+use crate::experiment::{run_configs, RunConfig, TrialResult};
+use crate::paper::objective::{Objective, Verdict};
+use crate::pendulum::{PhysicalPendulumTask, SimulatedPendulumTask};
+use crate::stats::Estimate;
+use crate::summary::RunSummary;
+use crate::task::Task;
+use pada_core::policy::PolicyKind;
+use serde::Serialize;
+
+/// Low-pass α values of the sweep.
+pub const LOWPASS_ALPHAS: [f32; 6] = [0.1, 0.25, 0.5, 0.7, 0.834, 0.9];
+/// Integrator Δ values of the sweep.
+pub const INTEGRATOR_DELTAS: [f32; 5] = [0.05, 0.1, 0.2, 0.3, 0.5];
+/// PADA Δ values of the sweep.
+pub const PADA_DELTAS: [f32; 1] = [0.5];
+
+/// How to run the experiments.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PendulumOptions {
+    /// Trials per configuration on the simulated pendulum (paper: 29).
+    pub sim_trials: u32,
+    /// Trials per configuration on the physical pendulum (paper: 28).
+    pub phys_trials: u32,
+    /// Learning time per simulated-pendulum trial \[s\].
+    pub sim_seconds: f64,
+    /// Learning time per physical-pendulum trial \[s\].
+    pub phys_seconds: f64,
+    /// Master seed.
+    pub seed: u64,
+}
+
+/// One point of a mean learning curve.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct CurvePoint {
+    /// Mean learning time of the test run \[s\].
+    pub learning_time_s: f64,
+    /// Mean test return over trials.
+    pub mean: f64,
+    /// 95% half-width over trials.
+    pub ci95: f64,
+}
+
+/// The result of one configuration.
+#[derive(Debug, Clone, Serialize)]
+pub struct ConfigResult {
+    /// The policy and its parameter.
+    #[serde(skip)]
+    pub policy: PolicyKind,
+    /// Its summary (per-configuration wall time is not measured: trials of
+    /// all configurations share the pool).
+    pub summary: RunSummary,
+    /// The mean learning curve.
+    #[serde(skip)]
+    pub curve: Vec<CurvePoint>,
+}
+
+impl ConfigResult {
+    /// The algorithm.
+    pub fn algo(&self) -> Algo {
+        algo_of(&self.policy)
+    }
+}
+
+/// Everything `pada paper pendulum` measured.
+#[derive(Debug, Clone, Serialize)]
+pub struct PendulumResults {
+    /// The options used.
+    #[serde(skip)]
+    pub options: PendulumOptions,
+    /// Simulated pendulum, SARSA(λ) first, then the sweeps.
+    pub simulated: Vec<ConfigResult>,
+    /// The objective derived from the simulated SARSA(λ).
+    pub objective: Objective,
+    /// Verdicts, parallel to `simulated`.
+    pub verdicts: Vec<Verdict>,
+    /// Physical pendulum: SARSA(λ), low-pass α = 0.834, PADA Δ = 0.5.
+    pub physical: Vec<ConfigResult>,
+    /// Wall-clock time of everything \[s\].
+    pub wall_s: f64,
+    /// Environment steps of everything.
+    pub env_steps: u64,
+    /// Worker threads.
+    pub threads: usize,
+}
+
+/// The simulated-pendulum configurations, SARSA(λ) first.
+pub fn simulated_policies() -> Vec<PolicyKind> {
+    let mut p = vec![PolicyKind::Sarsa];
+    p.extend(LOWPASS_ALPHAS.iter().map(|&alpha| PolicyKind::LowPass { alpha }));
+    p.extend(LOWPASS_ALPHAS.iter().map(|&alpha| PolicyKind::MarkovLowPass { alpha }));
+    p.extend(INTEGRATOR_DELTAS.iter().map(|&delta| PolicyKind::Integrator { delta }));
+    p.extend(INTEGRATOR_DELTAS.iter().map(|&delta| PolicyKind::MarkovIntegrator { delta }));
+    p.extend(PADA_DELTAS.iter().map(|&delta| PolicyKind::Pada { delta }));
+    p
+}
+
+/// The physical-pendulum configurations of the paper's experiment.
+pub fn physical_policies() -> Vec<PolicyKind> {
+    vec![PolicyKind::Sarsa, PolicyKind::LowPass { alpha: 0.834 }, PolicyKind::Pada { delta: 0.5 }]
+}
+
+/// Environment steps the whole experiment takes (for a progress bar).
+pub fn expected_steps(o: &PendulumOptions) -> u64 {
+    fn steps<T: Task>(task: &T, configs: usize, trials: u32, seconds: f64) -> u64 {
+        let s = task.spec();
+        let cfg = RunConfig { policy: PolicyKind::Sarsa, switch_at_s: None, seconds, trials, seed: 0 };
+        configs as u64 * trials as u64 * cfg.expected_steps(s.control_period_s, s.episode_steps, s.test_interval)
+    }
+    steps(&SimulatedPendulumTask::default(), simulated_policies().len(), o.sim_trials, o.sim_seconds)
+        + steps(&PhysicalPendulumTask::default(), physical_policies().len(), o.phys_trials, o.phys_seconds)
+}
+
+/// Runs the whole of Section VII.
+pub fn run(o: &PendulumOptions, progress: &(dyn Fn(u64) + Sync)) -> anyhow::Result<PendulumResults> {
+    let start = std::time::Instant::now();
+    let simulated = run_task(&SimulatedPendulumTask::default(), &simulated_policies(), o.sim_trials, o.sim_seconds, o.seed, progress)?;
+    let physical = run_task(&PhysicalPendulumTask::default(), &physical_policies(), o.phys_trials, o.phys_seconds, o.seed, progress)?;
+    let wall_s = start.elapsed().as_secs_f64();
+    let sarsa = &simulated[0].summary;
+    let objective = Objective::from_sarsa(&sarsa.end_performance, &sarsa.rise_time_s, &sarsa.mtbf_s);
+    let verdicts = simulated
+        .iter()
+        .map(|c| objective.judge(&c.summary.end_performance, &c.summary.rise_time_s, &c.summary.mtbf_s))
+        .collect();
+    let env_steps = simulated.iter().chain(&physical).map(|c| c.summary.env_steps).sum();
+    Ok(PendulumResults {
+        options: *o,
+        simulated,
+        objective,
+        verdicts,
+        physical,
+        wall_s,
+        env_steps,
+        threads: rayon::current_num_threads(),
+    })
+}
+
+fn run_task<T: Task>(
+    task: &T,
+    policies: &[PolicyKind],
+    trials: u32,
+    seconds: f64,
+    seed: u64,
+    progress: &(dyn Fn(u64) + Sync),
+) -> anyhow::Result<Vec<ConfigResult>> {
+    let cfgs: Vec<RunConfig> =
+        policies.iter().map(|&policy| RunConfig { policy, switch_at_s: None, seconds, trials, seed }).collect();
+    let results = run_configs(task, &cfgs, progress)?;
+    Ok(cfgs
+        .iter()
+        .zip(results)
+        .map(|(cfg, r)| ConfigResult {
+            policy: cfg.policy,
+            summary: RunSummary::new(task.spec(), cfg, &r, f64::NAN),
+            curve: mean_curve(&r),
+        })
+        .collect())
+}
+
+/// The mean learning curve over trials, test run by test run (up to the
+/// shortest trial's curve).
+pub fn mean_curve(results: &[TrialResult]) -> Vec<CurvePoint> {
+    let len = results.iter().map(|r| r.curve.len()).min().unwrap_or(0);
+    (0..len)
+        .map(|k| {
+            let returns: Vec<f64> = results.iter().map(|r| r.curve[k].test_return).collect();
+            let e = Estimate::of(&returns);
+            let t = results.iter().map(|r| r.curve[k].learning_time_s).sum::<f64>() / results.len() as f64;
+            CurvePoint { learning_time_s: t, mean: e.mean, ci95: e.ci95 }
+        })
+        .collect()
+}

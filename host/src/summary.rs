@@ -1,0 +1,186 @@
+//! The summary of a run (`summary.json`) and the per-trial CSV files.
+
+use crate::algo::{algo_of, parameter_of, Algo};
+use crate::experiment::{RunConfig, TrialResult, TILINGS, TRACE};
+use crate::stats::Estimate;
+use crate::task::TaskSpec;
+use pada_core::agent::WeightInit;
+use pada_core::fatigue::PAPER_WINDOW_STEPS;
+use serde::Serialize;
+
+/// Everything that defines a run besides the algorithm's name.
+#[derive(Debug, Clone, Serialize)]
+pub struct Parameters {
+    /// Low-pass α (Eq. 8), for the low-pass algorithms.
+    pub alpha: Option<f32>,
+    /// Δ relative to the action range (Eq. 9), for the integrators and PADA.
+    pub delta: Option<f32>,
+    /// Learning time of the switch back to SARSA(λ) \[s\], if any.
+    pub switch_at_s: Option<f64>,
+    /// Learning time per trial \[s\].
+    pub seconds: f64,
+    /// Master seed.
+    pub seed: u64,
+    /// Control period \[s\].
+    pub control_period_s: f64,
+    /// Episode length \[s\].
+    pub episode_s: f64,
+    /// Learning episodes between greedy test runs.
+    pub test_interval_episodes: u32,
+    /// SARSA learning rate α.
+    pub learning_rate: f32,
+    /// Discount γ per step.
+    pub gamma: f32,
+    /// Trace decay λ per step.
+    pub lambda: f32,
+    /// Exploration rate ε.
+    pub epsilon: f32,
+    /// Initial weights.
+    pub weight_init: String,
+    /// Tilings.
+    pub tilings: usize,
+    /// Trace capacity \[entries\].
+    pub trace_capacity: usize,
+    /// Learning actions counted for the MTBF.
+    pub mtbf_window_actions: u32,
+    /// How gearbox torques are obtained.
+    pub gearbox_torque: String,
+}
+
+/// The summary of one run of one algorithm.
+#[derive(Debug, Clone, Serialize)]
+pub struct RunSummary {
+    /// Task name.
+    pub task: String,
+    /// Algorithm name.
+    pub algo: Algo,
+    /// Parameters.
+    pub parameters: Parameters,
+    /// Number of trials.
+    pub trials: u32,
+    /// End performance over trials (Section VI).
+    pub end_performance: Estimate,
+    /// Rise time over trials \[s\] (Section VI).
+    pub rise_time_s: Estimate,
+    /// Predicted MTBF from the first 1200 actions \[s\] (Eqs. 3–7).
+    pub mtbf_s: Estimate,
+    /// Backlash re-engagements within those actions.
+    pub window_reengagements: Estimate,
+    /// Wall-clock time of the run \[s\].
+    pub wall_s: f64,
+    /// Environment steps (learning and test runs, all trials).
+    pub env_steps: u64,
+    /// Environment steps per wall-clock second, all threads together.
+    pub env_steps_per_s: f64,
+    /// Worker threads.
+    pub threads: usize,
+    /// Per-trial results.
+    pub per_trial: Vec<TrialResult>,
+}
+
+impl RunSummary {
+    /// Summarises `results` of `cfg` on a task with `spec`.
+    pub fn new(spec: &TaskSpec, cfg: &RunConfig, results: &[TrialResult], wall_s: f64) -> RunSummary {
+        let algo = algo_of(&cfg.policy);
+        let p = parameter_of(&cfg.policy);
+        let col = |f: fn(&TrialResult) -> f64| results.iter().map(f).collect::<Vec<_>>();
+        let env_steps: u64 = results.iter().map(|r| r.learning_steps + r.test_steps).sum();
+        RunSummary {
+            task: spec.name.to_string(),
+            algo,
+            parameters: Parameters {
+                alpha: if algo.takes_alpha() { p } else { None },
+                delta: if algo.takes_delta() { p } else { None },
+                switch_at_s: cfg.switch_at_s,
+                seconds: cfg.seconds,
+                seed: cfg.seed,
+                control_period_s: spec.control_period_s,
+                episode_s: spec.episode_steps as f64 * spec.control_period_s,
+                test_interval_episodes: spec.test_interval,
+                learning_rate: spec.params.alpha,
+                gamma: spec.params.gamma,
+                lambda: spec.params.lambda,
+                epsilon: spec.params.epsilon,
+                weight_init: match spec.params.init {
+                    WeightInit::Constant(c) => format!("constant {c}"),
+                    WeightInit::Uniform { min, max } => format!("uniform [{min}, {max}]"),
+                },
+                tilings: TILINGS,
+                trace_capacity: TRACE,
+                mtbf_window_actions: PAPER_WINDOW_STEPS,
+                gearbox_torque: spec.torque_note.to_string(),
+            },
+            trials: cfg.trials,
+            end_performance: Estimate::of(&col(|r| r.end_performance)),
+            rise_time_s: Estimate::of(&col(|r| r.rise_time_s)),
+            mtbf_s: Estimate::of(&col(|r| r.mtbf_s)),
+            window_reengagements: Estimate::of(&col(|r| r.window_reengagements as f64)),
+            wall_s,
+            env_steps,
+            env_steps_per_s: if wall_s > 0.0 { env_steps as f64 / wall_s } else { f64::NAN },
+            threads: rayon::current_num_threads(),
+            per_trial: results.to_vec(),
+        }
+    }
+
+    /// The summary as pretty JSON (non-finite numbers become `null`).
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
+    }
+}
+
+/// A trial's learning curve as CSV: `test_run,learning_time_s,learning_episodes,return`.
+pub fn curve_csv(result: &TrialResult) -> anyhow::Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(["test_run", "learning_time_s", "learning_episodes", "return"])?;
+    for (i, p) in result.curve.iter().enumerate() {
+        w.write_record([
+            i.to_string(),
+            format!("{}", p.learning_time_s),
+            p.learning_episodes.to_string(),
+            format!("{}", p.test_return),
+        ])?;
+    }
+    Ok(w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?)
+}
+
+/// One row per trial: `trial,seed,end_performance,rise_time_s,mtbf_s,window_reengagements,learning_steps,test_steps`.
+pub fn trials_csv(results: &[TrialResult]) -> anyhow::Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record([
+        "trial",
+        "seed",
+        "end_performance",
+        "rise_time_s",
+        "mtbf_s",
+        "window_reengagements",
+        "learning_steps",
+        "test_steps",
+    ])?;
+    for r in results {
+        w.write_record([
+            r.trial.to_string(),
+            r.seed.to_string(),
+            format!("{}", r.end_performance),
+            format!("{}", r.rise_time_s),
+            format!("{}", r.mtbf_s),
+            r.window_reengagements.to_string(),
+            r.learning_steps.to_string(),
+            r.test_steps.to_string(),
+        ])?;
+    }
+    Ok(w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?)
+}
+
+/// The files of a run: `summary.json`, `trials.csv` and
+/// `trial-NNN.csv` learning curves.
+pub fn run_files(summary: &RunSummary) -> anyhow::Result<Vec<(String, Vec<u8>)>> {
+    let mut files = vec![
+        ("summary.json".to_string(), (summary.to_json() + "\n").into_bytes()),
+        ("trials.csv".to_string(), trials_csv(&summary.per_trial)?),
+    ];
+    for r in &summary.per_trial {
+        files.push((format!("trial-{:03}.csv", r.trial), curve_csv(r)?));
+    }
+    Ok(files)
+}

@@ -1,0 +1,99 @@
+//! What the experiment runner needs from a learning task: a [`Task`]
+//! describes the problem (state, motor, timing, learning parameters) and
+//! builds [`Plant`]s, the simulated systems the agent drives.
+//!
+//! The pendulums of Section VII implement these traits in
+//! [`crate::pendulum`]; a further task (LEO, Section VIII) implements the
+//! same two traits and is run by the same [`crate::experiment`] code.
+
+use pada_core::action_space::{ActionSpace, Output};
+use pada_core::agent::SarsaParams;
+use pada_core::tile_coding::StateDim;
+use rand_core::RngCore;
+
+/// The result of one control period.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Step {
+    /// The reward earned by the command just applied.
+    pub reward: f32,
+    /// Whether the plant reached an absorbing state (a fall): the episode
+    /// ends without bootstrapping.
+    pub terminal: bool,
+}
+
+/// A simulated system driven at a fixed control period.
+///
+/// Observations are written into caller-provided buffers of
+/// [`TaskSpec::state`]`.len()` values, so a step allocates nothing.
+pub trait Plant: Send {
+    /// Puts the plant in the start state of an episode and writes the first
+    /// observation. `rng` is for tasks with random starts.
+    fn reset(&mut self, rng: &mut dyn RngCore, obs: &mut [f32]);
+
+    /// Applies `command` (one value per motor of [`TaskSpec::motor`], after
+    /// the policy) for one control period, writes the next observation and
+    /// returns the reward and whether the state is absorbing.
+    fn step(&mut self, command: &[f32], obs: &mut [f32]) -> Step;
+
+    /// The torque on each gearbox \[N·m\] while `command` is applied, for
+    /// the fatigue counter (Eqs. 3–7). Unused joints are 0.
+    fn gearbox_torques(&self, command: &[f32]) -> Output;
+}
+
+/// The weight table of a task's agents.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WeightTable {
+    /// One weight per (tiling, tile, action), sized to fit exactly: no
+    /// collisions, and small enough for the cache on low-dimensional tasks.
+    Exact,
+    /// A hashed table of `2^log2_size` weights (collisions allowed), for
+    /// tasks with many state dimensions.
+    Hashed {
+        /// Base-2 logarithm of the table size.
+        log2_size: u32,
+    },
+}
+
+/// The fixed description of a task.
+#[derive(Debug, Clone)]
+pub struct TaskSpec {
+    /// The task's name as the command line spells it.
+    pub name: &'static str,
+    /// A one-line description for reports.
+    pub title: &'static str,
+    /// Seconds per control step (1/sampling rate).
+    pub control_period_s: f64,
+    /// Control steps of an episode before the time limit (a non-absorbing
+    /// end).
+    pub episode_steps: u32,
+    /// The observed state, with ranges and tile widths.
+    pub state: Vec<StateDim>,
+    /// The motor's discrete levels (torques or voltages).
+    pub motor: ActionSpace,
+    /// How the weight table is laid out.
+    pub table: WeightTable,
+    /// SARSA(λ) parameters shared by all six algorithms.
+    pub params: SarsaParams,
+    /// One greedy test episode after this many learning episodes
+    /// (Section VI's test runs).
+    pub test_interval: u32,
+    /// Default learning time of a trial \[s of simulated time\].
+    pub default_seconds: f64,
+    /// Default number of trials (the paper's count for this task).
+    pub default_trials: u32,
+    /// How [`Plant::gearbox_torques`] is obtained from the command, for
+    /// reports.
+    pub torque_note: &'static str,
+}
+
+/// A learning task: its description and a factory of plants.
+pub trait Task: Sync {
+    /// The plant type.
+    type Plant: Plant;
+
+    /// The task's description.
+    fn spec(&self) -> &TaskSpec;
+
+    /// A new plant (one per trial; trials run in parallel).
+    fn plant(&self) -> Self::Plant;
+}
