@@ -20,7 +20,6 @@ use pada_core::policy::PolicyKind;
 use pada_core::wire::{self, ToHost};
 use pada_firmware::config::{Robot, WeightTable, DEFAULT_SEED, WEIGHTS};
 use pada_firmware::control::Controller;
-use {defmt_rtt as _, panic_probe as _};
 
 /// The robot this image drives (cargo features `robot-leo`,
 /// `robot-pendulum-20hz`; the 33 Hz pendulum otherwise).

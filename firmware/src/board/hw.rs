@@ -17,6 +17,10 @@ use embassy_time::{with_deadline, Instant};
 use pada_core::checkpoint::CheckpointStore;
 use pada_firmware::io::{self, PortError};
 use static_cell::StaticCell;
+// defmt over RTT (probe-rs shows it), and panics printed there before the
+// core halts; the watchdog then resets the chip. An emulated board picks
+// its own (semihosting).
+use {defmt_rtt as _, panic_probe as _};
 
 bind_interrupts!(struct Irqs {
     USART1 => usart::InterruptHandler<peripherals::USART1>;
