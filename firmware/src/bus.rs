@@ -49,7 +49,7 @@ pub struct BusStats {
     pub requests: u32,
     /// Status packets received from the servo asked.
     pub replies: u32,
-    /// Attempts without a valid answer before the deadline.
+    /// Attempts without an answer before the deadline.
     pub timeouts: u32,
     /// Status packets with a bad checksum.
     pub checksum_errors: u32,
@@ -286,6 +286,7 @@ impl<P: BusPort> ServoBus<P> {
                 }
             };
             let mut found = None;
+            let mut corrupted = false;
             for result in self.decoder.feed(&self.rx[..got]) {
                 match result {
                     Ok(status) => {
@@ -295,6 +296,7 @@ impl<P: BusPort> ServoBus<P> {
                     Err(DecodeError::BadChecksum { .. }) => {
                         self.stats.checksum_errors = self.stats.checksum_errors.wrapping_add(1);
                         *checksum_errors = checksum_errors.saturating_add(1);
+                        corrupted = true;
                     }
                     Err(DecodeError::UnexpectedId { .. } | DecodeError::BadLength { .. }) => {
                         self.stats.stray_packets = self.stats.stray_packets.wrapping_add(1);
@@ -304,6 +306,11 @@ impl<P: BusPort> ServoBus<P> {
             if found.is_some() {
                 self.stats.replies = self.stats.replies.wrapping_add(1);
                 return found;
+            }
+            if corrupted {
+                // The answer came and was damaged: no point waiting for the
+                // deadline, the next attempt asks again.
+                return None;
             }
         }
         self.stats.timeouts = self.stats.timeouts.wrapping_add(1);
@@ -484,7 +491,10 @@ pub(crate) mod tests {
         assert_eq!(ex.timeouts, 1);
 
         bus.port_mut().corrupt_next = 1;
+        let before = bus.port_mut().now;
         let (state, ex) = block_on(bus.read_present(1));
+        // A damaged answer is retried at once, without waiting for the deadline.
+        assert!(bus.port_mut().now - before < 1000, "{}", bus.port_mut().now - before);
         assert!(state.is_some());
         assert_eq!((ex.timeouts, ex.checksum_errors), (1, 1));
         assert_eq!(bus.stats().checksum_errors, 1);
