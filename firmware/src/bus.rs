@@ -403,11 +403,7 @@ pub(crate) mod tests {
                 let id = p.id;
                 let srl = self.tables.iter().find(|(i, _)| *i == id).map(|(_, t)| t[16]);
                 match p.instruction().unwrap() {
-                    Instruction::Ping => {
-                        if srl.is_some() {
-                            self.answer(id, &[]);
-                        }
-                    }
+                    Instruction::Ping if srl.is_some() => self.answer(id, &[]),
                     Instruction::Read { addr, len } => {
                         if let Some((_, t)) = self.tables.iter().find(|(i, _)| *i == id) {
                             let data = t[addr as usize..(addr + len) as usize].to_vec();

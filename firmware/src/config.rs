@@ -145,15 +145,18 @@ const fn limit(min: f32, max: f32) -> Option<SoftLimit> {
 
 /// LEO's soft limits in joint order: the shoulder has no stop in the model
 /// (±90° here), hips −45°…146°, knees −150°…+2°, ankles −90°…83°.
-const LEO_LIMITS: [Option<SoftLimit>; 7] = [
-    limit(-1.570_796, 1.570_796),
-    limit(-0.785_398, 2.548_181),
-    limit(-0.785_398, 2.548_181),
-    limit(-2.617_994, 0.034_907),
-    limit(-2.617_994, 0.034_907),
-    limit(-1.570_796, 1.448_623),
-    limit(-1.570_796, 1.448_623),
-];
+const LEO_LIMITS: [Option<SoftLimit>; 7] = {
+    use core::f32::consts::{FRAC_PI_2, FRAC_PI_4};
+    [
+        limit(-FRAC_PI_2, FRAC_PI_2),
+        limit(-FRAC_PI_4, 2.548_181),
+        limit(-FRAC_PI_4, 2.548_181),
+        limit(-2.617_994, 0.034_907),
+        limit(-2.617_994, 0.034_907),
+        limit(-FRAC_PI_2, 1.448_623),
+        limit(-FRAC_PI_2, 1.448_623),
+    ]
+};
 
 /// The pendulum turns freely: no soft limit.
 const PENDULUM_LIMITS: [Option<SoftLimit>; 1] = [None];
