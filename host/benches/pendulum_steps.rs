@@ -6,7 +6,9 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use pada::experiment::{run_trial, RunConfig};
-use pada::pendulum::{PhysicalPendulumTask, SimulatedPendulum, SimulatedPendulumParams, SimulatedPendulumTask};
+use pada::pendulum::{
+    PhysicalPendulumTask, SimulatedPendulum, SimulatedPendulumParams, SimulatedPendulumTask,
+};
 use pada::task::{Plant, Task};
 use pada_core::policy::PolicyKind;
 use std::hint::black_box;
@@ -16,7 +18,13 @@ use std::hint::black_box;
 const SECONDS: f64 = 300.0;
 
 fn trial_steps<T: Task>(task: &T, policy: PolicyKind) -> u64 {
-    let cfg = RunConfig { policy, switch_at_s: None, seconds: SECONDS, trials: 1, seed: 1 };
+    let cfg = RunConfig {
+        policy,
+        switch_at_s: None,
+        seconds: SECONDS,
+        trials: 1,
+        seed: 1,
+    };
     let r = run_trial(task, &cfg, 0, &|_| {}).expect("trial runs");
     r.learning_steps + r.test_steps
 }
@@ -28,7 +36,10 @@ fn bench_trials(c: &mut Criterion) {
     let mut g = c.benchmark_group("pendulum_env_steps");
     let sim = SimulatedPendulumTask::default();
     let phys = PhysicalPendulumTask::default();
-    for (name, policy) in [("sarsa", PolicyKind::Sarsa), ("pada_0.5", PolicyKind::Pada { delta: 0.5 })] {
+    for (name, policy) in [
+        ("sarsa", PolicyKind::Sarsa),
+        ("pada_0.5", PolicyKind::Pada { delta: 0.5 }),
+    ] {
         let steps = trial_steps(&sim, policy);
         g.throughput(Throughput::Elements(steps));
         g.bench_with_input(BenchmarkId::new("simulated", name), &policy, |b, &p| {
@@ -37,7 +48,9 @@ fn bench_trials(c: &mut Criterion) {
     }
     let steps = trial_steps(&phys, PolicyKind::Sarsa);
     g.throughput(Throughput::Elements(steps));
-    g.bench_function(BenchmarkId::new("physical", "sarsa"), |b| b.iter(|| black_box(trial_steps(&phys, PolicyKind::Sarsa))));
+    g.bench_function(BenchmarkId::new("physical", "sarsa"), |b| {
+        b.iter(|| black_box(trial_steps(&phys, PolicyKind::Sarsa)))
+    });
     g.finish();
 }
 

@@ -25,8 +25,14 @@ pub enum Algo {
 
 impl Algo {
     /// Every algorithm, in the paper's order.
-    pub const ALL: [Algo; 6] =
-        [Algo::Sarsa, Algo::Lowpass, Algo::MarkovLowpass, Algo::Integrator, Algo::MarkovIntegrator, Algo::Pada];
+    pub const ALL: [Algo; 6] = [
+        Algo::Sarsa,
+        Algo::Lowpass,
+        Algo::MarkovLowpass,
+        Algo::Integrator,
+        Algo::MarkovIntegrator,
+        Algo::Pada,
+    ];
 
     /// The command-line name.
     pub fn name(self) -> &'static str {
@@ -89,7 +95,11 @@ pub const DEFAULT_DELTA: f32 = 0.5;
 /// The policy of `algo` with `alpha` / `delta` (defaults
 /// [`DEFAULT_ALPHA`], [`DEFAULT_DELTA`]). A parameter the algorithm does not
 /// take, or one outside its range, is an error.
-pub fn policy_kind(algo: Algo, alpha: Option<f32>, delta: Option<f32>) -> Result<PolicyKind, AlgoError> {
+pub fn policy_kind(
+    algo: Algo,
+    alpha: Option<f32>,
+    delta: Option<f32>,
+) -> Result<PolicyKind, AlgoError> {
     if alpha.is_some() && !algo.takes_alpha() {
         return Err(AlgoError(format!(
             "--alpha applies only to lowpass and markov-lowpass, not to {algo}"
@@ -103,7 +113,9 @@ pub fn policy_kind(algo: Algo, alpha: Option<f32>, delta: Option<f32>) -> Result
     let a = alpha.unwrap_or(DEFAULT_ALPHA);
     let d = delta.unwrap_or(DEFAULT_DELTA);
     if algo.takes_alpha() && !(a.is_finite() && a > 0.0 && a <= 1.0) {
-        return Err(AlgoError(format!("--alpha {a} is out of range: valid is 0 < alpha <= 1")));
+        return Err(AlgoError(format!(
+            "--alpha {a} is out of range: valid is 0 < alpha <= 1"
+        )));
     }
     if algo.takes_delta() && !(d.is_finite() && d > 0.0 && d <= 1.0) {
         return Err(AlgoError(format!(
@@ -137,9 +149,9 @@ pub fn parameter_of(kind: &PolicyKind) -> Option<f32> {
     match *kind {
         PolicyKind::Sarsa => None,
         PolicyKind::LowPass { alpha } | PolicyKind::MarkovLowPass { alpha } => Some(alpha),
-        PolicyKind::Integrator { delta } | PolicyKind::MarkovIntegrator { delta } | PolicyKind::Pada { delta } => {
-            Some(delta)
-        }
+        PolicyKind::Integrator { delta }
+        | PolicyKind::MarkovIntegrator { delta }
+        | PolicyKind::Pada { delta } => Some(delta),
     }
 }
 
@@ -159,12 +171,20 @@ mod tests {
 
     #[test]
     fn parameters_map_and_are_checked() {
-        assert_eq!(policy_kind(Algo::Pada, None, Some(0.5)), Ok(PolicyKind::Pada { delta: 0.5 }));
-        assert_eq!(policy_kind(Algo::Lowpass, None, None), Ok(PolicyKind::LowPass { alpha: 0.834 }));
+        assert_eq!(
+            policy_kind(Algo::Pada, None, Some(0.5)),
+            Ok(PolicyKind::Pada { delta: 0.5 })
+        );
+        assert_eq!(
+            policy_kind(Algo::Lowpass, None, None),
+            Ok(PolicyKind::LowPass { alpha: 0.834 })
+        );
         assert_eq!(policy_kind(Algo::Sarsa, None, None), Ok(PolicyKind::Sarsa));
         let e = policy_kind(Algo::Lowpass, Some(1.5), None).unwrap_err().0;
         assert!(e.contains("0 < alpha <= 1"), "{e}");
-        let e = policy_kind(Algo::Integrator, None, Some(0.0)).unwrap_err().0;
+        let e = policy_kind(Algo::Integrator, None, Some(0.0))
+            .unwrap_err()
+            .0;
         assert!(e.contains("0 < delta <= 1"), "{e}");
         assert!(policy_kind(Algo::Pada, None, Some(f32::NAN)).is_err());
         let e = policy_kind(Algo::Sarsa, Some(0.5), None).unwrap_err().0;
@@ -175,7 +195,10 @@ mod tests {
     #[test]
     fn labels() {
         assert_eq!(label(&PolicyKind::Pada { delta: 0.5 }), "pada Δ=0.5");
-        assert_eq!(label(&PolicyKind::LowPass { alpha: 0.834 }), "lowpass α=0.834");
+        assert_eq!(
+            label(&PolicyKind::LowPass { alpha: 0.834 }),
+            "lowpass α=0.834"
+        );
         assert_eq!(label(&PolicyKind::Sarsa), "sarsa");
         for a in Algo::ALL {
             assert_eq!(algo_of(&policy_kind(a, None, None).unwrap()), a);

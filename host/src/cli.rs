@@ -161,7 +161,9 @@ pub fn check_seconds(flag: &str, s: f64) -> Result<f64, CliError> {
     if s.is_finite() && s > 0.0 && s <= MAX_SECONDS {
         Ok(s)
     } else {
-        Err(usage(format!("{flag} {s} is out of range: valid is 0 < seconds <= {MAX_SECONDS}")))
+        Err(usage(format!(
+            "{flag} {s} is out of range: valid is 0 < seconds <= {MAX_SECONDS}"
+        )))
     }
 }
 
@@ -183,7 +185,9 @@ fn clap_one_line(e: &clap::Error) -> String {
     let line = text
         .lines()
         .map(str::trim)
-        .filter(|l| !l.is_empty() && !l.starts_with("Usage:") && !l.starts_with("For more information"))
+        .filter(|l| {
+            !l.is_empty() && !l.starts_with("Usage:") && !l.starts_with("For more information")
+        })
         .collect::<Vec<_>>()
         .join(" ");
     line.strip_prefix("error: ").unwrap_or(&line).to_string()

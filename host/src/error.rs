@@ -24,7 +24,12 @@ impl CliError {
 
     /// The message on one line (newlines of nested causes joined).
     pub fn one_line(&self) -> String {
-        self.to_string().split('\n').map(str::trim).filter(|l| !l.is_empty()).collect::<Vec<_>>().join(" ")
+        self.to_string()
+            .split('\n')
+            .map(str::trim)
+            .filter(|l| !l.is_empty())
+            .collect::<Vec<_>>()
+            .join(" ")
     }
 }
 

@@ -7,7 +7,11 @@
 
 /// One RK4 step of size `h` for `ẋ = f(x)`.
 #[inline]
-pub fn rk4_step<const N: usize>(x: &[f64; N], h: f64, f: impl Fn(&[f64; N]) -> [f64; N]) -> [f64; N] {
+pub fn rk4_step<const N: usize>(
+    x: &[f64; N],
+    h: f64,
+    f: impl Fn(&[f64; N]) -> [f64; N],
+) -> [f64; N] {
     let k1 = f(x);
     let k2 = f(&add_scaled(x, &k1, h / 2.0));
     let k3 = f(&add_scaled(x, &k2, h / 2.0));
@@ -101,7 +105,11 @@ mod tests {
             let near = SinNear::new(theta0);
             for j in -50..=50 {
                 let theta = theta0 + j as f64 * 0.0025;
-                assert!((near.sin(theta) - theta.sin()).abs() < 4e-16, "{theta0} + {}", theta - theta0);
+                assert!(
+                    (near.sin(theta) - theta.sin()).abs() < 4e-16,
+                    "{theta0} + {}",
+                    theta - theta0
+                );
             }
             // Far away: the library itself.
             assert_eq!(near.sin(theta0 + 1.0), (theta0 + 1.0).sin());
@@ -122,7 +130,9 @@ mod tests {
     #[test]
     fn harmonic_oscillator_returns_after_one_period() {
         // ẍ = −x: after 2π the state is back at (1, 0).
-        let x = integrate([1.0, 0.0], 2.0 * std::f64::consts::PI, 1000, |x| [x[1], -x[0]]);
+        let x = integrate([1.0, 0.0], 2.0 * std::f64::consts::PI, 1000, |x| {
+            [x[1], -x[0]]
+        });
         assert!((x[0] - 1.0).abs() < 1e-10 && x[1].abs() < 1e-10, "{x:?}");
     }
 }

@@ -3,19 +3,19 @@
 //! of a recorded torque log.
 
 pub mod algo;
-pub mod experiment;
-pub mod integrator;
-pub mod pendulum;
-pub mod seed;
-pub mod stats;
-pub mod task;
 pub mod cli;
 pub mod commands;
 pub mod error;
+pub mod experiment;
+pub mod integrator;
 pub mod output;
 pub mod paper;
+pub mod pendulum;
 pub mod plot;
 pub mod progress;
+pub mod seed;
+pub mod stats;
 pub mod summary;
+pub mod task;
 pub mod tasks;
 pub mod torque_log;

@@ -22,7 +22,12 @@ impl OutDir {
     /// existing ancestor must be a directory that accepts one. Nothing is
     /// created.
     pub fn check(path: &Path) -> Result<OutDir, CliError> {
-        let fail = |why: String| CliError::Usage(format!("cannot write output directory {}: {why}", path.display()));
+        let fail = |why: String| {
+            CliError::Usage(format!(
+                "cannot write output directory {}: {why}",
+                path.display()
+            ))
+        };
         let mut probe_dir = path.to_path_buf();
         loop {
             match std::fs::metadata(&probe_dir) {
@@ -37,9 +42,15 @@ impl OutDir {
                 },
             }
         }
-        tempfile::NamedTempFile::new_in(&probe_dir)
-            .map_err(|e| fail(format!("{} does not accept new files ({e})", probe_dir.display())))?;
-        Ok(OutDir { path: path.to_path_buf() })
+        tempfile::NamedTempFile::new_in(&probe_dir).map_err(|e| {
+            fail(format!(
+                "{} does not accept new files ({e})",
+                probe_dir.display()
+            ))
+        })?;
+        Ok(OutDir {
+            path: path.to_path_buf(),
+        })
     }
 
     /// The directory's path.
@@ -62,11 +73,17 @@ impl OutDir {
 /// Writes `bytes` to `path` through a temporary file in the same directory
 /// and a rename.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     let mut tmp = tempfile::NamedTempFile::new_in(dir)
         .map_err(|e| anyhow::anyhow!("cannot write in {}: {e}", dir.display()))?;
-    tmp.write_all(bytes).and_then(|_| tmp.flush()).map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
-    tmp.persist(path).map_err(|e| anyhow::anyhow!("cannot write {}: {}", path.display(), e.error))?;
+    tmp.write_all(bytes)
+        .and_then(|_| tmp.flush())
+        .map_err(|e| anyhow::anyhow!("cannot write {}: {e}", path.display()))?;
+    tmp.persist(path)
+        .map_err(|e| anyhow::anyhow!("cannot write {}: {}", path.display(), e.error))?;
     Ok(())
 }
 
@@ -80,7 +97,11 @@ mod tests {
         let target = root.path().join("a/b");
         let out = OutDir::check(&target).unwrap();
         assert!(!target.exists(), "check must not create the directory");
-        out.write_all(&[("x.txt".into(), b"hello".to_vec()), ("y.txt".into(), b"world".to_vec())]).unwrap();
+        out.write_all(&[
+            ("x.txt".into(), b"hello".to_vec()),
+            ("y.txt".into(), b"world".to_vec()),
+        ])
+        .unwrap();
         assert_eq!(std::fs::read(target.join("x.txt")).unwrap(), b"hello");
         // Only the two files: no temporary left.
         assert_eq!(std::fs::read_dir(&target).unwrap().count(), 2);

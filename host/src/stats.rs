@@ -26,11 +26,19 @@ impl Estimate {
     pub fn of(values: &[f64]) -> Estimate {
         let n = values.len();
         if n == 0 {
-            return Estimate { mean: f64::NAN, ci95: f64::NAN, n };
+            return Estimate {
+                mean: f64::NAN,
+                ci95: f64::NAN,
+                n,
+            };
         }
         let mean = values.iter().sum::<f64>() / n as f64;
         if n < 2 || !mean.is_finite() {
-            return Estimate { mean, ci95: f64::NAN, n };
+            return Estimate {
+                mean,
+                ci95: f64::NAN,
+                n,
+            };
         }
         let var = values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1) as f64;
         let ci95 = student_t_quantile(0.975, (n - 1) as f64) * (var / n as f64).sqrt();

@@ -80,11 +80,19 @@ pub struct RunSummary {
 
 impl RunSummary {
     /// Summarises `results` of `cfg` on a task with `spec`.
-    pub fn new(spec: &TaskSpec, cfg: &RunConfig, results: &[TrialResult], wall_s: f64) -> RunSummary {
+    pub fn new(
+        spec: &TaskSpec,
+        cfg: &RunConfig,
+        results: &[TrialResult],
+        wall_s: f64,
+    ) -> RunSummary {
         let algo = algo_of(&cfg.policy);
         let p = parameter_of(&cfg.policy);
         let col = |f: fn(&TrialResult) -> f64| results.iter().map(f).collect::<Vec<_>>();
-        let env_steps: u64 = results.iter().map(|r| r.learning_steps + r.test_steps).sum();
+        let env_steps: u64 = results
+            .iter()
+            .map(|r| r.learning_steps + r.test_steps)
+            .sum();
         RunSummary {
             task: spec.name.to_string(),
             algo,
@@ -117,7 +125,11 @@ impl RunSummary {
             window_reengagements: Estimate::of(&col(|r| r.window_reengagements as f64)),
             wall_s,
             env_steps,
-            env_steps_per_s: if wall_s > 0.0 { env_steps as f64 / wall_s } else { f64::NAN },
+            env_steps_per_s: if wall_s > 0.0 {
+                env_steps as f64 / wall_s
+            } else {
+                f64::NAN
+            },
             threads: rayon::current_num_threads(),
             per_trial: results.to_vec(),
         }
@@ -141,7 +153,7 @@ pub fn curve_csv(result: &TrialResult) -> anyhow::Result<Vec<u8>> {
             format!("{}", p.test_return),
         ])?;
     }
-    Ok(w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?)
+    w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))
 }
 
 /// One row per trial: `trial,seed,end_performance,rise_time_s,mtbf_s,window_reengagements,learning_steps,test_steps`.
@@ -169,14 +181,17 @@ pub fn trials_csv(results: &[TrialResult]) -> anyhow::Result<Vec<u8>> {
             r.test_steps.to_string(),
         ])?;
     }
-    Ok(w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?)
+    w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))
 }
 
 /// The files of a run: `summary.json`, `trials.csv` and
 /// `trial-NNN.csv` learning curves.
 pub fn run_files(summary: &RunSummary) -> anyhow::Result<Vec<(String, Vec<u8>)>> {
     let mut files = vec![
-        ("summary.json".to_string(), (summary.to_json() + "\n").into_bytes()),
+        (
+            "summary.json".to_string(),
+            (summary.to_json() + "\n").into_bytes(),
+        ),
         ("trials.csv".to_string(), trials_csv(&summary.per_trial)?),
     ];
     for r in &summary.per_trial {

@@ -17,13 +17,18 @@ pub struct TorqueLog {
 
 /// Reads and checks the log at `path`.
 pub fn read(path: &Path) -> Result<TorqueLog, CliError> {
-    let text = std::fs::read(path).map_err(|e| usage(format!("cannot read torque log {}: {e}", path.display())))?;
+    let text = std::fs::read(path)
+        .map_err(|e| usage(format!("cannot read torque log {}: {e}", path.display())))?;
     parse(&text).map_err(|e| usage(format!("{}: {e}", path.display())))
 }
 
 /// Parses CSV bytes; the error names the line, the column and the problem.
 pub fn parse(bytes: &[u8]) -> Result<TorqueLog, String> {
-    let mut reader = csv::ReaderBuilder::new().has_headers(false).flexible(true).trim(csv::Trim::All).from_reader(bytes);
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .trim(csv::Trim::All)
+        .from_reader(bytes);
     let mut joints: Vec<String> = Vec::new();
     let mut rows: Vec<Vec<f32>> = Vec::new();
     for (i, record) in reader.records().enumerate() {
@@ -49,18 +54,28 @@ pub fn parse(bytes: &[u8]) -> Result<TorqueLog, String> {
         }
         let mut row = Vec::with_capacity(joints.len());
         for (j, field) in record.iter().enumerate() {
-            let v: f32 = field
-                .parse()
-                .map_err(|_| format!("line {line}, column {} ({}): '{field}' is not a number (torque in N m)", j + 1, joints[j]))?;
+            let v: f32 = field.parse().map_err(|_| {
+                format!(
+                    "line {line}, column {} ({}): '{field}' is not a number (torque in N m)",
+                    j + 1,
+                    joints[j]
+                )
+            })?;
             if !v.is_finite() {
-                return Err(format!("line {line}, column {} ({}): '{field}' is not a finite torque", j + 1, joints[j]));
+                return Err(format!(
+                    "line {line}, column {} ({}): '{field}' is not a finite torque",
+                    j + 1,
+                    joints[j]
+                ));
             }
             row.push(v);
         }
         rows.push(row);
     }
     if rows.is_empty() {
-        return Err("no torque rows (expected one row per control step, one column per joint)".into());
+        return Err(
+            "no torque rows (expected one row per control step, one column per joint)".into(),
+        );
     }
     Ok(TorqueLog { joints, rows })
 }
@@ -84,7 +99,10 @@ mod tests {
         let e = parse(b"hip,knee\n1.5,0\n-1.5\n").unwrap_err();
         assert!(e.contains("line 3") && e.contains("expected 2"), "{e}");
         let e = parse(b"hip,knee\n1.5,abc\n").unwrap_err();
-        assert!(e.contains("line 2, column 2 (knee)") && e.contains("not a number"), "{e}");
+        assert!(
+            e.contains("line 2, column 2 (knee)") && e.contains("not a number"),
+            "{e}"
+        );
         let e = parse(b"1,NaN\n").unwrap_err();
         assert!(e.contains("not a finite torque"), "{e}");
         assert!(parse(b"hip\n").unwrap_err().contains("no torque rows"));

@@ -5,7 +5,10 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 fn pada(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_pada")).args(args).output().expect("pada runs")
+    Command::new(env!("CARGO_BIN_EXE_pada"))
+        .args(args)
+        .output()
+        .expect("pada runs")
 }
 
 /// Asserts a bad-input failure: exit code 2, nothing on stdout, exactly
@@ -14,8 +17,16 @@ fn assert_bad_input(args: &[&str], needles: &[&str]) {
     let out = pada(args);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{args:?}: stderr {stderr}");
-    assert!(out.stdout.is_empty(), "{args:?}: stdout {}", String::from_utf8_lossy(&out.stdout));
-    assert_eq!(stderr.lines().count(), 1, "{args:?}: not one line: {stderr}");
+    assert!(
+        out.stdout.is_empty(),
+        "{args:?}: stdout {}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    assert_eq!(
+        stderr.lines().count(),
+        1,
+        "{args:?}: not one line: {stderr}"
+    );
     assert!(stderr.starts_with("error: "), "{stderr}");
     for n in needles {
         assert!(stderr.contains(n), "{args:?}: {stderr:?} lacks {n:?}");
@@ -24,8 +35,14 @@ fn assert_bad_input(args: &[&str], needles: &[&str]) {
 
 #[test]
 fn unknown_names_list_the_valid_values() {
-    assert_bad_input(&["run", "--algo", "qlearning"], &["qlearning", "sarsa", "markov-integrator", "pada"]);
-    assert_bad_input(&["run", "--task", "leo", "--algo", "sarsa"], &["leo", "pendulum", "physical-pendulum"]);
+    assert_bad_input(
+        &["run", "--algo", "qlearning"],
+        &["qlearning", "sarsa", "markov-integrator", "pada"],
+    );
+    assert_bad_input(
+        &["run", "--task", "leo", "--algo", "sarsa"],
+        &["leo", "pendulum", "physical-pendulum"],
+    );
     assert_bad_input(&["paper", "cartpole"], &["cartpole", "pendulum"]);
     assert_bad_input(&["frobnicate"], &["frobnicate"]);
     assert_bad_input(&[], &["run, demo, paper, mtbf"]);
@@ -33,23 +50,79 @@ fn unknown_names_list_the_valid_values() {
 
 #[test]
 fn parameters_out_of_range_name_the_range() {
-    assert_bad_input(&["run", "--algo", "lowpass", "--alpha", "1.5"], &["--alpha 1.5", "0 < alpha <= 1"]);
-    assert_bad_input(&["run", "--algo", "lowpass", "--alpha", "-0.2"], &["0 < alpha <= 1"]);
-    assert_bad_input(&["run", "--algo", "pada", "--delta", "0"], &["--delta 0", "0 < delta <= 1"]);
-    assert_bad_input(&["run", "--algo", "integrator", "--delta", "NaN"], &["0 < delta <= 1"]);
-    assert_bad_input(&["run", "--algo", "sarsa", "--delta", "0.5"], &["--delta applies only"]);
-    assert_bad_input(&["run", "--algo", "pada", "--alpha", "0.5"], &["--alpha applies only"]);
-    assert_bad_input(&["run", "--algo", "sarsa", "--trials", "0"], &["--trials", "1..=10000"]);
-    assert_bad_input(&["run", "--algo", "sarsa", "--trials", "many"], &["--trials", "many"]);
-    assert_bad_input(&["run", "--algo", "sarsa", "--seconds", "-5"], &["--seconds -5", "0 < seconds"]);
-    assert_bad_input(&["run", "--algo", "sarsa", "--seconds", "inf"], &["0 < seconds"]);
-    assert_bad_input(&["run", "--algo", "sarsa", "--switch-at", "10"], &["--switch-at applies only"]);
-    assert_bad_input(&["run", "--algo", "pada", "--seconds", "100", "--switch-at", "200"], &["0 <= switch-at <= seconds"]);
-    assert_bad_input(&["run", "--algo", "sarsa", "--threads", "0"], &["--threads"]);
+    assert_bad_input(
+        &["run", "--algo", "lowpass", "--alpha", "1.5"],
+        &["--alpha 1.5", "0 < alpha <= 1"],
+    );
+    assert_bad_input(
+        &["run", "--algo", "lowpass", "--alpha", "-0.2"],
+        &["0 < alpha <= 1"],
+    );
+    assert_bad_input(
+        &["run", "--algo", "pada", "--delta", "0"],
+        &["--delta 0", "0 < delta <= 1"],
+    );
+    assert_bad_input(
+        &["run", "--algo", "integrator", "--delta", "NaN"],
+        &["0 < delta <= 1"],
+    );
+    assert_bad_input(
+        &["run", "--algo", "sarsa", "--delta", "0.5"],
+        &["--delta applies only"],
+    );
+    assert_bad_input(
+        &["run", "--algo", "pada", "--alpha", "0.5"],
+        &["--alpha applies only"],
+    );
+    assert_bad_input(
+        &["run", "--algo", "sarsa", "--trials", "0"],
+        &["--trials", "1..=10000"],
+    );
+    assert_bad_input(
+        &["run", "--algo", "sarsa", "--trials", "many"],
+        &["--trials", "many"],
+    );
+    assert_bad_input(
+        &["run", "--algo", "sarsa", "--seconds", "-5"],
+        &["--seconds -5", "0 < seconds"],
+    );
+    assert_bad_input(
+        &["run", "--algo", "sarsa", "--seconds", "inf"],
+        &["0 < seconds"],
+    );
+    assert_bad_input(
+        &["run", "--algo", "sarsa", "--switch-at", "10"],
+        &["--switch-at applies only"],
+    );
+    assert_bad_input(
+        &[
+            "run",
+            "--algo",
+            "pada",
+            "--seconds",
+            "100",
+            "--switch-at",
+            "200",
+        ],
+        &["0 <= switch-at <= seconds"],
+    );
+    assert_bad_input(
+        &["run", "--algo", "sarsa", "--threads", "0"],
+        &["--threads"],
+    );
     assert_bad_input(&["demo", "--seconds", "0"], &["0 < seconds"]);
-    assert_bad_input(&["paper", "pendulum", "--physical-seconds", "-1"], &["--physical-seconds"]);
-    assert_bad_input(&["mtbf", "--torques", "x.csv", "--rate", "0"], &["--rate 0", "0 < rate"]);
-    assert_bad_input(&["mtbf", "--torques", "x.csv", "--window", "0"], &["--window"]);
+    assert_bad_input(
+        &["paper", "pendulum", "--physical-seconds", "-1"],
+        &["--physical-seconds"],
+    );
+    assert_bad_input(
+        &["mtbf", "--torques", "x.csv", "--rate", "0"],
+        &["--rate 0", "0 < rate"],
+    );
+    assert_bad_input(
+        &["mtbf", "--torques", "x.csv", "--window", "0"],
+        &["--window"],
+    );
 }
 
 #[test]
@@ -59,11 +132,30 @@ fn an_unwritable_output_directory_is_refused_before_running() {
     std::fs::write(&file, b"x").unwrap();
     let out = file.join("results");
     assert_bad_input(
-        &["run", "--algo", "sarsa", "--seconds", "1", "--trials", "1", "--out", out.to_str().unwrap()],
+        &[
+            "run",
+            "--algo",
+            "sarsa",
+            "--seconds",
+            "1",
+            "--trials",
+            "1",
+            "--out",
+            out.to_str().unwrap(),
+        ],
         &["cannot write output directory", "is not a directory"],
     );
     assert_bad_input(
-        &["paper", "pendulum", "--trials", "1", "--seconds", "1", "--out", out.to_str().unwrap()],
+        &[
+            "paper",
+            "pendulum",
+            "--trials",
+            "1",
+            "--seconds",
+            "1",
+            "--out",
+            out.to_str().unwrap(),
+        ],
         &["cannot write output directory"],
     );
     // Nothing was created next to the file.
@@ -81,13 +173,22 @@ fn write(dir: &Path, name: &str, text: &str) -> String {
 fn malformed_torque_logs_are_reported_by_line_and_column() {
     let dir = tempfile::tempdir().unwrap();
     let missing = write(dir.path(), "missing.csv", "hip,knee\n1.5,0\n-1.5\n");
-    assert_bad_input(&["mtbf", "--torques", &missing], &["line 3", "1 columns, expected 2"]);
+    assert_bad_input(
+        &["mtbf", "--torques", &missing],
+        &["line 3", "1 columns, expected 2"],
+    );
     let text = write(dir.path(), "text.csv", "hip,knee\n1.5,0\n-1.5,lots\n");
-    assert_bad_input(&["mtbf", "--torques", &text], &["line 3, column 2 (knee)", "'lots' is not a number"]);
+    assert_bad_input(
+        &["mtbf", "--torques", &text],
+        &["line 3, column 2 (knee)", "'lots' is not a number"],
+    );
     let empty = write(dir.path(), "empty.csv", "");
     assert_bad_input(&["mtbf", "--torques", &empty], &["no torque rows"]);
     let nowhere = dir.path().join("nowhere.csv");
-    assert_bad_input(&["mtbf", "--torques", nowhere.to_str().unwrap()], &["cannot read torque log"]);
+    assert_bad_input(
+        &["mtbf", "--torques", nowhere.to_str().unwrap()],
+        &["cannot read torque log"],
+    );
 }
 
 #[test]
@@ -100,24 +201,47 @@ fn mtbf_of_a_known_log() {
         csv += &format!("{},0.7\n", if k % 2 == 0 { 1.5 } else { -1.5 });
     }
     let path = write(dir.path(), "log.csv", &csv);
-    let out = pada(&["mtbf", "--torques", &path, "--rate", "20", "--window", "4", "--json"]);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = pada(&[
+        "mtbf",
+        "--torques",
+        &path,
+        "--rate",
+        "20",
+        "--window",
+        "4",
+        "--json",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let a = &v["joints"][0]["report"];
     assert_eq!(a["reengagements"], 9);
     assert_eq!(a["window"]["reengagements"], 3);
     let per_event = pada_core::fatigue::GearboxParams::TABLE_I.damage_per_reengagement(1.5);
     let mtbf = a["mtbf_s"].as_f64().unwrap();
-    assert!((mtbf / (0.5 / (9.0 * per_event)) - 1.0).abs() < 1e-9, "{mtbf}");
+    assert!(
+        (mtbf / (0.5 / (9.0 * per_event)) - 1.0).abs() < 1e-9,
+        "{mtbf}"
+    );
     let window = a["window"]["mtbf_s"].as_f64().unwrap();
-    assert!((window / (0.2 / (3.0 * per_event)) - 1.0).abs() < 1e-9, "{window}");
+    assert!(
+        (window / (0.2 / (3.0 * per_event)) - 1.0).abs() < 1e-9,
+        "{window}"
+    );
     // The constant joint never re-engages: infinite MTBF, written as null.
     assert_eq!(v["joints"][1]["report"]["reengagements"], 0);
     assert!(v["joints"][1]["report"]["mtbf_s"].is_null());
     // Human-readable output names both joints.
     let text = pada(&["mtbf", "--torques", &path]);
     let s = String::from_utf8_lossy(&text.stdout);
-    assert!(s.contains("a ") && s.contains("b ") && s.contains("inf"), "{s}");
+    assert!(
+        s.contains("a ") && s.contains("b ") && s.contains("inf"),
+        "{s}"
+    );
 }
 
 #[test]
@@ -125,12 +249,32 @@ fn run_json_prints_the_summary_and_writes_the_files() {
     let dir = tempfile::tempdir().unwrap();
     let out_dir = dir.path().join("run");
     let args = [
-        "run", "--task", "pendulum", "--algo", "pada", "--delta", "0.5", "--trials", "2", "--seconds", "60", "--seed",
-        "9", "--json", "--out", out_dir.to_str().unwrap(),
+        "run",
+        "--task",
+        "pendulum",
+        "--algo",
+        "pada",
+        "--delta",
+        "0.5",
+        "--trials",
+        "2",
+        "--seconds",
+        "60",
+        "--seed",
+        "9",
+        "--json",
+        "--out",
+        out_dir.to_str().unwrap(),
     ];
     let out = pada(&args);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is the JSON summary");
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value =
+        serde_json::from_slice(&out.stdout).expect("stdout is the JSON summary");
     assert_eq!(v["task"], "pendulum");
     assert_eq!(v["algo"], "pada");
     assert_eq!(v["trials"], 2);
@@ -150,11 +294,22 @@ fn run_json_prints_the_summary_and_writes_the_files() {
         serde_json::from_slice(&std::fs::read(out_dir.join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary, v);
     let curve = std::fs::read_to_string(out_dir.join("trial-001.csv")).unwrap();
-    assert!(curve.starts_with("test_run,learning_time_s,learning_episodes,return\n"), "{curve}");
+    assert!(
+        curve.starts_with("test_run,learning_time_s,learning_episodes,return\n"),
+        "{curve}"
+    );
     assert_eq!(curve.lines().count(), 1 + 3);
-    assert_eq!(std::fs::read_to_string(out_dir.join("trials.csv")).unwrap().lines().count(), 3);
-    let names: Vec<String> =
-        std::fs::read_dir(&out_dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    assert_eq!(
+        std::fs::read_to_string(out_dir.join("trials.csv"))
+            .unwrap()
+            .lines()
+            .count(),
+        3
+    );
+    let names: Vec<String> = std::fs::read_dir(&out_dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
     assert_eq!(names.len(), 4, "no temporary files left: {names:?}");
 
     // The same seed reproduces the numbers.
@@ -180,16 +335,38 @@ fn paper_pendulum_writes_the_report_and_the_figures() {
         "--out",
         out_dir.to_str().unwrap(),
     ]);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let report = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
-    for needle in ["SARSA(λ) on the simulated pendulum", "-851 ± 39", "-1093", "839", "6.920e7", "pada Δ=0.5", "lowpass α=0.834"] {
+    for needle in [
+        "SARSA(λ) on the simulated pendulum",
+        "-851 ± 39",
+        "-1093",
+        "839",
+        "6.920e7",
+        "pada Δ=0.5",
+        "lowpass α=0.834",
+    ] {
         assert!(report.contains(needle), "report lacks {needle}");
     }
-    for stem in ["fig3-mtbf", "fig4-end-performance", "fig5-rise-time", "fig6-physical-curves", "fig6-simulated-curves"] {
+    for stem in [
+        "fig3-mtbf",
+        "fig4-end-performance",
+        "fig5-rise-time",
+        "fig6-physical-curves",
+        "fig6-simulated-curves",
+    ] {
         let png = std::fs::read(out_dir.join(format!("{stem}.png"))).unwrap();
         assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "{stem}.png is a PNG");
         let svg = std::fs::read_to_string(out_dir.join(format!("{stem}.svg"))).unwrap();
-        assert!(svg.starts_with("<svg") && (svg.contains("MTBF") || svg.contains("learning")), "{stem}.svg");
+        assert!(
+            svg.starts_with("<svg") && (svg.contains("MTBF") || svg.contains("learning")),
+            "{stem}.svg"
+        );
     }
     let summary: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out_dir.join("summary.json")).unwrap()).unwrap();

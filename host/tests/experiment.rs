@@ -8,8 +8,20 @@ use pada::task::Task;
 use pada_core::fatigue::PAPER_WINDOW_STEPS;
 use pada_core::policy::PolicyKind;
 
-fn run<T: Task>(task: &T, policy: PolicyKind, seconds: f64, trials: u32, seed: u64) -> Vec<TrialResult> {
-    let cfg = RunConfig { policy, switch_at_s: None, seconds, trials, seed };
+fn run<T: Task>(
+    task: &T,
+    policy: PolicyKind,
+    seconds: f64,
+    trials: u32,
+    seed: u64,
+) -> Vec<TrialResult> {
+    let cfg = RunConfig {
+        policy,
+        switch_at_s: None,
+        seconds,
+        trials,
+        seed,
+    };
     run_trials(task, &cfg, &|_| {}).expect("trials run")
 }
 
@@ -34,7 +46,10 @@ fn pada_with_delta_one_is_sarsa_bit_for_bit() {
     let pada = run(&task, PolicyKind::Pada { delta: 1.0 }, 90.0, 2, 3);
     assert_eq!(sarsa, pada);
     // Δ = 0.5 does restrict.
-    assert_ne!(sarsa, run(&task, PolicyKind::Pada { delta: 0.5 }, 90.0, 2, 3));
+    assert_ne!(
+        sarsa,
+        run(&task, PolicyKind::Pada { delta: 0.5 }, 90.0, 2, 3)
+    );
 }
 
 #[test]
@@ -68,12 +83,19 @@ fn the_mtbf_counts_the_first_1200_learning_actions() {
     let long = run(&task, PolicyKind::Sarsa, 120.0, 1, 5);
     assert_eq!(short[0].mtbf_s, long[0].mtbf_s);
     assert_eq!(short[0].window_reengagements, long[0].window_reengagements);
-    assert!(short[0].window_reengagements > 0 && short[0].window_reengagements < PAPER_WINDOW_STEPS as u64);
+    assert!(
+        short[0].window_reengagements > 0
+            && short[0].window_reengagements < PAPER_WINDOW_STEPS as u64
+    );
     // Each re-engagement at 1.5 N·m costs the same damage, so the MTBF is
     // 60 s over that many times one event's damage (Eqs. 3–7).
     let per_event = pada_core::fatigue::GearboxParams::TABLE_I.damage_per_reengagement(1.5);
     let expected = 60.0 / (short[0].window_reengagements as f64 * per_event);
-    assert!((short[0].mtbf_s / expected - 1.0).abs() < 1e-6, "{} vs {expected}", short[0].mtbf_s);
+    assert!(
+        (short[0].mtbf_s / expected - 1.0).abs() < 1e-6,
+        "{} vs {expected}",
+        short[0].mtbf_s
+    );
 }
 
 #[test]
@@ -105,12 +127,22 @@ fn switching_to_sarsa_changes_the_run_only_after_the_switch() {
     let task = SimulatedPendulumTask::default();
     let pada = PolicyKind::Pada { delta: 0.5 };
     let plain = run(&task, pada, 120.0, 1, 4);
-    let cfg = RunConfig { policy: pada, switch_at_s: Some(60.0), seconds: 120.0, trials: 1, seed: 4 };
+    let cfg = RunConfig {
+        policy: pada,
+        switch_at_s: Some(60.0),
+        seconds: 120.0,
+        trials: 1,
+        seed: 4,
+    };
     let switched = run_trials(&task, &cfg, &|_| {}).unwrap();
     // Same first 60 s: the window MTBF (first 1200 actions = 60 s) agrees …
     assert_eq!(plain[0].mtbf_s, switched[0].mtbf_s);
     // … and the test runs up to 60 s too; afterwards the runs part.
-    let upto = plain[0].curve.iter().filter(|p| p.learning_time_s <= 60.0).count();
+    let upto = plain[0]
+        .curve
+        .iter()
+        .filter(|p| p.learning_time_s <= 60.0)
+        .count();
     assert_eq!(plain[0].curve[..upto], switched[0].curve[..upto]);
     assert_ne!(plain[0].curve, switched[0].curve);
 }

@@ -23,19 +23,35 @@ pub fn run(args: DemoArgs) -> Result<(), CliError> {
     let spec = task.spec();
     let cfgs: Vec<RunConfig> = [PolicyKind::Sarsa, PolicyKind::Pada { delta: 0.5 }]
         .into_iter()
-        .map(|policy| RunConfig { policy, switch_at_s: None, seconds, trials: args.trials, seed: args.trial.seed })
+        .map(|policy| RunConfig {
+            policy,
+            switch_at_s: None,
+            seconds,
+            trials: args.trials,
+            seed: args.trial.seed,
+        })
         .collect();
     let total: u64 = cfgs
         .iter()
-        .map(|c| c.trials as u64 * c.expected_steps(spec.control_period_s, spec.episode_steps, spec.test_interval))
+        .map(|c| {
+            c.trials as u64
+                * c.expected_steps(
+                    spec.control_period_s,
+                    spec.episode_steps,
+                    spec.test_interval,
+                )
+        })
         .sum();
     let bar = steps_bar(total, "SARSA vs PADA");
     let start = Instant::now();
     let results = run_configs(&task, &cfgs, &|n| bar.inc(n))?;
     let wall = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
-    let summaries: Vec<RunSummary> =
-        cfgs.iter().zip(&results).map(|(c, r)| RunSummary::new(spec, c, r, wall)).collect();
+    let summaries: Vec<RunSummary> = cfgs
+        .iter()
+        .zip(&results)
+        .map(|(c, r)| RunSummary::new(spec, c, r, wall))
+        .collect();
     let env_steps: u64 = summaries.iter().map(|s| s.env_steps).sum();
 
     if let Some(out) = &out {
@@ -52,8 +68,12 @@ pub fn run(args: DemoArgs) -> Result<(), CliError> {
         out.write_all(&files)?;
     }
     if args.json {
-        let json = serde_json::json!({ "sarsa": summaries[0], "pada": summaries[1], "wall_s": wall });
-        println!("{}", serde_json::to_string_pretty(&json).map_err(anyhow::Error::from)?);
+        let json =
+            serde_json::json!({ "sarsa": summaries[0], "pada": summaries[1], "wall_s": wall });
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&json).map_err(anyhow::Error::from)?
+        );
         return Ok(());
     }
     let (s, p) = (&summaries[0], &summaries[1]);
@@ -61,27 +81,42 @@ pub fn run(args: DemoArgs) -> Result<(), CliError> {
         "Simulated pendulum of Section VII, {} trials × {} s of learning each (seed {}):\n",
         args.trials, seconds, args.trial.seed
     );
-    println!("{:<22} {:>18} {:>18} {:>18}", "", "SARSA(λ)", "PADA Δ=0.5", "paper SARSA(λ)");
+    println!(
+        "{:<22} {:>18} {:>18} {:>18}",
+        "", "SARSA(λ)", "PADA Δ=0.5", "paper SARSA(λ)"
+    );
     println!(
         "{:<22} {:>18} {:>18} {:>18}",
         "end performance",
         fmt_estimate(s.end_performance.mean, s.end_performance.ci95, 0, ""),
         fmt_estimate(p.end_performance.mean, p.end_performance.ci95, 0, ""),
-        format!("{:.0} ± {:.0}", SIM_SARSA_END.mean, SIM_SARSA_END.ci95.unwrap_or(f64::NAN))
+        format!(
+            "{:.0} ± {:.0}",
+            SIM_SARSA_END.mean,
+            SIM_SARSA_END.ci95.unwrap_or(f64::NAN)
+        )
     );
     println!(
         "{:<22} {:>18} {:>18} {:>18}",
         "rise time",
         fmt_estimate(s.rise_time_s.mean, s.rise_time_s.ci95, 0, " s"),
         fmt_estimate(p.rise_time_s.mean, p.rise_time_s.ci95, 0, " s"),
-        format!("{:.0} ± {:.0} s", SIM_SARSA_RISE_S.mean, SIM_SARSA_RISE_S.ci95.unwrap_or(f64::NAN))
+        format!(
+            "{:.0} ± {:.0} s",
+            SIM_SARSA_RISE_S.mean,
+            SIM_SARSA_RISE_S.ci95.unwrap_or(f64::NAN)
+        )
     );
     println!(
         "{:<22} {:>18} {:>18} {:>18}",
         "MTBF (1200 actions)",
         fmt_mtbf(s.mtbf_s.mean, s.mtbf_s.ci95),
         fmt_mtbf(p.mtbf_s.mean, p.mtbf_s.ci95),
-        format!("{:.0} ± {:.0} s", SIM_SARSA_MTBF_S.mean, SIM_SARSA_MTBF_S.ci95.unwrap_or(f64::NAN))
+        format!(
+            "{:.0} ± {:.0} s",
+            SIM_SARSA_MTBF_S.mean,
+            SIM_SARSA_MTBF_S.ci95.unwrap_or(f64::NAN)
+        )
     );
     println!(
         "{:<22} {:>18.0} {:>18.0} {:>18}",

@@ -32,23 +32,33 @@ struct Output<'a> {
 /// Runs `pada mtbf`.
 pub fn run(args: MtbfArgs) -> Result<(), CliError> {
     if !(args.rate.is_finite() && args.rate > 0.0 && args.rate <= 1e6) {
-        return Err(usage(format!("--rate {} is out of range: valid is 0 < rate <= 1000000 (Hz)", args.rate)));
+        return Err(usage(format!(
+            "--rate {} is out of range: valid is 0 < rate <= 1000000 (Hz)",
+            args.rate
+        )));
     }
     let log = torque_log::read(&args.torques)?;
     let period = 1.0 / args.rate;
     let mut joints = Vec::new();
     for (j, name) in log.joints.iter().enumerate() {
-        let mut f = JointFatigue::new(&GearboxParams::TABLE_I, Some(args.window)).map_err(|e| usage(e.to_string()))?;
+        let mut f = JointFatigue::new(&GearboxParams::TABLE_I, Some(args.window))
+            .map_err(|e| usage(e.to_string()))?;
         for row in &log.rows {
             f.update(row[j]).map_err(|e| usage(e.to_string()))?;
         }
-        joints.push(JointMtbf { joint: name.clone(), report: f.report(period) });
+        joints.push(JointMtbf {
+            joint: name.clone(),
+            report: f.report(period),
+        });
     }
     let robot_window = joints
         .iter()
         .filter_map(|j| j.report.window.map(|w| w.mtbf_s))
         .fold(f64::INFINITY, f64::min);
-    let robot = joints.iter().map(|j| j.report.mtbf_s).fold(f64::INFINITY, f64::min);
+    let robot = joints
+        .iter()
+        .map(|j| j.report.mtbf_s)
+        .fold(f64::INFINITY, f64::min);
     if args.json {
         let out = Output {
             file: args.torques.display().to_string(),
@@ -59,7 +69,10 @@ pub fn run(args: MtbfArgs) -> Result<(), CliError> {
             robot_window_mtbf_s: robot_window,
             robot_mtbf_s: robot,
         };
-        println!("{}", serde_json::to_string_pretty(&out).map_err(anyhow::Error::from)?);
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&out).map_err(anyhow::Error::from)?
+        );
         return Ok(());
     }
     println!(
@@ -89,7 +102,11 @@ pub fn run(args: MtbfArgs) -> Result<(), CliError> {
         );
     }
     println!("(* = first {} steps, the paper's MTBF window)", args.window);
-    println!("robot MTBF (weakest joint): {} over the window, {} over the whole log", fmt_s(robot_window), fmt_s(robot));
+    println!(
+        "robot MTBF (weakest joint): {} over the window, {} over the whole log",
+        fmt_s(robot_window),
+        fmt_s(robot)
+    );
     Ok(())
 }
 

@@ -8,7 +8,9 @@ use crate::output::OutDir;
 use crate::paper::numbers::{PHYS_TRIALS, SIM_TRIALS};
 use crate::paper::pendulum::{self, ConfigResult, PendulumOptions, PendulumResults};
 use crate::paper::report;
-use crate::plot::figures::{Curve, LearningCurves, Measure, MtbfSweep, PerformanceVsMtbf, SweepPoint};
+use crate::plot::figures::{
+    Curve, LearningCurves, Measure, MtbfSweep, PerformanceVsMtbf, SweepPoint,
+};
 use crate::plot::save;
 use crate::progress::steps_bar;
 
@@ -49,12 +51,22 @@ fn pendulum_cmd(args: PaperArgs) -> Result<(), CliError> {
         ("report.md".to_string(), report.clone().into_bytes()),
         (
             "summary.json".to_string(),
-            (serde_json::to_string_pretty(&results).map_err(anyhow::Error::from)? + "\n").into_bytes(),
+            (serde_json::to_string_pretty(&results).map_err(anyhow::Error::from)? + "\n")
+                .into_bytes(),
         ),
-        ("simulated.csv".to_string(), configs_csv(&results.simulated)?),
+        (
+            "simulated.csv".to_string(),
+            configs_csv(&results.simulated)?,
+        ),
         ("physical.csv".to_string(), configs_csv(&results.physical)?),
-        ("physical-curves.csv".to_string(), curves_csv(&results.physical)?),
-        ("simulated-curves.csv".to_string(), curves_csv(&results.simulated)?),
+        (
+            "physical-curves.csv".to_string(),
+            curves_csv(&results.physical)?,
+        ),
+        (
+            "simulated-curves.csv".to_string(),
+            curves_csv(&results.simulated)?,
+        ),
     ];
     out.write_all(&files)?;
     draw_figures(&results, &out)?;
@@ -92,7 +104,11 @@ fn point(c: &ConfigResult) -> SweepPoint {
 fn curves(cs: &[ConfigResult], pick: impl Fn(&ConfigResult) -> bool) -> Vec<Curve> {
     cs.iter()
         .filter(|c| pick(c))
-        .map(|c| Curve { label: label(&c.policy), algo: algo_of(&c.policy), points: c.curve.clone() })
+        .map(|c| Curve {
+            label: label(&c.policy),
+            algo: algo_of(&c.policy),
+            points: c.curve.clone(),
+        })
         .collect()
 }
 
@@ -110,8 +126,18 @@ fn draw_figures(r: &PendulumResults, out: &OutDir) -> anyhow::Result<()> {
         "fig3-mtbf",
     )?;
     for (measure, stem, title, threshold) in [
-        (Measure::EndPerformance, "fig4-end-performance", "Fig. 4 — end performance against MTBF", r.objective.end_threshold),
-        (Measure::RiseTime, "fig5-rise-time", "Fig. 5 — rise time against MTBF", r.objective.rise_threshold_s),
+        (
+            Measure::EndPerformance,
+            "fig4-end-performance",
+            "Fig. 4 — end performance against MTBF",
+            r.objective.end_threshold,
+        ),
+        (
+            Measure::RiseTime,
+            "fig5-rise-time",
+            "Fig. 5 — rise time against MTBF",
+            r.objective.rise_threshold_s,
+        ),
     ] {
         save(
             &PerformanceVsMtbf {
@@ -173,7 +199,9 @@ fn configs_csv(cs: &[ConfigResult]) -> anyhow::Result<Vec<u8>> {
         let m = &c.summary;
         w.write_record([
             c.algo().name().to_string(),
-            parameter_of(&c.policy).map(|p| p.to_string()).unwrap_or_default(),
+            parameter_of(&c.policy)
+                .map(|p| p.to_string())
+                .unwrap_or_default(),
             m.trials.to_string(),
             m.mtbf_s.mean.to_string(),
             m.mtbf_s.ci95.to_string(),
@@ -190,12 +218,21 @@ fn configs_csv(cs: &[ConfigResult]) -> anyhow::Result<Vec<u8>> {
 /// Mean learning curves, one row per (configuration, test run).
 fn curves_csv(cs: &[ConfigResult]) -> anyhow::Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record(["algo", "parameter", "test_run", "learning_time_s", "mean_return", "ci95"])?;
+    w.write_record([
+        "algo",
+        "parameter",
+        "test_run",
+        "learning_time_s",
+        "mean_return",
+        "ci95",
+    ])?;
     for c in cs {
         for (i, p) in c.curve.iter().enumerate() {
             w.write_record([
                 c.algo().name().to_string(),
-                parameter_of(&c.policy).map(|p| p.to_string()).unwrap_or_default(),
+                parameter_of(&c.policy)
+                    .map(|p| p.to_string())
+                    .unwrap_or_default(),
                 i.to_string(),
                 p.learning_time_s.to_string(),
                 p.mean.to_string(),

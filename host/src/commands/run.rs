@@ -48,11 +48,19 @@ impl TaskVisitor for RunVisitor {
             trials: args.trials.unwrap_or(spec.default_trials),
             seed: args.trial.seed,
         };
-        let out_path = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("pada-out/run-{}-{}", spec.name, args.algo)));
+        let out_path = args
+            .out
+            .clone()
+            .unwrap_or_else(|| PathBuf::from(format!("pada-out/run-{}-{}", spec.name, args.algo)));
         let out = OutDir::check(&out_path)?;
         set_threads(args.trial.threads)?;
 
-        let total = cfg.trials as u64 * cfg.expected_steps(spec.control_period_s, spec.episode_steps, spec.test_interval);
+        let total = cfg.trials as u64
+            * cfg.expected_steps(
+                spec.control_period_s,
+                spec.episode_steps,
+                spec.test_interval,
+            );
         let bar = steps_bar(total, &format!("{} {}", spec.name, label(&policy)));
         let start = Instant::now();
         let results = run_trials(task, &cfg, &|n| bar.inc(n))?;
@@ -77,9 +85,18 @@ pub fn print_summary(s: &RunSummary, label: &str) {
         "{}, {}: {} trials of {} s learning (seed {})",
         s.task, label, s.trials, s.parameters.seconds, s.parameters.seed
     );
-    println!("  end performance      {}", fmt_estimate(s.end_performance.mean, s.end_performance.ci95, 1, ""));
-    println!("  rise time            {}", fmt_estimate(s.rise_time_s.mean, s.rise_time_s.ci95, 0, " s"));
-    println!("  MTBF (1200 actions)  {}", fmt_mtbf(s.mtbf_s.mean, s.mtbf_s.ci95));
+    println!(
+        "  end performance      {}",
+        fmt_estimate(s.end_performance.mean, s.end_performance.ci95, 1, "")
+    );
+    println!(
+        "  rise time            {}",
+        fmt_estimate(s.rise_time_s.mean, s.rise_time_s.ci95, 0, " s")
+    );
+    println!(
+        "  MTBF (1200 actions)  {}",
+        fmt_mtbf(s.mtbf_s.mean, s.mtbf_s.ci95)
+    );
     println!(
         "  wall {:.1} s, {:.0} env steps/s on {} threads",
         s.wall_s, s.env_steps_per_s, s.threads

@@ -34,11 +34,24 @@ pub fn build_agent(spec: &TaskSpec, policy: PolicyKind) -> anyhow::Result<HostAg
             for i in 0..p.extension_len() {
                 dims.push(p.extension_dim(i).map_err(err)?);
             }
-            let coder = TileCoder::<TILINGS>::new(&dims, p.learner_space().joint_count(), Layout::Exact, u32::MAX as usize)
-                .map_err(err)?;
+            let coder = TileCoder::<TILINGS>::new(
+                &dims,
+                p.learner_space().joint_count(),
+                Layout::Exact,
+                u32::MAX as usize,
+            )
+            .map_err(err)?;
             (Layout::Exact, coder.exact_size().unwrap_or(0))
         }
     };
     let weights = vec![Q16::ZERO; size].into_boxed_slice();
-    Agent::new(&spec.state, spec.motor.clone(), policy, spec.params, layout, weights).map_err(err)
+    Agent::new(
+        &spec.state,
+        spec.motor.clone(),
+        policy,
+        spec.params,
+        layout,
+        weights,
+    )
+    .map_err(err)
 }

@@ -22,7 +22,13 @@ pub fn rise_time(times: &[f64], returns: &[f64]) -> Option<f64> {
     let end = end_performance(returns)?;
     let first = returns[0];
     let target = first + 0.95 * (end - first);
-    let reached = |r: f64| if end >= first { r >= target } else { r <= target };
+    let reached = |r: f64| {
+        if end >= first {
+            r >= target
+        } else {
+            r <= target
+        }
+    };
     returns.iter().position(|&r| reached(r)).map(|k| times[k])
 }
 
@@ -49,7 +55,10 @@ mod tests {
         // t = τ·ln 20 ≈ 599 s, so the first test at or after it is 600 s.
         let tau = 200.0;
         let times: Vec<f64> = (0..=200).map(|k| k as f64 * 30.0).collect();
-        let returns: Vec<f64> = times.iter().map(|t| -3000.0 + 2200.0 * (1.0 - (-t / tau).exp())).collect();
+        let returns: Vec<f64> = times
+            .iter()
+            .map(|t| -3000.0 + 2200.0 * (1.0 - (-t / tau).exp()))
+            .collect();
         let end = end_performance(&returns).unwrap();
         assert!((end + 800.0).abs() < 1e-6, "{end}");
         assert_eq!(rise_time(&times, &returns), Some(600.0));
@@ -59,10 +68,14 @@ mod tests {
     fn rise_time_takes_the_first_crossing_and_handles_decline() {
         let times = [0.0, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 90.0];
         // A spike at 20 s crosses before the plateau: the first crossing counts.
-        let r = [-100.0, -90.0, -5.0, -50.0, -20.0, -10.0, -10.0, -10.0, -10.0, -10.0];
+        let r = [
+            -100.0, -90.0, -5.0, -50.0, -20.0, -10.0, -10.0, -10.0, -10.0, -10.0,
+        ];
         assert_eq!(rise_time(&times, &r), Some(20.0));
         // A falling curve: 95% of the fall from 0 to −100 is −95.
-        let r = [0.0, -50.0, -94.0, -96.0, -100.0, -100.0, -100.0, -100.0, -100.0, -100.0];
+        let r = [
+            0.0, -50.0, -94.0, -96.0, -100.0, -100.0, -100.0, -100.0, -100.0, -100.0,
+        ];
         assert_eq!(rise_time(&times, &r), Some(30.0));
         // Flat: reached at once.
         assert_eq!(rise_time(&times, &[-5.0; 10]), Some(0.0));

@@ -51,11 +51,19 @@ pub fn run_configs<T: Task>(
     cfgs: &[RunConfig],
     progress: &(dyn Fn(u64) + Sync),
 ) -> anyhow::Result<Vec<Vec<TrialResult>>> {
-    let jobs: Vec<(usize, u32)> =
-        cfgs.iter().enumerate().flat_map(|(c, cfg)| (0..cfg.trials).map(move |t| (c, t))).collect();
-    let results: Vec<TrialResult> =
-        jobs.par_iter().map(|&(c, t)| run_trial(task, &cfgs[c], t, progress)).collect::<anyhow::Result<_>>()?;
-    let mut out: Vec<Vec<TrialResult>> = cfgs.iter().map(|c| Vec::with_capacity(c.trials as usize)).collect();
+    let jobs: Vec<(usize, u32)> = cfgs
+        .iter()
+        .enumerate()
+        .flat_map(|(c, cfg)| (0..cfg.trials).map(move |t| (c, t)))
+        .collect();
+    let results: Vec<TrialResult> = jobs
+        .par_iter()
+        .map(|&(c, t)| run_trial(task, &cfgs[c], t, progress))
+        .collect::<anyhow::Result<_>>()?;
+    let mut out: Vec<Vec<TrialResult>> = cfgs
+        .iter()
+        .map(|c| Vec::with_capacity(c.trials as usize))
+        .collect();
     for (&(c, _), r) in jobs.iter().zip(results) {
         out[c].push(r);
     }

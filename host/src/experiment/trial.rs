@@ -75,8 +75,12 @@ pub fn run_trial<T: Task>(
     let mut rng = trial_rng(cfg.seed, trial);
     let mut agent = build_agent(spec, cfg.policy)?;
     agent.reset_weights(&mut rng);
-    let fatigue = FatigueCounter::new(GearboxParams::TABLE_I, spec.control_period_s, Some(PAPER_WINDOW_STEPS))
-        .map_err(|e| anyhow!("{e}"))?;
+    let fatigue = FatigueCounter::new(
+        GearboxParams::TABLE_I,
+        spec.control_period_s,
+        Some(PAPER_WINDOW_STEPS),
+    )
+    .map_err(|e| anyhow!("{e}"))?;
     let mut t = Trial {
         spec,
         agent,
@@ -84,7 +88,9 @@ pub fn run_trial<T: Task>(
         rng,
         fatigue,
         obs: [0.0; MAX_STATE_DIMS],
-        switch_step: cfg.switch_at_s.map(|s| (s / spec.control_period_s).round() as u64),
+        switch_step: cfg
+            .switch_at_s
+            .map(|s| (s / spec.control_period_s).round() as u64),
         learning_steps: 0,
         test_steps: 0,
         episodes: 0,
@@ -111,7 +117,12 @@ pub fn run_trial<T: Task>(
         end_performance: end_performance(&returns).unwrap_or(f64::NAN),
         rise_time_s: rise_time(&times, &returns).unwrap_or(f64::NAN),
         mtbf_s: t.fatigue.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
-        window_reengagements: t.fatigue.joints().iter().filter_map(|j| j.window_reengagements()).sum(),
+        window_reengagements: t
+            .fatigue
+            .joints()
+            .iter()
+            .filter_map(|j| j.window_reengagements())
+            .sum(),
         learning_steps: t.learning_steps,
         test_steps: t.test_steps,
         saturations: stats.saturations,
@@ -172,27 +183,41 @@ impl<P: Plant> Trial<'_, P> {
             self.maybe_switch()?;
         }
         self.plant.reset(&mut self.rng, &mut self.obs[..n]);
-        let mut d: Decision = self.agent.start_episode(&self.obs[..n], &mut self.rng).map_err(bad)?;
+        let mut d: Decision = self
+            .agent
+            .start_episode(&self.obs[..n], &mut self.rng)
+            .map_err(bad)?;
         let mut ret = 0.0f64;
         for k in 1..=spec.episode_steps {
             let command = &d.output[..motors];
             if learning {
-                self.fatigue.update(&self.plant.gearbox_torques(command)).map_err(|e| anyhow!("{e}"))?;
+                self.fatigue
+                    .update(&self.plant.gearbox_torques(command))
+                    .map_err(|e| anyhow!("{e}"))?;
                 self.learning_steps += 1;
             }
             let step = self.plant.step(command, &mut self.obs[..n]);
             ret += step.reward as f64;
             let obs = &self.obs[..n];
             if step.terminal || k == spec.episode_steps {
-                let end = if step.terminal { EpisodeEnd::Absorbing } else { EpisodeEnd::Timeout(obs) };
-                self.agent.end_episode(step.reward, end, &mut self.rng).map_err(bad)?;
+                let end = if step.terminal {
+                    EpisodeEnd::Absorbing
+                } else {
+                    EpisodeEnd::Timeout(obs)
+                };
+                self.agent
+                    .end_episode(step.reward, end, &mut self.rng)
+                    .map_err(bad)?;
                 return Ok((ret, k));
             }
             if learning {
                 self.maybe_switch()?;
             }
             let obs = &self.obs[..n];
-            d = self.agent.step(step.reward, obs, &mut self.rng).map_err(bad)?;
+            d = self
+                .agent
+                .step(step.reward, obs, &mut self.rng)
+                .map_err(bad)?;
         }
         Ok((ret, spec.episode_steps))
     }

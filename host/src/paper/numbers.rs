@@ -11,11 +11,20 @@ pub struct Published {
 }
 
 /// SARSA(λ) on the simulated pendulum: end performance −851 (±39).
-pub const SIM_SARSA_END: Published = Published { mean: -851.0, ci95: Some(39.0) };
+pub const SIM_SARSA_END: Published = Published {
+    mean: -851.0,
+    ci95: Some(39.0),
+};
 /// SARSA(λ) on the simulated pendulum: rise time 681 s (±67).
-pub const SIM_SARSA_RISE_S: Published = Published { mean: 681.0, ci95: Some(67.0) };
+pub const SIM_SARSA_RISE_S: Published = Published {
+    mean: 681.0,
+    ci95: Some(67.0),
+};
 /// SARSA(λ) on the simulated pendulum: MTBF 1596 s (±34).
-pub const SIM_SARSA_MTBF_S: Published = Published { mean: 1596.0, ci95: Some(34.0) };
+pub const SIM_SARSA_MTBF_S: Published = Published {
+    mean: 1596.0,
+    ci95: Some(34.0),
+};
 /// The paper's end-performance threshold derived from SARSA(λ): −1093.
 pub const SIM_END_THRESHOLD: f64 = -1093.0;
 /// The paper's rise-time threshold derived from SARSA(λ): 839 s.

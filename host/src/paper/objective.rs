@@ -67,7 +67,8 @@ impl Objective {
         Verdict {
             end_ok: end.mean - width(end) > self.end_threshold,
             rise_ok: rise_s.mean + width(rise_s) < self.rise_threshold_s,
-            mtbf_up: mtbf_s.mean - width(mtbf_s) > self.sarsa_mtbf_s.mean + width(&self.sarsa_mtbf_s),
+            mtbf_up: mtbf_s.mean - width(mtbf_s)
+                > self.sarsa_mtbf_s.mean + width(&self.sarsa_mtbf_s),
         }
     }
 }
@@ -94,7 +95,11 @@ mod tests {
 
     #[test]
     fn verdicts_use_the_whole_interval() {
-        let o = Objective { end_threshold: -1093.0, rise_threshold_s: 839.0, sarsa_mtbf_s: est(1596.0, 34.0) };
+        let o = Objective {
+            end_threshold: -1093.0,
+            rise_threshold_s: 839.0,
+            sarsa_mtbf_s: est(1596.0, 34.0),
+        };
         let good = o.judge(&est(-900.0, 50.0), &est(700.0, 60.0), &est(3200.0, 100.0));
         assert!(good.meets());
         // Mean above the line but the interval crosses it.

@@ -100,43 +100,108 @@ pub struct PendulumResults {
 /// The simulated-pendulum configurations, SARSA(λ) first.
 pub fn simulated_policies() -> Vec<PolicyKind> {
     let mut p = vec![PolicyKind::Sarsa];
-    p.extend(LOWPASS_ALPHAS.iter().map(|&alpha| PolicyKind::LowPass { alpha }));
-    p.extend(LOWPASS_ALPHAS.iter().map(|&alpha| PolicyKind::MarkovLowPass { alpha }));
-    p.extend(INTEGRATOR_DELTAS.iter().map(|&delta| PolicyKind::Integrator { delta }));
-    p.extend(INTEGRATOR_DELTAS.iter().map(|&delta| PolicyKind::MarkovIntegrator { delta }));
+    p.extend(
+        LOWPASS_ALPHAS
+            .iter()
+            .map(|&alpha| PolicyKind::LowPass { alpha }),
+    );
+    p.extend(
+        LOWPASS_ALPHAS
+            .iter()
+            .map(|&alpha| PolicyKind::MarkovLowPass { alpha }),
+    );
+    p.extend(
+        INTEGRATOR_DELTAS
+            .iter()
+            .map(|&delta| PolicyKind::Integrator { delta }),
+    );
+    p.extend(
+        INTEGRATOR_DELTAS
+            .iter()
+            .map(|&delta| PolicyKind::MarkovIntegrator { delta }),
+    );
     p.extend(PADA_DELTAS.iter().map(|&delta| PolicyKind::Pada { delta }));
     p
 }
 
 /// The physical-pendulum configurations of the paper's experiment.
 pub fn physical_policies() -> Vec<PolicyKind> {
-    vec![PolicyKind::Sarsa, PolicyKind::LowPass { alpha: 0.834 }, PolicyKind::Pada { delta: 0.5 }]
+    vec![
+        PolicyKind::Sarsa,
+        PolicyKind::LowPass { alpha: 0.834 },
+        PolicyKind::Pada { delta: 0.5 },
+    ]
 }
 
 /// Environment steps the whole experiment takes (for a progress bar).
 pub fn expected_steps(o: &PendulumOptions) -> u64 {
     fn steps<T: Task>(task: &T, configs: usize, trials: u32, seconds: f64) -> u64 {
         let s = task.spec();
-        let cfg = RunConfig { policy: PolicyKind::Sarsa, switch_at_s: None, seconds, trials, seed: 0 };
-        configs as u64 * trials as u64 * cfg.expected_steps(s.control_period_s, s.episode_steps, s.test_interval)
+        let cfg = RunConfig {
+            policy: PolicyKind::Sarsa,
+            switch_at_s: None,
+            seconds,
+            trials,
+            seed: 0,
+        };
+        configs as u64
+            * trials as u64
+            * cfg.expected_steps(s.control_period_s, s.episode_steps, s.test_interval)
     }
-    steps(&SimulatedPendulumTask::default(), simulated_policies().len(), o.sim_trials, o.sim_seconds)
-        + steps(&PhysicalPendulumTask::default(), physical_policies().len(), o.phys_trials, o.phys_seconds)
+    steps(
+        &SimulatedPendulumTask::default(),
+        simulated_policies().len(),
+        o.sim_trials,
+        o.sim_seconds,
+    ) + steps(
+        &PhysicalPendulumTask::default(),
+        physical_policies().len(),
+        o.phys_trials,
+        o.phys_seconds,
+    )
 }
 
 /// Runs the whole of Section VII.
-pub fn run(o: &PendulumOptions, progress: &(dyn Fn(u64) + Sync)) -> anyhow::Result<PendulumResults> {
+pub fn run(
+    o: &PendulumOptions,
+    progress: &(dyn Fn(u64) + Sync),
+) -> anyhow::Result<PendulumResults> {
     let start = std::time::Instant::now();
-    let simulated = run_task(&SimulatedPendulumTask::default(), &simulated_policies(), o.sim_trials, o.sim_seconds, o.seed, progress)?;
-    let physical = run_task(&PhysicalPendulumTask::default(), &physical_policies(), o.phys_trials, o.phys_seconds, o.seed, progress)?;
+    let simulated = run_task(
+        &SimulatedPendulumTask::default(),
+        &simulated_policies(),
+        o.sim_trials,
+        o.sim_seconds,
+        o.seed,
+        progress,
+    )?;
+    let physical = run_task(
+        &PhysicalPendulumTask::default(),
+        &physical_policies(),
+        o.phys_trials,
+        o.phys_seconds,
+        o.seed,
+        progress,
+    )?;
     let wall_s = start.elapsed().as_secs_f64();
     let sarsa = &simulated[0].summary;
-    let objective = Objective::from_sarsa(&sarsa.end_performance, &sarsa.rise_time_s, &sarsa.mtbf_s);
+    let objective =
+        Objective::from_sarsa(&sarsa.end_performance, &sarsa.rise_time_s, &sarsa.mtbf_s);
     let verdicts = simulated
         .iter()
-        .map(|c| objective.judge(&c.summary.end_performance, &c.summary.rise_time_s, &c.summary.mtbf_s))
+        .map(|c| {
+            objective.judge(
+                &c.summary.end_performance,
+                &c.summary.rise_time_s,
+                &c.summary.mtbf_s,
+            )
+        })
         .collect();
-    let env_steps = simulated.iter().chain(&physical).map(|c| c.summary.env_steps).sum();
+    let env_steps = simulated
+        .iter()
+        .chain(&physical)
+        .map(|c| c.summary.env_steps)
+        .sum();
     Ok(PendulumResults {
         options: *o,
         simulated,
@@ -157,8 +222,16 @@ fn run_task<T: Task>(
     seed: u64,
     progress: &(dyn Fn(u64) + Sync),
 ) -> anyhow::Result<Vec<ConfigResult>> {
-    let cfgs: Vec<RunConfig> =
-        policies.iter().map(|&policy| RunConfig { policy, switch_at_s: None, seconds, trials, seed }).collect();
+    let cfgs: Vec<RunConfig> = policies
+        .iter()
+        .map(|&policy| RunConfig {
+            policy,
+            switch_at_s: None,
+            seconds,
+            trials,
+            seed,
+        })
+        .collect();
     let results = run_configs(task, &cfgs, progress)?;
     Ok(cfgs
         .iter()
@@ -179,8 +252,16 @@ pub fn mean_curve(results: &[TrialResult]) -> Vec<CurvePoint> {
         .map(|k| {
             let returns: Vec<f64> = results.iter().map(|r| r.curve[k].test_return).collect();
             let e = Estimate::of(&returns);
-            let t = results.iter().map(|r| r.curve[k].learning_time_s).sum::<f64>() / results.len() as f64;
-            CurvePoint { learning_time_s: t, mean: e.mean, ci95: e.ci95 }
+            let t = results
+                .iter()
+                .map(|r| r.curve[k].learning_time_s)
+                .sum::<f64>()
+                / results.len() as f64;
+            CurvePoint {
+                learning_time_s: t,
+                mean: e.mean,
+                ci95: e.ci95,
+            }
         })
         .collect()
 }

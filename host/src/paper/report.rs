@@ -9,11 +9,26 @@ use std::fmt::Write;
 
 /// The figure files, `(stem, caption)`.
 pub const FIGURES: [(&str, &str); 5] = [
-    ("fig3-mtbf", "Fig. 3: predicted MTBF against α or Δ (simulated pendulum)"),
-    ("fig4-end-performance", "Fig. 4: end performance against MTBF (simulated pendulum)"),
-    ("fig5-rise-time", "Fig. 5: rise time against MTBF (simulated pendulum)"),
-    ("fig6-physical-curves", "Fig. 6: learning curves on the physical pendulum's model"),
-    ("fig6-simulated-curves", "Fig. 6 style: learning curves on the simulated pendulum"),
+    (
+        "fig3-mtbf",
+        "Fig. 3: predicted MTBF against α or Δ (simulated pendulum)",
+    ),
+    (
+        "fig4-end-performance",
+        "Fig. 4: end performance against MTBF (simulated pendulum)",
+    ),
+    (
+        "fig5-rise-time",
+        "Fig. 5: rise time against MTBF (simulated pendulum)",
+    ),
+    (
+        "fig6-physical-curves",
+        "Fig. 6: learning curves on the physical pendulum's model",
+    ),
+    (
+        "fig6-simulated-curves",
+        "Fig. 6 style: learning curves on the simulated pendulum",
+    ),
 ];
 
 fn pm(e: &Estimate, digits: usize) -> String {
@@ -59,8 +74,9 @@ fn yes(b: bool) -> &'static str {
     }
 }
 
-fn find<'a>(cs: &'a [ConfigResult], algo: Algo, param: Option<f32>) -> Option<&'a ConfigResult> {
-    cs.iter().find(|c| c.algo() == algo && parameter_of(&c.policy) == param)
+fn find(cs: &[ConfigResult], algo: Algo, param: Option<f32>) -> Option<&ConfigResult> {
+    cs.iter()
+        .find(|c| c.algo() == algo && parameter_of(&c.policy) == param)
 }
 
 /// The report as Markdown. `command` is the command line that produced it.
@@ -68,7 +84,10 @@ pub fn render(r: &PendulumResults, command: &str) -> String {
     let mut s = String::new();
     let o = &r.options;
     let sarsa = &r.simulated[0].summary;
-    let _ = writeln!(s, "# The pendulum experiments of Section VII, reproduced by pada\n");
+    let _ = writeln!(
+        s,
+        "# The pendulum experiments of Section VII, reproduced by pada\n"
+    );
     let _ = writeln!(
         s,
         "Produced by `{command}`: {} configurations × {} trials × {} s of learning on the simulated pendulum, \
@@ -96,7 +115,10 @@ pub fn render(r: &PendulumResults, command: &str) -> String {
 
     // --- SARSA baseline -------------------------------------------------------
     let _ = writeln!(s, "## SARSA(λ) on the simulated pendulum\n");
-    let _ = writeln!(s, "| measure | paper | pada | pada − paper |\n|---|---|---|---|");
+    let _ = writeln!(
+        s,
+        "| measure | paper | pada | pada − paper |\n|---|---|---|---|"
+    );
     let _ = writeln!(
         s,
         "| end performance | {} | {} | {} |",
@@ -135,11 +157,22 @@ pub fn render(r: &PendulumResults, command: &str) -> String {
          threshold, and its MTBF interval lies above SARSA(λ)'s.\n"
     );
     let _ = writeln!(s, "| threshold | paper | pada |\n|---|---|---|");
-    let _ = writeln!(s, "| end performance above | {SIM_END_THRESHOLD:.0} | {:.0} |", obj.end_threshold);
-    let _ = writeln!(s, "| rise time below [s] | {SIM_RISE_THRESHOLD_S:.0} | {:.0} |\n", obj.rise_threshold_s);
+    let _ = writeln!(
+        s,
+        "| end performance above | {SIM_END_THRESHOLD:.0} | {:.0} |",
+        obj.end_threshold
+    );
+    let _ = writeln!(
+        s,
+        "| rise time below [s] | {SIM_RISE_THRESHOLD_S:.0} | {:.0} |\n",
+        obj.rise_threshold_s
+    );
 
     // --- all configurations ---------------------------------------------------
-    let _ = writeln!(s, "## All algorithms on the simulated pendulum (Figs. 3–5)\n");
+    let _ = writeln!(
+        s,
+        "## All algorithms on the simulated pendulum (Figs. 3–5)\n"
+    );
     let _ = writeln!(
         s,
         "| algorithm | MTBF [s] | × SARSA(λ) | re-engagements | end performance | rise time [s] | end ok | rise ok | MTBF up | meets objective |\n\
@@ -150,7 +183,13 @@ pub fn render(r: &PendulumResults, command: &str) -> String {
         let verdicts = if i == 0 {
             "baseline | baseline | baseline | baseline".to_string()
         } else {
-            format!("{} | {} | {} | **{}**", yes(v.end_ok), yes(v.rise_ok), yes(v.mtbf_up), yes(v.meets()))
+            format!(
+                "{} | {} | {} | **{}**",
+                yes(v.end_ok),
+                yes(v.rise_ok),
+                yes(v.mtbf_up),
+                yes(v.meets())
+            )
         };
         let _ = writeln!(
             s,
@@ -177,8 +216,15 @@ pub fn render(r: &PendulumResults, command: &str) -> String {
          objective, both with about {SIM_MTBF_FACTOR:.0}× SARSA(λ)'s MTBF; the plain integrating controller misses \
          the end performance and both Markov variants miss the rise time.\n"
     );
-    for (algo, p) in [(Algo::Lowpass, SIM_LOWPASS_ALPHA), (Algo::Pada, SIM_PADA_DELTA)] {
-        if let Some(i) = r.simulated.iter().position(|c| c.algo() == algo && parameter_of(&c.policy) == Some(p)) {
+    for (algo, p) in [
+        (Algo::Lowpass, SIM_LOWPASS_ALPHA),
+        (Algo::Pada, SIM_PADA_DELTA),
+    ] {
+        if let Some(i) = r
+            .simulated
+            .iter()
+            .position(|c| c.algo() == algo && parameter_of(&c.policy) == Some(p))
+        {
             let c = &r.simulated[i];
             let v = r.verdicts[i];
             let _ = writeln!(
@@ -195,12 +241,22 @@ pub fn render(r: &PendulumResults, command: &str) -> String {
             );
         }
     }
-    let meeting: Vec<String> =
-        r.simulated.iter().zip(&r.verdicts).skip(1).filter(|(_, v)| v.meets()).map(|(c, _)| label(&c.policy)).collect();
+    let meeting: Vec<String> = r
+        .simulated
+        .iter()
+        .zip(&r.verdicts)
+        .skip(1)
+        .filter(|(_, v)| v.meets())
+        .map(|(c, _)| label(&c.policy))
+        .collect();
     let _ = writeln!(
         s,
         "- Configurations that meet the objective in this run: {}.\n",
-        if meeting.is_empty() { "none".to_string() } else { meeting.join(", ") }
+        if meeting.is_empty() {
+            "none".to_string()
+        } else {
+            meeting.join(", ")
+        }
     );
 
     // --- physical pendulum ----------------------------------------------------
@@ -243,7 +299,10 @@ pub fn render(r: &PendulumResults, command: &str) -> String {
     }
 
     // --- differences ----------------------------------------------------------
-    let _ = writeln!(s, "## Where pada differs from the paper, and why it might\n");
+    let _ = writeln!(
+        s,
+        "## Where pada differs from the paper, and why it might\n"
+    );
     let rel = |a: f64, b: f64| 100.0 * (a - b) / b.abs();
     let _ = writeln!(
         s,
@@ -259,9 +318,10 @@ pub fn render(r: &PendulumResults, command: &str) -> String {
         SIM_SARSA_MTBF_S.mean,
         rel(sarsa.mtbf_s.mean, SIM_SARSA_MTBF_S.mean)
     );
-    if let (Some(lp), Some(pd)) =
-        (find(&r.physical, Algo::Lowpass, Some(0.834)), find(&r.physical, Algo::Pada, Some(0.5)))
-    {
+    if let (Some(lp), Some(pd)) = (
+        find(&r.physical, Algo::Lowpass, Some(0.834)),
+        find(&r.physical, Algo::Pada, Some(0.5)),
+    ) {
         let _ = writeln!(
             s,
             "- Physical pendulum MTBF: pada/paper = {:.2} (SARSA(λ)), {:.2} (low-pass), {:.2} (PADA); the ratios to \
@@ -281,8 +341,9 @@ pub fn render(r: &PendulumResults, command: &str) -> String {
          interval or learning time per trial. pada uses 3 s episodes, 16 tilings of 20 angle tiles × π rad/s, \
          weights U[0, 1], a test run every 10 learning episodes and {} s (physical: {} s) of learning; the end \
          performance scales with the episode length and the rise time with the learning time, so both depend on \
-         these choices. A hand-written energy-pumping swing-up controller scores about −864 on a 3 s episode, \
-         close to the paper's −851, which supports the 3 s choice.",
+         these choices. A hand-written energy-pumping swing-up controller scores −864 on a 3 s episode \
+         (a unit test of `host/src/pendulum/simulated.rs`), close to the paper's −851, which supports the 3 s \
+         choice.",
         o.sim_seconds,
         o.phys_seconds
     );

@@ -76,7 +76,8 @@ impl PhysicalPendulumParams {
     pub fn derivative(&self, x: &[f64; 2], u: f64) -> [f64; 2] {
         let sin_theta = x[0].sin();
         let k_over_r = self.torque_constant / self.resistance_ohm;
-        let torque = self.mass_kg * self.gravity * self.length_m * sin_theta - self.damping * x[1]
+        let torque = self.mass_kg * self.gravity * self.length_m * sin_theta
+            - self.damping * x[1]
             - self.torque_constant * k_over_r * x[1]
             + k_over_r * u;
         [x[1], torque / self.inertia_kg_m2]
@@ -94,7 +95,9 @@ impl PhysicalPendulumParams {
         let friction = (self.damping + self.torque_constant * k_over_r) / self.inertia_kg_m2;
         for _ in 0..self.substeps {
             let near = SinNear::new(x[0]);
-            x = rk4_step(&x, h, |y| [y[1], gain * near.sin(y[0]) + drive - friction * y[1]]);
+            x = rk4_step(&x, h, |y| {
+                [y[1], gain * near.sin(y[0]) + drive - friction * y[1]]
+            });
         }
         x
     }
@@ -116,7 +119,10 @@ pub struct PhysicalPendulum {
 impl PhysicalPendulum {
     /// A pendulum hanging down at rest.
     pub fn new(params: PhysicalPendulumParams) -> Self {
-        PhysicalPendulum { params, x: [PI, 0.0] }
+        PhysicalPendulum {
+            params,
+            x: [PI, 0.0],
+        }
     }
 
     /// The internal state `[θ (unwrapped), θ̇]`.
@@ -141,7 +147,10 @@ impl Plant for PhysicalPendulum {
         self.x = self.params.advance(self.x, u);
         self.observe(obs);
         let reward = swing_up_reward(wrap_angle(self.x[0]), self.x[1], u);
-        Step { reward: reward as f32, terminal: false }
+        Step {
+            reward: reward as f32,
+            terminal: false,
+        }
     }
 
     fn gearbox_torques(&self, command: &[f32]) -> Output {
@@ -217,7 +226,10 @@ mod tests {
     use crate::task::Plant;
 
     fn rollout(substeps: u32) -> [f64; 2] {
-        let p = PhysicalPendulumParams { substeps, ..Default::default() };
+        let p = PhysicalPendulumParams {
+            substeps,
+            ..Default::default()
+        };
         let mut x = [PI, 0.0];
         for k in 0..100 {
             let u = if (k / 7) % 2 == 0 { 3.0 } else { -3.0 };
@@ -236,7 +248,11 @@ mod tests {
     #[test]
     fn energy_is_conserved_without_voltage_and_friction() {
         // No friction and no back-EMF (K = 0 also removes the motor).
-        let p = PhysicalPendulumParams { damping: 0.0, torque_constant: 0.0, ..Default::default() };
+        let p = PhysicalPendulumParams {
+            damping: 0.0,
+            torque_constant: 0.0,
+            ..Default::default()
+        };
         let energy = |x: &[f64; 2]| {
             0.5 * p.inertia_kg_m2 * x[1] * x[1] + p.mass_kg * p.gravity * p.length_m * x[0].cos()
         };
@@ -255,7 +271,11 @@ mod tests {
         let p = PhysicalPendulumParams::default();
         // Upright-free fall is symmetric; a spinning pendulum with the
         // motor shorted (u = 0) slows down faster than without the motor.
-        let free = PhysicalPendulumParams { torque_constant: 0.0, damping: 0.0, ..p };
+        let free = PhysicalPendulumParams {
+            torque_constant: 0.0,
+            damping: 0.0,
+            ..p
+        };
         let spin = [PI, 20.0];
         assert!(p.advance(spin, 0.0)[1].abs() < free.advance(spin, 0.0)[1].abs());
         let plant = PhysicalPendulum::new(p);

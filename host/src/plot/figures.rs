@@ -43,7 +43,13 @@ pub struct SweepPoint {
 }
 
 /// The algorithms drawn as swept lines, in the paper's order.
-const SWEPT: [Algo; 5] = [Algo::Lowpass, Algo::MarkovLowpass, Algo::Integrator, Algo::MarkovIntegrator, Algo::Pada];
+const SWEPT: [Algo; 5] = [
+    Algo::Lowpass,
+    Algo::MarkovLowpass,
+    Algo::Integrator,
+    Algo::MarkovIntegrator,
+    Algo::Pada,
+];
 
 fn finite_ci(e: &Estimate) -> f64 {
     if e.ci95.is_finite() {
@@ -101,7 +107,12 @@ impl Figure for MtbfSweep {
         let y = log_range(
             self.points
                 .iter()
-                .flat_map(|p| [p.mtbf_s.mean - finite_ci(&p.mtbf_s), p.mtbf_s.mean + finite_ci(&p.mtbf_s)])
+                .flat_map(|p| {
+                    [
+                        p.mtbf_s.mean - finite_ci(&p.mtbf_s),
+                        p.mtbf_s.mean + finite_ci(&p.mtbf_s),
+                    ]
+                })
                 .chain([s.mean - finite_ci(s), s.mean + finite_ci(s)]),
         );
         let mut chart = ChartBuilder::on(root)
@@ -123,35 +134,61 @@ impl Figure for MtbfSweep {
         for bound in [s.lower(), s.upper()] {
             if bound.is_finite() && bound > 0.0 {
                 chart
-                    .draw_series(DashedLineSeries::new(vec![(0.0, bound), (1.05, bound)], 8, 6, BLACK.stroke_width(1)))
+                    .draw_series(DashedLineSeries::new(
+                        vec![(0.0, bound), (1.05, bound)],
+                        8,
+                        6,
+                        BLACK.stroke_width(1),
+                    ))
                     .map_err(plot_err)?;
             }
         }
         for algo in SWEPT {
-            let mut pts: Vec<&SweepPoint> =
-                self.points.iter().filter(|p| p.algo == algo && p.mtbf_s.mean.is_finite()).collect();
+            let mut pts: Vec<&SweepPoint> = self
+                .points
+                .iter()
+                .filter(|p| p.algo == algo && p.mtbf_s.mean.is_finite())
+                .collect();
             pts.sort_by(|a, b| a.param.total_cmp(&b.param));
             if pts.is_empty() {
                 continue;
             }
             let c = color(algo);
             chart
-                .draw_series(LineSeries::new(pts.iter().map(|p| (p.param, p.mtbf_s.mean)), c.stroke_width(2)))
+                .draw_series(LineSeries::new(
+                    pts.iter().map(|p| (p.param, p.mtbf_s.mean)),
+                    c.stroke_width(2),
+                ))
                 .map_err(plot_err)?
                 .label(algo.title())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
+                });
             chart
                 .draw_series(pts.iter().map(|p| {
                     let e = finite_ci(&p.mtbf_s);
-                    ErrorBar::new_vertical(p.param, (p.mtbf_s.mean - e).max(y.start), p.mtbf_s.mean, p.mtbf_s.mean + e, c.filled(), 8)
+                    ErrorBar::new_vertical(
+                        p.param,
+                        (p.mtbf_s.mean - e).max(y.start),
+                        p.mtbf_s.mean,
+                        p.mtbf_s.mean + e,
+                        c.filled(),
+                        8,
+                    )
                 }))
                 .map_err(plot_err)?;
             chart
-                .draw_series(pts.iter().map(|p| Circle::new((p.param, p.mtbf_s.mean), 4, c.filled())))
+                .draw_series(
+                    pts.iter()
+                        .map(|p| Circle::new((p.param, p.mtbf_s.mean), 4, c.filled())),
+                )
                 .map_err(plot_err)?;
         }
         chart
-            .draw_series(std::iter::once(PathElement::new(vec![(0.0, s.mean), (0.0, s.mean)], BLACK)))
+            .draw_series(std::iter::once(PathElement::new(
+                vec![(0.0, s.mean), (0.0, s.mean)],
+                BLACK,
+            )))
             .map_err(plot_err)?
             .label("SARSA(λ) 95% interval (dashed)")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(1)));
@@ -206,7 +243,12 @@ impl Figure for PerformanceVsMtbf {
         DB::ErrorType: 'static,
     {
         root.fill(&WHITE).map_err(plot_err)?;
-        let x = log_range(self.points.iter().map(|p| p.mtbf_s.mean).chain([self.sarsa_mtbf_s]));
+        let x = log_range(
+            self.points
+                .iter()
+                .map(|p| p.mtbf_s.mean)
+                .chain([self.sarsa_mtbf_s]),
+        );
         let y = lin_range(
             self.points
                 .iter()
@@ -259,8 +301,11 @@ impl Figure for PerformanceVsMtbf {
             ))
             .map_err(plot_err)?;
         for algo in std::iter::once(Algo::Sarsa).chain(SWEPT) {
-            let mut pts: Vec<&SweepPoint> =
-                self.points.iter().filter(|p| p.algo == algo && p.mtbf_s.mean.is_finite()).collect();
+            let mut pts: Vec<&SweepPoint> = self
+                .points
+                .iter()
+                .filter(|p| p.algo == algo && p.mtbf_s.mean.is_finite())
+                .collect();
             pts.sort_by(|a, b| a.mtbf_s.mean.total_cmp(&b.mtbf_s.mean));
             if pts.is_empty() {
                 continue;
@@ -270,16 +315,31 @@ impl Figure for PerformanceVsMtbf {
                 .draw_series(pts.iter().map(|p| {
                     let v = self.value(p);
                     let e = finite_ci(&v);
-                    ErrorBar::new_vertical(p.mtbf_s.mean, v.mean - e, v.mean, v.mean + e, c.stroke_width(2), 8)
+                    ErrorBar::new_vertical(
+                        p.mtbf_s.mean,
+                        v.mean - e,
+                        v.mean,
+                        v.mean + e,
+                        c.stroke_width(2),
+                        8,
+                    )
                 }))
                 .map_err(plot_err)?;
-            series.label(algo.title()).legend(move |(x, y)| Circle::new((x + 10, y), 4, c.filled()));
+            series
+                .label(algo.title())
+                .legend(move |(x, y)| Circle::new((x + 10, y), 4, c.filled()));
             chart
-                .draw_series(pts.iter().map(|p| Circle::new((p.mtbf_s.mean, self.value(p).mean), 4, c.filled())))
+                .draw_series(
+                    pts.iter()
+                        .map(|p| Circle::new((p.mtbf_s.mean, self.value(p).mean), 4, c.filled())),
+                )
                 .map_err(plot_err)?;
             if algo != Algo::Sarsa {
                 chart
-                    .draw_series(LineSeries::new(pts.iter().map(|p| (p.mtbf_s.mean, self.value(p).mean)), c.mix(0.5)))
+                    .draw_series(LineSeries::new(
+                        pts.iter().map(|p| (p.mtbf_s.mean, self.value(p).mean)),
+                        c.mix(0.5),
+                    ))
                     .map_err(plot_err)?;
                 let prefix = if algo.takes_alpha() { "α" } else { "Δ" };
                 chart
@@ -369,17 +429,33 @@ impl Figure for LearningCurves {
                 .points
                 .iter()
                 .map(|p| (p.learning_time_s, p.mean + ci(p)))
-                .chain(curve.points.iter().rev().map(|p| (p.learning_time_s, p.mean - ci(p))))
+                .chain(
+                    curve
+                        .points
+                        .iter()
+                        .rev()
+                        .map(|p| (p.learning_time_s, p.mean - ci(p))),
+                )
                 .collect();
-            chart.draw_series(std::iter::once(Polygon::new(band, c.mix(0.18)))).map_err(plot_err)?;
             chart
-                .draw_series(LineSeries::new(curve.points.iter().map(|p| (p.learning_time_s, p.mean)), c.stroke_width(2)))
+                .draw_series(std::iter::once(Polygon::new(band, c.mix(0.18))))
+                .map_err(plot_err)?;
+            chart
+                .draw_series(LineSeries::new(
+                    curve.points.iter().map(|p| (p.learning_time_s, p.mean)),
+                    c.stroke_width(2),
+                ))
                 .map_err(plot_err)?
                 .label(curve.label.as_str())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
+                });
         }
         chart
-            .draw_series(LineSeries::new(vec![(x.start, self.sarsa_end), (x.end, self.sarsa_end)], BLACK.stroke_width(1)))
+            .draw_series(LineSeries::new(
+                vec![(x.start, self.sarsa_end), (x.end, self.sarsa_end)],
+                BLACK.stroke_width(1),
+            ))
             .map_err(plot_err)?
             .label(format!("SARSA(λ) end performance {:.0}", self.sarsa_end))
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(1)));

@@ -44,7 +44,8 @@ pub fn save<F: Figure>(figure: &F, dir: &Path, stem: &str) -> anyhow::Result<()>
     {
         let root = SVGBackend::with_string(&mut svg, figure.size()).into_drawing_area();
         figure.draw(&root)?;
-        root.present().map_err(|e| anyhow::anyhow!("drawing {stem}.svg: {e}"))?;
+        root.present()
+            .map_err(|e| anyhow::anyhow!("drawing {stem}.svg: {e}"))?;
     }
     crate::output::write_atomic(&dir.join(format!("{stem}.svg")), svg.as_bytes())?;
 
@@ -56,14 +57,18 @@ pub fn save<F: Figure>(figure: &F, dir: &Path, stem: &str) -> anyhow::Result<()>
     {
         let root = BitMapBackend::new(tmp.path(), figure.size()).into_drawing_area();
         figure.draw(&root)?;
-        root.present().map_err(|e| anyhow::anyhow!("drawing {stem}.png: {e}"))?;
+        root.present()
+            .map_err(|e| anyhow::anyhow!("drawing {stem}.png: {e}"))?;
     }
     let path = dir.join(format!("{stem}.png"));
-    tmp.persist(&path).map_err(|e| anyhow::anyhow!("cannot write {}: {}", path.display(), e.error))?;
+    tmp.persist(&path)
+        .map_err(|e| anyhow::anyhow!("cannot write {}: {}", path.display(), e.error))?;
     Ok(())
 }
 
 /// Maps a plotters error into anyhow.
-pub fn plot_err<E: std::error::Error + Send + Sync + 'static>(e: DrawingAreaErrorKind<E>) -> anyhow::Error {
+pub fn plot_err<E: std::error::Error + Send + Sync + 'static>(
+    e: DrawingAreaErrorKind<E>,
+) -> anyhow::Error {
     anyhow::anyhow!("plotting: {e}")
 }
