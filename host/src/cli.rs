@@ -82,6 +82,7 @@ pub struct RunArgs {
     /// Print the summary as JSON on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Seed and threads.
     #[command(flatten)]
     pub trial: TrialOptions,
 }
@@ -101,6 +102,7 @@ pub struct DemoArgs {
     /// Print both summaries as JSON on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Seed and threads.
     #[command(flatten)]
     pub trial: TrialOptions,
 }
@@ -131,6 +133,7 @@ pub struct PaperArgs {
     /// Learning time per trial on the physical pendulum [s].
     #[arg(long, value_name = "S", default_value_t = 1500.0)]
     pub physical_seconds: f64,
+    /// Seed and threads.
     #[command(flatten)]
     pub trial: TrialOptions,
 }

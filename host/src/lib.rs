@@ -2,6 +2,8 @@
 //! paper's pendulum experiments (Section VII), plots and the fatigue check
 //! of a recorded torque log.
 
+#![warn(missing_docs)]
+
 pub mod algo;
 pub mod cli;
 pub mod commands;

@@ -64,7 +64,7 @@ pub struct TaskSpec {
     /// Seconds per control step (1/sampling rate).
     pub control_period_s: f64,
     /// Control steps of an episode before the time limit (a non-absorbing
-    /// end).
+    /// end), at least 1.
     pub episode_steps: u32,
     /// The observed state, with ranges and tile widths.
     pub state: Vec<StateDim>,
@@ -75,7 +75,7 @@ pub struct TaskSpec {
     /// SARSA(λ) parameters shared by all six algorithms.
     pub params: SarsaParams,
     /// One greedy test episode after this many learning episodes
-    /// (Section VI's test runs).
+    /// (Section VI's test runs); 0 is taken as 1.
     pub test_interval: u32,
     /// Default learning time of a trial \[s of simulated time\].
     pub default_seconds: f64,

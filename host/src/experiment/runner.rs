@@ -28,8 +28,8 @@ impl RunConfig {
     /// estimate for progress bars: exact when no episode ends early).
     pub fn expected_steps(&self, period_s: f64, episode_steps: u32, test_interval: u32) -> u64 {
         let learning = (self.seconds / period_s).round() as u64;
-        let episodes = learning.div_ceil(episode_steps as u64);
-        let tests = 1 + episodes.div_ceil(test_interval as u64);
+        let episodes = learning.div_ceil(episode_steps.max(1) as u64);
+        let tests = 1 + episodes.div_ceil(test_interval.max(1) as u64);
         (episodes + tests) * episode_steps as u64
     }
 }

@@ -72,6 +72,11 @@ pub fn run_trial<T: Task>(
     progress: &(dyn Fn(u64) + Sync),
 ) -> anyhow::Result<TrialResult> {
     let spec = task.spec();
+    anyhow::ensure!(
+        spec.episode_steps >= 1,
+        "task {}: episodes must have at least one step",
+        spec.name
+    );
     let mut rng = trial_rng(cfg.seed, trial);
     let mut agent = build_agent(spec, cfg.policy)?;
     agent.reset_weights(&mut rng);
@@ -102,7 +107,7 @@ pub fn run_trial<T: Task>(
     while t.learning_steps < budget {
         let mut done = t.episode(true)?.1 as u64;
         t.episodes += 1;
-        if t.episodes % spec.test_interval == 0 || t.learning_steps >= budget {
+        if t.episodes % spec.test_interval.max(1) == 0 || t.learning_steps >= budget {
             done += t.test_run()?;
         }
         progress(done);

@@ -354,14 +354,23 @@ mod tests {
             } else {
                 0.0
             };
-            let level = if u > 0.75 { 1.5 } else if u < -0.75 { -1.5 } else { 0.0 };
+            let level = if u > 0.75 {
+                1.5
+            } else if u < -0.75 {
+                -1.5
+            } else {
+                0.0
+            };
             ret += plant.step(&[level], &mut obs).reward as f64;
         }
         eprintln!("hand-written swing-up: return {ret:.1}");
         assert!((-900.0..-820.0).contains(&ret), "return {ret}");
         // It does balance: upright and slow at the end.
         let [theta, omega] = plant.state();
-        assert!(wrap_angle(theta).abs() < 0.1 && omega.abs() < 1.0, "{theta} {omega}");
+        assert!(
+            wrap_angle(theta).abs() < 0.1 && omega.abs() < 1.0,
+            "{theta} {omega}"
+        );
     }
 
     #[test]
