@@ -30,9 +30,6 @@ fn trial_steps<T: Task>(task: &T, policy: PolicyKind) -> u64 {
 }
 
 fn bench_trials(c: &mut Criterion) {
-    // pada enables plotters' ab_glyph text, which criterion's own plots
-    // then use too: give them the embedded font.
-    pada::plot::register_fonts();
     let mut g = c.benchmark_group("pendulum_env_steps");
     let sim = SimulatedPendulumTask::default();
     let phys = PhysicalPendulumTask::default();

@@ -1,27 +1,17 @@
 //! Figures in the style of the paper's Figs. 3–6, drawn with plotters as
-//! SVG and PNG. Text uses DejaVu Sans embedded in the binary, so no system
-//! font is needed.
+//! SVG and rasterised to PNG with resvg. Text in the PNGs uses DejaVu Sans
+//! embedded in the binary, so no system font is needed.
 
 pub mod figures;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use resvg::{tiny_skia, usvg};
 use std::path::Path;
-use std::sync::Once;
+use std::sync::{Arc, OnceLock};
 
-/// The font family the figures use.
+/// The font family the figures name (resolved to DejaVu Sans in the PNGs).
 pub const FONT: &str = "sans-serif";
-
-/// Registers the embedded DejaVu Sans as [`FONT`] (once per process).
-pub fn register_fonts() {
-    static ONCE: Once = Once::new();
-    ONCE.call_once(|| {
-        // The embedded font is a valid TrueType file; a failure would only
-        // leave text undrawn in the PNGs, which the tests would notice.
-        let _ = plotters::style::register_font(FONT, FontStyle::Normal, dejavu::sans::regular());
-        let _ = plotters::style::register_font(FONT, FontStyle::Bold, dejavu::sans::bold());
-    });
-}
 
 /// A figure that can draw itself on any plotters backend.
 pub trait Figure {
@@ -36,33 +26,59 @@ pub trait Figure {
         DB::ErrorType: 'static;
 }
 
-/// Writes `<stem>.svg` and `<stem>.png` into `dir`, each through a
-/// temporary file and a rename.
-pub fn save<F: Figure>(figure: &F, dir: &Path, stem: &str) -> anyhow::Result<()> {
-    register_fonts();
+/// The figure as an SVG document.
+pub fn to_svg<F: Figure>(figure: &F) -> anyhow::Result<String> {
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, figure.size()).into_drawing_area();
         figure.draw(&root)?;
         root.present()
-            .map_err(|e| anyhow::anyhow!("drawing {stem}.svg: {e}"))?;
+            .map_err(|e| anyhow::anyhow!("drawing SVG: {e}"))?;
     }
-    crate::output::write_atomic(&dir.join(format!("{stem}.svg")), svg.as_bytes())?;
+    Ok(svg)
+}
 
-    let tmp = tempfile::Builder::new()
-        .prefix(".pada-")
-        .suffix(".png")
-        .tempfile_in(dir)
-        .map_err(|e| anyhow::anyhow!("cannot write in {}: {e}", dir.display()))?;
-    {
-        let root = BitMapBackend::new(tmp.path(), figure.size()).into_drawing_area();
-        figure.draw(&root)?;
-        root.present()
-            .map_err(|e| anyhow::anyhow!("drawing {stem}.png: {e}"))?;
-    }
-    let path = dir.join(format!("{stem}.png"));
-    tmp.persist(&path)
-        .map_err(|e| anyhow::anyhow!("cannot write {}: {}", path.display(), e.error))?;
+/// The embedded fonts, with DejaVu Sans as every generic family.
+fn fonts() -> Arc<usvg::fontdb::Database> {
+    static DB: OnceLock<Arc<usvg::fontdb::Database>> = OnceLock::new();
+    DB.get_or_init(|| {
+        let mut db = usvg::fontdb::Database::new();
+        db.load_font_data(dejavu::sans::regular().to_vec());
+        db.load_font_data(dejavu::sans::bold().to_vec());
+        db.set_sans_serif_family("DejaVu Sans");
+        db.set_serif_family("DejaVu Sans");
+        db.set_monospace_family("DejaVu Sans");
+        Arc::new(db)
+    })
+    .clone()
+}
+
+/// Rasterises an SVG document to PNG bytes.
+pub fn svg_to_png(svg: &str) -> anyhow::Result<Vec<u8>> {
+    let options = usvg::Options {
+        fontdb: fonts(),
+        font_family: "DejaVu Sans".into(),
+        ..Default::default()
+    };
+    let tree =
+        usvg::Tree::from_str(svg, &options).map_err(|e| anyhow::anyhow!("rendering SVG: {e}"))?;
+    let size = tree.size().to_int_size();
+    let mut pixmap = tiny_skia::Pixmap::new(size.width(), size.height())
+        .ok_or_else(|| anyhow::anyhow!("empty figure"))?;
+    pixmap.fill(tiny_skia::Color::WHITE);
+    resvg::render(&tree, tiny_skia::Transform::default(), &mut pixmap.as_mut());
+    pixmap
+        .encode_png()
+        .map_err(|e| anyhow::anyhow!("encoding PNG: {e}"))
+}
+
+/// Writes `<stem>.svg` and `<stem>.png` into `dir`, each through a
+/// temporary file and a rename.
+pub fn save<F: Figure>(figure: &F, dir: &Path, stem: &str) -> anyhow::Result<()> {
+    let svg = to_svg(figure)?;
+    let png = svg_to_png(&svg)?;
+    crate::output::write_atomic(&dir.join(format!("{stem}.svg")), svg.as_bytes())?;
+    crate::output::write_atomic(&dir.join(format!("{stem}.png")), &png)?;
     Ok(())
 }
 
