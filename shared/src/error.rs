@@ -97,3 +97,7 @@ pub(crate) fn check_range(
         Err(ConfigError::new(param, value, valid))
     }
 }
+
+impl core::error::Error for ConfigError {}
+
+impl core::error::Error for StepError {}
