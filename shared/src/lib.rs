@@ -22,7 +22,9 @@
 //! - [`checkpoint`]: learned weights in two alternating flash slots that
 //!   survive a torn write;
 //! - [`safety`]: the Idle → Learning/Testing → Fault state machine that owns
-//!   torque enable.
+//!   torque enable;
+//! - [`rx28`]: the RX-28 servo's voltage-driven motor model (shared by the
+//!   LEO simulator and the firmware's torque estimate).
 //!
 //! Section and equation numbers refer to Meijdam, Plooij and Caarls,
 //! "Learning while preventing mechanical failure due to random motions".
@@ -41,6 +43,7 @@ pub mod error;
 pub mod fatigue;
 pub mod fixed;
 pub mod policy;
+pub mod rx28;
 pub mod safety;
 pub mod tile_coding;
 pub mod trace;
