@@ -1,6 +1,7 @@
 //! pada on the host: the plants, the experiment runner of Section VI, the
-//! paper's pendulum experiments (Section VII), plots and the fatigue check
-//! of a recorded torque log.
+//! paper's pendulum experiments (Section VII), the LEO biped in rapier3d
+//! (Section VIII, [`leo`]), plots and the fatigue check of a recorded
+//! torque log.
 
 #![warn(missing_docs)]
 
@@ -10,6 +11,7 @@ pub mod commands;
 pub mod error;
 pub mod experiment;
 pub mod integrator;
+pub mod leo;
 pub mod output;
 pub mod paper;
 pub mod pendulum;

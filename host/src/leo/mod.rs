@@ -1,0 +1,387 @@
+//! LEO (issue 4): the Delft biped in rapier3d, its RX-28 servos and the
+//! walking task of Section VIII of the paper, behind one small interface:
+//!
+//! ```text
+//! LeoEnv::new(config) -> Result<LeoEnv, LeoError>
+//! env.reset(&mut rng) -> Observation            // 10-D, mirrored (§3.4)
+//! env.step([U_hip,st, U_hip,sw, U_knee,sw]) -> StepResult
+//! ```
+//!
+//! All facts come from `shared/reference/grl-facts.md` (sections cited in
+//! [`constants`]): [`model`] builds the rapier world (§1) with the servo
+//! model of [`pada_core::rx28`] (§2), [`task`] holds the walking task's
+//! rules (§3). The step size and solver settings, and the measurements
+//! behind them, are in `README.md` next to this file.
+//!
+//! A simulation that blows up (NaN, a body far away, an absurd joint rate)
+//! ends the episode as a fall, is counted ([`LeoEnv::blow_ups`]) and never
+//! panics; non-finite action voltages are read as 0 V and flagged.
+
+pub mod constants;
+pub mod model;
+pub mod task;
+
+use rand_core::RngCore;
+
+use constants::*;
+use model::{BlowUp, InitialPose, LeoModel, ModelError, ModelOptions, NUM_JOINTS};
+use task::{Leg, Observation, RateFilter, StanceTracker, ACTION_DIM};
+
+/// Configuration of the LEO walking environment.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LeoConfig {
+    /// Physics settings (step, solver, switches for the sanity checks).
+    pub model: ModelOptions,
+    /// Randomise the starting pose as GRL can (§1.8; off in every LEO
+    /// configuration of the reference).
+    pub randomize_start: bool,
+    /// Episode timeout in simulated seconds after the first observation
+    /// (§3.8: 25 s).
+    pub timeout: f32,
+}
+
+impl Default for LeoConfig {
+    fn default() -> Self {
+        Self { model: ModelOptions::default(), randomize_start: false, timeout: EPISODE_TIMEOUT }
+    }
+}
+
+/// Why an environment could not be made.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LeoError {
+    /// The physics model refused its options.
+    Model(ModelError),
+    /// The timeout is not finite and positive.
+    InvalidTimeout(f32),
+}
+
+impl core::fmt::Display for LeoError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            LeoError::Model(e) => e.fmt(f),
+            LeoError::InvalidTimeout(t) => write!(f, "invalid LEO episode timeout {t} s: must be finite and > 0"),
+        }
+    }
+}
+
+impl std::error::Error for LeoError {}
+
+impl From<ModelError> for LeoError {
+    fn from(e: ModelError) -> Self {
+        LeoError::Model(e)
+    }
+}
+
+/// How an episode ended (§3.8).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Terminal {
+    /// Not ended.
+    None,
+    /// Doomed to fall (absorbing, no bootstrap), including blow-ups.
+    Fall,
+    /// 25 s passed (bootstrapped).
+    Timeout,
+}
+
+/// What a step reports besides observation and reward.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepInfo {
+    /// Walked distance in this episode: the sum of footstep lengths (m, §3.3).
+    pub walked_distance: f32,
+    /// Footsteps in this episode (+1 forward, −1 backward, §3.3).
+    pub footsteps: i32,
+    /// Motor work of this step, E of §3.7 (J).
+    pub energy: f32,
+    /// Mean gear torque of the three learned joints over the step (N m),
+    /// in action order (stance hip, swing hip, swing knee with the stance
+    /// leg the action was applied with) — for the fatigue counter.
+    pub learned_torques: [f32; ACTION_DIM],
+    /// Mean gear torque of every joint (N m, [`model::Joint`] order).
+    pub joint_torques: [f32; NUM_JOINTS],
+    /// The stance leg after the step.
+    pub stance: Leg,
+    /// Whether the stance leg changed in this step.
+    pub footstep: bool,
+    /// Simulated time since the first observation (s).
+    pub time: f32,
+    /// `Some` if the simulation blew up in this step (then the episode
+    /// ended as a fall).
+    pub blow_up: Option<BlowUp>,
+    /// Whether an action voltage was not finite (it was read as 0 V).
+    pub invalid_action: bool,
+}
+
+/// The result of one control step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepResult {
+    /// Observation after the step (the last valid one after a blow-up).
+    pub obs: Observation,
+    /// Reward r = −1 − 3E + 300ΔL − 125·[fall] (§3.7).
+    pub reward: f32,
+    /// Whether and how the episode ended.
+    pub terminal: Terminal,
+    /// Diagnostics.
+    pub info: StepInfo,
+}
+
+/// The LEO walking environment (§3).
+pub struct LeoEnv {
+    config: LeoConfig,
+    model: LeoModel,
+    joint_filters: [RateFilter; NUM_JOINTS],
+    torso_filter: RateFilter,
+    filtered: [f32; NUM_JOINTS],
+    stance: StanceTracker,
+    obs: Observation,
+    time: f32,
+    terminal: Terminal,
+    last_info: StepInfo,
+    blow_ups: u64,
+    falls: u64,
+    episodes: u64,
+}
+
+impl LeoEnv {
+    /// A new environment; call [`LeoEnv::reset`] before stepping (a step
+    /// before the first reset acts on the reference pose as if reset).
+    pub fn new(config: LeoConfig) -> Result<Self, LeoError> {
+        if !(config.timeout.is_finite() && config.timeout > 0.0) {
+            return Err(LeoError::InvalidTimeout(config.timeout));
+        }
+        let model = LeoModel::new(config.model, &InitialPose::REFERENCE)?;
+        let mut env = Self {
+            config,
+            model,
+            joint_filters: [RateFilter::joint(); NUM_JOINTS],
+            torso_filter: RateFilter::torso(),
+            filtered: [0.0; NUM_JOINTS],
+            stance: StanceTracker::new(),
+            obs: Observation([0.0; task::OBS_DIM]),
+            time: 0.0,
+            terminal: Terminal::None,
+            last_info: empty_info(),
+            blow_ups: 0,
+            falls: 0,
+            episodes: 0,
+        };
+        env.start_episode();
+        Ok(env)
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &LeoConfig {
+        &self.config
+    }
+
+    /// The physics model (for inspection, drawing and tests).
+    pub fn model(&self) -> &LeoModel {
+        &self.model
+    }
+
+    /// Blow-ups since the environment was made (each also counted as a fall).
+    pub fn blow_ups(&self) -> u64 {
+        self.blow_ups
+    }
+
+    /// Falls since the environment was made (blow-ups included).
+    pub fn falls(&self) -> u64 {
+        self.falls
+    }
+
+    /// Episodes started.
+    pub fn episodes(&self) -> u64 {
+        self.episodes
+    }
+
+    /// The current observation.
+    pub fn observation(&self) -> Observation {
+        self.obs
+    }
+
+    /// How the current episode stands.
+    pub fn terminal(&self) -> Terminal {
+        self.terminal
+    }
+
+    /// Starts an episode (§1.8): the starting pose (randomised if
+    /// configured), voltages 0, one control period simulated, then the first
+    /// observation.
+    pub fn reset<R: RngCore + ?Sized>(&mut self, rng: &mut R) -> Observation {
+        let pose = if self.config.randomize_start { randomized_pose(rng) } else { InitialPose::REFERENCE };
+        match LeoModel::new(self.config.model, &pose) {
+            Ok(model) => {
+                self.model = model;
+                self.start_episode();
+            }
+            Err(_) => {
+                // Cannot happen (the options were validated and the pose is
+                // finite); if it did, the episode ends at once as a fall.
+                self.episodes += 1;
+                self.terminal = Terminal::Fall;
+                self.falls += 1;
+            }
+        }
+        self.obs
+    }
+
+    fn start_episode(&mut self) {
+        self.episodes += 1;
+        self.joint_filters = [RateFilter::joint(); NUM_JOINTS];
+        self.torso_filter = RateFilter::torso();
+        self.filtered = [0.0; NUM_JOINTS];
+        self.stance = StanceTracker::new();
+        self.time = 0.0;
+        self.terminal = Terminal::None;
+        self.last_info = empty_info();
+        self.model.set_voltages([0.0; NUM_JOINTS]);
+        match self.model.control_step() {
+            Ok(_) => {
+                self.sense();
+            }
+            Err(b) => {
+                self.blow_ups += 1;
+                self.falls += 1;
+                self.terminal = Terminal::Fall;
+                self.last_info.blow_up = Some(b);
+            }
+        }
+    }
+
+    /// Reads the state after a control step: filters the rates, updates
+    /// the stance logic and the observation. Returns the filtered rates
+    /// before this update, the stance update and φ.
+    fn sense(&mut self) -> ([f32; NUM_JOINTS], task::StanceUpdate, f32) {
+        let s = self.model.state();
+        let before = self.filtered;
+        for k in 0..NUM_JOINTS {
+            self.filtered[k] = self.joint_filters[k].update(s.rates[k]);
+        }
+        let phi = -s.torso_pitch;
+        let phi_rate = -self.torso_filter.update(s.torso_rate);
+        let q = &s.angles;
+        let ankle = |leg: Leg| task::ankle_x(phi, q[leg.hip() as usize], q[leg.knee() as usize]);
+        let update = self.stance.update(
+            s.contacts[0] || s.contacts[1],
+            s.contacts[2] || s.contacts[3],
+            ankle(Leg::Left),
+            ankle(Leg::Right),
+        );
+        let stance = self.current_stance();
+        self.obs = task::observe(phi, phi_rate, q, &self.filtered, stance);
+        (before, update, phi)
+    }
+
+    /// The stance leg; the starting pose stands on the left leg (§1.8), so
+    /// that is the answer before any foot ever touched.
+    fn current_stance(&self) -> Leg {
+        self.stance.stance().unwrap_or(Leg::Left)
+    }
+
+    /// One control step (§3.6) with the three learned voltages (stance hip,
+    /// swing hip, swing knee; clipped to ±10.7 V, non-finite → 0 V).
+    ///
+    /// After the episode ended, returns the final observation again with
+    /// reward 0 and the same terminal, without simulating.
+    pub fn step(&mut self, action_voltages: [f32; ACTION_DIM]) -> StepResult {
+        if self.terminal != Terminal::None {
+            return StepResult { obs: self.obs, reward: 0.0, terminal: self.terminal, info: self.last_info };
+        }
+        let stance = self.current_stance();
+        let (angles, _) = self.model.joint_state();
+        let voltages = task::joint_voltages(action_voltages, &angles, stance);
+        let invalid_action = action_voltages.iter().any(|v| !v.is_finite());
+        self.model.set_voltages(voltages);
+        let learned = task::learned_joints(stance);
+        let torques = match self.model.control_step() {
+            Ok(t) => t,
+            Err(b) => {
+                self.blow_ups += 1;
+                self.falls += 1;
+                self.terminal = Terminal::Fall;
+                self.time += CONTROL_PERIOD;
+                let info = StepInfo {
+                    blow_up: Some(b),
+                    invalid_action,
+                    time: self.time,
+                    stance,
+                    walked_distance: self.stance.walked(),
+                    footsteps: self.stance.footsteps(),
+                    ..empty_info()
+                };
+                self.last_info = info;
+                return StepResult { obs: self.obs, reward: REWARD_TIME + REWARD_FALL, terminal: Terminal::Fall, info };
+            }
+        };
+        self.time += CONTROL_PERIOD;
+        let (filtered_before, update, phi) = self.sense();
+        let energy = task::step_energy(&voltages, &filtered_before, &self.filtered);
+        let stance_after = self.current_stance();
+        let (q, _) = self.model.joint_state();
+        let fall = task::is_fall(phi, q[stance_after.hip() as usize]);
+        let reward = task::reward(energy, &update, fall);
+        self.terminal = if fall {
+            self.falls += 1;
+            Terminal::Fall
+        } else if self.time > self.config.timeout {
+            Terminal::Timeout
+        } else {
+            Terminal::None
+        };
+        let info = StepInfo {
+            walked_distance: self.stance.walked(),
+            footsteps: self.stance.footsteps(),
+            energy,
+            learned_torques: learned.map(|j| torques[j as usize]),
+            joint_torques: torques,
+            stance: stance_after,
+            footstep: update.footstep,
+            time: self.time,
+            blow_up: None,
+            invalid_action,
+        };
+        self.last_info = info;
+        StepResult { obs: self.obs, reward, terminal: self.terminal, info }
+    }
+}
+
+fn empty_info() -> StepInfo {
+    StepInfo {
+        walked_distance: 0.0,
+        footsteps: 0,
+        energy: 0.0,
+        learned_torques: [0.0; ACTION_DIM],
+        joint_torques: [0.0; NUM_JOINTS],
+        stance: Leg::Left,
+        footstep: false,
+        time: 0.0,
+        blow_up: None,
+        invalid_action: false,
+    }
+}
+
+/// Uniform in [lo, hi) from 24 random bits.
+fn uniform<R: RngCore + ?Sized>(rng: &mut R, lo: f32, hi: f32) -> f32 {
+    lo + (hi - lo) * ((rng.next_u32() >> 8) as f32 / (1u32 << 24) as f32)
+}
+
+/// GRL's optional start randomisation (§1.8), as offsets on the reference
+/// pose: torso d_t ~ U(−C, C); thighs d_t + U(−C, C); shanks their thigh's
+/// offset + U(0, 2C); right foot the right shank's offset + U(−C, C); left
+/// foot 0; arm U(−C, C). The left foot is placed on the floor as usual.
+pub fn randomized_pose<R: RngCore + ?Sized>(rng: &mut R) -> InitialPose {
+    let c = INIT_RANDOMIZATION;
+    let mut p = InitialPose::REFERENCE;
+    let dt = uniform(rng, -c, c);
+    p.torso += dt;
+    let thigh_l = dt + uniform(rng, -c, c);
+    let thigh_r = dt + uniform(rng, -c, c);
+    let shank_l = thigh_l + uniform(rng, 0.0, 2.0 * c);
+    let shank_r = thigh_r + uniform(rng, 0.0, 2.0 * c);
+    p.left[0] += thigh_l;
+    p.left[1] += shank_l;
+    p.right[0] += thigh_r;
+    p.right[1] += shank_r;
+    p.right[2] += shank_r + uniform(rng, -c, c);
+    p.arm += uniform(rng, -c, c);
+    p
+}
