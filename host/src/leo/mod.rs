@@ -24,7 +24,7 @@ pub mod task;
 use rand_core::RngCore;
 
 use constants::*;
-use model::{BlowUp, InitialPose, LeoModel, ModelError, ModelOptions, NUM_JOINTS};
+use model::{BlowUp, InitialPose, LeoModel, ModelError, ModelOptions, Snapshot, NUM_JOINTS};
 use task::{Leg, Observation, RateFilter, StanceTracker, ACTION_DIM};
 
 /// Configuration of the LEO walking environment.
@@ -53,6 +53,9 @@ pub enum LeoError {
     Model(ModelError),
     /// The timeout is not finite and positive.
     InvalidTimeout(f32),
+    /// The simulation blew up in the first control period of the
+    /// reference start: the physics settings are unusable.
+    UnstableStart(BlowUp),
 }
 
 impl core::fmt::Display for LeoError {
@@ -60,6 +63,7 @@ impl core::fmt::Display for LeoError {
         match self {
             LeoError::Model(e) => e.fmt(f),
             LeoError::InvalidTimeout(t) => write!(f, "invalid LEO episode timeout {t} s: must be finite and > 0"),
+            LeoError::UnstableStart(b) => write!(f, "the LEO simulation blew up ({b:?}) while settling into the starting pose"),
         }
     }
 }
@@ -128,6 +132,8 @@ pub struct StepResult {
 pub struct LeoEnv {
     config: LeoConfig,
     model: LeoModel,
+    /// The state after the first control period of the reference start.
+    settled: Snapshot,
     joint_filters: [RateFilter; NUM_JOINTS],
     torso_filter: RateFilter,
     filtered: [f32; NUM_JOINTS],
@@ -148,10 +154,15 @@ impl LeoEnv {
         if !(config.timeout.is_finite() && config.timeout > 0.0) {
             return Err(LeoError::InvalidTimeout(config.timeout));
         }
-        let model = LeoModel::new(config.model, &InitialPose::REFERENCE)?;
+        let mut model = LeoModel::new(config.model, &InitialPose::REFERENCE)?;
+        // The first control period of every reference episode (§1.8).
+        model.set_voltages([0.0; NUM_JOINTS]);
+        model.control_step().map_err(LeoError::UnstableStart)?;
+        let settled = model.snapshot();
         let mut env = Self {
             config,
             model,
+            settled,
             joint_filters: [RateFilter::joint(); NUM_JOINTS],
             torso_filter: RateFilter::torso(),
             filtered: [0.0; NUM_JOINTS],
@@ -164,7 +175,10 @@ impl LeoEnv {
             falls: 0,
             episodes: 0,
         };
-        env.start_episode();
+        env.model.restore(&env.settled);
+        env.begin_episode();
+        env.sense();
+        env.episodes = 0;
         Ok(env)
     }
 
@@ -178,6 +192,12 @@ impl LeoEnv {
         &self.model
     }
 
+    /// The physics model, mutable: for tools and tests that inject states
+    /// (changing it mid-episode bypasses the task's bookkeeping).
+    pub fn model_mut(&mut self) -> &mut LeoModel {
+        &mut self.model
+    }
+
     /// Blow-ups since the environment was made (each also counted as a fall).
     pub fn blow_ups(&self) -> u64 {
         self.blow_ups
@@ -188,7 +208,7 @@ impl LeoEnv {
         self.falls
     }
 
-    /// Episodes started.
+    /// Episodes started by [`LeoEnv::reset`].
     pub fn episodes(&self) -> u64 {
         self.episodes
     }
@@ -207,12 +227,17 @@ impl LeoEnv {
     /// configured), voltages 0, one control period simulated, then the first
     /// observation.
     pub fn reset<R: RngCore + ?Sized>(&mut self, rng: &mut R) -> Observation {
-        let pose = if self.config.randomize_start { randomized_pose(rng) } else { InitialPose::REFERENCE };
-        match LeoModel::new(self.config.model, &pose) {
-            Ok(model) => {
-                self.model = model;
-                self.start_episode();
-            }
+        if !self.config.randomize_start {
+            // The reference start is deterministic: restore the state after
+            // its first control period instead of simulating it again.
+            self.model.restore(&self.settled);
+            self.begin_episode();
+            self.sense();
+            return self.obs;
+        }
+        let pose = randomized_pose(rng);
+        match self.model.reset(&pose) {
+            Ok(()) => self.start_episode(),
             Err(_) => {
                 // Cannot happen (the options were validated and the pose is
                 // finite); if it did, the episode ends at once as a fall.
@@ -224,7 +249,8 @@ impl LeoEnv {
         self.obs
     }
 
-    fn start_episode(&mut self) {
+    /// Clears the task's state for a new episode.
+    fn begin_episode(&mut self) {
         self.episodes += 1;
         self.joint_filters = [RateFilter::joint(); NUM_JOINTS];
         self.torso_filter = RateFilter::torso();
@@ -233,6 +259,12 @@ impl LeoEnv {
         self.time = 0.0;
         self.terminal = Terminal::None;
         self.last_info = empty_info();
+    }
+
+    /// Starts an episode from a model in its starting pose: voltages 0,
+    /// one control period, the first observation (§1.8).
+    fn start_episode(&mut self) {
+        self.begin_episode();
         self.model.set_voltages([0.0; NUM_JOINTS]);
         match self.model.control_step() {
             Ok(_) => {

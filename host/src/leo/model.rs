@@ -310,12 +310,18 @@ pub struct ModelOptions {
     /// Back-EMF damping of the servos (§2.1). Off = "torque off"
     /// (free-wheeling windings); the armature inertia stays.
     pub back_emf: bool,
-    /// Dampers of the joint stops (§1.5); the springs are always on.
+    /// Soft joint stops (§1.5).
+    pub joint_stops: bool,
+    /// Dampers of the joint stops (§1.5).
     pub stop_damping: bool,
     /// The boom's extra vertical force on the torso (§1.4).
     pub boom_force: bool,
     /// Gravity on.
     pub gravity: bool,
+    /// Weld the torso to the world in its starting pose instead of the
+    /// planar joint (for the energy and joint-limit checks: the legs and
+    /// the arm become a tree of pendulums).
+    pub fixed_torso: bool,
 }
 
 impl Default for ModelOptions {
@@ -328,9 +334,11 @@ impl Default for ModelOptions {
             contacts: true,
             dry_friction: true,
             back_emf: true,
+            joint_stops: true,
             stop_damping: true,
             boom_force: true,
             gravity: true,
+            fixed_torso: false,
         }
     }
 }
@@ -439,9 +447,28 @@ pub struct LeoModel {
     links: [usize; NUM_JOINTS],
     /// Index of each joint's DoF in the generalized velocity.
     dofs: [usize; NUM_JOINTS],
-    /// Link id and first DoF of the planar root joint (x, z, pitch).
+    /// Link id of the torso and first DoF of the planar root joint
+    /// (x, z, pitch); `None` with a fixed torso.
     root_link: usize,
-    root_dof: usize,
+    root_dof: Option<usize>,
+    voltages: [f32; NUM_JOINTS],
+    time: f64,
+    /// The world as built and its pose, for [`LeoModel::reset`].
+    built: Option<(Snapshot, InitialPose)>,
+}
+
+/// A copy of a [`LeoModel`]'s state (see [`LeoModel::snapshot`]).
+#[derive(Clone)]
+pub struct Snapshot {
+    bodies: RigidBodySet,
+    colliders: ColliderSet,
+    impulse_joints: ImpulseJointSet,
+    multibody_joints: MultibodyJointSet,
+    soft_bodies: SoftBodySet,
+    islands: IslandManager,
+    broad_phase: BroadPhaseBvh,
+    narrow_phase: NarrowPhase,
+    ccd_solver: CCDSolver,
     voltages: [f32; NUM_JOINTS],
     time: f64,
 }
@@ -514,9 +541,16 @@ impl LeoModel {
         // torso free in x, z and pitch (issue 4: planar motion locked
         // explicitly).
         let anchor = world.bodies.insert(RigidBodyBuilder::fixed());
-        let planar = GenericJointBuilder::new(JointAxesMask::LIN_Y | JointAxesMask::ANG_X | JointAxesMask::ANG_Z)
-            .contacts_enabled(false)
-            .build();
+        let planar = if options.fixed_torso {
+            GenericJointBuilder::new(JointAxesMask::all())
+                .local_frame1(body_pose(origin[Body::Torso as usize], pitch[Body::Torso as usize]))
+                .contacts_enabled(false)
+                .build()
+        } else {
+            GenericJointBuilder::new(JointAxesMask::LIN_Y | JointAxesMask::ANG_X | JointAxesMask::ANG_Z)
+                .contacts_enabled(false)
+                .build()
+        };
         world
             .multibody_joints
             .insert(anchor, bodies[Body::Torso as usize], planar, true)
@@ -550,17 +584,24 @@ impl LeoModel {
         }
 
         let servo = options_servo(&options);
+        // Rapier computes mass properties lazily at the first step; the
+        // multibody's Jacobians (used below and by `energy`) need them now.
+        for &h in &bodies {
+            let rb = &mut world.bodies[h];
+            rb.recompute_mass_properties_from_colliders(&world.colliders);
+        }
         let mb = world.multibody_joints.get_multibody_mut(multibody).ok_or(ModelError::Topology)?;
         // The root (the fixed anchor) counts as a free 6-DoF joint until
         // the multibody has looked at its body type.
         mb.forward_kinematics(&world.bodies, true);
         let root_link = torso_link.id;
+        let root_dofs = if options.fixed_torso { 0 } else { 3 };
         let root_dof = mb.link(root_link).ok_or(ModelError::Topology)?.assembly_id();
         let mut dofs = [0usize; NUM_JOINTS];
         for k in 0..NUM_JOINTS {
             dofs[k] = mb.link(links[k]).ok_or(ModelError::Topology)?.assembly_id();
         }
-        if mb.ndofs() != 3 + NUM_JOINTS {
+        if mb.ndofs() != root_dofs + NUM_JOINTS {
             return Err(ModelError::Topology);
         }
         // Per-DoF servo model; the root DoFs get none (rapier's default
@@ -576,10 +617,12 @@ impl LeoModel {
         // Joint coordinates of the pose: the multibody starts at zero
         // coordinates, so the pose is a displacement.
         let torso = origin[Body::Torso as usize];
-        mb.link_mut(root_link)
-            .ok_or(ModelError::Topology)?
-            .joint
-            .apply_displacement(&[torso[0], torso[1], pitch[Body::Torso as usize]]);
+        if !options.fixed_torso {
+            mb.link_mut(root_link)
+                .ok_or(ModelError::Topology)?
+                .joint
+                .apply_displacement(&[torso[0], torso[1], pitch[Body::Torso as usize]]);
+        }
         let angles = pose.joint_angles();
         for k in 0..NUM_JOINTS {
             mb.link_mut(links[k]).ok_or(ModelError::Topology)?.joint.apply_displacement(&[angles[k]]);
@@ -588,7 +631,7 @@ impl LeoModel {
         mb.forward_kinematics(&world.bodies, false);
         mb.update_rigid_bodies(&mut world.bodies, true);
 
-        Ok(Self {
+        let mut model = Self {
             world,
             options,
             servo,
@@ -597,10 +640,99 @@ impl LeoModel {
             links,
             dofs,
             root_link,
-            root_dof,
+            root_dof: (!options.fixed_torso).then_some(root_dof),
             voltages: [0.0; NUM_JOINTS],
             time: 0.0,
-        })
+            built: None,
+        };
+        model.built = Some((model.snapshot(), *pose));
+        Ok(model)
+    }
+
+    /// A copy of the world's state (bodies, colliders, joints, contact
+    /// and broad-phase caches) plus the held voltages and the time, to be
+    /// put back with [`LeoModel::restore`]. Restoring a snapshot continues
+    /// exactly (bit for bit) as the original did from that point.
+    pub fn snapshot(&self) -> Snapshot {
+        let w = &self.world;
+        Snapshot {
+            bodies: w.bodies.clone(),
+            colliders: w.colliders.clone(),
+            impulse_joints: w.impulse_joints.clone(),
+            multibody_joints: w.multibody_joints.clone(),
+            soft_bodies: w.soft_bodies.clone(),
+            islands: w.islands.clone(),
+            broad_phase: w.broad_phase.clone(),
+            narrow_phase: w.narrow_phase.clone(),
+            ccd_solver: w.ccd_solver.clone(),
+            voltages: self.voltages,
+            time: self.time,
+        }
+    }
+
+    /// Puts a snapshot of this model back (see [`LeoModel::snapshot`]).
+    pub fn restore(&mut self, snapshot: &Snapshot) {
+        let w = &mut self.world;
+        w.bodies.clone_from(&snapshot.bodies);
+        w.colliders.clone_from(&snapshot.colliders);
+        w.impulse_joints.clone_from(&snapshot.impulse_joints);
+        w.multibody_joints.clone_from(&snapshot.multibody_joints);
+        w.soft_bodies.clone_from(&snapshot.soft_bodies);
+        w.islands.clone_from(&snapshot.islands);
+        w.broad_phase.clone_from(&snapshot.broad_phase);
+        w.narrow_phase.clone_from(&snapshot.narrow_phase);
+        w.ccd_solver.clone_from(&snapshot.ccd_solver);
+        self.voltages = snapshot.voltages;
+        self.time = snapshot.time;
+    }
+
+    /// Puts the robot into `pose` at rest with 0 V and time 0, as if just
+    /// built: the world as built (no contacts yet) is restored, then the
+    /// joint coordinates are moved to the pose. Cheaper than a rebuild,
+    /// which costs about as much as a control step (and early-learning
+    /// episodes last only a dozen steps).
+    pub fn reset(&mut self, pose: &InitialPose) -> Result<(), ModelError> {
+        if !pose.is_finite() {
+            return Err(ModelError::InvalidPose);
+        }
+        let built = core::mem::replace(&mut self.built, None);
+        if let Some((snapshot, built_pose)) = &built {
+            self.restore(snapshot);
+            if pose != built_pose {
+                self.set_pose(pose)?;
+            }
+        } else {
+            *self = Self::new(self.options, pose)?;
+            return Ok(());
+        }
+        self.built = built;
+        Ok(())
+    }
+
+    /// Moves the joint coordinates of a model at rest to `pose`.
+    fn set_pose(&mut self, pose: &InitialPose) -> Result<(), ModelError> {
+        let origin = assemble(pose);
+        let torso = origin[Body::Torso as usize];
+        let root_target = [torso[0], torso[1], pose.torso];
+        let angles = pose.joint_angles();
+        let mb = self.world.multibody_joints.get_multibody_mut(self.multibody).ok_or(ModelError::Topology)?;
+        // Joint coordinates only move by displacements.
+        let root = mb.link_mut(self.root_link).ok_or(ModelError::Topology)?;
+        if self.root_dof.is_some() {
+            let c = root.joint.coords();
+            root.joint.apply_displacement(&[root_target[0] - c[0], root_target[1] - c[2], root_target[2] - c[4]]);
+        } else {
+            root.joint.data.local_frame1 = body_pose(torso, pose.torso);
+        }
+        for k in 0..NUM_JOINTS {
+            let link = mb.link_mut(self.links[k]).ok_or(ModelError::Topology)?;
+            let q = link.joint.coords()[3];
+            link.joint.apply_displacement(&[angles[k] - q]);
+        }
+        mb.generalized_velocity_mut().fill(0.0);
+        mb.forward_kinematics(&self.world.bodies, false);
+        mb.update_rigid_bodies(&mut self.world.bodies, true);
+        Ok(())
     }
 
     /// The options the model was built with.
@@ -629,6 +761,14 @@ impl LeoModel {
     /// The voltages being held.
     pub fn voltages(&self) -> [f32; NUM_JOINTS] {
         self.voltages
+    }
+
+    /// The multibody link of a body ([`Body`] index).
+    fn body_link(&self, body: usize) -> usize {
+        if body == Body::Torso as usize {
+            return self.root_link;
+        }
+        JOINT_SPECS.iter().position(|j| j.child as usize == body).map_or(self.root_link, |k| self.links[k])
     }
 
     fn multibody(&self) -> &Multibody {
@@ -679,19 +819,22 @@ impl LeoModel {
     /// The state the task reads (§3.1).
     pub fn state(&self) -> RawState {
         let mb = self.multibody();
-        let v = mb.generalized_velocity();
         let (angles, rates) = self.joint_state();
         let root = mb.link(self.root_link).map(|l| l.joint.coords());
-        let (x, z, pitch) = match root {
+        let (x, z, pitch) = match (root, self.root_dof) {
             // Free DoFs of the planar joint: coords[0] = x, coords[2] = z,
-            // coords[4] = rotation about y.
-            Some(c) => (c[0], c[2], c[4]),
-            None => (f32::NAN, f32::NAN, f32::NAN),
+            // coords[4] = rotation about y (not wrapped).
+            (Some(c), Some(_)) => (c[0], c[2], c[4]),
+            _ => {
+                let pose = self.body_pose(Body::Torso);
+                let ex = pose.rotation * Vector::X;
+                (pose.translation.x, pose.translation.z, (-ex.z).atan2(ex.x))
+            }
         };
         let clear = self.foot_clearances();
         RawState {
             torso_pitch: pitch,
-            torso_rate: v[self.root_dof + ROOT_PITCH],
+            torso_rate: self.root_velocity()[ROOT_PITCH],
             torso_position: [x, z],
             angles,
             rates,
@@ -702,7 +845,10 @@ impl LeoModel {
     /// The generalized velocity of the root joint (ẋ, ż, θ̇).
     pub fn root_velocity(&self) -> [f32; 3] {
         let v = self.multibody().generalized_velocity();
-        [v[self.root_dof + ROOT_X], v[self.root_dof + ROOT_Z], v[self.root_dof + ROOT_PITCH]]
+        match self.root_dof {
+            Some(r) => [v[r + ROOT_X], v[r + ROOT_Z], v[r + ROOT_PITCH]],
+            None => [0.0; 3],
+        }
     }
 
     /// Sets joint rates (rad/s, [`Joint`] order) and the root velocity
@@ -715,9 +861,11 @@ impl LeoModel {
             for k in 0..NUM_JOINTS {
                 v[dofs[k]] = joint_rates[k];
             }
-            v[root_dof + ROOT_X] = root[0];
-            v[root_dof + ROOT_Z] = root[1];
-            v[root_dof + ROOT_PITCH] = root[2];
+            if let Some(r) = root_dof {
+                v[r + ROOT_X] = root[0];
+                v[r + ROOT_Z] = root[1];
+                v[r + ROOT_PITCH] = root[2];
+            }
         }
     }
 
@@ -728,10 +876,17 @@ impl LeoModel {
         let g = if self.options.gravity { GRAVITY } else { 0.0 };
         let mut kinetic = 0.0f64;
         let mut potential = 0.0f64;
+        let mb = self.multibody();
+        let gv = mb.generalized_velocity();
         for (i, spec) in BODY_SPECS.iter().enumerate() {
             let rb = &self.world.bodies[self.bodies[i]];
-            let v = rb.linvel();
-            let w = rb.position().rotation.inverse() * rb.angvel();
+            // Body velocity from the generalized velocity (the rigid bodies'
+            // own velocities lag behind a `set_velocities` until the next
+            // step): rows 0..3 the CoM's linear, 3..6 the angular velocity.
+            let link = self.body_link(i);
+            let jv = mb.body_jacobian(link) * gv;
+            let v = Vector::new(jv[0], jv[1], jv[2]);
+            let w = rb.position().rotation.inverse() * Vector::new(jv[3], jv[4], jv[5]);
             let inertia = [INERTIA_DONT_CARE, spec.iyy, INERTIA_DONT_CARE];
             kinetic += 0.5 * spec.mass as f64 * v.length_squared() as f64;
             kinetic += 0.5 * (inertia[0] * w.x * w.x + inertia[1] * w.y * w.y + inertia[2] * w.z * w.z) as f64;
@@ -741,7 +896,7 @@ impl LeoModel {
         let (q, qd) = self.joint_state();
         for k in 0..NUM_JOINTS {
             kinetic += 0.5 * (self.servo.armature * qd[k] * qd[k]) as f64;
-            if let Some((limits, stop)) = JOINT_SPECS[k].stop {
+            if let (Some((limits, stop)), true) = (JOINT_SPECS[k].stop, self.options.joint_stops) {
                 let over = (q[k] - limits[1]).max(0.0) + (limits[0] - q[k]).max(0.0);
                 potential += 0.5 * (stop[0] * over * over) as f64;
             }
@@ -761,17 +916,16 @@ impl LeoModel {
         }
         for &h in &self.bodies {
             let rb = &self.world.bodies[h];
-            let t = rb.position().translation;
-            if !(t.is_finite() && rb.linvel().is_finite() && rb.angvel().is_finite()) {
+            if !(rb.position().translation.is_finite() && rb.linvel().is_finite() && rb.angvel().is_finite()) {
                 return Err(BlowUp::NonFinite);
-            }
-            if t.length() > BLOWUP_DISTANCE {
-                return Err(BlowUp::FarAway);
             }
         }
         let v = mb.generalized_velocity();
         if self.dofs.iter().any(|&d| v[d].abs() > BLOWUP_JOINT_RATE) {
             return Err(BlowUp::JointRate);
+        }
+        if self.bodies.iter().any(|&h| self.world.bodies[h].position().translation.length() > BLOWUP_DISTANCE) {
+            return Err(BlowUp::FarAway);
         }
         Ok(())
     }
@@ -786,7 +940,9 @@ impl LeoModel {
                 let Some((limits, [stiffness, damping])) = JOINT_SPECS[k].stop else { continue };
                 let Some(link) = mb.link_mut(self.links[k]) else { continue };
                 let data = &mut link.joint.data;
-                let (target, inward) = if q[k] > limits[1] {
+                let (target, inward) = if !self.options.joint_stops {
+                    continue;
+                } else if q[k] > limits[1] {
                     (limits[1], qd[k] > 0.0)
                 } else if q[k] < limits[0] {
                     (limits[0], qd[k] < 0.0)

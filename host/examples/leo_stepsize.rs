@@ -1,0 +1,162 @@
+//! Step-size study for the LEO model (README.md table): for each
+//! (physics steps per control period, rapier solver iterations) it measures
+//! accuracy against a fine reference and the sanity checks, then speed.
+//!
+//! cargo run --release -p pada --example leo_stepsize [-- quick]
+use pada::leo::constants::*;
+use pada::leo::model::*;
+use pada::leo::*;
+use rand_core::{RngCore, SeedableRng};
+
+const LEVELS: [f32; 7] = [-10.7, -7.1333, -3.5667, 0.0, 3.5667, 7.1333, 10.7];
+
+fn cfg(sub: u32, it: usize) -> LeoConfig {
+    LeoConfig { model: ModelOptions { substeps: sub, solver_iterations: it, ..Default::default() }, ..Default::default() }
+}
+
+fn sequences(n: usize, len: usize, seed: u64) -> Vec<Vec<[f32; 3]>> {
+    let mut rng = rand_pcg::Pcg32::seed_from_u64(seed);
+    (0..n).map(|_| (0..len).map(|_| [0, 1, 2].map(|_| LEVELS[(rng.next_u32() % 7) as usize])).collect()).collect()
+}
+
+/// Torso pitch and the seven joint angles (unmirrored) after each step of
+/// each sequence (NaN after a terminal).
+fn rollouts(c: LeoConfig, seqs: &[Vec<[f32; 3]>]) -> Vec<Vec<[f32; 8]>> {
+    let mut env = LeoEnv::new(c).unwrap();
+    let mut rng = rand_pcg::Pcg32::seed_from_u64(0);
+    seqs.iter()
+        .map(|s| {
+            env.reset(&mut rng);
+            let mut done = false;
+            s.iter()
+                .map(|a| {
+                    if done { return [f32::NAN; 8]; }
+                    let r = env.step(*a);
+                    done = r.terminal != Terminal::None;
+                    let s = env.model().state();
+                    let mut x = [s.torso_pitch; 8];
+                    x[1..].copy_from_slice(&s.angles);
+                    x
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// RMS angle error (rad, torso pitch and joints) after 3 and after 6
+/// control steps (0.1 s and 0.2 s), over the sequences alive in both.
+fn error(reference: &[Vec<[f32; 8]>], test: &[Vec<[f32; 8]>]) -> (f64, f64) {
+    let at = |k: usize| {
+        let (mut se, mut n) = (0.0f64, 0usize);
+        for (a, b) in reference.iter().zip(test) {
+            if a[k][0].is_nan() || b[k][0].is_nan() { continue; }
+            n += 8;
+            se += a[k].iter().zip(&b[k]).map(|(x, y)| ((x - y) as f64).powi(2)).sum::<f64>();
+        }
+        (se / n.max(1) as f64).sqrt()
+    };
+    (at(2), at(5))
+}
+
+fn model(sub: u32, it: usize, f: impl FnOnce(&mut ModelOptions)) -> LeoModel {
+    let mut o = ModelOptions { substeps: sub, solver_iterations: it, ..Default::default() };
+    f(&mut o);
+    LeoModel::new(o, &InitialPose::REFERENCE).unwrap()
+}
+
+/// Energy drift (J, max |E − E0|) of the torso-welded robot swinging its
+/// limbs under gravity for 10 s, contacts/friction/back-EMF/stop damping off.
+fn energy_drift(sub: u32, it: usize) -> (f32, f32) {
+    let mut m = model(sub, it, |o| {
+        o.contacts = false;
+        o.dry_friction = false;
+        o.back_emf = false;
+        o.joint_stops = false;
+        o.fixed_torso = true;
+    });
+    m.set_velocities([3.0, 2.0, -2.0, -3.0, 3.0, 4.0, -4.0], [0.0; 3]);
+    let e0 = m.energy().total();
+    let mut worst = 0.0f32;
+    for _ in 0..300 {
+        if m.control_step().is_err() { return (f32::NAN, f32::NAN); }
+        worst = worst.max((m.energy().total() - e0).abs());
+    }
+    (worst, m.energy().kinetic)
+}
+
+/// Passive fall, 0 V: largest energy gain over the start (J), kinetic
+/// energy after 5 s (J), deepest penetration of any foot sphere (mm).
+fn passive(sub: u32, it: usize) -> (f32, f32, f32) {
+    let mut m = model(sub, it, |_| {});
+    let e0 = m.energy().total();
+    let (mut gain, mut pen) = (f32::MIN, 0.0f32);
+    for _ in 0..150 {
+        if m.control_step().is_err() { return (f32::NAN, f32::NAN, f32::NAN); }
+        gain = gain.max(m.energy().total() - e0);
+        pen = pen.max(-m.foot_clearances().iter().cloned().fold(f32::MAX, f32::min));
+    }
+    (gain, m.energy().kinetic, pen * 1000.0)
+}
+
+/// Joint limits: torso welded, no floor, every joint driven at +10.7 V
+/// for 1 s then −10.7 V for 1 s. Largest excursion beyond a limit (rad).
+fn limits(sub: u32, it: usize) -> f32 {
+    let mut m = model(sub, it, |o| { o.contacts = false; o.fixed_torso = true; });
+    let mut worst = 0.0f32;
+    for u in [10.7f32, -10.7] {
+        m.set_voltages([u; NUM_JOINTS]);
+        for _ in 0..30 {
+            if m.control_step().is_err() { return f32::NAN; }
+            let (q, _) = m.joint_state();
+            for j in JOINTS {
+                if let Some([lo, hi]) = joint_limits(j) {
+                    worst = worst.max(q[j as usize] - hi).max(lo - q[j as usize]);
+                }
+            }
+        }
+    }
+    worst
+}
+
+/// Random-action statistics: mean episode length (steps), mean return, blow-ups,
+/// and the real-time factor (min of 3 runs) over `secs` simulated seconds.
+fn random(sub: u32, it: usize, secs: f32) -> (f64, f64, u64, f64) {
+    let mut best = 0.0f64;
+    let mut stats = (0.0, 0.0, 0);
+    for rep in 0..3 {
+        let mut env = LeoEnv::new(cfg(sub, it)).unwrap();
+        let mut rng = rand_pcg::Pcg32::seed_from_u64(1);
+        let steps = (secs * 30.0) as usize;
+        let t0 = std::time::Instant::now();
+        env.reset(&mut rng);
+        let (mut eps, mut ret) = (0u64, 0.0f64);
+        for _ in 0..steps {
+            let a = [0, 1, 2].map(|_| LEVELS[(rng.next_u32() % 7) as usize]);
+            let r = env.step(a);
+            ret += r.reward as f64;
+            if r.terminal != Terminal::None { eps += 1; env.reset(&mut rng); }
+        }
+        best = best.max(secs as f64 / t0.elapsed().as_secs_f64());
+        if rep == 0 { stats = (steps as f64 / eps as f64, ret / eps as f64, env.blow_ups()); }
+    }
+    (stats.0, stats.1, stats.2, best)
+}
+
+fn main() {
+    let quick = std::env::args().any(|a| a == "quick");
+    let seqs = sequences(if quick { 40 } else { 200 }, 10, 42);
+    let (rs, ri) = (40u32, 4usize);
+    println!("reference: {rs} steps x {ri} iterations (h = {:.3} ms per solver sub-step)\n", 1000.0 / (30.0 * (rs as f32) * ri as f32));
+    let reference = rollouts(cfg(rs, ri), &seqs);
+    println!("| steps/period | iterations | h (ms) | angle err 0.1 s (rad) | angle err 0.2 s (rad) | energy drift 10 s (J) | passive: max gain (J) | KE after 5 s (J) | max foot penetration (mm) | limit overshoot (rad) | mean episode (steps) | mean return | blow-ups | RTF |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let configs: &[(u32, usize)] = &[(1, 1), (1, 2), (1, 4), (1, 8), (2, 1), (2, 2), (2, 4), (3, 1), (4, 1), (4, 2), (8, 1), (8, 2), (16, 2), (40, 4), (80, 4)];
+    for &(s, i) in configs {
+        let (ea, er) = error(&reference, &rollouts(cfg(s, i), &seqs));
+        let (drift, _) = energy_drift(s, i);
+        let (gain, ke, pen) = passive(s, i);
+        let lim = limits(s, i);
+        let (len, ret, blow, rtf) = random(s, i, if quick { 30.0 } else { 120.0 });
+        println!("| {s} | {i} | {:.2} | {ea:.3} | {er:.3} | {drift:.4} | {gain:.4} | {ke:.1e} | {pen:.2} | {lim:.4} | {len:.1} | {ret:.1} | {blow} | {rtf:.0} |", 1000.0 * CONTROL_PERIOD / s as f32);
+    }
+}
