@@ -6,7 +6,7 @@ fn main() {
     let sub: u32 = a.get(1).and_then(|s| s.parse().ok()).unwrap_or(8);
     let it: usize = a.get(2).and_then(|s| s.parse().ok()).unwrap_or(2);
     let secs: f32 = a.get(3).and_then(|s| s.parse().ok()).unwrap_or(300.0);
-    let cfg = LeoConfig { model: ModelOptions { substeps: sub, solver_iterations: it, ..Default::default() }, ..Default::default() };
+    let cfg = LeoConfig { model: ModelOptions { substeps: sub, solver_iterations: it, motor_lag_correction: !a.iter().any(|x| x == "nocorr"), ..Default::default() }, ..Default::default() };
     let mut env = LeoEnv::new(cfg).unwrap();
     let mut rng = rand_pcg::Pcg32::seed_from_u64(1);
     let levels = [-10.7f32, -7.1333, -3.5667, 0.0, 3.5667, 7.1333, 10.7];

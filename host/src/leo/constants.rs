@@ -265,9 +265,9 @@ pub const BLOWUP_JOINT_RATE: f32 = 100.0;
 // ---------------------------------------------------------------------------
 
 /// Physics steps per control period: h = (1/30)/N.
-pub const SUBSTEPS: u32 = 8;
+pub const SUBSTEPS: u32 = 3;
 /// Rapier solver iterations per physics step.
-pub const SOLVER_ITERATIONS: usize = 2;
+pub const SOLVER_ITERATIONS: usize = 1;
 /// Natural frequency (Hz) of rapier's soft contact. Rapier's softness is
 /// mass-normalised (k = m·ω², c = 2ζ·m·ω with m the contact's effective
 /// mass); with the rubber pair's K = 2.5e4 N/m and D = 250 N s/m (§1.7) and
