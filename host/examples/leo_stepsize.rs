@@ -118,6 +118,23 @@ fn limits(sub: u32, it: usize) -> f32 {
     worst
 }
 
+/// Shoulder speed after one control period from rest at 10.6919 V (torso
+/// welded, no gravity, no dry friction), relative error against the exact
+/// first-order response v∞·(1 − exp(−T·d/J)).
+fn motor_response(sub: u32, it: usize) -> f32 {
+    let servo = pada_core::rx28::Rx28::LEO.reduced();
+    let r2 = ARM_COM[0] * ARM_COM[0] + ARM_COM[1] * ARM_COM[1];
+    let j = ARM_IYY + ARM_MASS * r2 + servo.armature;
+    let u = pada_core::rx28::LEO_MAX_VOLTAGE;
+    let expect = servo.voltage_torque(u) / servo.damping * (1.0 - (-CONTROL_PERIOD * servo.damping / j).exp());
+    let mut m = model(sub, it, |o| { o.fixed_torso = true; o.gravity = false; o.contacts = false; o.dry_friction = false; });
+    let mut v = [0.0; NUM_JOINTS];
+    v[Joint::Shoulder as usize] = u;
+    m.set_voltages(v);
+    if m.control_step().is_err() { return f32::NAN; }
+    m.joint_state().1[Joint::Shoulder as usize] / expect - 1.0
+}
+
 /// Random-action statistics: mean episode length (steps), mean return, blow-ups,
 /// and the real-time factor (min of 3 runs) over `secs` simulated seconds.
 fn random(sub: u32, it: usize, secs: f32) -> (f64, f64, u64, f64) {
@@ -148,15 +165,16 @@ fn main() {
     let (rs, ri) = (40u32, 4usize);
     println!("reference: {rs} steps x {ri} iterations (h = {:.3} ms per solver sub-step)\n", 1000.0 / (30.0 * (rs as f32) * ri as f32));
     let reference = rollouts(cfg(rs, ri), &seqs);
-    println!("| steps/period | iterations | h (ms) | angle err 0.1 s (rad) | angle err 0.2 s (rad) | energy drift 10 s (J) | passive: max gain (J) | KE after 5 s (J) | max foot penetration (mm) | limit overshoot (rad) | mean episode (steps) | mean return | blow-ups | RTF |");
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("| steps/period | iterations | h (ms) | angle err 0.1 s (rad) | angle err 0.2 s (rad) | energy drift 10 s (J) | passive: max gain (J) | KE after 5 s (J) | max foot penetration (mm) | limit overshoot (rad) | motor response error | mean episode (steps) | mean return | blow-ups | RTF |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     let configs: &[(u32, usize)] = &[(1, 1), (1, 2), (1, 4), (1, 8), (2, 1), (2, 2), (2, 4), (3, 1), (4, 1), (4, 2), (8, 1), (8, 2), (16, 2), (40, 4), (80, 4)];
     for &(s, i) in configs {
         let (ea, er) = error(&reference, &rollouts(cfg(s, i), &seqs));
         let (drift, _) = energy_drift(s, i);
         let (gain, ke, pen) = passive(s, i);
         let lim = limits(s, i);
+        let resp = motor_response(s, i);
         let (len, ret, blow, rtf) = random(s, i, if quick { 30.0 } else { 120.0 });
-        println!("| {s} | {i} | {:.2} | {ea:.3} | {er:.3} | {drift:.4} | {gain:.4} | {ke:.1e} | {pen:.2} | {lim:.4} | {len:.1} | {ret:.1} | {blow} | {rtf:.0} |", 1000.0 * CONTROL_PERIOD / s as f32);
+        println!("| {s} | {i} | {:.2} | {ea:.3} | {er:.3} | {drift:.4} | {gain:.4} | {ke:.1e} | {pen:.2} | {lim:.4} | {:+.1}% | {len:.1} | {ret:.1} | {blow} | {rtf:.0} |", 1000.0 * CONTROL_PERIOD / s as f32, 100.0 * resp);
     }
 }
