@@ -11,12 +11,25 @@ use rand_core::{RngCore, SeedableRng};
 const LEVELS: [f32; 7] = [-10.7, -7.1333, -3.5667, 0.0, 3.5667, 7.1333, 10.7];
 
 fn cfg(sub: u32, it: usize) -> LeoConfig {
-    LeoConfig { model: ModelOptions { substeps: sub, solver_iterations: it, ..Default::default() }, ..Default::default() }
+    LeoConfig {
+        model: ModelOptions {
+            substeps: sub,
+            solver_iterations: it,
+            ..Default::default()
+        },
+        ..Default::default()
+    }
 }
 
 fn sequences(n: usize, len: usize, seed: u64) -> Vec<Vec<[f32; 3]>> {
     let mut rng = rand_pcg::Pcg32::seed_from_u64(seed);
-    (0..n).map(|_| (0..len).map(|_| [0, 1, 2].map(|_| LEVELS[(rng.next_u32() % 7) as usize])).collect()).collect()
+    (0..n)
+        .map(|_| {
+            (0..len)
+                .map(|_| [0, 1, 2].map(|_| LEVELS[(rng.next_u32() % 7) as usize]))
+                .collect()
+        })
+        .collect()
 }
 
 /// Torso pitch and the seven joint angles (unmirrored) after each step of
@@ -30,7 +43,9 @@ fn rollouts(c: LeoConfig, seqs: &[Vec<[f32; 3]>]) -> Vec<Vec<[f32; 8]>> {
             let mut done = false;
             s.iter()
                 .map(|a| {
-                    if done { return [f32::NAN; 8]; }
+                    if done {
+                        return [f32::NAN; 8];
+                    }
                     let r = env.step(*a);
                     done = r.terminal != Terminal::None;
                     let s = env.model().state();
@@ -49,9 +64,15 @@ fn error(reference: &[Vec<[f32; 8]>], test: &[Vec<[f32; 8]>]) -> (f64, f64) {
     let at = |k: usize| {
         let (mut se, mut n) = (0.0f64, 0usize);
         for (a, b) in reference.iter().zip(test) {
-            if a[k][0].is_nan() || b[k][0].is_nan() { continue; }
+            if a[k][0].is_nan() || b[k][0].is_nan() {
+                continue;
+            }
             n += 8;
-            se += a[k].iter().zip(&b[k]).map(|(x, y)| ((x - y) as f64).powi(2)).sum::<f64>();
+            se += a[k]
+                .iter()
+                .zip(&b[k])
+                .map(|(x, y)| ((x - y) as f64).powi(2))
+                .sum::<f64>();
         }
         (se / n.max(1) as f64).sqrt()
     };
@@ -59,7 +80,11 @@ fn error(reference: &[Vec<[f32; 8]>], test: &[Vec<[f32; 8]>]) -> (f64, f64) {
 }
 
 fn model(sub: u32, it: usize, f: impl FnOnce(&mut ModelOptions)) -> LeoModel {
-    let mut o = ModelOptions { substeps: sub, solver_iterations: it, ..Default::default() };
+    let mut o = ModelOptions {
+        substeps: sub,
+        solver_iterations: it,
+        ..Default::default()
+    };
     f(&mut o);
     LeoModel::new(o, &InitialPose::REFERENCE).unwrap()
 }
@@ -78,7 +103,9 @@ fn energy_drift(sub: u32, it: usize) -> (f32, f32) {
     let e0 = m.energy().total();
     let mut worst = 0.0f32;
     for _ in 0..300 {
-        if m.control_step().is_err() { return (f32::NAN, f32::NAN); }
+        if m.control_step().is_err() {
+            return (f32::NAN, f32::NAN);
+        }
         worst = worst.max((m.energy().total() - e0).abs());
     }
     (worst, m.energy().kinetic)
@@ -91,7 +118,9 @@ fn passive(sub: u32, it: usize) -> (f32, f32, f32) {
     let e0 = m.energy().total();
     let (mut gain, mut pen) = (f32::MIN, 0.0f32);
     for _ in 0..150 {
-        if m.control_step().is_err() { return (f32::NAN, f32::NAN, f32::NAN); }
+        if m.control_step().is_err() {
+            return (f32::NAN, f32::NAN, f32::NAN);
+        }
         gain = gain.max(m.energy().total() - e0);
         pen = pen.max(-m.foot_clearances().iter().cloned().fold(f32::MAX, f32::min));
     }
@@ -101,12 +130,17 @@ fn passive(sub: u32, it: usize) -> (f32, f32, f32) {
 /// Joint limits: torso welded, no floor, every joint driven at +10.7 V
 /// for 1 s then −10.7 V for 1 s. Largest excursion beyond a limit (rad).
 fn limits(sub: u32, it: usize) -> f32 {
-    let mut m = model(sub, it, |o| { o.contacts = false; o.fixed_torso = true; });
+    let mut m = model(sub, it, |o| {
+        o.contacts = false;
+        o.fixed_torso = true;
+    });
     let mut worst = 0.0f32;
     for u in [10.7f32, -10.7] {
         m.set_voltages([u; NUM_JOINTS]);
         for _ in 0..30 {
-            if m.control_step().is_err() { return f32::NAN; }
+            if m.control_step().is_err() {
+                return f32::NAN;
+            }
             let (q, _) = m.joint_state();
             for j in JOINTS {
                 if let Some([lo, hi]) = joint_limits(j) {
@@ -126,12 +160,20 @@ fn motor_response(sub: u32, it: usize) -> f32 {
     let r2 = ARM_COM[0] * ARM_COM[0] + ARM_COM[1] * ARM_COM[1];
     let j = ARM_IYY + ARM_MASS * r2 + servo.armature;
     let u = pada_core::rx28::LEO_MAX_VOLTAGE;
-    let expect = servo.voltage_torque(u) / servo.damping * (1.0 - (-CONTROL_PERIOD * servo.damping / j).exp());
-    let mut m = model(sub, it, |o| { o.fixed_torso = true; o.gravity = false; o.contacts = false; o.dry_friction = false; });
+    let expect = servo.voltage_torque(u) / servo.damping
+        * (1.0 - (-CONTROL_PERIOD * servo.damping / j).exp());
+    let mut m = model(sub, it, |o| {
+        o.fixed_torso = true;
+        o.gravity = false;
+        o.contacts = false;
+        o.dry_friction = false;
+    });
     let mut v = [0.0; NUM_JOINTS];
     v[Joint::Shoulder as usize] = u;
     m.set_voltages(v);
-    if m.control_step().is_err() { return f32::NAN; }
+    if m.control_step().is_err() {
+        return f32::NAN;
+    }
     m.joint_state().1[Joint::Shoulder as usize] / expect - 1.0
 }
 
@@ -151,10 +193,15 @@ fn random(sub: u32, it: usize, secs: f32) -> (f64, f64, u64, f64) {
             let a = [0, 1, 2].map(|_| LEVELS[(rng.next_u32() % 7) as usize]);
             let r = env.step(a);
             ret += r.reward as f64;
-            if r.terminal != Terminal::None { eps += 1; env.reset(&mut rng); }
+            if r.terminal != Terminal::None {
+                eps += 1;
+                env.reset(&mut rng);
+            }
         }
         best = best.max(secs as f64 / t0.elapsed().as_secs_f64());
-        if rep == 0 { stats = (steps as f64 / eps as f64, ret / eps as f64, env.blow_ups()); }
+        if rep == 0 {
+            stats = (steps as f64 / eps as f64, ret / eps as f64, env.blow_ups());
+        }
     }
     (stats.0, stats.1, stats.2, best)
 }
@@ -163,11 +210,30 @@ fn main() {
     let quick = std::env::args().any(|a| a == "quick");
     let seqs = sequences(if quick { 40 } else { 200 }, 10, 42);
     let (rs, ri) = (40u32, 4usize);
-    println!("reference: {rs} steps x {ri} iterations (h = {:.3} ms per solver sub-step)\n", 1000.0 / (30.0 * (rs as f32) * ri as f32));
+    println!(
+        "reference: {rs} steps x {ri} iterations (h = {:.3} ms per solver sub-step)\n",
+        1000.0 / (30.0 * (rs as f32) * ri as f32)
+    );
     let reference = rollouts(cfg(rs, ri), &seqs);
     println!("| steps/period | iterations | h (ms) | angle err 0.1 s (rad) | angle err 0.2 s (rad) | energy drift 10 s (J) | passive: max gain (J) | KE after 5 s (J) | max foot penetration (mm) | limit overshoot (rad) | motor response error | mean episode (steps) | mean return | blow-ups | RTF |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
-    let configs: &[(u32, usize)] = &[(1, 1), (1, 2), (1, 4), (1, 8), (2, 1), (2, 2), (2, 4), (3, 1), (4, 1), (4, 2), (8, 1), (8, 2), (16, 2), (40, 4), (80, 4)];
+    let configs: &[(u32, usize)] = &[
+        (1, 1),
+        (1, 2),
+        (1, 4),
+        (1, 8),
+        (2, 1),
+        (2, 2),
+        (2, 4),
+        (3, 1),
+        (4, 1),
+        (4, 2),
+        (8, 1),
+        (8, 2),
+        (16, 2),
+        (40, 4),
+        (80, 4),
+    ];
     for &(s, i) in configs {
         let (ea, er) = error(&reference, &rollouts(cfg(s, i), &seqs));
         let (drift, _) = energy_drift(s, i);

@@ -35,8 +35,14 @@ fn close(a: [f32; 2], b: [f32; 2], tol: f32) -> bool {
 fn folded_boom_matches_the_reference() {
     assert!((TORSO_MASS - 1.230991).abs() < 1e-5, "{TORSO_MASS}");
     assert!((TORSO_IYY - 0.00870763).abs() < 1e-7, "{TORSO_IYY}");
-    assert!(close(TORSO_COM, [-0.0000521, -0.0237952], 1e-6), "{TORSO_COM:?}");
-    assert!((BOOM_EXTRA_FORCE_Z + 1.026915).abs() < 1e-4, "{BOOM_EXTRA_FORCE_Z}");
+    assert!(
+        close(TORSO_COM, [-0.0000521, -0.0237952], 1e-6),
+        "{TORSO_COM:?}"
+    );
+    assert!(
+        (BOOM_EXTRA_FORCE_Z + 1.026915).abs() < 1e-4,
+        "{BOOM_EXTRA_FORCE_Z}"
+    );
 }
 
 /// §1.8: the starting pose stands on the left foot (toe and heel on the
@@ -46,15 +52,49 @@ fn folded_boom_matches_the_reference() {
 fn initial_pose_has_the_left_foot_on_the_floor() {
     let m = model(|_| {});
     let c = m.foot_clearances();
-    assert!(c[0].abs() < 1e-5 && c[1].abs() < 1e-5, "left toe/heel clearance {c:?}");
-    assert!((c[2] - 0.0229).abs() < 1e-3 && (c[3] - 0.0652).abs() < 1e-3, "right toe/heel {c:?}");
-    assert!(close(m.body_point(Body::Torso, TORSO_HIP_ANCHOR), [0.0274, 0.2691], 1e-3));
-    assert!(close(m.body_point(Body::ThighLeft, THIGH_KNEE_ANCHOR), [0.0274, 0.1531], 1e-3));
-    assert!(close(m.body_point(Body::ShankLeft, SHANK_ANKLE_ANCHOR), [0.0315, 0.0486], 1e-3));
-    assert!(close(m.body_point(Body::ThighRight, THIGH_KNEE_ANCHOR), [0.1039, 0.1819], 1e-3));
-    assert!(close(m.body_point(Body::ShankRight, SHANK_ANKLE_ANCHOR), [0.0528, 0.0907], 1e-3));
-    assert!(close(m.body_point(Body::Torso, TORSO_SHOULDER_ANCHOR), [0.0405, 0.4809], 1e-3));
-    assert!(close(m.body_point(Body::Torso, TORSO_COM), [0.0344, 0.3659], 1e-3));
+    assert!(
+        c[0].abs() < 1e-5 && c[1].abs() < 1e-5,
+        "left toe/heel clearance {c:?}"
+    );
+    assert!(
+        (c[2] - 0.0229).abs() < 1e-3 && (c[3] - 0.0652).abs() < 1e-3,
+        "right toe/heel {c:?}"
+    );
+    assert!(close(
+        m.body_point(Body::Torso, TORSO_HIP_ANCHOR),
+        [0.0274, 0.2691],
+        1e-3
+    ));
+    assert!(close(
+        m.body_point(Body::ThighLeft, THIGH_KNEE_ANCHOR),
+        [0.0274, 0.1531],
+        1e-3
+    ));
+    assert!(close(
+        m.body_point(Body::ShankLeft, SHANK_ANKLE_ANCHOR),
+        [0.0315, 0.0486],
+        1e-3
+    ));
+    assert!(close(
+        m.body_point(Body::ThighRight, THIGH_KNEE_ANCHOR),
+        [0.1039, 0.1819],
+        1e-3
+    ));
+    assert!(close(
+        m.body_point(Body::ShankRight, SHANK_ANKLE_ANCHOR),
+        [0.0528, 0.0907],
+        1e-3
+    ));
+    assert!(close(
+        m.body_point(Body::Torso, TORSO_SHOULDER_ANCHOR),
+        [0.0405, 0.4809],
+        1e-3
+    ));
+    assert!(close(
+        m.body_point(Body::Torso, TORSO_COM),
+        [0.0344, 0.3659],
+        1e-3
+    ));
     let s = m.state();
     assert_eq!(s.contacts, [true, true, false, false]);
     let q = InitialPose::REFERENCE.joint_angles();
@@ -81,15 +121,29 @@ fn motion_stays_planar() {
     let mut r = rng(3);
     env.reset(&mut r);
     for _ in 0..60 {
-        env.model_mut().set_disturbance(Some((Body::Torso, [0.0, 5.0, 0.0], [0.5, 0.0, 0.5])));
+        env.model_mut()
+            .set_disturbance(Some((Body::Torso, [0.0, 5.0, 0.0], [0.5, 0.0, 0.5])));
         if env.step(random_action(&mut r)).terminal != Terminal::None {
             env.reset(&mut r);
         }
-        for b in [Body::Torso, Body::Arm, Body::FootLeft, Body::FootRight, Body::ShankRight] {
+        for b in [
+            Body::Torso,
+            Body::Arm,
+            Body::FootLeft,
+            Body::FootRight,
+            Body::ShankRight,
+        ] {
             let p = env.model().body_pose(b);
-            assert!(p.translation.y.abs() < 1e-6, "{b:?} left the plane: {:?}", p.translation);
+            assert!(
+                p.translation.y.abs() < 1e-6,
+                "{b:?} left the plane: {:?}",
+                p.translation
+            );
             let axis = p.rotation * rapier3d::math::Vector::Y;
-            assert!((axis.y - 1.0).abs() < 1e-5, "{b:?} tilted out of the plane: {axis:?}");
+            assert!(
+                (axis.y - 1.0).abs() < 1e-5,
+                "{b:?} tilted out of the plane: {axis:?}"
+            );
         }
     }
 }
@@ -123,7 +177,10 @@ fn servo_reproduces_stall_torque_and_no_load_speed() {
     assert!((speed / 5.5845 - 1.0).abs() < 0.01, "no-load speed {speed}");
     let over = q[Joint::KneeLeft as usize] - KNEE_LIMITS[1];
     let torque = KNEE_STOP[0] * over;
-    assert!((torque / 1.7852 - 1.0).abs() < 0.01, "stall torque {torque} (δ = {over})");
+    assert!(
+        (torque / 1.7852 - 1.0).abs() < 0.01,
+        "stall torque {torque} (δ = {over})"
+    );
     assert!(qd[Joint::KneeLeft as usize].abs() < 1e-3);
     // The same numbers from the motor model itself.
     let servo = Rx28::LEO;
@@ -156,7 +213,10 @@ fn servo_response_over_one_control_period() {
     m.set_voltages(v);
     m.control_step().unwrap();
     let got = m.joint_state().1[Joint::Shoulder as usize];
-    assert!((got / expect - 1.0).abs() < 0.015, "speed after 1/30 s: {got}, expected {expect}");
+    assert!(
+        (got / expect - 1.0).abs() < 0.015,
+        "speed after 1/30 s: {got}, expected {expect}"
+    );
 }
 
 /// Issue 4: a passive robot (0 V: back-EMF braking, dry friction) falls
@@ -222,7 +282,10 @@ fn energy_is_conserved_without_contacts_and_friction() {
     for _ in 0..300 {
         m.control_step().unwrap();
         let k = m.energy().kinetic;
-        assert!((k / k0 - 1.0).abs() < 0.02, "free-floating kinetic energy {k0} → {k}");
+        assert!(
+            (k / k0 - 1.0).abs() < 0.02,
+            "free-floating kinetic energy {k0} → {k}"
+        );
     }
 }
 
@@ -284,7 +347,9 @@ fn random_actions_end_in_falls_with_finite_rewards() {
             let res = env.step(random_action(&mut r));
             steps += 1;
             assert!(res.reward.is_finite() && res.obs.0.iter().all(|x| x.is_finite()));
-            assert!(res.info.energy >= 0.0 && res.info.learned_torques.iter().all(|t| t.abs() < 5.0));
+            assert!(
+                res.info.energy >= 0.0 && res.info.learned_torques.iter().all(|t| t.abs() < 5.0)
+            );
             match res.terminal {
                 Terminal::None => assert!(steps <= 751),
                 Terminal::Fall => {
@@ -305,7 +370,10 @@ fn random_actions_end_in_falls_with_finite_rewards() {
 /// end repeats the last result without simulating.
 #[test]
 fn timeout_ends_the_episode() {
-    let cfg = LeoConfig { timeout: 0.2, ..LeoConfig::default() };
+    let cfg = LeoConfig {
+        timeout: 0.2,
+        ..LeoConfig::default()
+    };
     let mut env = LeoEnv::new(cfg).unwrap();
     env.reset(&mut rng(1));
     let mut n = 0;
@@ -333,7 +401,11 @@ fn first_step_reward_carries_the_reference_artefact() {
     let mut env = LeoEnv::new(LeoConfig::default()).unwrap();
     env.reset(&mut rng(1));
     let res = env.step([0.0; 3]);
-    assert!(res.reward > 8.0 && res.reward < 13.0, "first reward {}", res.reward);
+    assert!(
+        res.reward > 8.0 && res.reward < 13.0,
+        "first reward {}",
+        res.reward
+    );
     assert_eq!(res.info.stance, Leg::Left);
 }
 
@@ -368,18 +440,25 @@ fn blow_ups_are_falls_not_panics() {
     let res = env.step([f32::NAN, f32::INFINITY, 1.0]);
     assert!(res.info.invalid_action && res.obs.0.iter().all(|x| x.is_finite()));
 
-    for (rates, kind) in [([1.0e6f32; NUM_JOINTS], BlowUp::JointRate), ([f32::NAN; NUM_JOINTS], BlowUp::NonFinite)] {
+    for (rates, kind) in [
+        ([1.0e6f32; NUM_JOINTS], BlowUp::JointRate),
+        ([f32::NAN; NUM_JOINTS], BlowUp::NonFinite),
+    ] {
         env.reset(&mut r);
         env.model_mut().set_velocities(rates, [0.0; 3]);
         let res = env.step([0.0; 3]);
         assert_eq!(res.terminal, Terminal::Fall);
         assert!(res.reward <= -125.0);
-        assert_eq!(res.info.blow_up.map(|b| core::mem::discriminant(&b)), Some(core::mem::discriminant(&kind)));
+        assert_eq!(
+            res.info.blow_up.map(|b| core::mem::discriminant(&b)),
+            Some(core::mem::discriminant(&kind))
+        );
         assert!(res.obs.0.iter().all(|x| x.is_finite()));
     }
     // A body far away.
     env.reset(&mut r);
-    env.model_mut().set_velocities([0.0; NUM_JOINTS], [1.0e4, 0.0, 0.0]);
+    env.model_mut()
+        .set_velocities([0.0; NUM_JOINTS], [1.0e4, 0.0, 0.0]);
     let res = env.step([0.0; 3]);
     assert_eq!(res.info.blow_up, Some(BlowUp::FarAway));
     assert_eq!(env.blow_ups(), 3);
@@ -394,22 +473,49 @@ fn blow_ups_are_falls_not_panics() {
 #[test]
 fn invalid_config_is_refused() {
     for bad in [
-        LeoConfig { model: ModelOptions { substeps: 0, ..Default::default() }, ..Default::default() },
-        LeoConfig { model: ModelOptions { solver_iterations: 0, ..Default::default() }, ..Default::default() },
-        LeoConfig { model: ModelOptions { contact_frequency: f32::NAN, ..Default::default() }, ..Default::default() },
-        LeoConfig { timeout: -1.0, ..Default::default() },
+        LeoConfig {
+            model: ModelOptions {
+                substeps: 0,
+                ..Default::default()
+            },
+            ..Default::default()
+        },
+        LeoConfig {
+            model: ModelOptions {
+                solver_iterations: 0,
+                ..Default::default()
+            },
+            ..Default::default()
+        },
+        LeoConfig {
+            model: ModelOptions {
+                contact_frequency: f32::NAN,
+                ..Default::default()
+            },
+            ..Default::default()
+        },
+        LeoConfig {
+            timeout: -1.0,
+            ..Default::default()
+        },
     ] {
         let e = LeoEnv::new(bad).err().expect("refused");
         assert!(!e.to_string().is_empty());
     }
-    let pose = InitialPose { torso: f32::NAN, ..InitialPose::REFERENCE };
+    let pose = InitialPose {
+        torso: f32::NAN,
+        ..InitialPose::REFERENCE
+    };
     assert!(LeoModel::new(ModelOptions::default(), &pose).is_err());
 }
 
 /// §1.8 randomisation (off by default) still starts on the left foot.
 #[test]
 fn randomized_start_stands_on_the_left_foot() {
-    let cfg = LeoConfig { randomize_start: true, ..LeoConfig::default() };
+    let cfg = LeoConfig {
+        randomize_start: true,
+        ..LeoConfig::default()
+    };
     let mut env = LeoEnv::new(cfg).unwrap();
     let mut r = rng(8);
     for _ in 0..5 {

@@ -13,6 +13,10 @@
 //! +x). Hinge angles follow ODE: q = θ_parent − θ_child, so a positive torque
 //! increases q.
 
+// Numbers are written as the reference prints them (more digits than f32
+// holds; limits such as −0.785398 are the reference's degrees, not π/4).
+#![allow(clippy::excessive_precision, clippy::approx_constant)]
+
 use pada_core::rx28;
 
 // ---------------------------------------------------------------------------
@@ -103,9 +107,9 @@ pub const BOOM_LENGTH: f32 = 1.70;
 pub const BOOM_PIVOT_INERTIA: f32 = 0.31863;
 /// Horizontal (inertial) equivalent mass of the boom at the robot,
 /// (d²·m + I)/L² ≈ 0.317731 kg, added to the torso at the hip anchor (§1.4).
-pub const BOOM_HORIZONTAL_MASS: f32 =
-    (BOOM_COM_DISTANCE * BOOM_COM_DISTANCE * BOOM_MASS + BOOM_PIVOT_INERTIA)
-        / (BOOM_LENGTH * BOOM_LENGTH);
+pub const BOOM_HORIZONTAL_MASS: f32 = (BOOM_COM_DISTANCE * BOOM_COM_DISTANCE * BOOM_MASS
+    + BOOM_PIVOT_INERTIA)
+    / (BOOM_LENGTH * BOOM_LENGTH);
 /// Vertical (weight) equivalent mass of the boom, m·d/L ≈ 0.422412 kg (§1.4).
 pub const BOOM_VERTICAL_MASS: f32 = BOOM_MASS * BOOM_COM_DISTANCE / BOOM_LENGTH;
 /// The constant extra world-frame vertical force on the torso,

@@ -42,7 +42,11 @@ pub struct LeoConfig {
 
 impl Default for LeoConfig {
     fn default() -> Self {
-        Self { model: ModelOptions::default(), randomize_start: false, timeout: EPISODE_TIMEOUT }
+        Self {
+            model: ModelOptions::default(),
+            randomize_start: false,
+            timeout: EPISODE_TIMEOUT,
+        }
     }
 }
 
@@ -62,8 +66,14 @@ impl core::fmt::Display for LeoError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
             LeoError::Model(e) => e.fmt(f),
-            LeoError::InvalidTimeout(t) => write!(f, "invalid LEO episode timeout {t} s: must be finite and > 0"),
-            LeoError::UnstableStart(b) => write!(f, "the LEO simulation blew up ({b:?}) while settling into the starting pose"),
+            LeoError::InvalidTimeout(t) => write!(
+                f,
+                "invalid LEO episode timeout {t} s: must be finite and > 0"
+            ),
+            LeoError::UnstableStart(b) => write!(
+                f,
+                "the LEO simulation blew up ({b:?}) while settling into the starting pose"
+            ),
         }
     }
 }
@@ -316,7 +326,12 @@ impl LeoEnv {
     /// reward 0 and the same terminal, without simulating.
     pub fn step(&mut self, action_voltages: [f32; ACTION_DIM]) -> StepResult {
         if self.terminal != Terminal::None {
-            return StepResult { obs: self.obs, reward: 0.0, terminal: self.terminal, info: self.last_info };
+            return StepResult {
+                obs: self.obs,
+                reward: 0.0,
+                terminal: self.terminal,
+                info: self.last_info,
+            };
         }
         let stance = self.current_stance();
         let (angles, _) = self.model.joint_state();
@@ -341,7 +356,12 @@ impl LeoEnv {
                     ..empty_info()
                 };
                 self.last_info = info;
-                return StepResult { obs: self.obs, reward: REWARD_TIME + REWARD_FALL, terminal: Terminal::Fall, info };
+                return StepResult {
+                    obs: self.obs,
+                    reward: REWARD_TIME + REWARD_FALL,
+                    terminal: Terminal::Fall,
+                    info,
+                };
             }
         };
         self.time += CONTROL_PERIOD;
@@ -372,7 +392,12 @@ impl LeoEnv {
             invalid_action,
         };
         self.last_info = info;
-        StepResult { obs: self.obs, reward, terminal: self.terminal, info }
+        StepResult {
+            obs: self.obs,
+            reward,
+            terminal: self.terminal,
+            info,
+        }
     }
 }
 

@@ -35,6 +35,10 @@
 //! The step size, solver iterations and contact softness are chosen in
 //! `README.md` next to this file.
 
+// Index loops over several parallel fixed-size arrays (joints, DoFs, links)
+// read more plainly than zipped iterators here.
+#![allow(clippy::needless_range_loop)]
+
 use pada_core::rx28::ReducedJoint;
 use rapier3d::prelude::*;
 
@@ -115,7 +119,11 @@ struct BodySpec {
 
 const TORSO_SPHERES: [([f32; 2], f32, Material); 3] = [
     (TORSO_ASS_PAMPER.0, TORSO_ASS_PAMPER.1, Material::Foam),
-    (TORSO_SHOULDER_FRONT.0, TORSO_SHOULDER_FRONT.1, Material::Foam),
+    (
+        TORSO_SHOULDER_FRONT.0,
+        TORSO_SHOULDER_FRONT.1,
+        Material::Foam,
+    ),
     (TORSO_SHOULDER_BACK.0, TORSO_SHOULDER_BACK.1, Material::Foam),
 ];
 const ARM_SPHERES: [([f32; 2], f32, Material); 1] = [(ARM_HAND, WHEEL_RADIUS, Material::Rubber)];
@@ -128,19 +136,44 @@ const FOOT_SPHERES: [([f32; 2], f32, Material); 2] = [
 ];
 
 const fn thigh() -> BodySpec {
-    BodySpec { mass: THIGH_MASS, iyy: THIGH_IYY, com: THIGH_COM, spheres: &[] }
+    BodySpec {
+        mass: THIGH_MASS,
+        iyy: THIGH_IYY,
+        com: THIGH_COM,
+        spheres: &[],
+    }
 }
 const fn shank() -> BodySpec {
-    BodySpec { mass: SHANK_MASS, iyy: SHANK_IYY, com: SHANK_COM, spheres: &SHANK_SPHERES }
+    BodySpec {
+        mass: SHANK_MASS,
+        iyy: SHANK_IYY,
+        com: SHANK_COM,
+        spheres: &SHANK_SPHERES,
+    }
 }
 const fn foot() -> BodySpec {
-    BodySpec { mass: FOOT_MASS, iyy: FOOT_IYY, com: FOOT_COM, spheres: &FOOT_SPHERES }
+    BodySpec {
+        mass: FOOT_MASS,
+        iyy: FOOT_IYY,
+        com: FOOT_COM,
+        spheres: &FOOT_SPHERES,
+    }
 }
 
 /// Bodies in [`Body`] order (§1.3, §1.6).
 const BODY_SPECS: [BodySpec; NUM_BODIES] = [
-    BodySpec { mass: TORSO_MASS, iyy: TORSO_IYY, com: TORSO_COM, spheres: &TORSO_SPHERES },
-    BodySpec { mass: ARM_MASS, iyy: ARM_IYY, com: ARM_COM, spheres: &ARM_SPHERES },
+    BodySpec {
+        mass: TORSO_MASS,
+        iyy: TORSO_IYY,
+        com: TORSO_COM,
+        spheres: &TORSO_SPHERES,
+    },
+    BodySpec {
+        mass: ARM_MASS,
+        iyy: ARM_IYY,
+        com: ARM_COM,
+        spheres: &ARM_SPHERES,
+    },
     thigh(),
     shank(),
     foot(),
@@ -361,7 +394,9 @@ pub enum ModelError {
 impl core::fmt::Display for ModelError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
-            ModelError::InvalidOption(name, why) => write!(f, "invalid LEO model option `{name}`: {why}"),
+            ModelError::InvalidOption(name, why) => {
+                write!(f, "invalid LEO model option `{name}`: {why}")
+            }
             ModelError::InvalidPose => write!(f, "the starting pose has a non-finite angle"),
             ModelError::Topology => write!(f, "rapier refused LEO's joint tree"),
         }
@@ -378,13 +413,22 @@ impl ModelOptions {
             return Err(ModelError::InvalidOption("substeps", "must be in 1..=1000"));
         }
         if !(1..=100).contains(&self.solver_iterations) {
-            return Err(ModelError::InvalidOption("solver_iterations", "must be in 1..=100"));
+            return Err(ModelError::InvalidOption(
+                "solver_iterations",
+                "must be in 1..=100",
+            ));
         }
         if !(self.contact_frequency.is_finite() && self.contact_frequency > 0.0) {
-            return Err(ModelError::InvalidOption("contact_frequency", "must be finite and > 0"));
+            return Err(ModelError::InvalidOption(
+                "contact_frequency",
+                "must be finite and > 0",
+            ));
         }
         if !(self.contact_damping_ratio.is_finite() && self.contact_damping_ratio >= 0.0) {
-            return Err(ModelError::InvalidOption("contact_damping_ratio", "must be finite and >= 0"));
+            return Err(ModelError::InvalidOption(
+                "contact_damping_ratio",
+                "must be finite and >= 0",
+            ));
         }
         Ok(())
     }
@@ -495,19 +539,26 @@ impl LeoModel {
             return Err(ModelError::InvalidPose);
         }
         let mut world = PhysicsWorld::new();
-        world.gravity = if options.gravity { Vector::new(0.0, 0.0, -GRAVITY) } else { Vector::ZERO };
+        world.gravity = if options.gravity {
+            Vector::new(0.0, 0.0, -GRAVITY)
+        } else {
+            Vector::ZERO
+        };
         let p = &mut world.integration_parameters;
         p.dt = options.dt();
         p.num_solver_iterations = options.solver_iterations;
-        let softness = SpringCoefficients::new(options.contact_frequency, options.contact_damping_ratio);
+        let softness =
+            SpringCoefficients::new(options.contact_frequency, options.contact_damping_ratio);
         p.contact_softness = softness;
         p.static_contact_softness = softness;
         // The default recycles contacts until a pair moved 5 cm, far more
         // than LEO's 3.5 mm wheels allow.
         p.contact_recycling = false;
 
-        let robot_groups = InteractionGroups::new(Group::GROUP_1, Group::GROUP_2, InteractionTestMode::And);
-        let floor_groups = InteractionGroups::new(Group::GROUP_2, Group::GROUP_1, InteractionTestMode::And);
+        let robot_groups =
+            InteractionGroups::new(Group::GROUP_1, Group::GROUP_2, InteractionTestMode::And);
+        let floor_groups =
+            InteractionGroups::new(Group::GROUP_2, Group::GROUP_1, InteractionTestMode::And);
         if options.contacts {
             world.colliders.insert(
                 ColliderBuilder::new(SharedShape::halfspace(Vector::Z))
@@ -541,7 +592,9 @@ impl LeoModel {
                     .friction(friction)
                     .friction_combine_rule(CoefficientCombineRule::Min)
                     .collision_groups(robot_groups);
-                world.colliders.insert_with_parent(collider, handle, &mut world.bodies);
+                world
+                    .colliders
+                    .insert_with_parent(collider, handle, &mut world.bodies);
             }
             bodies[i] = handle;
         }
@@ -552,13 +605,18 @@ impl LeoModel {
         let anchor = world.bodies.insert(RigidBodyBuilder::fixed());
         let planar = if options.fixed_torso {
             GenericJointBuilder::new(JointAxesMask::all())
-                .local_frame1(body_pose(origin[Body::Torso as usize], pitch[Body::Torso as usize]))
+                .local_frame1(body_pose(
+                    origin[Body::Torso as usize],
+                    pitch[Body::Torso as usize],
+                ))
                 .contacts_enabled(false)
                 .build()
         } else {
-            GenericJointBuilder::new(JointAxesMask::LIN_Y | JointAxesMask::ANG_X | JointAxesMask::ANG_Z)
-                .contacts_enabled(false)
-                .build()
+            GenericJointBuilder::new(
+                JointAxesMask::LIN_Y | JointAxesMask::ANG_X | JointAxesMask::ANG_Z,
+            )
+            .contacts_enabled(false)
+            .build()
         };
         world
             .multibody_joints
@@ -571,7 +629,12 @@ impl LeoModel {
                 .contacts_enabled(false);
             world
                 .multibody_joints
-                .insert(bodies[j.parent as usize], bodies[j.child as usize], hinge, true)
+                .insert(
+                    bodies[j.parent as usize],
+                    bodies[j.child as usize],
+                    hinge,
+                    true,
+                )
                 .ok_or(ModelError::Topology)?;
         }
 
@@ -599,13 +662,19 @@ impl LeoModel {
             let rb = &mut world.bodies[h];
             rb.recompute_mass_properties_from_colliders(&world.colliders);
         }
-        let mb = world.multibody_joints.get_multibody_mut(multibody).ok_or(ModelError::Topology)?;
+        let mb = world
+            .multibody_joints
+            .get_multibody_mut(multibody)
+            .ok_or(ModelError::Topology)?;
         // The root (the fixed anchor) counts as a free 6-DoF joint until
         // the multibody has looked at its body type.
         mb.forward_kinematics(&world.bodies, true);
         let root_link = torso_link.id;
         let root_dofs = if options.fixed_torso { 0 } else { 3 };
-        let root_dof = mb.link(root_link).ok_or(ModelError::Topology)?.assembly_id();
+        let root_dof = mb
+            .link(root_link)
+            .ok_or(ModelError::Topology)?
+            .assembly_id();
         let mut dofs = [0usize; NUM_JOINTS];
         for k in 0..NUM_JOINTS {
             dofs[k] = mb.link(links[k]).ok_or(ModelError::Topology)?.assembly_id();
@@ -634,7 +703,10 @@ impl LeoModel {
         }
         let angles = pose.joint_angles();
         for k in 0..NUM_JOINTS {
-            mb.link_mut(links[k]).ok_or(ModelError::Topology)?.joint.apply_displacement(&[angles[k]]);
+            mb.link_mut(links[k])
+                .ok_or(ModelError::Topology)?
+                .joint
+                .apply_displacement(&[angles[k]]);
         }
         mb.generalized_velocity_mut().fill(0.0);
         mb.forward_kinematics(&world.bodies, false);
@@ -708,7 +780,7 @@ impl LeoModel {
         if !pose.is_finite() {
             return Err(ModelError::InvalidPose);
         }
-        let built = core::mem::replace(&mut self.built, None);
+        let built = self.built.take();
         if let Some((snapshot, built_pose)) = &built {
             self.restore(snapshot);
             if pose != built_pose {
@@ -728,12 +800,20 @@ impl LeoModel {
         let torso = origin[Body::Torso as usize];
         let root_target = [torso[0], torso[1], pose.torso];
         let angles = pose.joint_angles();
-        let mb = self.world.multibody_joints.get_multibody_mut(self.multibody).ok_or(ModelError::Topology)?;
+        let mb = self
+            .world
+            .multibody_joints
+            .get_multibody_mut(self.multibody)
+            .ok_or(ModelError::Topology)?;
         // Joint coordinates only move by displacements.
         let root = mb.link_mut(self.root_link).ok_or(ModelError::Topology)?;
         if self.root_dof.is_some() {
             let c = root.joint.coords();
-            root.joint.apply_displacement(&[root_target[0] - c[0], root_target[1] - c[2], root_target[2] - c[4]]);
+            root.joint.apply_displacement(&[
+                root_target[0] - c[0],
+                root_target[1] - c[2],
+                root_target[2] - c[4],
+            ]);
         } else {
             root.joint.data.local_frame1 = body_pose(torso, pose.torso);
         }
@@ -768,7 +848,13 @@ impl LeoModel {
     /// (zero-order hold, §1.1). Each passes the supply clip of §2.1;
     /// non-finite values become 0 V.
     pub fn set_voltages(&mut self, voltages: [f32; NUM_JOINTS]) {
-        self.voltages = voltages.map(|u| if u.is_finite() { u.clamp(-SERVO.supply_clip, SERVO.supply_clip) } else { 0.0 });
+        self.voltages = voltages.map(|u| {
+            if u.is_finite() {
+                u.clamp(-SERVO.supply_clip, SERVO.supply_clip)
+            } else {
+                0.0
+            }
+        });
     }
 
     /// A constant external force (N) at the body's centre of mass and a
@@ -790,7 +876,10 @@ impl LeoModel {
         if body == Body::Torso as usize {
             return self.root_link;
         }
-        JOINT_SPECS.iter().position(|j| j.child as usize == body).map_or(self.root_link, |k| self.links[k])
+        JOINT_SPECS
+            .iter()
+            .position(|j| j.child as usize == body)
+            .map_or(self.root_link, |k| self.links[k])
     }
 
     fn multibody(&self) -> &Multibody {
@@ -808,7 +897,9 @@ impl LeoModel {
         for k in 0..NUM_JOINTS {
             // A revolute joint's coordinate is its angle about the joint
             // frame's x axis (−y in the world here).
-            q[k] = mb.link(self.links[k]).map_or(f32::NAN, |l| l.joint.coords()[3]);
+            q[k] = mb
+                .link(self.links[k])
+                .map_or(f32::NAN, |l| l.joint.coords()[3]);
             qd[k] = v[self.dofs[k]];
         }
         (q, qd)
@@ -821,7 +912,9 @@ impl LeoModel {
 
     /// World (x, z) of a point given in a body's frame.
     pub fn body_point(&self, body: Body, point: [f32; 2]) -> [f32; 2] {
-        let p = self.body_pose(body).transform_point(Vector::new(point[0], 0.0, point[1]));
+        let p = self
+            .body_pose(body)
+            .transform_point(Vector::new(point[0], 0.0, point[1]));
         [p.x, p.z]
     }
 
@@ -878,7 +971,11 @@ impl LeoModel {
     pub fn set_velocities(&mut self, joint_rates: [f32; NUM_JOINTS], root: [f32; 3]) {
         let dofs = self.dofs;
         let root_dof = self.root_dof;
-        if let Some(mb) = self.world.multibody_joints.get_multibody_mut(self.multibody) {
+        if let Some(mb) = self
+            .world
+            .multibody_joints
+            .get_multibody_mut(self.multibody)
+        {
             let mut v = mb.generalized_velocity_mut();
             for k in 0..NUM_JOINTS {
                 v[dofs[k]] = joint_rates[k];
@@ -911,8 +1008,11 @@ impl LeoModel {
             let w = rb.position().rotation.inverse() * Vector::new(jv[3], jv[4], jv[5]);
             let inertia = [INERTIA_DONT_CARE, spec.iyy, INERTIA_DONT_CARE];
             kinetic += 0.5 * spec.mass as f64 * v.length_squared() as f64;
-            kinetic += 0.5 * (inertia[0] * w.x * w.x + inertia[1] * w.y * w.y + inertia[2] * w.z * w.z) as f64;
-            let com = rb.position().transform_point(Vector::new(spec.com[0], 0.0, spec.com[1]));
+            kinetic += 0.5
+                * (inertia[0] * w.x * w.x + inertia[1] * w.y * w.y + inertia[2] * w.z * w.z) as f64;
+            let com = rb
+                .position()
+                .transform_point(Vector::new(spec.com[0], 0.0, spec.com[1]));
             potential += (spec.mass * g * com.z) as f64;
         }
         let (q, qd) = self.joint_state();
@@ -929,7 +1029,10 @@ impl LeoModel {
             let p = self.body_point(Body::Torso, BOOM_FORCE_POINT);
             potential += (-BOOM_EXTRA_FORCE_Z * p[1]) as f64;
         }
-        Energy { kinetic: kinetic as f32, potential: potential as f32 }
+        Energy {
+            kinetic: kinetic as f32,
+            potential: potential as f32,
+        }
     }
 
     /// Checks the state for a blow-up (NaN, far away, absurd joint rate).
@@ -940,7 +1043,10 @@ impl LeoModel {
         }
         for &h in &self.bodies {
             let rb = &self.world.bodies[h];
-            if !(rb.position().translation.is_finite() && rb.linvel().is_finite() && rb.angvel().is_finite()) {
+            if !(rb.position().translation.is_finite()
+                && rb.linvel().is_finite()
+                && rb.angvel().is_finite())
+            {
                 return Err(BlowUp::NonFinite);
             }
         }
@@ -948,7 +1054,11 @@ impl LeoModel {
         if self.dofs.iter().any(|&d| v[d].abs() > BLOWUP_JOINT_RATE) {
             return Err(BlowUp::JointRate);
         }
-        if self.bodies.iter().any(|&h| self.world.bodies[h].position().translation.length() > BLOWUP_DISTANCE) {
+        if self
+            .bodies
+            .iter()
+            .any(|&h| self.world.bodies[h].position().translation.length() > BLOWUP_DISTANCE)
+        {
             return Err(BlowUp::FarAway);
         }
         Ok(())
@@ -959,10 +1069,18 @@ impl LeoModel {
     pub fn physics_step(&mut self) -> Result<(), BlowUp> {
         let (q, qd) = self.joint_state();
         // Soft stops (§1.5).
-        if let Some(mb) = self.world.multibody_joints.get_multibody_mut(self.multibody) {
+        if let Some(mb) = self
+            .world
+            .multibody_joints
+            .get_multibody_mut(self.multibody)
+        {
             for k in 0..NUM_JOINTS {
-                let Some((limits, [stiffness, damping])) = JOINT_SPECS[k].stop else { continue };
-                let Some(link) = mb.link_mut(self.links[k]) else { continue };
+                let Some((limits, [stiffness, damping])) = JOINT_SPECS[k].stop else {
+                    continue;
+                };
+                let Some(link) = mb.link_mut(self.links[k]) else {
+                    continue;
+                };
                 let data = &mut link.joint.data;
                 let (target, inward) = if !self.options.joint_stops {
                     continue;
@@ -974,7 +1092,11 @@ impl LeoModel {
                     data.motor_axes.remove(JointAxesMask::ANG_X);
                     continue;
                 };
-                let d = if inward && self.options.stop_damping { damping } else { 0.0 };
+                let d = if inward && self.options.stop_damping {
+                    damping
+                } else {
+                    0.0
+                };
                 data.set_motor_model(JointAxis::AngX, MotorModel::ForceBased);
                 data.set_motor(JointAxis::AngX, target, 0.0, stiffness, d);
             }
@@ -986,7 +1108,11 @@ impl LeoModel {
             rb.reset_torques(false);
         }
         if self.options.boom_force {
-            let p = self.body_pose(Body::Torso).transform_point(Vector::new(BOOM_FORCE_POINT[0], 0.0, BOOM_FORCE_POINT[1]));
+            let p = self.body_pose(Body::Torso).transform_point(Vector::new(
+                BOOM_FORCE_POINT[0],
+                0.0,
+                BOOM_FORCE_POINT[1],
+            ));
             self.world.bodies[self.bodies[Body::Torso as usize]].add_force_at_point(
                 Vector::new(0.0, 0.0, BOOM_EXTRA_FORCE_Z),
                 p,
@@ -1068,7 +1194,13 @@ impl LeoModel {
         }
         let dofs = self.dofs;
         let stepped = self.stepped;
-        let Some(mb) = self.world.multibody_joints.get_multibody_mut(self.multibody) else { return };
+        let Some(mb) = self
+            .world
+            .multibody_joints
+            .get_multibody_mut(self.multibody)
+        else {
+            return;
+        };
         // (M⁻¹)_dd: after a step, from the factorisation rapier already has
         // of M + armature + h·damping (cheap: one solve per DoF); before
         // the first step, from a fresh assembly of M + armature.
@@ -1080,7 +1212,11 @@ impl LeoModel {
             for (i, &k) in dofs.iter().enumerate() {
                 e.fill(0.0);
                 e[k] = 1.0;
-                inv[i] = if mb.inv_augmented_mass().solve_mut(&mut e) { e[k] } else { f32::NAN };
+                inv[i] = if mb.inv_augmented_mass().solve_mut(&mut e) {
+                    e[k]
+                } else {
+                    f32::NAN
+                };
             }
             damped = h * d;
         } else {
@@ -1118,5 +1254,8 @@ fn options_servo(options: &ModelOptions) -> ReducedJoint {
 
 /// A body's world pose from its origin (x, z) and pitch.
 fn body_pose(origin: [f32; 2], pitch: f32) -> Pose {
-    Pose::from_parts(Vector::new(origin[0], 0.0, origin[1]), Rotation::from_rotation_y(pitch))
+    Pose::from_parts(
+        Vector::new(origin[0], 0.0, origin[1]),
+        Rotation::from_rotation_y(pitch),
+    )
 }

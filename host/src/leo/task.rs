@@ -66,7 +66,12 @@ impl RateFilter {
     /// A filter for sampling frequency `fs` and cut-off `fc` (Hz), state 0.
     pub fn new(fs: f32, fc: f32) -> Self {
         let tc = 2.0 * core::f32::consts::PI * fc / fs;
-        Self { b: tc / (tc + 2.0), a1: (tc - 2.0) / (tc + 2.0), x_prev: 0.0, y_prev: 0.0 }
+        Self {
+            b: tc / (tc + 2.0),
+            a1: (tc - 2.0) / (tc + 2.0),
+            x_prev: 0.0,
+            y_prev: 0.0,
+        }
     }
     /// The servo-joint filter: 30 Hz sampling, 10 Hz cut-off (§3.2).
     pub fn joint() -> Self {
@@ -135,7 +140,13 @@ impl Default for StanceTracker {
 impl StanceTracker {
     /// Unknown stance, no footsteps (episode start).
     pub fn new() -> Self {
-        Self { stance: None, length: 0.0, last_was_footstep: false, footsteps: 0, walked: 0.0 }
+        Self {
+            stance: None,
+            length: 0.0,
+            last_was_footstep: false,
+            footsteps: 0,
+            walked: 0.0,
+        }
     }
 
     /// The current stance leg, `None` before the first update.
@@ -163,14 +174,28 @@ impl StanceTracker {
     /// - a footstep is a stance change with a known previous stance:
     ///   count ±1 by the sign of L, walked distance += L;
     /// - L_prev = old L, negated if the previous update was a footstep.
-    pub fn update(&mut self, contact_left: bool, contact_right: bool, ankle_left: f32, ankle_right: f32) -> StanceUpdate {
-        let previous_length = if self.last_was_footstep { -self.length } else { self.length };
+    pub fn update(
+        &mut self,
+        contact_left: bool,
+        contact_right: bool,
+        ankle_left: f32,
+        ankle_right: f32,
+    ) -> StanceUpdate {
+        let previous_length = if self.last_was_footstep {
+            -self.length
+        } else {
+            self.length
+        };
         let before = self.stance;
         let after = match (contact_left, contact_right) {
             (true, false) => Some(Leg::Left),
             (false, true) => Some(Leg::Right),
             (false, false) => before,
-            (true, true) => Some(if ankle_left >= ankle_right { Leg::Left } else { Leg::Right }),
+            (true, true) => Some(if ankle_left >= ankle_right {
+                Leg::Left
+            } else {
+                Leg::Right
+            }),
         };
         let x = |leg: Leg| match leg {
             Leg::Left => ankle_left,
@@ -187,7 +212,11 @@ impl StanceTracker {
         }
         self.last_was_footstep = footstep;
         self.stance = after;
-        StanceUpdate { length: self.length, previous_length, footstep }
+        StanceUpdate {
+            length: self.length,
+            previous_length,
+            footstep,
+        }
     }
 }
 
@@ -199,10 +228,19 @@ pub fn auto_voltages(angles: &[f32; NUM_JOINTS], stance: Leg) -> [(Joint, f32); 
     let p = |[gain, setpoint]: [f32; 2], q: f32| clip(gain * (setpoint - q));
     let knee = stance.knee();
     [
-        (Joint::Shoulder, p(SHOULDER_GAIN_SETPOINT, angles[Joint::Shoulder as usize])),
+        (
+            Joint::Shoulder,
+            p(SHOULDER_GAIN_SETPOINT, angles[Joint::Shoulder as usize]),
+        ),
         (knee, p(STANCE_KNEE_GAIN_SETPOINT, angles[knee as usize])),
-        (Joint::AnkleLeft, p(ANKLE_GAIN_SETPOINT, angles[Joint::AnkleLeft as usize])),
-        (Joint::AnkleRight, p(ANKLE_GAIN_SETPOINT, angles[Joint::AnkleRight as usize])),
+        (
+            Joint::AnkleLeft,
+            p(ANKLE_GAIN_SETPOINT, angles[Joint::AnkleLeft as usize]),
+        ),
+        (
+            Joint::AnkleRight,
+            p(ANKLE_GAIN_SETPOINT, angles[Joint::AnkleRight as usize]),
+        ),
     ]
 }
 
@@ -215,7 +253,11 @@ pub fn learned_joints(stance: Leg) -> [Joint; ACTION_DIM] {
 /// All seven voltages for one control step (§3.6 step 1): the learned
 /// voltages (clipped to ±10.7 V; non-finite → 0 V) on the stance hip, swing
 /// hip and swing knee, the auto-actuation on the rest.
-pub fn joint_voltages(action: [f32; ACTION_DIM], angles: &[f32; NUM_JOINTS], stance: Leg) -> [f32; NUM_JOINTS] {
+pub fn joint_voltages(
+    action: [f32; ACTION_DIM],
+    angles: &[f32; NUM_JOINTS],
+    stance: Leg,
+) -> [f32; NUM_JOINTS] {
     let mut u = [0.0f32; NUM_JOINTS];
     for (joint, v) in auto_voltages(angles, stance) {
         u[joint as usize] = v;
@@ -238,17 +280,26 @@ pub fn sanitize_action(v: f32) -> f32 {
 /// Motor work of one control step (§3.7): Σ over both hips and both knees
 /// of max(0, U·I)/30 with I = (U − k·G·ω̄)/R, ω̄ the mean of the previous
 /// and current filtered rate.
-pub fn step_energy(voltages: &[f32; NUM_JOINTS], filtered_prev: &[f32; NUM_JOINTS], filtered_now: &[f32; NUM_JOINTS]) -> f32 {
+pub fn step_energy(
+    voltages: &[f32; NUM_JOINTS],
+    filtered_prev: &[f32; NUM_JOINTS],
+    filtered_now: &[f32; NUM_JOINTS],
+) -> f32 {
     let servo = Rx28::LEO;
-    [Joint::HipLeft, Joint::HipRight, Joint::KneeLeft, Joint::KneeRight]
-        .iter()
-        .map(|&j| {
-            let k = j as usize;
-            let w = 0.5 * (filtered_prev[k] + filtered_now[k]);
-            let u = voltages[k];
-            (u * servo.current(u, w)).max(0.0) * CONTROL_PERIOD
-        })
-        .sum()
+    [
+        Joint::HipLeft,
+        Joint::HipRight,
+        Joint::KneeLeft,
+        Joint::KneeRight,
+    ]
+    .iter()
+    .map(|&j| {
+        let k = j as usize;
+        let w = 0.5 * (filtered_prev[k] + filtered_now[k]);
+        let u = voltages[k];
+        (u * servo.current(u, w)).max(0.0) * CONTROL_PERIOD
+    })
+    .sum()
 }
 
 /// Reward of one step (§3.7): r = −1 − 3·E + 300·(clip(L) − clip(L_prev))
@@ -269,20 +320,23 @@ pub fn is_fall(phi: f32, q_hip_stance: f32) -> bool {
 
 /// The mirrored observation (§3.4) from the torso angle φ and its filtered
 /// rate, the raw angles and filtered rates, and the stance leg.
-pub fn observe(phi: f32, phi_rate: f32, angles: &[f32; NUM_JOINTS], rates: &[f32; NUM_JOINTS], stance: Leg) -> Observation {
+pub fn observe(
+    phi: f32,
+    phi_rate: f32,
+    angles: &[f32; NUM_JOINTS],
+    rates: &[f32; NUM_JOINTS],
+    stance: Leg,
+) -> Observation {
     let sw = stance.other();
-    let (hs, hw, ks, kw) = (stance.hip() as usize, sw.hip() as usize, stance.knee() as usize, sw.knee() as usize);
+    let (hs, hw, ks, kw) = (
+        stance.hip() as usize,
+        sw.hip() as usize,
+        stance.knee() as usize,
+        sw.knee() as usize,
+    );
     Observation([
-        phi,
-        phi_rate,
-        angles[hs],
-        rates[hs],
-        angles[hw],
-        rates[hw],
-        angles[ks],
-        rates[ks],
-        angles[kw],
-        rates[kw],
+        phi, phi_rate, angles[hs], rates[hs], angles[hw], rates[hw], angles[ks], rates[ks],
+        angles[kw], rates[kw],
     ])
 }
 
@@ -293,9 +347,15 @@ mod tests {
     #[test]
     fn filter_coefficients_match_section_3_2() {
         let (b, a1) = RateFilter::joint().coefficients();
-        assert!((b - 0.511527).abs() < 1e-5 && (a1 - 0.023055).abs() < 1e-5, "{b} {a1}");
+        assert!(
+            (b - 0.511527).abs() < 1e-5 && (a1 - 0.023055).abs() < 1e-5,
+            "{b} {a1}"
+        );
         let (b, a1) = RateFilter::torso().coefficients();
-        assert!((b - 0.999576).abs() < 1e-5 && (a1 - 0.999152).abs() < 1e-5, "{b} {a1}");
+        assert!(
+            (b - 0.999576).abs() < 1e-5 && (a1 - 0.999152).abs() < 1e-5,
+            "{b} {a1}"
+        );
         // DC gain 1: a constant input is passed through.
         let mut f = RateFilter::joint();
         let mut y = 0.0;
@@ -357,7 +417,11 @@ mod tests {
 
     #[test]
     fn reward_and_fall() {
-        let up = StanceUpdate { length: 0.05, previous_length: 0.03, footstep: false };
+        let up = StanceUpdate {
+            length: 0.05,
+            previous_length: 0.03,
+            footstep: false,
+        };
         assert!((reward(0.1, &up, false) - (-1.0 - 0.3 + 6.0)).abs() < 1e-4);
         assert!((reward(0.0, &up, true) - (-1.0 + 6.0 - 125.0)).abs() < 1e-4);
         assert!(!is_fall(-0.1, 0.1));
