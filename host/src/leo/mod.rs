@@ -130,7 +130,7 @@ pub struct StepInfo {
 pub struct StepResult {
     /// Observation after the step (the last valid one after a blow-up).
     pub obs: Observation,
-    /// Reward r = −1 − 3E + 300ΔL − 125·[fall] (§3.7).
+    /// Reward r = −1 − 3E + 300ΔL − 125·\[fall\] (§3.7).
     pub reward: f32,
     /// Whether and how the episode ended.
     pub terminal: Terminal,

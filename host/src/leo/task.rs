@@ -53,7 +53,7 @@ impl Leg {
 
 /// First-order Butterworth low-pass discretised with Tustin, no
 /// pre-warping (§3.2): T_c = 2π·f_c/f_s, b0 = b1 = T_c/(T_c + 2),
-/// a1 = (T_c − 2)/(T_c + 2), y[n] = b0·(x[n] + x[n−1]) − a1·y[n−1].
+/// a1 = (T_c − 2)/(T_c + 2), `y[n] = b0·(x[n] + x[n−1]) − a1·y[n−1]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RateFilter {
     b: f32,
@@ -303,7 +303,7 @@ pub fn step_energy(
 }
 
 /// Reward of one step (§3.7): r = −1 − 3·E + 300·(clip(L) − clip(L_prev))
-/// − 125·[fall], lengths clipped to ±10.2 m.
+/// − 125·\[fall\], lengths clipped to ±10.2 m.
 pub fn reward(energy: f32, update: &StanceUpdate, fall: bool) -> f32 {
     let clip = |l: f32| l.clamp(-FOOTSTEP_MAX_LENGTH, FOOTSTEP_MAX_LENGTH);
     REWARD_TIME
