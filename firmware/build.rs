@@ -4,21 +4,28 @@
 use std::{env, fs, path::PathBuf};
 
 fn main() {
-    let chips: Vec<&str> = ["stm32f405", "stm32f407", "stm32f446"]
+    let chips: Vec<&str> = ["stm32f405", "stm32f407", "stm32f446", "qemu"]
         .into_iter()
         .filter(|c| env::var_os(format!("CARGO_FEATURE_{}", c.to_uppercase())).is_some())
         .collect();
+    let for_chip = env::var("CARGO_CFG_TARGET_OS").as_deref() == Ok("none");
+    // On the host only the library is built (its tests, and the host's
+    // replay of the firmware's agent); it needs no board.
+    if !for_chip && chips.is_empty() {
+        println!("cargo:rerun-if-changed=build.rs");
+        return;
+    }
     if chips.len() != 1 {
         panic!(
-            "pada-firmware: enable exactly one chip feature (stm32f405, stm32f407, stm32f446); \
-             got {chips:?}. For a non-default chip use --no-default-features --features <chip>."
+            "pada-firmware: enable exactly one board feature (stm32f405, stm32f407, stm32f446, qemu); \
+             got {chips:?}. For a non-default board use --no-default-features --features <board>."
         );
     }
     let manifest_dir = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").unwrap());
     // The workspace's memory.x describes the STM32F405RG and the F407VG
-    // (same layout); the STM32F446RE (512 KB flash, checkpoint sectors 6
-    // and 7, no CCM RAM) has its own.
-    let memory_x = if chips[0] == "stm32f446" {
+    // (same layout; QEMU's netduinoplus2 is an F405RG); the STM32F446RE
+    // (512 KB flash, checkpoint sectors 6 and 7, no CCM RAM) has its own.
+    let memory_x = if chips.first() == Some(&"stm32f446") {
         manifest_dir.join("memory-f446.x")
     } else {
         manifest_dir.join("..").join("memory.x")
@@ -33,7 +40,7 @@ fn main() {
 
     // The library also builds for the host (its tests); only the chip's
     // binary is linked with these scripts.
-    if env::var("CARGO_CFG_TARGET_OS").as_deref() != Ok("none") {
+    if !for_chip {
         return;
     }
     // Segments need no page alignment in flash (keeps images small); both

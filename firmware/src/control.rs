@@ -26,6 +26,7 @@
 //! host build of the same agent, fed the reported observations and rewards,
 //! draws the same numbers and takes the same actions.
 
+use crate::bus::BusConfig;
 use crate::config::{self, FirmwareAgent, Robot, RobotConfig, MAX_OBS, MAX_SERVOS};
 use crate::encoder::Unwrapper;
 use crate::io::CycleCounter;
@@ -116,6 +117,24 @@ enum Phase {
     },
 }
 
+/// The fault thresholds: a request that fails every attempt of its period
+/// is a fault in that period, so torque goes off within one control period
+/// of a servo falling silent or its answers arriving damaged:
+/// [`BusConfig::attempts`] timeouts in a row (the retry budget is one less)
+/// or as many checksum errors within a second. The cause tells which
+/// (servo-timeout or checksum-errors); a damaged answer counts as both, and
+/// checksum errors are seen first.
+pub fn safety_config(soft_limits: Vec<pada_core::safety::SoftLimit, { pada_core::safety::MAX_SOFT_LIMITS }>) -> SafetyConfig {
+    let attempts = BusConfig::default().attempts.max(1);
+    SafetyConfig {
+        soft_limits,
+        servo_retry_budget: attempts - 1,
+        checksum_threshold: attempts,
+        checksum_window_ms: 1000,
+        ..SafetyConfig::default()
+    }
+}
+
 /// The control loop's state: agent, safety machine, observer, fatigue.
 pub struct Controller<W> {
     robot: Robot,
@@ -160,7 +179,7 @@ where
         for limit in config.soft_limits.iter().map_while(|l| *l) {
             let _ = soft_limits.push(limit);
         }
-        let safety = Safety::new(SafetyConfig { soft_limits, ..SafetyConfig::default() })?;
+        let safety = Safety::new(safety_config(soft_limits))?;
         let fatigue = FatigueCounter::new(GearboxParams::TABLE_I, config.period_s() as f64, Some(PAPER_WINDOW_STEPS))
             .map_err(|_| ConfigError::new("fatigue", 0.0, "Table I parameters"))?;
         let plant = match robot {
@@ -617,6 +636,7 @@ where
             explored: decision.is_some_and(|d| d.explored),
             joints,
             loop_us: 0,
+            agent_cycles: out.agent_cycles.unwrap_or(0),
         });
     }
 
@@ -753,22 +773,38 @@ mod tests {
         let mut out = PeriodOutput::default();
         c.period(&pendulum_readings(0, 0), &clock, &mut out);
         assert!(out.torque);
-        // Two attempts time out this period, one more the next: budget 2.
+        // One attempt of two lost: the retry answered, no fault.
         let mut r = pendulum_readings(0, 30);
-        r.servos[0] = ServoRead { state: None, timeouts: 2, ..ServoRead::default() };
+        r.servos[0].timeouts = 1;
         c.period(&r, &clock, &mut out);
         assert!(out.torque);
-        r.servos[0].timeouts = 1;
+        // Both attempts of a period time out: a fault in that period.
+        r.servos[0] = ServoRead { state: None, timeouts: 2, ..ServoRead::default() };
         c.period(&r, &clock, &mut out);
         assert!(!out.torque, "torque off in the period the fault is found");
         assert_eq!(out.speeds.as_slice(), &[(1, 0)]);
         let t = out.transitions.iter().find_map(|t| t.entered_fault()).unwrap();
-        assert_eq!(t, FaultCause::ServoTimeout { servo: 1, attempts: 3 });
+        assert_eq!(t, FaultCause::ServoTimeout { servo: 1, attempts: 2 });
         // Start is refused until the host clears the fault.
         let (result, _) = c.command(&wire::ToChip::Start(RunMode::Learning));
         assert_eq!(result, Err(NackReason::State(pada_core::safety::Rejection::InFault)));
         assert_eq!(c.command(&wire::ToChip::ClearFault).0, Ok(()));
         start(&mut c, RunMode::Learning);
+    }
+
+    #[test]
+    fn damaged_answers_fault_as_checksum_errors_in_the_period() {
+        let mut c = Controller::new(Robot::Pendulum33, PolicyKind::Sarsa, table(), 1).unwrap();
+        start(&mut c, RunMode::Learning);
+        let clock = Clock(Cell::new(0));
+        let mut out = PeriodOutput::default();
+        // Both answers of the period damaged (each also counts as a timeout).
+        let mut r = pendulum_readings(0, 30);
+        r.servos[0] = ServoRead { state: None, timeouts: 2, checksum_errors: 2, ..ServoRead::default() };
+        c.period(&r, &clock, &mut out);
+        assert!(!out.torque);
+        let t = out.transitions.iter().find_map(|t| t.entered_fault()).unwrap();
+        assert_eq!(t, FaultCause::ChecksumErrors { count: 2, window_ms: 1000 });
     }
 
     #[test]

@@ -17,6 +17,7 @@
 //! | [`pendulum`], [`leo`] | per robot: observation, reward, episode end, PD holds, command mapping |
 //! | [`control`] | one control period: safety, agent step, episodes, fatigue, telemetry records |
 //! | [`timing`] | loop-time and overrun accounting |
+//! | [`sil`] | software in the loop: the emulated board's lock-step clock and sensor device, shared with the host |
 #![cfg_attr(not(test), no_std)]
 #![deny(missing_docs)]
 #![allow(async_fn_in_trait)]
@@ -31,4 +32,5 @@ pub mod io;
 pub mod leo;
 pub mod pendulum;
 pub mod servo;
+pub mod sil;
 pub mod timing;

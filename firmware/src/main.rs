@@ -55,7 +55,13 @@ fn weight_table() -> &'static mut WeightTable {
     }
 }
 
-#[embassy_executor::main]
+// The real boards run embassy's thread-mode executor; the emulated board
+// its own, which advances the lock-step clock when nothing is left to run.
+#[cfg_attr(not(feature = "qemu"), embassy_executor::main)]
+#[cfg_attr(
+    feature = "qemu",
+    embassy_executor::main(entry = "cortex_m_rt::entry", executor = "crate::board::Executor")
+)]
 async fn main(spawner: Spawner) {
     let board = board::Board::init();
     info!("pada firmware {}: {}", env!("CARGO_PKG_VERSION"), ROBOT.name());

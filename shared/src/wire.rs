@@ -72,7 +72,7 @@ pub use crate::safety::RunMode;
 
 /// Version of this protocol, sent in [`Hello`]; changes with any change of
 /// a message's layout.
-pub const PROTOCOL_VERSION: u16 = 1;
+pub const PROTOCOL_VERSION: u16 = 2;
 /// State dimensions a [`Step`] carries.
 pub const MAX_STATE_DIMS: usize = 16;
 /// Action dimensions (motor outputs) a [`Step`] carries.
@@ -201,6 +201,9 @@ pub struct Step {
     pub joints: Vec<JointFatigue, MAX_JOINTS>,
     /// Duration of this control period's work, µs.
     pub loop_us: u32,
+    /// Cycles of the agent call of this period (DWT cycles on the chip;
+    /// instructions executed on the emulated board); 0 if none was taken.
+    pub agent_cycles: u32,
 }
 
 /// One finished episode.

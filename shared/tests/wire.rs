@@ -35,6 +35,7 @@ fn full_step() -> Step {
         explored: true,
         joints: HVec::from_slice(&[JointFatigue { damage: 1e-300, reengagements: u32::MAX }; MAX_JOINTS]).unwrap(),
         loop_us: u32::MAX,
+        agent_cycles: u32::MAX,
     }
 }
 
@@ -70,6 +71,7 @@ fn all_to_host() -> Vec<ToHost> {
         explored: false,
         joints: HVec::from_slice(&[JointFatigue { damage: 3.2e-9, reengagements: 4 }]).unwrap(),
         loop_us: 812,
+        agent_cycles: 41_000,
     };
     let mut v = vec![
         ToHost::Hello(Hello {
@@ -512,6 +514,7 @@ fn arb_step() -> impl Strategy<Value = Step> {
                 explored: ex,
                 joints: j.into_iter().map(|(damage, reengagements)| JointFatigue { damage, reengagements }).collect(),
                 loop_us: lus,
+                agent_cycles: lus.rotate_left(7),
             }
         })
 }

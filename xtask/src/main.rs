@@ -4,6 +4,8 @@
 //! - `firmware [--release] [--chip f405|f407|f446]`: build the firmware ELF
 //!   for thumbv7em-none-eabihf with whichever toolchain this machine has
 //!   (see [`toolchain`]), then print its flash and RAM use (see [`elf`]).
+//! - `qemu`, `sil`: the same firmware for the emulated board (QEMU's
+//!   `netduinoplus2`), and a software-in-the-loop run of it (`pada sil`).
 //!
 //! The xtask has no dependencies. Its command line is two flags and a
 //! subcommand, so a hand-written parser is shorter than the argument-parser
@@ -37,6 +39,14 @@ tasks:
   firmware-test
         run the firmware library's tests on the host (controller, servo-bus
         transactions, LEO and pendulum observers)
+  qemu [--debug] [--robot ...]
+        build the firmware for the emulated board (QEMU's netduinoplus2, an
+        STM32F405RG; cargo feature `qemu`) into target/firmware-qemu,
+        release unless --debug; its ELF path is the last line printed
+  sil [--debug] [--robot ...] [-- <pada sil options>]
+        build as `qemu`, then run it in qemu-system-arm against the
+        simulated plant: `pada sil --elf <ELF> <options>` (release build
+        of the host); the robot's task is passed on (--task)
   help  print this message";
 
 /// A microcontroller the firmware can be built for (one cargo feature each).
@@ -128,6 +138,38 @@ enum Task {
     Firmware(Build),
     Flash(Build),
     FirmwareTest,
+    /// Build for the emulated board.
+    Qemu(Build),
+    /// Build for the emulated board and run `pada sil` with these options.
+    Sil(Build, Vec<String>),
+}
+
+/// `qemu` and `sil`: release unless `--debug`, a robot, and for `sil`
+/// everything after `--`.
+fn parse_emulated(task: &str, rest: &[String]) -> Result<Task, String> {
+    let mut build = Build { release: true, chip: Chip::F405, robot: Robot::Pendulum };
+    let (own, passed) = match rest.iter().position(|a| a == "--") {
+        Some(i) if task == "sil" => (&rest[..i], rest[i + 1..].to_vec()),
+        _ => (rest, Vec::new()),
+    };
+    let mut own = own.iter();
+    while let Some(arg) = own.next() {
+        let value = match arg.as_str() {
+            "--debug" => {
+                build.release = false;
+                continue;
+            }
+            "-h" | "--help" => return Ok(Task::Help),
+            "--robot" => own.next().ok_or("--robot needs a value: pendulum, pendulum-20hz or leo")?.as_str(),
+            other => match other.strip_prefix("--robot=") {
+                Some(v) => v,
+                None => return Err(format!("unknown argument `{other}` for `{task}`")),
+            },
+        };
+        build.robot = Robot::parse(value)
+            .ok_or_else(|| format!("unknown robot `{value}`: expected pendulum, pendulum-20hz or leo"))?;
+    }
+    Ok(if task == "sil" { Task::Sil(build, passed) } else { Task::Qemu(build) })
 }
 
 fn parse_args(args: &[String]) -> Result<Task, String> {
@@ -167,6 +209,7 @@ fn parse_args(args: &[String]) -> Result<Task, String> {
             }
             Ok(if task == "flash" { Task::Flash(build) } else { Task::Firmware(build) })
         }
+        "qemu" | "sil" => parse_emulated(task, rest),
         "firmware-test" => match rest.first() {
             None => Ok(Task::FirmwareTest),
             Some(other) => Err(format!("unknown argument `{other}` for `firmware-test`")),
@@ -205,6 +248,10 @@ fn main() -> ExitCode {
         Task::Firmware(build) => firmware(&workspace_root(), build).map(|_| ()),
         Task::Flash(build) => firmware(&workspace_root(), build).and_then(|elf| flash(&elf, build.chip)),
         Task::FirmwareTest => firmware_test(&workspace_root()),
+        Task::Qemu(build) => qemu_image(&workspace_root(), build).map(|_| ()),
+        Task::Sil(build, args) => {
+            qemu_image(&workspace_root(), build).and_then(|elf| sil(&workspace_root(), &elf, build.robot, &args))
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -292,6 +339,72 @@ fn firmware(root: &Path, build: Build) -> Result<PathBuf, String> {
         elf_path.display()
     );
     Ok(elf_path)
+}
+
+/// Builds the emulated board's image; returns the ELF's path.
+fn qemu_image(root: &Path, build: Build) -> Result<PathBuf, String> {
+    let toolchain = toolchain::detect()?;
+    println!("xtask: toolchain: {}", toolchain.describe());
+    let firmware_dir = root.join("firmware");
+    // Its own target directory: the real board's image keeps its path.
+    let target_dir = root.join("target").join("firmware-qemu");
+    let profile = if build.release { "release" } else { "debug" };
+    let mut features = vec!["qemu"];
+    features.extend(build.robot.feature());
+    let mut cmd = toolchain.cargo_build(&firmware_dir);
+    cmd.arg("--manifest-path")
+        .arg(firmware_dir.join("Cargo.toml"))
+        .arg("--target")
+        .arg(TARGET)
+        .arg("--target-dir")
+        .arg(&target_dir)
+        .args(["--no-default-features", "--features", &features.join(",")]);
+    if build.release {
+        cmd.arg("--release");
+    }
+    println!(
+        "xtask: building pada-firmware ({profile}, emulated board `qemu`, {}) for {TARGET}",
+        build.robot.feature().unwrap_or("robot-pendulum-33hz (default)")
+    );
+    let started = Instant::now();
+    let status = cmd
+        .status()
+        .map_err(|e| format!("cannot start {}: {e}", toolchain.cargo_path().display()))?;
+    if !status.success() {
+        return Err(format!("emulated-board build failed ({status}); cargo's errors are above"));
+    }
+    let elf = target_dir.join(TARGET).join(profile).join("pada-firmware");
+    if !elf.is_file() {
+        return Err(format!("build succeeded but {} is missing", elf.display()));
+    }
+    println!("xtask: built in {:.1} s", started.elapsed().as_secs_f64());
+    println!("xtask: firmware ELF: {}", elf.display());
+    Ok(elf)
+}
+
+/// Runs `pada sil --elf <elf> --task <robot's task> <args>` (release build).
+fn sil(root: &Path, elf: &Path, robot: Robot, args: &[String]) -> Result<(), String> {
+    let cargo = env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let task = match robot {
+        Robot::Pendulum => "pendulum",
+        Robot::Pendulum20 => "pendulum-20hz",
+        Robot::Leo => "leo",
+    };
+    let mut cmd = std::process::Command::new(&cargo);
+    toolchain::clean_env(&mut cmd, false);
+    cmd.current_dir(root)
+        .args(["run", "--release", "--quiet", "--package", "pada", "--", "sil", "--elf"])
+        .arg(elf);
+    if !args.iter().any(|a| a == "--task" || a.starts_with("--task=")) {
+        cmd.args(["--task", task]);
+    }
+    cmd.args(args);
+    let status = cmd.status().map_err(|e| format!("cannot start cargo: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("pada sil failed ({status})"))
+    }
 }
 
 /// Flashes `elf` and streams its defmt log (`probe-rs run`), as `cargo run`
@@ -384,6 +497,24 @@ mod tests {
         assert_eq!(parse_args(&args("firmware-test")), Ok(Task::FirmwareTest));
         assert!(parse_args(&args("firmware-test --release")).is_err());
         assert!(parse_args(&args("firmware --robot walker")).is_err());
+    }
+
+    #[test]
+    fn emulated_board_builds_release_by_default_and_passes_sil_options_on() {
+        let release = Build { release: true, chip: Chip::F405, robot: Robot::Pendulum };
+        assert_eq!(parse_args(&args("qemu")), Ok(Task::Qemu(release)));
+        assert_eq!(
+            parse_args(&args("qemu --debug --robot leo")),
+            Ok(Task::Qemu(Build { release: false, chip: Chip::F405, robot: Robot::Leo }))
+        );
+        assert_eq!(
+            parse_args(&args("sil -- --seconds 60 --json")),
+            Ok(Task::Sil(release, args("--seconds 60 --json")))
+        );
+        assert_eq!(parse_args(&args("sil --robot=leo")), Ok(Task::Sil(Build { robot: Robot::Leo, ..release }, vec![])));
+        assert!(parse_args(&args("qemu --release")).is_err());
+        assert!(parse_args(&args("qemu -- --json")).is_err());
+        assert!(parse_args(&args("sil --robot")).is_err());
     }
 
     #[test]

@@ -52,16 +52,23 @@
 //!
 //! # Variants
 //!
-//! [`hw`] is the real board on embassy-stm32. Issue 6 adds an emulated
-//! board for QEMU's `netduinoplus2` next to it: the same type names
-//! (`ServoPort`, `TelemetryTx`, `TelemetryRx`, `BoardSensors`,
-//! `FlashStore`, `Watchdog`, `Cycles`, `Board`) implementing the same
-//! `pada_firmware::io` traits, built on a few PAC register accesses, with
-//! a lock-step time driver; everything above (tasks, controller, agent)
-//! stays as it is.
+//! `hw` is the real board on embassy-stm32. `qemu` (cargo feature `qemu`)
+//! is the emulated board of QEMU's `netduinoplus2` for the
+//! software-in-the-loop run: the same type names (`ServoPort`,
+//! `TelemetryTx`, `TelemetryRx`, `BoardSensors`, `FlashStore`, `Watchdog`,
+//! `Cycles`, `Led`, `Board`) implementing the same `pada_firmware::io`
+//! traits, built on a few PAC register accesses, with a lock-step time
+//! driver; everything above (tasks, controller, agent) stays as it is.
 
+#[cfg(not(feature = "qemu"))]
 mod hw;
+#[cfg(not(feature = "qemu"))]
 pub use hw::*;
+
+#[cfg(feature = "qemu")]
+mod qemu;
+#[cfg(feature = "qemu")]
+pub use qemu::*;
 
 /// Pins of the generic STM32F405RG board.
 #[cfg(feature = "stm32f405")]
