@@ -36,6 +36,12 @@ pub enum Command {
     /// Predicted MTBF of a recorded torque log (Eqs. 3–7).
     #[command(allow_negative_numbers = true)]
     Mtbf(MtbfArgs),
+    /// Software in the loop: the firmware learns inside QEMU against the
+    /// simulated plant (docs/sil.md).
+    #[command(allow_negative_numbers = true)]
+    Sil(commands::sil::SilArgs),
+    /// Decode telemetry from a board's serial port or a recorded stream.
+    Capture(commands::capture::CaptureArgs),
 }
 
 /// Options shared by the commands that run trials.
@@ -213,7 +219,7 @@ where
                     Ok(())
                 }
                 ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => Err(usage(
-                    "no command given: valid commands are run, demo, paper, mtbf (see pada --help)",
+                    "no command given: valid commands are run, demo, paper, mtbf, sil, capture (see pada --help)",
                 )),
                 _ => Err(usage(clap_one_line(&e))),
             };
@@ -224,5 +230,7 @@ where
         Command::Demo(a) => commands::demo::run(a),
         Command::Paper(a) => commands::paper::run(a),
         Command::Mtbf(a) => commands::mtbf::run(a),
+        Command::Sil(a) => commands::sil::run(a),
+        Command::Capture(a) => commands::capture::run(a),
     }
 }

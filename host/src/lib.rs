@@ -6,6 +6,7 @@
 #![warn(missing_docs)]
 
 pub mod algo;
+pub mod capture;
 pub mod cli;
 pub mod commands;
 pub mod error;
@@ -18,6 +19,7 @@ pub mod pendulum;
 pub mod plot;
 pub mod progress;
 pub mod seed;
+pub mod sil;
 pub mod stats;
 pub mod summary;
 pub mod task;

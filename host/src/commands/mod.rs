@@ -1,6 +1,8 @@
 //! One module per subcommand of `pada`.
 
+pub mod capture;
 pub mod demo;
 pub mod mtbf;
 pub mod paper;
 pub mod run;
+pub mod sil;

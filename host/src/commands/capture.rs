@@ -1,0 +1,213 @@
+//! `pada capture`: telemetry from a board's serial port or a recorded
+//! stream, decoded, recorded as CSV, with a live one-line status.
+//!
+//! Nothing stops a capture but the end of its input (end of file, the port
+//! going away), Ctrl-C, or `--seconds`: a bad frame is counted and the
+//! decoder picks up at the next frame.
+
+use crate::capture::Recorder;
+use crate::error::{usage, CliError};
+use anyhow::Context;
+use clap::Args;
+use serde::Serialize;
+use std::io::{IsTerminal, Read, Write};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// `pada capture`.
+#[derive(Debug, Clone, Args)]
+#[command(group(clap::ArgGroup::new("input").required(true).args(["port", "file"])))]
+pub struct CaptureArgs {
+    /// A serial port with a board on it (e.g. /dev/ttyUSB0, /dev/ttyACM0).
+    #[arg(long, value_name = "DEVICE")]
+    pub port: Option<PathBuf>,
+    /// A recorded byte stream (a board's raw output, or `pada run
+    /// --telemetry FILE`); `-` reads standard input.
+    #[arg(long, value_name = "FILE")]
+    pub file: Option<PathBuf>,
+    /// The port's baud rate.
+    #[arg(long, value_name = "B", default_value_t = 921_600)]
+    pub baud: u32,
+    /// Write every frame, lost frame and sequence gap as a CSV row.
+    #[arg(long, value_name = "FILE.csv")]
+    pub out: Option<PathBuf>,
+    /// Stop after this many wall-clock seconds.
+    #[arg(long, value_name = "S")]
+    pub seconds: Option<f64>,
+    /// Print the final summary as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The end of a capture.
+#[derive(Debug, Clone, Serialize)]
+pub struct CaptureSummary {
+    /// What was read.
+    pub source: String,
+    /// Why the capture ended.
+    pub ended: String,
+    /// Wall-clock duration \[s\].
+    pub wall_s: f64,
+    /// Frames, bytes and every kind of loss.
+    pub link: pada_core::wire::LinkStats,
+    /// Frames that could not be used (all kinds).
+    pub bad_frames: u32,
+    /// Frames by message.
+    pub messages: crate::capture::MessageCounts,
+    /// The latest values (episodes, returns, fatigue, fault).
+    pub latest: crate::capture::Latest,
+}
+
+enum Source {
+    Port(Box<dyn serialport::SerialPort>),
+    Reader(Box<dyn Read + Send>),
+}
+
+/// Runs `pada capture`.
+pub fn run(args: CaptureArgs) -> Result<(), CliError> {
+    if let Some(s) = args.seconds {
+        if !(s.is_finite() && s > 0.0) {
+            return Err(usage(format!(
+                "--seconds {s} is out of range: valid is > 0"
+            )));
+        }
+    }
+    if args.baud == 0 || args.baud > 12_000_000 {
+        return Err(usage(format!(
+            "--baud {} is out of range: valid is 1..=12000000",
+            args.baud
+        )));
+    }
+    let (mut source, name) = match (&args.port, &args.file) {
+        (Some(port), _) => {
+            let p = serialport::new(port.to_string_lossy(), args.baud)
+                .timeout(Duration::from_millis(100))
+                .open()
+                .map_err(|e| usage(format!("--port {}: cannot open: {e}", port.display())))?;
+            (Source::Port(p), port.display().to_string())
+        }
+        (None, Some(file)) if file.as_os_str() == "-" => (
+            Source::Reader(Box::new(std::io::stdin())),
+            "standard input".to_string(),
+        ),
+        (None, Some(file)) => {
+            let f = std::fs::File::open(file)
+                .map_err(|e| usage(format!("--file {}: cannot open: {e}", file.display())))?;
+            (Source::Reader(Box::new(f)), file.display().to_string())
+        }
+        (None, None) => return Err(usage("give --port DEVICE or --file FILE")),
+    };
+    let csv: Option<Box<dyn Write + Send>> = match &args.out {
+        Some(p) => Some(Box::new(std::io::BufWriter::new(
+            std::fs::File::create(p)
+                .map_err(|e| usage(format!("--out {}: cannot create: {e}", p.display())))?,
+        ))),
+        None => None,
+    };
+    let mut rec = Recorder::new(csv)
+        .context("cannot write the CSV header")
+        .map_err(CliError::Runtime)?;
+
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        // A second handler cannot be installed (tests run several captures
+        // in one process): then Ctrl-C simply ends the process.
+        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
+    }
+    let tty = std::io::stderr().is_terminal();
+    let started = Instant::now();
+    let mut last_status = Instant::now();
+    let mut buf = vec![0u8; 4096];
+    let mut frames = Vec::new();
+    let ended = loop {
+        if stop.load(Ordering::SeqCst) {
+            break "interrupted".to_string();
+        }
+        if args
+            .seconds
+            .is_some_and(|s| started.elapsed().as_secs_f64() >= s)
+        {
+            break "time limit".to_string();
+        }
+        let n = match &mut source {
+            Source::Port(p) => match p.read(&mut buf) {
+                Ok(0) => break "the port closed".to_string(),
+                Ok(n) => n,
+                Err(e)
+                    if e.kind() == std::io::ErrorKind::TimedOut
+                        || e.kind() == std::io::ErrorKind::Interrupted =>
+                {
+                    0
+                }
+                Err(e) => break format!("the port went away ({e})"),
+            },
+            Source::Reader(r) => match r.read(&mut buf) {
+                Ok(0) => break "end of file".to_string(),
+                Ok(n) => n,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => 0,
+                Err(e) => break format!("read error ({e})"),
+            },
+        };
+        frames.clear();
+        rec.feed(&buf[..n], started.elapsed().as_secs_f64(), &mut frames)
+            .context("cannot write the CSV")
+            .map_err(CliError::Runtime)?;
+        let every = if tty {
+            Duration::from_millis(100)
+        } else {
+            Duration::from_secs(1)
+        };
+        if last_status.elapsed() >= every {
+            last_status = Instant::now();
+            status(&rec, tty, false);
+        }
+    };
+    rec.flush()
+        .context("cannot write the CSV")
+        .map_err(CliError::Runtime)?;
+    status(&rec, tty, true);
+    let link = rec.stats();
+    let summary = CaptureSummary {
+        source: name,
+        ended,
+        wall_s: started.elapsed().as_secs_f64(),
+        link,
+        bad_frames: link.bad_frames(),
+        messages: rec.counts(),
+        latest: rec.latest().clone(),
+    };
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&summary).map_err(|e| CliError::Runtime(e.into()))?
+        );
+    } else {
+        eprintln!(
+            "capture of {} ended ({}): {} frames, {} lost, {} sequence gaps ({} frames missing)",
+            summary.source,
+            summary.ended,
+            link.frames,
+            summary.bad_frames,
+            link.seq_gaps,
+            link.frames_missed
+        );
+    }
+    Ok(())
+}
+
+fn status(rec: &Recorder, tty: bool, last: bool) {
+    let line = rec.status_line();
+    let mut err = std::io::stderr().lock();
+    if tty {
+        let _ = write!(err, "\r\x1b[K{line}");
+        if last {
+            let _ = writeln!(err);
+        }
+    } else {
+        let _ = writeln!(err, "{line}");
+    }
+    let _ = err.flush();
+}

@@ -1,0 +1,203 @@
+//! `pada sil`: the firmware image learns inside QEMU against the simulated
+//! plant (docs/sil.md).
+
+use crate::algo::{label, policy_kind, Algo};
+use crate::cli::check_seconds;
+use crate::error::{usage, CliError};
+use crate::output::OutDir;
+use crate::sil::{self, fault, SilConfig, SilSummary, SilTask};
+use anyhow::{anyhow, Context};
+use clap::Args;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+/// `pada sil`.
+#[derive(Debug, Clone, Args)]
+pub struct SilArgs {
+    /// The robot: the physical pendulum (against its model), or LEO
+    /// (against a stand-in holding its start pose: instruction counts only).
+    #[arg(long, value_enum, default_value_t = SilTask::Pendulum)]
+    pub task: SilTask,
+    /// Learning time to reach [s of emulated learning episodes] (default:
+    /// 600 for the pendulum, 60 for LEO).
+    #[arg(long, value_name = "S")]
+    pub seconds: Option<f64>,
+    /// The algorithm the firmware learns with (Section V).
+    #[arg(long, value_enum, default_value_t = Algo::Sarsa)]
+    pub algo: Algo,
+    /// Low-pass α (lowpass, markov-lowpass; default 0.834).
+    #[arg(long)]
+    pub alpha: Option<f32>,
+    /// Δ relative to the action range (integrator, markov-integrator, pada;
+    /// default 0.5).
+    #[arg(long)]
+    pub delta: Option<f32>,
+    /// Inject a fault on the servo bus (repeatable):
+    /// KIND[:at=S][:for=S][:servo=ID][:ms=MS][:bits=NAME] with KIND drop,
+    /// corrupt, delay or error-bits (docs/sil.md).
+    #[arg(long, value_name = "SPEC")]
+    pub fault: Vec<String>,
+    /// The firmware ELF built for the emulated board (default: build it
+    /// with `cargo xtask qemu` in this repository).
+    #[arg(long, value_name = "FILE")]
+    pub elf: Option<PathBuf>,
+    /// The QEMU to run (10 or later).
+    #[arg(long, value_name = "PROGRAM", default_value = "qemu-system-arm")]
+    pub qemu: PathBuf,
+    /// Output directory: telemetry.bin (the raw stream), telemetry.csv,
+    /// episodes.csv, summary.json, the firmware's log (default:
+    /// pada-out/sil-<task>-<algo>).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Wall-clock seconds without a word from the board before the run is
+    /// called hung.
+    #[arg(long, value_name = "S", default_value_t = 60)]
+    pub hang_timeout: u64,
+    /// Print the summary as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs `pada sil`.
+pub fn run(args: SilArgs) -> Result<(), CliError> {
+    let policy = policy_kind(args.algo, args.alpha, args.delta).map_err(|e| usage(e.0))?;
+    let default_seconds = match args.task {
+        SilTask::Pendulum => 600.0,
+        SilTask::Leo => 60.0,
+    };
+    let seconds = check_seconds("--seconds", args.seconds.unwrap_or(default_seconds))?;
+    let faults = args
+        .fault
+        .iter()
+        .map(|f| fault::parse(f))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(usage)?;
+    if !(1..=3600).contains(&args.hang_timeout) {
+        return Err(usage(format!(
+            "--hang-timeout {} is out of range: valid is 1..=3600 s",
+            args.hang_timeout
+        )));
+    }
+    let task_name = match args.task {
+        SilTask::Pendulum => "pendulum",
+        SilTask::Leo => "leo",
+    };
+    let out_path = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("pada-out/sil-{task_name}-{}", args.algo)));
+    OutDir::check(&out_path)?;
+    let elf = match &args.elf {
+        Some(p) if p.is_file() => p.clone(),
+        Some(p) => return Err(usage(format!("--elf {}: no such file", p.display()))),
+        None => build_image(args.task)?,
+    };
+    let cfg = SilConfig {
+        qemu: args.qemu.clone(),
+        elf,
+        task: args.task,
+        policy,
+        seconds,
+        faults,
+        out_dir: out_path.clone(),
+        hang_timeout: Duration::from_secs(args.hang_timeout),
+        progress: !args.json,
+    };
+    let summary = sil::run(&cfg)?;
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&summary).map_err(|e| CliError::Runtime(e.into()))?
+        );
+    } else {
+        print_summary(&summary, &label(&policy));
+        println!("wrote {}", out_path.display());
+    }
+    if summary.passed {
+        Ok(())
+    } else {
+        let failed: Vec<&str> = summary
+            .checks
+            .iter()
+            .filter(|c| !c.ok)
+            .map(|c| c.name)
+            .collect();
+        Err(CliError::Runtime(anyhow!(
+            "SIL checks failed: {}",
+            failed.join("; ")
+        )))
+    }
+}
+
+/// Builds the emulated board's image with `cargo xtask qemu` in the
+/// repository this binary was built from.
+fn build_image(task: SilTask) -> Result<PathBuf, CliError> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_default();
+    if !root.join("xtask").is_dir() || !root.join("firmware").is_dir() {
+        return Err(usage(format!(
+            "no firmware image given and no pada repository at {} to build one: pass --elf FILE \
+             (built with `cargo xtask qemu`)",
+            root.display()
+        )));
+    }
+    let robot = match task {
+        SilTask::Pendulum => "pendulum",
+        SilTask::Leo => "leo",
+    };
+    eprintln!(
+        "pada sil: building the firmware for the emulated board (cargo xtask qemu --robot {robot})"
+    );
+    let output =
+        std::process::Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()))
+            .current_dir(&root)
+            .args(["xtask", "qemu", "--robot", robot])
+            .stderr(std::process::Stdio::inherit())
+            .output()
+            .context("cannot start cargo to build the firmware (pass --elf FILE instead)")?;
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    if !output.status.success() {
+        return Err(CliError::Runtime(anyhow!(
+            "cargo xtask qemu failed ({}):\n{stdout}",
+            output.status
+        )));
+    }
+    stdout
+        .lines()
+        .rev()
+        .find_map(|l| l.strip_prefix("xtask: firmware ELF: "))
+        .map(PathBuf::from)
+        .ok_or_else(|| {
+            CliError::Runtime(anyhow!("cargo xtask qemu did not name the ELF:\n{stdout}"))
+        })
+}
+
+fn print_summary(s: &SilSummary, policy: &str) {
+    println!(
+        "sil {} ({}), {policy}: {:.0} s learning in {:.0} s emulated, {:.1} s wall ({:.0}x real time)",
+        s.robot, s.plant, s.learning_s, s.emulated_s, s.wall_s, s.speedup
+    );
+    let fmt = |x: Option<f64>| x.map(|v| format!("{v:.1}")).unwrap_or_else(|| "-".into());
+    println!(
+        "  test return: first {}, end performance {}, rise time {} s; {} learning episodes",
+        fmt(s.first_test_return),
+        fmt(s.end_performance),
+        fmt(s.rise_time_s),
+        s.learning_episodes
+    );
+    let i = &s.agent_instructions;
+    println!(
+        "  agent step on the Cortex-M4 build: {:.0} instructions mean (min {}, max {}) learning; {:.0} greedy",
+        i.learning_step.mean, i.learning_step.min, i.learning_step.max, i.test_step.mean
+    );
+    for c in &s.checks {
+        println!(
+            "  [{}] {}: {}",
+            if c.ok { "ok" } else { "FAILED" },
+            c.name,
+            c.detail
+        );
+    }
+}

@@ -1,0 +1,129 @@
+//! The bit-for-bit check: the observations and rewards the firmware
+//! reported, replayed through the host build of the same agent (the
+//! firmware's own configuration from `pada_firmware::config`, the same
+//! policy and seed), must give the same action at every step and the same
+//! weight checksum at every episode's end.
+//!
+//! The firmware's agent draws from its generator only in the agent calls
+//! (`pada_firmware::control`), and a `Step` frame says which call it was
+//! (start, step, absorbing end, time-limit end), with the observation, the
+//! reward and the mode, so the replay makes the same calls in the same
+//! order. A policy change (`SetPolicy`) starts a fresh learner from the
+//! seed, as on the chip; the replay is given the policy the run used.
+
+use pada_core::agent::{EpisodeEnd, Mode};
+use pada_core::fixed::Q16;
+use pada_core::policy::PolicyKind;
+use pada_core::wire::{Episode, RunMode, Step, StepKind};
+use pada_firmware::config::{FirmwareAgent, Robot, LAYOUT, WEIGHTS};
+use rand_core::SeedableRng;
+use rand_pcg::Pcg32;
+use serde::Serialize;
+
+/// A record of the run, in the order the firmware sent it.
+#[derive(Debug, Clone)]
+pub enum Record {
+    /// A step.
+    Step(Step),
+    /// An episode's end.
+    Episode(Episode),
+}
+
+/// What the replay found.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct ReplayReport {
+    /// Agent calls replayed.
+    pub steps: u64,
+    /// Actions compared (calls that choose one).
+    pub actions_compared: u64,
+    /// Episode ends whose weight checksums were compared.
+    pub checksums_compared: u64,
+    /// The first step whose action differed: (control step, firmware's
+    /// action, replay's action).
+    pub first_action_mismatch: Option<(u32, u32, u32)>,
+    /// The first episode whose checksum differed: (index, firmware, replay).
+    pub first_checksum_mismatch: Option<(u32, u32, u32)>,
+    /// An agent call the host build refused (a non-finite observation the
+    /// firmware accepted, or a call out of order).
+    pub error: Option<String>,
+    /// The firmware's checksum at its last episode end.
+    pub final_checksum_firmware: Option<u32>,
+    /// The replay's checksum at the same point.
+    pub final_checksum_replay: Option<u32>,
+    /// Every action and every checksum identical.
+    pub identical: bool,
+}
+
+/// Replays `records` through a fresh host agent for `robot` with `policy`
+/// and `seed`.
+pub fn replay(robot: Robot, policy: PolicyKind, seed: u64, records: &[Record]) -> ReplayReport {
+    let mut report = ReplayReport::default();
+    let table = vec![Q16::ZERO; WEIGHTS].into_boxed_slice();
+    let agent = FirmwareAgent::new(
+        &robot.state_dims(),
+        robot.action_space(),
+        policy,
+        robot.params(),
+        LAYOUT,
+        table,
+    );
+    let mut agent = match agent {
+        Ok(a) => a,
+        Err(e) => {
+            report.error = Some(format!("cannot build the agent: {e}"));
+            return report;
+        }
+    };
+    let mut rng = Pcg32::seed_from_u64(seed);
+    agent.reset_weights(&mut rng);
+    for record in records {
+        match record {
+            Record::Step(s) => {
+                report.steps += 1;
+                agent.set_mode(if s.mode == RunMode::Testing {
+                    Mode::Testing
+                } else {
+                    Mode::Learning
+                });
+                let decision = match s.kind {
+                    StepKind::Start => agent.start_episode(&s.state, &mut rng).map(Some),
+                    StepKind::Step => agent.step(s.reward, &s.state, &mut rng).map(Some),
+                    StepKind::Absorbing => agent
+                        .end_episode(s.reward, EpisodeEnd::Absorbing, &mut rng)
+                        .map(|_| None),
+                    StepKind::Timeout => agent
+                        .end_episode(s.reward, EpisodeEnd::Timeout(&s.state), &mut rng)
+                        .map(|_| None),
+                };
+                match decision {
+                    Ok(Some(d)) => {
+                        report.actions_compared += 1;
+                        if d.action != s.action && report.first_action_mismatch.is_none() {
+                            report.first_action_mismatch = Some((s.step, s.action, d.action));
+                        }
+                    }
+                    Ok(None) => {}
+                    Err(e) => {
+                        report.error = Some(format!("step {}: {e}", s.step));
+                        break;
+                    }
+                }
+            }
+            Record::Episode(e) => {
+                report.checksums_compared += 1;
+                let mine = agent.weights_checksum();
+                if mine != e.weights_checksum && report.first_checksum_mismatch.is_none() {
+                    report.first_checksum_mismatch = Some((e.index, e.weights_checksum, mine));
+                }
+                report.final_checksum_firmware = Some(e.weights_checksum);
+                report.final_checksum_replay = Some(mine);
+            }
+        }
+    }
+    report.identical = report.error.is_none()
+        && report.first_action_mismatch.is_none()
+        && report.first_checksum_mismatch.is_none()
+        && report.actions_compared > 0
+        && report.checksums_compared > 0;
+    report
+}
