@@ -41,7 +41,7 @@ tasks:
         transactions, LEO and pendulum observers)
   qemu [--debug] [--robot ...]
         build the firmware for the emulated board (QEMU's netduinoplus2, an
-        STM32F405RG; cargo feature `qemu`) into target/firmware-qemu,
+        STM32F405RG; cargo feature `qemu`) into target/firmware-qemu-<robot>,
         release unless --debug; its ELF path is the last line printed
   sil [--debug] [--robot ...] [-- <pada sil options>]
         build as `qemu`, then run it in qemu-system-arm against the
@@ -346,8 +346,14 @@ fn qemu_image(root: &Path, build: Build) -> Result<PathBuf, String> {
     let toolchain = toolchain::detect()?;
     println!("xtask: toolchain: {}", toolchain.describe());
     let firmware_dir = root.join("firmware");
-    // Its own target directory: the real board's image keeps its path.
-    let target_dir = root.join("target").join("firmware-qemu");
+    // A target directory of its own per robot: the real board's image, and
+    // the other robots' emulated images, keep their paths.
+    let robot_name = match build.robot {
+        Robot::Pendulum => "pendulum",
+        Robot::Pendulum20 => "pendulum-20hz",
+        Robot::Leo => "leo",
+    };
+    let target_dir = root.join("target").join(format!("firmware-qemu-{robot_name}"));
     let profile = if build.release { "release" } else { "debug" };
     let mut features = vec!["qemu"];
     features.extend(build.robot.feature());

@@ -1,0 +1,254 @@
+//! `pada capture` end to end: the real binary reading a pseudo-terminal
+//! (as it reads a USB serial adapter) fed with a telemetry stream the
+//! firmware recorded in QEMU, with corruption, garbage and a lost frame
+//! mixed in; and the same stream from a file.
+//!
+//! `tests/data/sil-pendulum-3s.bin` is the raw USART2 stream of
+//! `pada sil --seconds 3` (telemetry.bin; wire protocol 2). Regenerate it
+//! with that command when the wire format changes.
+
+mod common;
+
+use pada_core::wire::{HostDecoder, ToHost};
+use rustix::fd::OwnedFd;
+use rustix::pty::{grantpt, openpt, ptsname, unlockpt, OpenptFlags};
+use std::io::{BufRead, BufReader, Write};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+fn recording() -> Vec<u8> {
+    std::fs::read(common::root().join("tests/data/sil-pendulum-3s.bin"))
+        .expect("the recorded stream")
+}
+
+/// Frame boundaries (start, end-exclusive including the 0x00) of a stream.
+fn frames(stream: &[u8]) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
+    let mut start = 0;
+    for (i, &b) in stream.iter().enumerate() {
+        if b == 0 {
+            out.push((start, i + 1));
+            start = i + 1;
+        }
+    }
+    out
+}
+
+/// What was done to the stream, and what a capture must count.
+struct Damaged {
+    bytes: Vec<u8>,
+    good_frames: u32,
+    bad_frames: u32,
+    seq_gaps: u32,
+    frames_missed: u64,
+}
+
+/// The recording with: 3 frames with a byte changed (CRC error or broken
+/// COBS), 1 frame cut out (lost on the line), 2 bursts of garbage between
+/// frames ending in a 0x00 (line noise that looks like a frame), all
+/// isolated from each other.
+fn damage(clean: &[u8]) -> Damaged {
+    let f = frames(clean);
+    let n = f.len();
+    assert!(n > 300, "{n} frames");
+    // Every frame of the clean recording decodes, in sequence.
+    let mut d = HostDecoder::new();
+    let kinds: Vec<bool> = d
+        .feed(clean)
+        .map(|r| matches!(r.unwrap().msg, ToHost::Step(_)))
+        .collect();
+    assert_eq!(kinds.len(), n);
+    assert!(d.stats().is_clean());
+    // Damage Step frames only (the episodes stay countable), far apart.
+    let step_near = |x: f64| (((n as f64) * x) as usize..n).find(|&k| kinds[k]).unwrap();
+    let corrupt = [step_near(0.1), step_near(0.4), step_near(0.8)];
+    let dropped = step_near(0.6);
+    let garbage_before = [step_near(0.3), step_near(0.9)];
+    let mut out = Vec::new();
+    for (k, &(a, b)) in f.iter().enumerate() {
+        if garbage_before.contains(&k) {
+            // Non-zero bytes, then a delimiter: one unusable "frame".
+            out.extend((1..=37u8).map(|x| x.wrapping_mul(73) | 1));
+            out.push(0);
+        }
+        if k == dropped {
+            continue;
+        }
+        let start = out.len();
+        out.extend_from_slice(&clean[a..b]);
+        if corrupt.contains(&k) {
+            // A byte in the middle, changed to another non-zero value.
+            let i = start + (b - a) / 2;
+            out[i] = if out[i] == 0xFF { 0x7F } else { out[i] + 1 };
+        }
+    }
+    Damaged {
+        bytes: out,
+        good_frames: (n - corrupt.len() - 1) as u32,
+        bad_frames: (corrupt.len() + garbage_before.len()) as u32,
+        seq_gaps: (corrupt.len() + 1) as u32,
+        frames_missed: (corrupt.len() + 1) as u64,
+    }
+}
+
+fn pty() -> (OwnedFd, String) {
+    // Close-on-exec: a child holding the master would keep the pty alive.
+    let master =
+        openpt(OpenptFlags::RDWR | OpenptFlags::NOCTTY | OpenptFlags::CLOEXEC).expect("openpt");
+    grantpt(&master).expect("grantpt");
+    unlockpt(&master).expect("unlockpt");
+    let name = ptsname(&master, Vec::new())
+        .expect("ptsname")
+        .into_string()
+        .unwrap();
+    (master, name)
+}
+
+fn check_summary(json: &serde_json::Value, want: &Damaged) {
+    let link = &json["link"];
+    assert_eq!(link["frames"], want.good_frames, "{json:#}");
+    assert_eq!(json["bad_frames"], want.bad_frames, "{json:#}");
+    assert_eq!(link["seq_gaps"], want.seq_gaps, "{json:#}");
+    assert_eq!(link["frames_missed"], want.frames_missed, "{json:#}");
+    assert_eq!(link["bytes"], want.bytes.len() as u64, "{json:#}");
+    // What the status line shows survived the damage: the three episodes.
+    assert_eq!(json["latest"]["learning_episodes"], 1, "{json:#}");
+    assert_eq!(json["latest"]["test_episodes"], 2, "{json:#}");
+}
+
+#[test]
+fn capture_from_a_pseudo_terminal_resynchronises_counts_every_loss_and_keeps_going() {
+    let want = damage(&recording());
+    let (master, slave) = pty();
+    // Raw mode before anything is written, so the line discipline passes
+    // every byte through (pada capture sets it too, through serialport).
+    {
+        let fd = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(&slave)
+            .unwrap();
+        let mut t = rustix::termios::tcgetattr(&fd).unwrap();
+        t.make_raw();
+        rustix::termios::tcsetattr(&fd, rustix::termios::OptionalActions::Now, &t).unwrap();
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("capture.csv");
+    let mut child = Command::new(common::pada_bin())
+        .args([
+            "capture", "--port", &slave, "--baud", "921600", "--json", "--out",
+        ])
+        .arg(&csv)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // The status lines, as they come.
+    let stderr = child.stderr.take().unwrap();
+    let lines = std::thread::spawn(move || {
+        BufReader::new(stderr)
+            .lines()
+            .map_while(Result::ok)
+            .collect::<Vec<_>>()
+    });
+    // Give it time to open the port, then feed the stream as a board would:
+    // in pieces, over about two and a half seconds.
+    std::thread::sleep(Duration::from_millis(500));
+    let mut m = std::fs::File::from(master);
+    let started = Instant::now();
+    for chunk in want.bytes.chunks(256) {
+        m.write_all(chunk).unwrap();
+        std::thread::sleep(Duration::from_millis(40));
+    }
+    let fed_in = started.elapsed();
+    // Let it drain, then hang up: the port goes away, the capture ends.
+    std::thread::sleep(Duration::from_millis(500));
+    drop(m);
+    let out = child.wait_with_output().unwrap();
+    let lines = lines.join().unwrap();
+    assert!(
+        out.status.success(),
+        "exit {:?}; stderr:\n{}",
+        out.status,
+        lines.join("\n")
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    check_summary(&json, &want);
+    assert!(json["ended"].as_str().unwrap().contains("port"), "{json:#}");
+    // A live status line every second while bytes came in, and a last one.
+    let status: Vec<&String> = lines.iter().filter(|l| l.starts_with("frames ")).collect();
+    assert!(
+        status.len() >= 2 && fed_in > Duration::from_secs(2),
+        "{lines:?}"
+    );
+    let last = status.last().unwrap();
+    assert!(
+        last.contains(&format!(
+            "gaps {} ({} frames)",
+            want.seq_gaps, want.frames_missed
+        )),
+        "{last}"
+    );
+    // Every frame, lost frame and gap is a CSV row.
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let kind = |k: &str| {
+        text.lines()
+            .filter(|l| l.split(',').nth(2) == Some(k))
+            .count()
+    };
+    assert_eq!(kind("lost") as u32, want.bad_frames);
+    assert_eq!(kind("gap") as u32, want.seq_gaps);
+    let rows = text.lines().count() - 1;
+    assert_eq!(rows - kind("lost") - kind("gap"), want.good_frames as usize);
+}
+
+#[test]
+fn capture_from_a_file_counts_the_same() {
+    let want = damage(&recording());
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("damaged.bin");
+    std::fs::write(&file, &want.bytes).unwrap();
+    let out = Command::new(common::pada_bin())
+        .args(["capture", "--json", "--file"])
+        .arg(&file)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    check_summary(&json, &want);
+    assert_eq!(json["ended"], "end of file");
+}
+
+#[test]
+fn capture_rejects_bad_input_with_exit_code_2() {
+    let bin = common::pada_bin();
+    for args in [
+        vec!["capture"],
+        vec!["capture", "--file", "/nonexistent/stream.bin"],
+        vec!["capture", "--port", "/dev/nonexistent-tty"],
+        vec!["capture", "--file", "-", "--port", "/dev/null"],
+        vec!["capture", "--file", "-", "--baud", "0"],
+        vec!["capture", "--file", "-", "--seconds", "-1"],
+    ] {
+        let out = Command::new(&bin)
+            .args(&args)
+            .stdin(Stdio::null())
+            .output()
+            .unwrap();
+        assert_eq!(
+            out.status.code(),
+            Some(2),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.starts_with("error: ") && err.lines().count() == 1,
+            "{args:?}: {err}"
+        );
+    }
+}

@@ -1,0 +1,93 @@
+//! Helpers shared by the end-to-end tests: the repository, the firmware
+//! image for the emulated board, the `pada` binary.
+
+#![allow(dead_code)]
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::Mutex;
+
+/// The repository root.
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("tests/ is inside the repository")
+        .to_path_buf()
+}
+
+fn cargo() -> Command {
+    let mut c = Command::new(env!("CARGO"));
+    c.current_dir(root());
+    c
+}
+
+/// The firmware image for QEMU's netduinoplus2 for `robot` (`pendulum` or
+/// `leo`), built once per test binary with `cargo xtask qemu` (which needs
+/// a toolchain for thumbv7em-none-eabihf; CI installs Debian's).
+pub fn image(robot: &str) -> PathBuf {
+    static BUILT: Mutex<Option<HashMap<String, PathBuf>>> = Mutex::new(None);
+    let mut built = BUILT.lock().unwrap_or_else(|e| e.into_inner());
+    let map = built.get_or_insert_with(HashMap::new);
+    if let Some(p) = map.get(robot) {
+        return p.clone();
+    }
+    let out = cargo()
+        .args(["xtask", "qemu", "--robot", robot])
+        .output()
+        .expect("cannot run cargo xtask qemu");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "cargo xtask qemu --robot {robot} failed (a thumbv7em-none-eabihf toolchain is needed, see .ci/run):\n{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let elf = stdout
+        .lines()
+        .rev()
+        .find_map(|l| l.strip_prefix("xtask: firmware ELF: "))
+        .map(PathBuf::from)
+        .expect("xtask names the ELF");
+    map.insert(robot.to_string(), elf.clone());
+    elf
+}
+
+/// The `pada` binary of this profile, built once.
+pub fn pada_bin() -> PathBuf {
+    static BUILT: Mutex<Option<PathBuf>> = Mutex::new(None);
+    let mut built = BUILT.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(p) = built.as_ref() {
+        return p.clone();
+    }
+    // target/<profile>/deps/<this test> → target/<profile>/pada
+    let exe = std::env::current_exe().expect("the test's path");
+    let profile_dir = exe
+        .parent()
+        .and_then(Path::parent)
+        .expect("target/<profile>")
+        .to_path_buf();
+    let release = profile_dir.file_name().is_some_and(|n| n == "release");
+    let mut c = cargo();
+    c.args(["build", "--quiet", "--package", "pada", "--bin", "pada"]);
+    if release {
+        c.arg("--release");
+    }
+    let status = c.status().expect("cannot run cargo build");
+    assert!(status.success(), "cargo build -p pada failed");
+    let bin = profile_dir.join("pada");
+    assert!(bin.is_file(), "{} missing after the build", bin.display());
+    *built = Some(bin.clone());
+    bin
+}
+
+/// `qemu-system-arm` is there (10 or later; CI installs it from
+/// bookworm-backports). Panics with what to do otherwise: the SIL tests
+/// are meant to run, not to be skipped.
+pub fn require_qemu() {
+    let out = Command::new("qemu-system-arm").arg("--version").output();
+    let ok = out.as_ref().is_ok_and(|o| o.status.success());
+    assert!(
+        ok,
+        "qemu-system-arm is not installed: install QEMU 10 from bookworm-backports (DESIGN.md, .ci/run)"
+    );
+}
