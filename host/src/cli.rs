@@ -88,6 +88,10 @@ pub struct RunArgs {
     /// Print the summary as JSON on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Stream trial 0 as the firmware's telemetry frames to FILE or to
+    /// tcp:HOST:PORT (loopback only); `pada capture --file` reads them.
+    #[arg(long, value_name = "FILE|tcp:HOST:PORT")]
+    pub telemetry: Option<String>,
     /// Seed and threads.
     #[command(flatten)]
     pub trial: TrialOptions,

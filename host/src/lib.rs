@@ -24,4 +24,5 @@ pub mod stats;
 pub mod summary;
 pub mod task;
 pub mod tasks;
+pub mod telemetry;
 pub mod torque_log;

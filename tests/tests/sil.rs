@@ -29,6 +29,7 @@ fn sil(task: SilTask, policy: PolicyKind, seconds: f64, faults: &[&str], out: &P
         out_dir: out.to_path_buf(),
         hang_timeout: Duration::from_secs(120),
         progress: false,
+        telemetry: None,
     };
     run(&cfg).unwrap_or_else(|e| panic!("SIL run failed: {e:#}"))
 }

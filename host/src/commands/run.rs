@@ -4,12 +4,14 @@
 use crate::algo::{label, policy_kind, Algo};
 use crate::cli::{check_seconds, set_threads, RunArgs};
 use crate::error::{usage, CliError};
-use crate::experiment::{run_trials, RunConfig};
+use crate::experiment::{build_agent, run_trials, run_trials_observed, RunConfig};
 use crate::output::OutDir;
 use crate::progress::steps_bar;
 use crate::summary::{run_files, RunSummary};
 use crate::task::Task;
 use crate::tasks::{visit_task, TaskVisitor};
+use crate::telemetry::{parse_target, TelemetrySink};
+use pada_core::wire::{self, ToHost};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -53,6 +55,10 @@ impl TaskVisitor for RunVisitor {
             .clone()
             .unwrap_or_else(|| PathBuf::from(format!("pada-out/run-{}-{}", spec.name, args.algo)));
         let out = OutDir::check(&out_path)?;
+        let mut telemetry = match &args.telemetry {
+            Some(t) => Some(TelemetrySink::open(&parse_target(t)?)?),
+            None => None,
+        };
         set_threads(args.trial.threads)?;
 
         let total = cfg.trials as u64
@@ -63,12 +69,36 @@ impl TaskVisitor for RunVisitor {
             );
         let bar = steps_bar(total, &format!("{} {}", spec.name, label(&policy)));
         let start = Instant::now();
-        let results = run_trials(task, &cfg, &|n| bar.inc(n))?;
+        let results = match telemetry.as_mut() {
+            None => run_trials(task, &cfg, &|n| bar.inc(n))?,
+            Some(sink) => {
+                sink.send(&ToHost::Hello(wire::Hello {
+                    protocol: wire::PROTOCOL_VERSION,
+                    // 0: a host run, not a firmware configuration.
+                    config_hash: 0,
+                    weight_count: build_agent(spec, policy)?.weights().len() as u32,
+                    period_us: (spec.control_period_s * 1e6).round() as u32,
+                    state_dims: spec.state.len() as u8,
+                    joints: spec.motor.dims() as u8,
+                }));
+                let mut observer = |msg: ToHost| sink.send(&msg);
+                run_trials_observed(task, &cfg, &|n| bar.inc(n), &mut observer)?
+            }
+        };
         let wall = start.elapsed().as_secs_f64();
         bar.finish_and_clear();
 
         let summary = RunSummary::new(spec, &cfg, &results, wall);
         out.write_all(&run_files(&summary)?)?;
+        if let Some(sink) = telemetry {
+            let totals = sink.finish()?;
+            if !args.json {
+                println!(
+                    "telemetry: trial 0, {} frames ({} bytes) to {}",
+                    totals.frames, totals.bytes, totals.target
+                );
+            }
+        }
         if args.json {
             println!("{}", summary.to_json());
         } else {

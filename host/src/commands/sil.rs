@@ -53,6 +53,10 @@ pub struct SilArgs {
     /// called hung.
     #[arg(long, value_name = "S", default_value_t = 60)]
     pub hang_timeout: u64,
+    /// Also stream the firmware's telemetry frames, as they come, to FILE
+    /// or to tcp:HOST:PORT (loopback only).
+    #[arg(long, value_name = "FILE|tcp:HOST:PORT")]
+    pub telemetry: Option<String>,
     /// Print the summary as JSON on stdout.
     #[arg(long)]
     pub json: bool,
@@ -78,6 +82,11 @@ pub fn run(args: SilArgs) -> Result<(), CliError> {
             args.hang_timeout
         )));
     }
+    let telemetry = args
+        .telemetry
+        .as_deref()
+        .map(crate::telemetry::parse_target)
+        .transpose()?;
     let task_name = match args.task {
         SilTask::Pendulum => "pendulum",
         SilTask::Leo => "leo",
@@ -102,6 +111,7 @@ pub fn run(args: SilArgs) -> Result<(), CliError> {
         out_dir: out_path.clone(),
         hang_timeout: Duration::from_secs(args.hang_timeout),
         progress: !args.json,
+        telemetry,
     };
     let summary = sil::run(&cfg)?;
     if args.json {

@@ -2,7 +2,7 @@
 //! rayon's pool (all cores by default), each with its own seed, so the
 //! results do not depend on scheduling.
 
-use super::trial::{run_trial, TrialResult};
+use super::trial::{run_trial, run_trial_observed, TrialObserver, TrialResult};
 use crate::task::Task;
 use pada_core::policy::PolicyKind;
 use rayon::prelude::*;
@@ -41,6 +41,28 @@ pub fn run_trials<T: Task>(
     progress: &(dyn Fn(u64) + Sync),
 ) -> anyhow::Result<Vec<TrialResult>> {
     Ok(run_configs(task, std::slice::from_ref(cfg), progress)?.remove(0))
+}
+
+/// [`run_trials`], with trial 0 told to `observer` (telemetry); the other
+/// trials run in parallel with it.
+pub fn run_trials_observed<T: Task>(
+    task: &T,
+    cfg: &RunConfig,
+    progress: &(dyn Fn(u64) + Sync),
+    observer: TrialObserver<'_>,
+) -> anyhow::Result<Vec<TrialResult>> {
+    let (first, rest) = rayon::join(
+        || run_trial_observed(task, cfg, 0, progress, Some(observer)),
+        || {
+            (1..cfg.trials)
+                .into_par_iter()
+                .map(|t| run_trial(task, cfg, t, progress))
+                .collect::<anyhow::Result<Vec<_>>>()
+        },
+    );
+    let mut results = vec![first?];
+    results.extend(rest?);
+    Ok(results)
 }
 
 /// Runs every configuration's trials as one pool of jobs (good load

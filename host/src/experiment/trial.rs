@@ -20,6 +20,7 @@ use pada_core::action_space::MAX_ACTION_DIMS;
 use pada_core::agent::{Decision, EpisodeEnd, Mode};
 use pada_core::fatigue::{FatigueCounter, GearboxParams, PAPER_WINDOW_STEPS};
 use pada_core::tile_coding::MAX_STATE_DIMS;
+use pada_core::wire::{self, RunMode, StepKind, ToHost};
 use rand_pcg::Pcg64;
 use serde::Serialize;
 
@@ -63,6 +64,11 @@ pub struct TrialResult {
     pub curve: Vec<TestPoint>,
 }
 
+/// Receives the trial as telemetry: a `Step` for every agent call and an
+/// `Episode` for every episode, as the firmware reports them
+/// (`pada_core::wire`; [`crate::telemetry`]).
+pub type TrialObserver<'o> = &'o mut (dyn FnMut(ToHost) + Send);
+
 /// Runs trial `trial` of `cfg` on `task`. `progress` is told the number of
 /// environment steps after every episode.
 pub fn run_trial<T: Task>(
@@ -70,6 +76,17 @@ pub fn run_trial<T: Task>(
     cfg: &RunConfig,
     trial: u32,
     progress: &(dyn Fn(u64) + Sync),
+) -> anyhow::Result<TrialResult> {
+    run_trial_observed(task, cfg, trial, progress, None)
+}
+
+/// [`run_trial`], telling `observer` every agent call and episode.
+pub fn run_trial_observed<T: Task>(
+    task: &T,
+    cfg: &RunConfig,
+    trial: u32,
+    progress: &(dyn Fn(u64) + Sync),
+    observer: Option<TrialObserver<'_>>,
 ) -> anyhow::Result<TrialResult> {
     let spec = task.spec();
     anyhow::ensure!(
@@ -100,6 +117,9 @@ pub fn run_trial<T: Task>(
         test_steps: 0,
         episodes: 0,
         curve: Vec::new(),
+        observer,
+        calls: 0,
+        reported_episodes: 0,
     };
 
     let budget = (cfg.seconds / spec.control_period_s).round() as u64;
@@ -137,7 +157,7 @@ pub fn run_trial<T: Task>(
 }
 
 /// The state of a running trial.
-struct Trial<'a, P: Plant> {
+struct Trial<'a, 'o, P: Plant> {
     spec: &'a TaskSpec,
     agent: HostAgent,
     plant: P,
@@ -150,9 +170,94 @@ struct Trial<'a, P: Plant> {
     test_steps: u64,
     episodes: u32,
     curve: Vec<TestPoint>,
+    observer: Option<TrialObserver<'o>>,
+    /// Agent calls so far (the `step` of telemetry).
+    calls: u32,
+    /// Episodes reported so far (the `episode` of telemetry).
+    reported_episodes: u32,
 }
 
-impl<P: Plant> Trial<'_, P> {
+impl<P: Plant> Trial<'_, '_, P> {
+    /// Reports one agent call to the observer.
+    fn report_step(
+        &mut self,
+        kind: StepKind,
+        learning: bool,
+        reward: f32,
+        decision: Option<&Decision>,
+    ) {
+        let Some(observer) = self.observer.as_mut() else {
+            return;
+        };
+        self.calls = self.calls.wrapping_add(1);
+        let n = self.spec.state.len();
+        let motors = self.spec.motor.dims();
+        let td_error = match (kind, learning) {
+            (StepKind::Start, _) | (_, false) => 0,
+            _ => self.agent.stats().last_td_error.0,
+        };
+        let joints = self
+            .fatigue
+            .joints()
+            .iter()
+            .take(motors.min(wire::MAX_JOINTS))
+            .map(|j| wire::JointFatigue {
+                damage: j.damage(),
+                reengagements: j.reengagements().min(u32::MAX as u64) as u32,
+            })
+            .collect();
+        let env_steps = self.learning_steps + self.test_steps;
+        observer(ToHost::Step(wire::Step {
+            step: self.calls,
+            time_ms: (env_steps as f64 * self.spec.control_period_s * 1000.0) as u32,
+            episode: self.reported_episodes,
+            mode: if learning {
+                RunMode::Learning
+            } else {
+                RunMode::Testing
+            },
+            kind,
+            state: self.obs[..n.min(wire::MAX_STATE_DIMS)]
+                .iter()
+                .copied()
+                .collect(),
+            action: decision.map_or(0, |d| d.action),
+            output: decision
+                .map(|d| {
+                    d.output[..motors.min(wire::MAX_OUTPUTS)]
+                        .iter()
+                        .copied()
+                        .collect()
+                })
+                .unwrap_or_default(),
+            reward,
+            td_error,
+            explored: decision.is_some_and(|d| d.explored),
+            joints,
+            loop_us: 0,
+            agent_cycles: 0,
+        }));
+    }
+
+    /// Reports a finished episode to the observer.
+    fn report_episode(&mut self, learning: bool, ret: f64, length: u32) {
+        let Some(observer) = self.observer.as_mut() else {
+            return;
+        };
+        observer(ToHost::Episode(wire::Episode {
+            index: self.reported_episodes,
+            mode: if learning {
+                RunMode::Learning
+            } else {
+                RunMode::Testing
+            },
+            total_reward: ret as f32,
+            length,
+            weights_checksum: self.agent.weights_checksum(),
+        }));
+        self.reported_episodes = self.reported_episodes.wrapping_add(1);
+    }
+
     /// A greedy test run, recorded on the curve; returns its steps.
     fn test_run(&mut self) -> anyhow::Result<u64> {
         self.agent.set_mode(Mode::Testing);
@@ -192,6 +297,7 @@ impl<P: Plant> Trial<'_, P> {
             .agent
             .start_episode(&self.obs[..n], &mut self.rng)
             .map_err(bad)?;
+        self.report_step(StepKind::Start, learning, 0.0, Some(&d));
         let mut ret = 0.0f64;
         for k in 1..=spec.episode_steps {
             let command = &d.output[..motors];
@@ -213,6 +319,13 @@ impl<P: Plant> Trial<'_, P> {
                 self.agent
                     .end_episode(step.reward, end, &mut self.rng)
                     .map_err(bad)?;
+                let kind = if step.terminal {
+                    StepKind::Absorbing
+                } else {
+                    StepKind::Timeout
+                };
+                self.report_step(kind, learning, step.reward, None);
+                self.report_episode(learning, ret, k);
                 return Ok((ret, k));
             }
             if learning {
@@ -223,6 +336,7 @@ impl<P: Plant> Trial<'_, P> {
                 .agent
                 .step(step.reward, obs, &mut self.rng)
                 .map_err(bad)?;
+            self.report_step(StepKind::Step, learning, step.reward, Some(&d));
         }
         Ok((ret, spec.episode_steps))
     }

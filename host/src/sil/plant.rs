@@ -271,7 +271,10 @@ mod tests {
         let lost_free = e0 - energy(free.state());
         let lost_braked = e0 - energy(braked.state());
         // Back-EMF (K²/R = 3.0e-4) against friction alone (b = 3e-6).
-        assert!(lost_braked > 20.0 * lost_free, "{lost_braked} vs {lost_free}");
+        assert!(
+            lost_braked > 20.0 * lost_free,
+            "{lost_braked} vs {lost_free}"
+        );
         assert!(lost_free > 0.0);
     }
 

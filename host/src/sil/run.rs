@@ -100,6 +100,9 @@ pub struct SilConfig {
     pub hang_timeout: Duration,
     /// Show a progress bar on stderr.
     pub progress: bool,
+    /// Also stream the firmware's telemetry, as it comes, to a file or a
+    /// loopback TCP listener.
+    pub telemetry: Option<crate::telemetry::TelemetryTarget>,
 }
 
 /// One test episode on the learning curve.
@@ -309,6 +312,7 @@ struct Session<'a> {
     booted: bool,
     episodes_csv: csv::Writer<std::fs::File>,
     raw: std::io::BufWriter<std::fs::File>,
+    sink: Option<crate::telemetry::TelemetrySink>,
     bar: Option<indicatif::ProgressBar>,
 }
 
@@ -344,6 +348,12 @@ pub fn run(cfg: &SilConfig) -> anyhow::Result<SilSummary> {
     let bar = cfg.progress.then(|| {
         crate::progress::steps_bar((cfg.seconds * 1000.0).round() as u64, "sil: learning ms")
     });
+    let sink = match &cfg.telemetry {
+        Some(t) => Some(
+            crate::telemetry::TelemetrySink::open(t).map_err(|e| anyhow!("{}", e.one_line()))?,
+        ),
+        None => None,
+    };
     let emu = Emulator::start(&setup)?;
     let mut s = Session {
         cfg,
@@ -375,6 +385,7 @@ pub fn run(cfg: &SilConfig) -> anyhow::Result<SilSummary> {
         booted: false,
         episodes_csv,
         raw: std::io::BufWriter::new(raw),
+        sink,
         bar,
     };
     let result = s.run_loop();
@@ -574,6 +585,9 @@ impl Session<'_> {
                     let tele_bytes = self.take(true, telemetry_tx)?;
                     if !tele_bytes.is_empty() {
                         std::io::Write::write_all(&mut self.raw, &tele_bytes)?;
+                        if let Some(sink) = self.sink.as_mut() {
+                            sink.forward(&tele_bytes);
+                        }
                         let mut frames = Vec::new();
                         self.recorder.feed(&tele_bytes, self.now_s(), &mut frames)?;
                         for f in frames {
@@ -865,6 +879,17 @@ impl Session<'_> {
                     first.map(|v| format!("{v:.0}")).unwrap_or("-".into()),
                     end.map(|v| format!("{v:.0}")).unwrap_or("-".into())
                 ),
+            });
+        }
+        if let Some(sink) = self.sink.take() {
+            let (ok, detail) = match sink.finish() {
+                Ok(t) => (true, format!("{} bytes to {}", t.bytes, t.target)),
+                Err(e) => (false, format!("{e:#}")),
+            };
+            checks.push(Check {
+                name: "telemetry forwarded (--telemetry)",
+                ok,
+                detail,
             });
         }
         let passed = checks.iter().all(|c| c.ok);
