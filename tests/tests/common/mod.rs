@@ -1,5 +1,5 @@
 //! Helpers shared by the end-to-end tests: the repository, the firmware
-//! image for the emulated board, the `pada` binary.
+//! image for the emulated board, QEMU.
 
 #![allow(dead_code)]
 
@@ -50,34 +50,6 @@ pub fn image(robot: &str) -> PathBuf {
         .expect("xtask names the ELF");
     map.insert(robot.to_string(), elf.clone());
     elf
-}
-
-/// The `pada` binary of this profile, built once.
-pub fn pada_bin() -> PathBuf {
-    static BUILT: Mutex<Option<PathBuf>> = Mutex::new(None);
-    let mut built = BUILT.lock().unwrap_or_else(|e| e.into_inner());
-    if let Some(p) = built.as_ref() {
-        return p.clone();
-    }
-    // target/<profile>/deps/<this test> → target/<profile>/pada
-    let exe = std::env::current_exe().expect("the test's path");
-    let profile_dir = exe
-        .parent()
-        .and_then(Path::parent)
-        .expect("target/<profile>")
-        .to_path_buf();
-    let release = profile_dir.file_name().is_some_and(|n| n == "release");
-    let mut c = cargo();
-    c.args(["build", "--quiet", "--package", "pada", "--bin", "pada"]);
-    if release {
-        c.arg("--release");
-    }
-    let status = c.status().expect("cannot run cargo build");
-    assert!(status.success(), "cargo build -p pada failed");
-    let bin = profile_dir.join("pada");
-    assert!(bin.is_file(), "{} missing after the build", bin.display());
-    *built = Some(bin.clone());
-    bin
 }
 
 /// `qemu-system-arm` is there (10 or later; CI installs it from

@@ -2,8 +2,6 @@
 //! frames for a host simulation, to a file or a loopback TCP listener, and
 //! `pada capture` reads them like a board's.
 
-mod common;
-
 use pada_core::wire::{HostDecoder, RunMode, ToHost};
 use std::io::Read;
 use std::net::TcpListener;
@@ -11,7 +9,7 @@ use std::path::Path;
 use std::process::Command;
 
 fn pada_run(out: &Path, telemetry: &str) -> std::process::Output {
-    Command::new(common::pada_bin())
+    Command::new(env!("CARGO_BIN_EXE_pada"))
         .args([
             "run",
             "--task",
@@ -90,7 +88,7 @@ fn pada_run_streams_trial_0_as_wire_frames_that_capture_reads() {
     let steps = msgs.iter().filter(|m| matches!(m, ToHost::Step(_))).count();
     assert_eq!(steps, episodes.len() * 101);
 
-    let cap = Command::new(common::pada_bin())
+    let cap = Command::new(env!("CARGO_BIN_EXE_pada"))
         .args(["capture", "--json", "--file"])
         .arg(&stream)
         .output()

@@ -3,11 +3,9 @@
 //! firmware recorded in QEMU, with corruption, garbage and a lost frame
 //! mixed in; and the same stream from a file.
 //!
-//! `tests/data/sil-pendulum-3s.bin` is the raw USART2 stream of
+//! `tests/data/sil-pendulum-3s.bin` (repository root) is the raw USART2 stream of
 //! `pada sil --seconds 3` (telemetry.bin; wire protocol 2). Regenerate it
 //! with that command when the wire format changes.
-
-mod common;
 
 use pada_core::wire::{HostDecoder, ToHost};
 use rustix::fd::OwnedFd;
@@ -17,8 +15,11 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 fn recording() -> Vec<u8> {
-    std::fs::read(common::root().join("tests/data/sil-pendulum-3s.bin"))
-        .expect("the recorded stream")
+    std::fs::read(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/data/sil-pendulum-3s.bin"
+    ))
+    .expect("the recorded stream")
 }
 
 /// Frame boundaries (start, end-exclusive including the 0x00) of a stream.
@@ -134,7 +135,7 @@ fn capture_from_a_pseudo_terminal_resynchronises_counts_every_loss_and_keeps_goi
     }
     let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("capture.csv");
-    let mut child = Command::new(common::pada_bin())
+    let mut child = Command::new(env!("CARGO_BIN_EXE_pada"))
         .args([
             "capture", "--port", &slave, "--baud", "921600", "--json", "--out",
         ])
@@ -208,7 +209,7 @@ fn capture_from_a_file_counts_the_same() {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("damaged.bin");
     std::fs::write(&file, &want.bytes).unwrap();
-    let out = Command::new(common::pada_bin())
+    let out = Command::new(env!("CARGO_BIN_EXE_pada"))
         .args(["capture", "--json", "--file"])
         .arg(&file)
         .output()
@@ -225,7 +226,7 @@ fn capture_from_a_file_counts_the_same() {
 
 #[test]
 fn capture_rejects_bad_input_with_exit_code_2() {
-    let bin = common::pada_bin();
+    let bin = env!("CARGO_BIN_EXE_pada");
     for args in [
         vec!["capture"],
         vec!["capture", "--file", "/nonexistent/stream.bin"],
