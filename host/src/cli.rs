@@ -42,6 +42,8 @@ pub enum Command {
     Sil(commands::sil::SilArgs),
     /// Decode telemetry from a board's serial port or a recorded stream.
     Capture(commands::capture::CaptureArgs),
+    /// Draw a learned LEO gait (saved weights) as a strip of stick figures.
+    Render(RenderArgs),
 }
 
 /// Options shared by the commands that run trials.
@@ -92,9 +94,33 @@ pub struct RunArgs {
     /// tcp:HOST:PORT (loopback only); `pada capture --file` reads them.
     #[arg(long, value_name = "FILE|tcp:HOST:PORT")]
     pub telemetry: Option<String>,
+    /// Save the first trial's learned weights to this file (versioned, with
+    /// a checksum; read by `pada render`).
+    #[arg(long, value_name = "FILE")]
+    pub save_weights: Option<PathBuf>,
     /// Seed and threads.
     #[command(flatten)]
     pub trial: TrialOptions,
+}
+
+/// `pada render`.
+#[derive(Debug, Clone, Args)]
+pub struct RenderArgs {
+    /// The task (only leo can be drawn).
+    #[arg(long, value_enum, default_value_t = TaskName::Leo)]
+    pub task: TaskName,
+    /// Weights saved by `pada run --save-weights`.
+    #[arg(long, value_name = "FILE")]
+    pub policy: PathBuf,
+    /// Output directory for gait.svg, gait.png and gait.csv.
+    #[arg(long, value_name = "DIR", default_value = "pada-out/render-leo")]
+    pub out: PathBuf,
+    /// Seconds of the greedy episode to draw.
+    #[arg(long, value_name = "S", default_value_t = 6.0)]
+    pub seconds: f64,
+    /// Frames in the strip.
+    #[arg(long, value_name = "N", default_value_t = 12, value_parser = clap::value_parser!(u32).range(1..=200))]
+    pub frames: u32,
 }
 
 /// `pada demo`.
@@ -122,6 +148,9 @@ pub struct DemoArgs {
 pub enum PaperExperiment {
     /// Section VII: the simulated pendulum sweeps and the physical pendulum.
     Pendulum,
+    /// Section VIII: SARSA(λ), PADA and low-pass on LEO, with and without
+    /// the switch back to SARSA(λ) at half the run.
+    Leo,
 }
 
 /// `pada paper`.
@@ -130,16 +159,18 @@ pub struct PaperArgs {
     /// The experiment.
     #[arg(value_enum)]
     pub experiment: PaperExperiment,
-    /// Output directory for report.md, the figures and the data.
-    #[arg(long, value_name = "DIR", default_value = "pada-out/paper-pendulum")]
-    pub out: PathBuf,
+    /// Output directory for report.md, the figures and the data (default:
+    /// pada-out/paper-<experiment>).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
     /// Trials per configuration (default: the paper's 29 simulated, 28
-    /// physical).
+    /// physical; LEO: 3, scaled down from the paper's 15).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=10000))]
     pub trials: Option<u32>,
-    /// Learning time per trial on the simulated pendulum [s].
-    #[arg(long, value_name = "S", default_value_t = 3000.0)]
-    pub seconds: f64,
+    /// Learning time per trial on the simulated pendulum [s] (default
+    /// 3000; LEO: 14666, the paper's).
+    #[arg(long, value_name = "S")]
+    pub seconds: Option<f64>,
     /// Learning time per trial on the physical pendulum [s].
     #[arg(long, value_name = "S", default_value_t = 1500.0)]
     pub physical_seconds: f64,
@@ -223,7 +254,7 @@ where
                     Ok(())
                 }
                 ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => Err(usage(
-                    "no command given: valid commands are run, demo, paper, mtbf, sil, capture (see pada --help)",
+                    "no command given: valid commands are run, demo, paper, mtbf, render, sil, capture (see pada --help)",
                 )),
                 _ => Err(usage(clap_one_line(&e))),
             };
@@ -236,5 +267,6 @@ where
         Command::Mtbf(a) => commands::mtbf::run(a),
         Command::Sil(a) => commands::sil::run(a),
         Command::Capture(a) => commands::capture::run(a),
+        Command::Render(a) => commands::render::run(a),
     }
 }

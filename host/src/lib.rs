@@ -26,3 +26,4 @@ pub mod task;
 pub mod tasks;
 pub mod telemetry;
 pub mod torque_log;
+pub mod weights;

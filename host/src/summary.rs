@@ -66,6 +66,18 @@ pub struct RunSummary {
     pub mtbf_s: Estimate,
     /// Backlash re-engagements within those actions.
     pub window_reengagements: Estimate,
+    /// Distance walked in the last 10% of the test runs \[m\] (walking
+    /// tasks only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub end_walked_m: Option<Estimate>,
+    /// Mean speed of the last 10% of the test runs \[m/s\] (walking tasks
+    /// only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub end_speed_m_s: Option<Estimate>,
+    /// Falls (absorbing ends) in learning episodes, per trial.
+    pub learning_falls: Estimate,
+    /// Falls in greedy test runs, per trial.
+    pub test_falls: Estimate,
     /// Wall-clock time of the run \[s\].
     pub wall_s: f64,
     /// Environment steps (learning and test runs, all trials).
@@ -93,6 +105,7 @@ impl RunSummary {
             .iter()
             .map(|r| r.learning_steps + r.test_steps)
             .sum();
+        let walking = results.iter().all(|r| r.end_walked_m.is_some());
         RunSummary {
             task: spec.name.to_string(),
             algo,
@@ -123,6 +136,10 @@ impl RunSummary {
             rise_time_s: Estimate::of(&col(|r| r.rise_time_s)),
             mtbf_s: Estimate::of(&col(|r| r.mtbf_s)),
             window_reengagements: Estimate::of(&col(|r| r.window_reengagements as f64)),
+            end_walked_m: walking.then(|| Estimate::of(&col(|r| r.end_walked_m.unwrap_or(f64::NAN)))),
+            end_speed_m_s: walking.then(|| Estimate::of(&col(|r| r.end_speed_m_s.unwrap_or(f64::NAN)))),
+            learning_falls: Estimate::of(&col(|r| r.learning_falls as f64)),
+            test_falls: Estimate::of(&col(|r| r.test_falls as f64)),
             wall_s,
             env_steps,
             env_steps_per_s: if wall_s > 0.0 {
@@ -141,17 +158,28 @@ impl RunSummary {
     }
 }
 
-/// A trial's learning curve as CSV: `test_run,learning_time_s,learning_episodes,return`.
+/// A trial's learning curve as CSV:
+/// `test_run,learning_time_s,learning_episodes,return`, and for a walking
+/// task (a plant that measures walked distance) also `walked_m,fell,duration_s`.
 pub fn curve_csv(result: &TrialResult) -> anyhow::Result<Vec<u8>> {
+    let walking = result.curve.iter().all(|p| p.walked_m.is_some()) && !result.curve.is_empty();
     let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record(["test_run", "learning_time_s", "learning_episodes", "return"])?;
+    let mut header = vec!["test_run", "learning_time_s", "learning_episodes", "return"];
+    if walking {
+        header.extend(["walked_m", "fell", "duration_s"]);
+    }
+    w.write_record(&header)?;
     for (i, p) in result.curve.iter().enumerate() {
-        w.write_record([
+        let mut row = vec![
             i.to_string(),
             format!("{}", p.learning_time_s),
             p.learning_episodes.to_string(),
             format!("{}", p.test_return),
-        ])?;
+        ];
+        if walking {
+            row.extend([format!("{}", p.walked_m.unwrap_or(f64::NAN)), (p.fell as u8).to_string(), format!("{}", p.duration_s)]);
+        }
+        w.write_record(&row)?;
     }
     w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))
 }

@@ -35,9 +35,16 @@ pub trait Plant: Send {
     /// returns the reward and whether the state is absorbing.
     fn step(&mut self, command: &[f32], obs: &mut [f32]) -> Step;
 
-    /// The torque on each gearbox \[N·m\] while `command` is applied, for
-    /// the fatigue counter (Eqs. 3–7). Unused joints are 0.
+    /// The torque on each gearbox \[N·m\] while `command` was applied in
+    /// the step just taken (the runner asks after [`Plant::step`]), for the
+    /// fatigue counter (Eqs. 3–7). Unused joints are 0.
     fn gearbox_torques(&self, command: &[f32]) -> Output;
+
+    /// Distance walked in the current episode \[m\], for walking tasks
+    /// (LEO); `None` for the others.
+    fn walked_distance_m(&self) -> Option<f64> {
+        None
+    }
 }
 
 /// The weight table of a task's agents.

@@ -1,6 +1,7 @@
 //! The tasks the command line knows, by name. A new task (LEO) adds a
 //! variant here and an arm in [`visit_task`]; everything else is generic.
 
+use crate::leo::rl::LeoTask;
 use crate::pendulum::{PhysicalPendulumTask, SimulatedPendulumTask};
 use crate::task::Task;
 use std::fmt;
@@ -12,6 +13,8 @@ pub enum TaskName {
     Pendulum,
     /// The model of the physical pendulum of the paper's experiment.
     PhysicalPendulum,
+    /// The LEO biped walking (Section VIII).
+    Leo,
 }
 
 impl fmt::Display for TaskName {
@@ -19,6 +22,7 @@ impl fmt::Display for TaskName {
         f.write_str(match self {
             TaskName::Pendulum => "pendulum",
             TaskName::PhysicalPendulum => "physical-pendulum",
+            TaskName::Leo => "leo",
         })
     }
 }
@@ -36,5 +40,6 @@ pub fn visit_task<V: TaskVisitor>(name: TaskName, v: V) -> V::Output {
     match name {
         TaskName::Pendulum => v.visit(&SimulatedPendulumTask::default()),
         TaskName::PhysicalPendulum => v.visit(&PhysicalPendulumTask::default()),
+        TaskName::Leo => v.visit(&LeoTask::default()),
     }
 }

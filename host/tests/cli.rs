@@ -40,8 +40,8 @@ fn unknown_names_list_the_valid_values() {
         &["qlearning", "sarsa", "markov-integrator", "pada"],
     );
     assert_bad_input(
-        &["run", "--task", "leo", "--algo", "sarsa"],
-        &["leo", "pendulum", "physical-pendulum"],
+        &["run", "--task", "walker", "--algo", "sarsa"],
+        &["walker", "pendulum", "physical-pendulum", "leo"],
     );
     assert_bad_input(&["paper", "cartpole"], &["cartpole", "pendulum"]);
     assert_bad_input(&["frobnicate"], &["frobnicate"]);

@@ -4,5 +4,7 @@ pub mod capture;
 pub mod demo;
 pub mod mtbf;
 pub mod paper;
+pub mod paper_leo;
+pub mod render;
 pub mod run;
 pub mod sil;

@@ -18,6 +18,7 @@ use crate::progress::steps_bar;
 pub fn run(args: PaperArgs) -> Result<(), CliError> {
     match args.experiment {
         PaperExperiment::Pendulum => pendulum_cmd(args),
+        PaperExperiment::Leo => super::paper_leo::run(args),
     }
 }
 
@@ -25,11 +26,16 @@ fn pendulum_cmd(args: PaperArgs) -> Result<(), CliError> {
     let options = PendulumOptions {
         sim_trials: args.trials.unwrap_or(SIM_TRIALS),
         phys_trials: args.trials.unwrap_or(PHYS_TRIALS),
-        sim_seconds: check_seconds("--seconds", args.seconds)?,
+        sim_seconds: check_seconds("--seconds", args.seconds.unwrap_or(3000.0))?,
         phys_seconds: check_seconds("--physical-seconds", args.physical_seconds)?,
         seed: args.trial.seed,
     };
-    let out = OutDir::check(&args.out)?;
+    let out = OutDir::check(
+        &args
+            .out
+            .clone()
+            .unwrap_or_else(|| "pada-out/paper-pendulum".into()),
+    )?;
     set_threads(args.trial.threads)?;
 
     let bar = steps_bar(pendulum::expected_steps(&options), "Section VII");
@@ -91,7 +97,7 @@ fn headline(r: &PendulumResults) -> String {
     )
 }
 
-fn point(c: &ConfigResult) -> SweepPoint {
+pub(crate) fn point(c: &ConfigResult) -> SweepPoint {
     SweepPoint {
         algo: c.algo(),
         param: parameter_of(&c.policy).unwrap_or(1.0) as f64,
@@ -101,7 +107,7 @@ fn point(c: &ConfigResult) -> SweepPoint {
     }
 }
 
-fn curves(cs: &[ConfigResult], pick: impl Fn(&ConfigResult) -> bool) -> Vec<Curve> {
+pub(crate) fn curves(cs: &[ConfigResult], pick: impl Fn(&ConfigResult) -> bool) -> Vec<Curve> {
     cs.iter()
         .filter(|c| pick(c))
         .map(|c| Curve {

@@ -69,21 +69,34 @@ impl TaskVisitor for RunVisitor {
             );
         let bar = steps_bar(total, &format!("{} {}", spec.name, label(&policy)));
         let start = Instant::now();
-        let results = match telemetry.as_mut() {
-            None => run_trials(task, &cfg, &|n| bar.inc(n))?,
-            Some(sink) => {
+        let results = if telemetry.is_none() && args.save_weights.is_none() {
+            run_trials(task, &cfg, &|n| bar.inc(n))?
+        } else {
+            let weight_count = build_agent(spec, policy)?.weights().len() as u32;
+            let mut observer = telemetry.as_mut().map(|sink| {
                 sink.send(&ToHost::Hello(wire::Hello {
                     protocol: wire::PROTOCOL_VERSION,
                     // 0: a host run, not a firmware configuration.
                     config_hash: 0,
-                    weight_count: build_agent(spec, policy)?.weights().len() as u32,
+                    weight_count,
                     period_us: (spec.control_period_s * 1e6).round() as u32,
                     state_dims: spec.state.len() as u8,
                     joints: spec.motor.dims() as u8,
                 }));
-                let mut observer = |msg: ToHost| sink.send(&msg);
-                run_trials_observed(task, &cfg, &|n| bar.inc(n), &mut observer)?
+                move |msg: ToHost| sink.send(&msg)
+            });
+            let (results, agent, switched) = run_trials_observed(
+                task,
+                &cfg,
+                &|n| bar.inc(n),
+                observer
+                    .as_mut()
+                    .map(|o| o as &mut (dyn FnMut(ToHost) + Send)),
+            )?;
+            if let Some(path) = &args.save_weights {
+                crate::weights::save(path, spec, cfg.policy, switched, &agent)?;
             }
+            results
         };
         let wall = start.elapsed().as_secs_f64();
         bar.finish_and_clear();
@@ -126,6 +139,20 @@ pub fn print_summary(s: &RunSummary, label: &str) {
     println!(
         "  MTBF (1200 actions)  {}",
         fmt_mtbf(s.mtbf_s.mean, s.mtbf_s.ci95)
+    );
+    if let (Some(w), Some(v)) = (&s.end_walked_m, &s.end_speed_m_s) {
+        println!(
+            "  walked (last 10%)    {}",
+            fmt_estimate(w.mean, w.ci95, 2, " m")
+        );
+        println!(
+            "  speed (last 10%)     {}",
+            fmt_estimate(v.mean, v.ci95, 3, " m/s")
+        );
+    }
+    println!(
+        "  falls                {:.1} learning, {:.1} test runs per trial",
+        s.learning_falls.mean, s.test_falls.mean
     );
     println!(
         "  wall {:.1} s, {:.0} env steps/s on {} threads",

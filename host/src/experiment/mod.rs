@@ -13,4 +13,6 @@ pub mod trial;
 pub use agent_setup::{build_agent, HostAgent, TILINGS, TRACE};
 pub use metrics::{end_performance, rise_time};
 pub use runner::{run_configs, run_trials, run_trials_observed, RunConfig};
-pub use trial::{run_trial, run_trial_observed, TestPoint, TrialObserver, TrialResult};
+pub use trial::{
+    run_trial, run_trial_keep, run_trial_observed, TestPoint, TrialObserver, TrialResult,
+};

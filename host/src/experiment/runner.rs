@@ -2,6 +2,7 @@
 //! rayon's pool (all cores by default), each with its own seed, so the
 //! results do not depend on scheduling.
 
+use super::agent_setup::HostAgent;
 use super::trial::{run_trial, run_trial_observed, TrialObserver, TrialResult};
 use crate::task::Task;
 use pada_core::policy::PolicyKind;
@@ -43,16 +44,18 @@ pub fn run_trials<T: Task>(
     Ok(run_configs(task, std::slice::from_ref(cfg), progress)?.remove(0))
 }
 
-/// [`run_trials`], with trial 0 told to `observer` (telemetry); the other
-/// trials run in parallel with it.
+/// [`run_trials`], with trial 0 told to `observer` (telemetry) if given,
+/// and trial 0's learned agent returned with whether it had switched back
+/// to SARSA(λ) (for saving its weights). The other trials run in parallel
+/// with it.
 pub fn run_trials_observed<T: Task>(
     task: &T,
     cfg: &RunConfig,
     progress: &(dyn Fn(u64) + Sync),
-    observer: TrialObserver<'_>,
-) -> anyhow::Result<Vec<TrialResult>> {
+    observer: Option<TrialObserver<'_>>,
+) -> anyhow::Result<(Vec<TrialResult>, HostAgent, bool)> {
     let (first, rest) = rayon::join(
-        || run_trial_observed(task, cfg, 0, progress, Some(observer)),
+        || run_trial_observed(task, cfg, 0, progress, observer),
         || {
             (1..cfg.trials)
                 .into_par_iter()
@@ -60,9 +63,10 @@ pub fn run_trials_observed<T: Task>(
                 .collect::<anyhow::Result<Vec<_>>>()
         },
     );
-    let mut results = vec![first?];
+    let (first, agent, switched) = first?;
+    let mut results = vec![first];
     results.extend(rest?);
-    Ok(results)
+    Ok((results, agent, switched))
 }
 
 /// Runs every configuration's trials as one pool of jobs (good load

@@ -33,6 +33,12 @@ pub struct TestPoint {
     pub learning_episodes: u32,
     /// Sum of the rewards of the greedy test run.
     pub test_return: f64,
+    /// Distance walked in the test run \[m\] (walking tasks only).
+    pub walked_m: Option<f64>,
+    /// Whether the test run ended in an absorbing state (a fall).
+    pub fell: bool,
+    /// Duration of the test run \[s\].
+    pub duration_s: f64,
 }
 
 /// Everything measured in one trial.
@@ -55,6 +61,18 @@ pub struct TrialResult {
     pub learning_steps: u64,
     /// Test-run steps taken.
     pub test_steps: u64,
+    /// Learning episodes that ended in an absorbing state (falls).
+    pub learning_falls: u64,
+    /// Learning episodes.
+    pub learning_episodes: u32,
+    /// Test runs that ended in an absorbing state (falls).
+    pub test_falls: u32,
+    /// Mean distance walked in the last 10% of the test runs \[m\]
+    /// (walking tasks only).
+    pub end_walked_m: Option<f64>,
+    /// Mean speed of the last 10% of the test runs, distance over duration
+    /// \[m/s\] (walking tasks only).
+    pub end_speed_m_s: Option<f64>,
     /// Weight writes that saturated the fixed-point range (should be 0).
     pub saturations: u32,
     /// Trace entries dropped for capacity (should be 0).
@@ -77,17 +95,28 @@ pub fn run_trial<T: Task>(
     trial: u32,
     progress: &(dyn Fn(u64) + Sync),
 ) -> anyhow::Result<TrialResult> {
+    run_trial_observed(task, cfg, trial, progress, None).map(|(r, _, _)| r)
+}
+
+/// [`run_trial`], also returning the agent as learned at the end (for
+/// saving its weights) and whether it had switched back to SARSA(λ).
+pub fn run_trial_keep<T: Task>(
+    task: &T,
+    cfg: &RunConfig,
+    trial: u32,
+    progress: &(dyn Fn(u64) + Sync),
+) -> anyhow::Result<(TrialResult, HostAgent, bool)> {
     run_trial_observed(task, cfg, trial, progress, None)
 }
 
-/// [`run_trial`], telling `observer` every agent call and episode.
+/// [`run_trial_keep`], telling `observer` every agent call and episode.
 pub fn run_trial_observed<T: Task>(
     task: &T,
     cfg: &RunConfig,
     trial: u32,
     progress: &(dyn Fn(u64) + Sync),
     observer: Option<TrialObserver<'_>>,
-) -> anyhow::Result<TrialResult> {
+) -> anyhow::Result<(TrialResult, HostAgent, bool)> {
     let spec = task.spec();
     anyhow::ensure!(
         spec.episode_steps >= 1,
@@ -114,6 +143,7 @@ pub fn run_trial_observed<T: Task>(
             .switch_at_s
             .map(|s| (s / spec.control_period_s).round() as u64),
         learning_steps: 0,
+        learning_falls: 0,
         test_steps: 0,
         episodes: 0,
         curve: Vec::new(),
@@ -136,7 +166,14 @@ pub fn run_trial_observed<T: Task>(
     let times: Vec<f64> = t.curve.iter().map(|p| p.learning_time_s).collect();
     let returns: Vec<f64> = t.curve.iter().map(|p| p.test_return).collect();
     let stats = t.agent.stats();
-    Ok(TrialResult {
+    let k = t.curve.len().div_ceil(10).max(1).min(t.curve.len());
+    let tail = &t.curve[t.curve.len() - k..];
+    // Walking metrics exist only when every test run measured a distance.
+    let walked: Option<f64> = tail.iter().map(|p| p.walked_m).sum();
+    let end_walked_m = walked.map(|w| w / k as f64);
+    let end_speed_m_s = walked.map(|w| w / tail.iter().map(|p| p.duration_s).sum::<f64>());
+    let switched = cfg.switch_at_s.is_some() && t.switch_step.is_none();
+    let result = TrialResult {
         trial,
         seed: trial_seed(cfg.seed, trial),
         end_performance: end_performance(&returns).unwrap_or(f64::NAN),
@@ -150,10 +187,16 @@ pub fn run_trial_observed<T: Task>(
             .sum(),
         learning_steps: t.learning_steps,
         test_steps: t.test_steps,
+        learning_falls: t.learning_falls,
+        learning_episodes: t.episodes,
+        test_falls: t.curve.iter().filter(|p| p.fell).count() as u32,
+        end_walked_m,
+        end_speed_m_s,
         saturations: stats.saturations,
         trace_drops: stats.trace_drops,
         curve: t.curve,
-    })
+    };
+    Ok((result, t.agent, switched))
 }
 
 /// The state of a running trial.
@@ -167,6 +210,7 @@ struct Trial<'a, 'o, P: Plant> {
     /// Learning step at which the policy switches back to SARSA(λ).
     switch_step: Option<u64>,
     learning_steps: u64,
+    learning_falls: u64,
     test_steps: u64,
     episodes: u32,
     curve: Vec<TestPoint>,
@@ -263,11 +307,14 @@ impl<P: Plant> Trial<'_, '_, P> {
         self.agent.set_mode(Mode::Testing);
         let result = self.episode(false);
         self.agent.set_mode(Mode::Learning);
-        let (ret, steps) = result?;
+        let (ret, steps, fell) = result?;
         self.curve.push(TestPoint {
             learning_time_s: self.learning_steps as f64 * self.spec.control_period_s,
             learning_episodes: self.episodes,
             test_return: ret,
+            walked_m: self.plant.walked_distance_m(),
+            fell,
+            duration_s: steps as f64 * self.spec.control_period_s,
         });
         self.test_steps += steps as u64;
         Ok(steps as u64)
@@ -283,9 +330,9 @@ impl<P: Plant> Trial<'_, '_, P> {
     }
 
     /// One episode to the time limit or an absorbing state; returns the
-    /// undiscounted return and the steps. A learning episode counts its
-    /// steps and applied torques.
-    fn episode(&mut self, learning: bool) -> anyhow::Result<(f64, u32)> {
+    /// undiscounted return, the steps and whether it ended absorbing. A
+    /// learning episode counts its steps, falls and applied torques.
+    fn episode(&mut self, learning: bool) -> anyhow::Result<(f64, u32, bool)> {
         let spec = self.spec;
         let (n, motors) = (spec.state.len(), spec.motor.dims());
         let bad = |e: pada_core::error::StepError| anyhow!("{}: {e}", spec.name);
@@ -301,13 +348,14 @@ impl<P: Plant> Trial<'_, '_, P> {
         let mut ret = 0.0f64;
         for k in 1..=spec.episode_steps {
             let command = &d.output[..motors];
+            let step = self.plant.step(command, &mut self.obs[..n]);
             if learning {
                 self.fatigue
                     .update(&self.plant.gearbox_torques(command))
                     .map_err(|e| anyhow!("{e}"))?;
                 self.learning_steps += 1;
+                self.learning_falls += step.terminal as u64;
             }
-            let step = self.plant.step(command, &mut self.obs[..n]);
             ret += step.reward as f64;
             let obs = &self.obs[..n];
             if step.terminal || k == spec.episode_steps {
@@ -326,7 +374,7 @@ impl<P: Plant> Trial<'_, '_, P> {
                 };
                 self.report_step(kind, learning, step.reward, None);
                 self.report_episode(learning, ret, k);
-                return Ok((ret, k));
+                return Ok((ret, k, step.terminal));
             }
             if learning {
                 self.maybe_switch()?;
@@ -338,6 +386,6 @@ impl<P: Plant> Trial<'_, '_, P> {
                 .map_err(bad)?;
             self.report_step(StepKind::Step, learning, step.reward, Some(&d));
         }
-        Ok((ret, spec.episode_steps))
+        Ok((ret, spec.episode_steps, false))
     }
 }

@@ -19,6 +19,7 @@
 
 pub mod constants;
 pub mod model;
+pub mod rl;
 pub mod task;
 
 use rand_core::RngCore;

@@ -4,5 +4,6 @@
 
 pub mod numbers;
 pub mod objective;
+pub mod leo;
 pub mod pendulum;
 pub mod report;

@@ -1,0 +1,183 @@
+//! `pada paper leo`: Section VIII on the LEO model — report.md next to the
+//! paper's numbers, Fig. 7-style learning curves and Fig. 8-style end
+//! performance against MTBF.
+
+use super::paper::{curves, point};
+use super::run::{fmt_estimate, fmt_mtbf};
+use crate::algo::label;
+use crate::cli::{check_seconds, set_threads, PaperArgs};
+use crate::error::CliError;
+use crate::output::OutDir;
+use crate::paper::leo::{self, LeoOptions, LeoResults};
+use crate::paper::objective::Objective;
+use crate::plot::figures::{LearningCurves, Measure, PerformanceVsMtbf, SweepPoint};
+use crate::plot::save;
+use crate::progress::steps_bar;
+use std::fmt::Write as _;
+
+/// Default trials per configuration of `pada paper leo` (paper: 15).
+pub const DEFAULT_TRIALS: u32 = 3;
+
+/// Runs `pada paper leo`.
+pub fn run(args: PaperArgs) -> Result<(), CliError> {
+    let o = LeoOptions {
+        trials: args.trials.unwrap_or(DEFAULT_TRIALS),
+        seconds: check_seconds("--seconds", args.seconds.unwrap_or(leo::PAPER_SECONDS))?,
+        seed: args.trial.seed,
+    };
+    let out = OutDir::check(
+        &args
+            .out
+            .clone()
+            .unwrap_or_else(|| "pada-out/paper-leo".into()),
+    )?;
+    set_threads(args.trial.threads)?;
+    let bar = steps_bar(leo::expected_steps(&o), "Section VIII (LEO)");
+    let r = leo::run(&o, &|n| bar.inc(n))?;
+    bar.finish_and_clear();
+    let command = format!(
+        "pada paper leo --trials {} --seconds {} --seed {}",
+        o.trials, o.seconds, o.seed
+    );
+    let report = render(&r, &command);
+    out.write_all(&[
+        ("report.md".to_string(), report.clone().into_bytes()),
+        (
+            "summary.json".to_string(),
+            (serde_json::to_string_pretty(&r).map_err(anyhow::Error::from)? + "\n").into_bytes(),
+        ),
+    ])?;
+    draw(&r, &out)?;
+    println!("{report}");
+    println!("wrote {}/report.md and the figures", out.path().display());
+    Ok(())
+}
+
+fn name(r: &LeoResults, i: usize) -> String {
+    let c = &r.configs[i];
+    if r.switched[i] {
+        format!(
+            "{}, switch at {:.0} s",
+            label(&c.policy),
+            r.options.seconds / 2.0
+        )
+    } else {
+        label(&c.policy)
+    }
+}
+
+/// The report: the table next to the paper's numbers.
+pub fn render(r: &LeoResults, command: &str) -> String {
+    let sarsa = &r.configs[0].summary;
+    let obj = Objective::from_sarsa(&sarsa.end_performance, &sarsa.rise_time_s, &sarsa.mtbf_s);
+    let mut s = String::new();
+    let _ = writeln!(s, "# Section VIII on the LEO model\n");
+    let _ = writeln!(s, "Command: `{command}`\n");
+    let _ = writeln!(
+        s,
+        "Scale: {} trials × {} s of learning per configuration (paper: {} trials × {} s), {} configurations, {:.0} s wall on {} threads, {} environment steps ({:.0} steps/s).\n",
+        r.options.trials,
+        r.options.seconds,
+        leo::PAPER_TRIALS,
+        leo::PAPER_SECONDS,
+        r.configs.len(),
+        r.wall_s,
+        r.threads,
+        r.env_steps,
+        r.env_steps as f64 / r.wall_s
+    );
+    let _ = writeln!(
+        s,
+        "Paper: SARSA(λ) end performance {} ± {}, MTBF {} s; PADA and low-pass with the switch back to SARSA(λ) at 7,333 s reach ≈ {} s (×108) with end performance near SARSA(λ)'s (objective: above 1441). pada's reward scale and model differ (rapier3d, not ODE): compare ratios and shapes.\n",
+        leo::PAPER_SARSA_END.0, leo::PAPER_SARSA_END.1, leo::PAPER_SARSA_MTBF_S, leo::PAPER_FILTERED_MTBF_S
+    );
+    let _ = writeln!(
+        s,
+        "Objective from this run's SARSA(λ) (Section VI rule): end performance above {:.1}.\n",
+        obj.end_threshold
+    );
+    let _ = writeln!(s, "| configuration | end performance | MTBF (1200 actions) | MTBF / SARSA | walked, last 10% of tests | speed | learning falls / trial |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|");
+    for (i, c) in r.configs.iter().enumerate() {
+        let m = &c.summary;
+        let w = m
+            .end_walked_m
+            .unwrap_or_else(|| crate::stats::Estimate::of(&[]));
+        let v = m
+            .end_speed_m_s
+            .unwrap_or_else(|| crate::stats::Estimate::of(&[]));
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | ×{:.2} | {} | {} | {:.0} |",
+            name(r, i),
+            fmt_estimate(m.end_performance.mean, m.end_performance.ci95, 1, ""),
+            fmt_mtbf(m.mtbf_s.mean, m.mtbf_s.ci95),
+            m.mtbf_s.mean / sarsa.mtbf_s.mean,
+            fmt_estimate(w.mean, w.ci95, 2, " m"),
+            fmt_estimate(v.mean, v.ci95, 3, " m/s"),
+            m.learning_falls.mean
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\nThe MTBF is predicted from the first 1200 learning actions (40 s), before any switch; the switch only changes the end performance. Figures: `fig7-learning-curves.svg/png`, `fig8-end-vs-mtbf.svg/png` (without switch), `fig8-end-vs-mtbf-switch.svg/png` (with)."
+    );
+    s
+}
+
+fn draw(r: &LeoResults, out: &OutDir) -> anyhow::Result<()> {
+    let dir = out.path();
+    let sarsa = &r.configs[0].summary;
+    let obj = Objective::from_sarsa(&sarsa.end_performance, &sarsa.rise_time_s, &sarsa.mtbf_s);
+    let curve_set: Vec<_> = curves(&r.configs, |_| true)
+        .into_iter()
+        .enumerate()
+        .map(|(i, mut c)| {
+            c.label = name(r, i);
+            c
+        })
+        .filter(|c| c.label == "sarsa" || c.label.contains("switch"))
+        .collect();
+    save(
+        &LearningCurves {
+            title: "Fig. 7 — LEO learning curves (filters switch back to SARSA at half)".into(),
+            curves: curve_set,
+            sarsa_end: sarsa.end_performance.mean,
+            sarsa_rise_s: sarsa.rise_time_s.mean,
+        },
+        dir,
+        "fig7-learning-curves",
+    )?;
+    for (switch, stem, title) in [
+        (
+            false,
+            "fig8-end-vs-mtbf",
+            "Fig. 8 — LEO end performance against MTBF (no switch)",
+        ),
+        (
+            true,
+            "fig8-end-vs-mtbf-switch",
+            "Fig. 8 — LEO end performance against MTBF (switch back at half)",
+        ),
+    ] {
+        let points: Vec<SweepPoint> = r
+            .configs
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| *i == 0 || r.switched[*i] == switch)
+            .map(|(_, c)| point(c))
+            .collect();
+        save(
+            &PerformanceVsMtbf {
+                title: title.into(),
+                measure: Measure::EndPerformance,
+                points,
+                threshold: obj.end_threshold,
+                sarsa_mtbf_s: sarsa.mtbf_s.mean,
+            },
+            dir,
+            stem,
+        )?;
+    }
+    Ok(())
+}

@@ -1,0 +1,193 @@
+//! `pada render`: a learned LEO gait as a strip of stick figures (SVG and
+//! PNG) and the trajectory as CSV, from weights saved by
+//! `pada run --task leo --save-weights FILE`.
+
+use crate::cli::RenderArgs;
+use crate::error::{usage, CliError};
+use crate::leo::constants::*;
+use crate::leo::model::Body;
+use crate::leo::rl::{LeoPlant, LeoTask};
+use crate::output::OutDir;
+use crate::plot::{plot_err, svg_to_png, FONT};
+use crate::task::{Plant, Task};
+use crate::tasks::TaskName;
+use pada_core::agent::{EpisodeEnd, Mode};
+use plotters::prelude::*;
+use rand_core::SeedableRng;
+
+/// One drawn frame: line segments in world (x, z) and the time.
+#[derive(Debug, Clone)]
+pub struct Frame {
+    /// Simulated time \[s\].
+    pub time: f64,
+    /// Segments (from, to) in metres.
+    pub segments: Vec<([f32; 2], [f32; 2])>,
+    /// Hip x \[m\] (the panel's centre).
+    pub hip_x: f32,
+    /// Walked distance so far \[m\].
+    pub walked: f64,
+}
+
+/// The stick figure of the plant's current pose.
+pub fn stick_figure(plant: &LeoPlant) -> Vec<([f32; 2], [f32; 2])> {
+    let m = plant.env().model();
+    let seg = |b: Body, a: [f32; 2], c: [f32; 2]| (m.body_point(b, a), m.body_point(b, c));
+    let mut v = vec![
+        seg(Body::Torso, TORSO_HIP_ANCHOR, TORSO_SHOULDER_ANCHOR),
+        seg(Body::Arm, ARM_SHOULDER_ANCHOR, ARM_HAND),
+    ];
+    for (thigh, shank, foot) in [
+        (Body::ThighLeft, Body::ShankLeft, Body::FootLeft),
+        (Body::ThighRight, Body::ShankRight, Body::FootRight),
+    ] {
+        v.push(seg(thigh, THIGH_HIP_ANCHOR, THIGH_KNEE_ANCHOR));
+        v.push(seg(shank, SHANK_KNEE_ANCHOR, SHANK_ANKLE_ANCHOR));
+        v.push(seg(foot, FOOT_HEEL, FOOT_TOE));
+    }
+    v
+}
+
+/// Runs the greedy policy of the weights file for up to `seconds` and
+/// records every control step.
+pub fn record(args: &RenderArgs) -> anyhow::Result<(Vec<Frame>, bool)> {
+    let task = LeoTask::default();
+    let spec = task.spec();
+    let (_, mut agent) = crate::weights::load(&args.policy, spec)?;
+    agent.set_mode(Mode::Testing);
+    let mut plant = task.plant();
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(1);
+    let mut obs = [0.0f32; 10];
+    plant.reset(&mut rng, &mut obs);
+    let err = |e: pada_core::error::StepError| anyhow::anyhow!("{e}");
+    let mut d = agent.start_episode(&obs, &mut rng).map_err(err)?;
+    let period = spec.control_period_s;
+    let steps = ((args.seconds / period).round() as u32).max(1);
+    let frame = |plant: &LeoPlant, k: u32| {
+        let segments = stick_figure(plant);
+        Frame {
+            time: k as f64 * period,
+            hip_x: segments[0].0[0],
+            segments,
+            walked: plant.walked_distance_m().unwrap_or(0.0),
+        }
+    };
+    let mut frames = vec![frame(&plant, 0)];
+    let mut fell = false;
+    for k in 1..=steps {
+        let s = plant.step(&d.output[..3], &mut obs);
+        frames.push(frame(&plant, k));
+        if s.terminal {
+            fell = true;
+            agent
+                .end_episode(s.reward, EpisodeEnd::Absorbing, &mut rng)
+                .map_err(err)?;
+            break;
+        }
+        d = agent.step(s.reward, &obs, &mut rng).map_err(err)?;
+    }
+    Ok((frames, fell))
+}
+
+/// The strip of `n` frames evenly spaced over `frames`, as SVG.
+pub fn strip_svg(frames: &[Frame], n: usize, title: &str) -> anyhow::Result<String> {
+    let n = n.min(frames.len()).max(1);
+    let picks: Vec<&Frame> = (0..n)
+        .map(|i| {
+            &frames[if n == 1 {
+                0
+            } else {
+                i * (frames.len() - 1) / (n - 1)
+            }]
+        })
+        .collect();
+    let (pw, ph) = (180u32, 230u32);
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (pw * n as u32, ph + 40)).into_drawing_area();
+        root.fill(&WHITE).map_err(plot_err)?;
+        let (top, body) = root.split_vertically(40);
+        top.draw(&Text::new(title.to_string(), (10, 10), (FONT, 18)))
+            .map_err(plot_err)?;
+        let panels = body.split_evenly((1, n));
+        for (panel, f) in panels.iter().zip(picks) {
+            let cx = f.hip_x;
+            let mut chart = ChartBuilder::on(panel)
+                .margin(4)
+                .caption(
+                    format!("t = {:.2} s, {:.2} m", f.time, f.walked),
+                    (FONT, 13),
+                )
+                .build_cartesian_2d(cx - 0.3..cx + 0.3, -0.05f32..0.65f32)
+                .map_err(plot_err)?;
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    vec![(cx - 0.3, 0.0), (cx + 0.3, 0.0)],
+                    BLACK.stroke_width(1),
+                )))
+                .map_err(plot_err)?;
+            for (i, (a, b)) in f.segments.iter().enumerate() {
+                // Torso and arm dark, left leg blue, right leg red.
+                let c = match i {
+                    0 | 1 => RGBColor(40, 40, 40),
+                    2..=4 => RGBColor(30, 90, 200),
+                    _ => RGBColor(200, 50, 40),
+                };
+                chart
+                    .draw_series(std::iter::once(PathElement::new(
+                        vec![(a[0], a[1]), (b[0], b[1])],
+                        c.stroke_width(4),
+                    )))
+                    .map_err(plot_err)?;
+            }
+        }
+        root.present()
+            .map_err(|e| anyhow::anyhow!("drawing SVG: {e}"))?;
+    }
+    Ok(svg)
+}
+
+/// Runs `pada render`.
+pub fn run(args: RenderArgs) -> Result<(), CliError> {
+    if args.task != TaskName::Leo {
+        return Err(usage(format!(
+            "pada render draws only --task leo, not {}",
+            args.task
+        )));
+    }
+    if !(args.seconds.is_finite() && args.seconds > 0.0 && args.seconds <= 3600.0) {
+        return Err(usage(format!(
+            "--seconds {} is out of range: valid is 0 < seconds <= 3600",
+            args.seconds
+        )));
+    }
+    let out = OutDir::check(&args.out)?;
+    let (frames, fell) = record(&args)?;
+    let last = frames.last().expect("at least the first frame");
+    let title = format!(
+        "LEO, greedy policy of {}: {:.2} m in {:.2} s{}",
+        args.policy
+            .file_name()
+            .map(|f| f.to_string_lossy())
+            .unwrap_or_default(),
+        last.walked,
+        last.time,
+        if fell { ", fell" } else { "" }
+    );
+    let svg = strip_svg(&frames, args.frames as usize, &title)?;
+    let png = svg_to_png(&svg)?;
+    let mut csv = String::from("time_s,hip_x_m,walked_m\n");
+    for f in &frames {
+        csv += &format!("{},{},{}\n", f.time, f.hip_x, f.walked);
+    }
+    out.write_all(&[
+        ("gait.svg".to_string(), svg.into_bytes()),
+        ("gait.png".to_string(), png),
+        ("gait.csv".to_string(), csv.into_bytes()),
+    ])?;
+    println!("{title}");
+    println!(
+        "wrote {}/gait.svg, gait.png, gait.csv",
+        out.path().display()
+    );
+    Ok(())
+}

@@ -1,0 +1,128 @@
+//! LEO as a runner task: `pada run --task leo` end to end, the weights file
+//! (round trip, refusal of another configuration, of a corrupted file) and
+//! `pada render`.
+
+use pada::experiment::build_agent;
+use pada::leo::rl::{leo_params, LeoTask};
+use pada::task::Task;
+use pada::weights::{decode, encode, load, save, WeightsHeader};
+use pada_core::fixed::Q16;
+use pada_core::policy::PolicyKind;
+use std::process::Command;
+
+fn pada(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_pada"))
+        .args(args)
+        .output()
+        .expect("pada runs")
+}
+
+#[test]
+fn run_task_leo_json_end_to_end_then_render() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let w = dir.path().join("leo.pdw");
+    let o = pada(&[
+        "run",
+        "--task",
+        "leo",
+        "--algo",
+        "pada",
+        "--delta",
+        "0.34",
+        "--trials",
+        "1",
+        "--seconds",
+        "60",
+        "--json",
+        "--out",
+        out.to_str().unwrap(),
+        "--save-weights",
+        w.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["task"], "leo");
+    assert_eq!(v["parameters"]["gamma"].as_f64().unwrap() as f32, 0.9962);
+    assert!(v["end_walked_m"]["mean"].is_number(), "{v}");
+    assert!(v["end_speed_m_s"]["mean"].is_number(), "{v}");
+    assert!(v["learning_falls"]["mean"].as_f64().unwrap() >= 0.0);
+    let steps = v["per_trial"][0]["learning_steps"].as_u64().unwrap();
+    assert!((1800..1800 + 750).contains(&steps), "{steps}");
+    let curve = std::fs::read_to_string(out.join("trial-000.csv")).unwrap();
+    assert!(curve
+        .starts_with("test_run,learning_time_s,learning_episodes,return,walked_m,fell,duration_s"));
+
+    let r = dir.path().join("render");
+    let o = pada(&[
+        "render",
+        "--task",
+        "leo",
+        "--policy",
+        w.to_str().unwrap(),
+        "--out",
+        r.to_str().unwrap(),
+        "--seconds",
+        "1",
+        "--frames",
+        "4",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["gait.svg", "gait.png", "gait.csv"] {
+        let len = std::fs::metadata(r.join(f)).unwrap().len();
+        assert!(len > 100, "{f}: {len} bytes");
+    }
+    let png = std::fs::read(r.join("gait.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+}
+
+#[test]
+fn weights_round_trip_and_refusals() {
+    let task = LeoTask::default();
+    let spec = task.spec();
+    let policy = PolicyKind::Pada { delta: 1.0 / 3.0 };
+    let mut agent = build_agent(spec, policy).unwrap();
+    for (i, w) in agent.weights_mut().iter_mut().enumerate().step_by(4097) {
+        *w = Q16(i as i32 * 7 - 100_000);
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("w.pdw");
+    save(&path, spec, policy, true, &agent).unwrap();
+    let (h, loaded) = load(&path, spec).unwrap();
+    assert_eq!(h.policy, policy);
+    assert!(h.switched);
+    assert_eq!(loaded.weights(), agent.weights());
+
+    // Another configuration: γ differs.
+    let other = LeoTask::new(pada_core::agent::SarsaParams {
+        gamma: 0.99,
+        ..leo_params()
+    });
+    let e = load(&path, other.spec())
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(
+        e.contains("gamma") && e.contains("another configuration"),
+        "{e}"
+    );
+
+    // A corrupted byte in the weights.
+    let mut bytes = std::fs::read(&path).unwrap();
+    let k = bytes.len() / 2;
+    bytes[k] ^= 0x40;
+    std::fs::write(&path, &bytes).unwrap();
+    let e = load(&path, spec).err().expect("refused").to_string();
+    assert!(e.contains("corrupted") && e.contains("checksum"), "{e}");
+
+    // Not a weights file; another version.
+    assert!(decode(b"hello world, not weights")
+        .unwrap_err()
+        .to_string()
+        .contains("magic"));
+    let header = WeightsHeader::new(spec, policy, false, 2);
+    let mut b = encode(&header, &[Q16(1), Q16(2)]).unwrap();
+    assert_eq!(decode(&b).unwrap().1, vec![Q16(1), Q16(2)]);
+    b[7] = b'9';
+    assert!(decode(&b).unwrap_err().to_string().contains("version"));
+}
