@@ -79,6 +79,10 @@ pub struct TaskSpec {
     pub motor: ActionSpace,
     /// How the weight table is laid out.
     pub table: WeightTable,
+    /// Tile widths of the action dimensions when the agent generalises over
+    /// actions (hashed tables only; [`pada_core::action_tiles`]), `None` for
+    /// one independent set of weights per joint action.
+    pub action_tiles: Option<Vec<f32>>,
     /// SARSA(λ) parameters shared by all six algorithms.
     pub params: SarsaParams,
     /// One greedy test episode after this many learning episodes

@@ -34,7 +34,8 @@ pub struct WeightsHeader {
     pub switched: bool,
     /// Tilings.
     pub tilings: usize,
-    /// Weight table layout and size, e.g. `hashed 2^22`.
+    /// Weight table layout and size, e.g. `hashed 2^22` (with the action
+    /// tile widths when actions are tile-coded).
     pub table: String,
     /// Number of weights.
     pub weights: usize,
@@ -60,9 +61,12 @@ impl WeightsHeader {
             policy,
             switched,
             tilings: TILINGS,
-            table: match spec.table {
-                WeightTable::Exact => "exact".into(),
-                WeightTable::Hashed { log2_size } => format!("hashed 2^{log2_size}"),
+            table: match (&spec.table, &spec.action_tiles) {
+                (WeightTable::Exact, _) => "exact".into(),
+                (WeightTable::Hashed { log2_size }, None) => format!("hashed 2^{log2_size}"),
+                (WeightTable::Hashed { log2_size }, Some(w)) => {
+                    format!("hashed 2^{log2_size}, action tiles {w:?}")
+                }
             },
             weights: n,
             state: spec.state.iter().map(|d| format!("{:?}", d)).collect(),

@@ -30,8 +30,9 @@ fn pendulum(policy: PolicyKind) -> (Agent<Box<[Q16]>, TILINGS, TRACE>, Vec<[f32;
     (agent, states(2, &[PI, 12.0 * PI]))
 }
 
-/// LEO: 10-D state, 3 × 7 voltages (343 joint actions), 16 tilings,
-/// 2^22 weights (GRL used 2^23).
+/// LEO: 10-D state, 3 × 7 voltages (343 joint actions) tile-coded with
+/// 6.67 V action tiles (GRL's `generalizeActions`), 16 tilings, 2^22
+/// weights (GRL used 2^23).
 fn leo(policy: PolicyKind) -> (Agent<Box<[Q16]>, TILINGS, TRACE>, Vec<[f32; 10]>) {
     let angle = StateDim::new(-PI, PI, 0.28).unwrap();
     let rate = StateDim::new(-30.0, 30.0, 10.0).unwrap();
@@ -42,7 +43,8 @@ fn leo(policy: PolicyKind) -> (Agent<Box<[Q16]>, TILINGS, TRACE>, Vec<[f32; 10]>
     ];
     let space = ActionSpace::repeated(ActionDim::uniform(-10.7, 10.7, 7).unwrap(), 3).unwrap();
     let weights = vec![Q16::ZERO; 1 << 22].into_boxed_slice();
-    let agent = Agent::new(&obs, space, policy, params(), Layout::Hashed, weights).unwrap();
+    let mut agent = Agent::new(&obs, space, policy, params(), Layout::Hashed, weights).unwrap();
+    agent.generalise_actions(&[6.67; 3]).unwrap();
     (agent, states(10, &[1.0, 30.0, 2.0, 30.0, 2.0, 30.0, 2.0, 30.0, 2.0, 30.0]))
 }
 

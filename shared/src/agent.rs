@@ -18,6 +18,7 @@
 //! before anything changes: a NaN state is an error that changes no weight.
 
 use crate::action_space::{ActionSpace, Levels, Output, MAX_ACTION_DIMS};
+use crate::action_tiles::{ActionTiles, MAX_ACTION_COMBOS};
 use crate::error::{check_range, ConfigError, StepError};
 use crate::fixed::{Frac, Q16};
 use crate::policy::{uniform_below, Candidates, Policy, PolicyKind};
@@ -239,6 +240,18 @@ where
             current: None,
             stats: AgentStats::default(),
         })
+    }
+
+    /// Generalises over actions from now on: the learner's action values are
+    /// tile-coded with these widths, one per action dimension
+    /// ([`crate::action_tiles`]; the paper's LEO learner uses 6.67 V). Call
+    /// it before learning: weights learned without it mean something else.
+    ///
+    /// Errors: those of [`TileCoder::with_action_tiles`]; the agent is
+    /// unchanged then.
+    pub fn generalise_actions(&mut self, widths: &[f32]) -> Result<(), ConfigError> {
+        self.coder = self.coder.clone().with_action_tiles(self.policy.learner_space(), widths)?;
+        Ok(())
     }
 
     /// Sets every weight from `params.init` (draws from `rng` if uniform).
@@ -463,11 +476,56 @@ where
         space: &ActionSpace,
         rng: &mut R,
     ) -> Levels {
+        if let Some(at) = self.coder.action_tiles() {
+            // Fewer combinations than candidates: load each combination's
+            // weight once per tiling. Same sums, same order, same ties.
+            if at.combos() < candidates.count() {
+                return self.greedy_tiled(code, candidates, at, rng);
+            }
+        }
         let mut best = candidates.lo;
         let mut best_sum = i64::MIN;
         let mut ties = 0u32;
         candidates.for_each(|levels| {
             let sum = self.q_sum(code, space.encode(levels));
+            if sum > best_sum {
+                best_sum = sum;
+                best = *levels;
+                ties = 1;
+            } else if sum == best_sum {
+                ties += 1;
+                if uniform_below(rng, ties) == 0 {
+                    best = *levels;
+                }
+            }
+        });
+        best
+    }
+
+    /// [`greedy`](Self::greedy) with action tiles: a table of the
+    /// `TILINGS × combos` active weights, then 16 table reads per candidate.
+    fn greedy_tiled<R: RngCore + ?Sized>(
+        &self,
+        code: &StateCode<TILINGS>,
+        candidates: &Candidates,
+        at: &ActionTiles<TILINGS>,
+        rng: &mut R,
+    ) -> Levels {
+        let w = self.weights.as_ref();
+        let mut table = [[0i32; MAX_ACTION_COMBOS]; TILINGS];
+        for (j, row) in table.iter_mut().enumerate() {
+            for (c, slot) in row.iter_mut().enumerate().take(at.combos() as usize) {
+                *slot = w[self.coder.combo_feature(code, j, c as u32) as usize].0;
+            }
+        }
+        let mut best = candidates.lo;
+        let mut best_sum = i64::MIN;
+        let mut ties = 0u32;
+        candidates.for_each(|levels| {
+            let mut sum = 0i64;
+            for (j, row) in table.iter().enumerate() {
+                sum += row[at.combo(j, levels) as usize] as i64;
+            }
             if sum > best_sum {
                 best_sum = sum;
                 best = *levels;

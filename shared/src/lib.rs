@@ -8,6 +8,8 @@
 //! - [`tile_coding`]: state → integer tile coordinates → feature indices
 //!   (hashed or exact layout);
 //! - [`action_space`]: discrete multi-dimensional actions and joint indices;
+//! - [`action_tiles`]: optional generalisation over actions (their values
+//!   tile-coded, as the paper's LEO learner does);
 //! - [`policy`]: the six action policies of Section V (SARSA, low-pass,
 //!   Markov low-pass, integrator, Markov integrator, PADA) as one concept;
 //! - [`trace`]: bounded eligibility traces;
@@ -36,6 +38,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod action_space;
+pub mod action_tiles;
 pub mod agent;
 pub mod checkpoint;
 pub mod dynamixel;

@@ -24,9 +24,14 @@
 //! allowed. [`Layout::Exact`]: every (tiling, tile, action) has its own
 //! weight; for small problems whose tile count fits the table.
 //!
-//! Actions are not generalised over: the joint action index is one more
-//! integer coordinate.
+//! By default actions are not generalised over: the joint action index is
+//! one more integer word of the hash. With
+//! [`TileCoder::with_action_tiles`] (hashed layout) the actions' values are
+//! tile-coded too and the word is the action's tile combination
+//! ([`crate::action_tiles`]), as the paper's LEO learner does.
 
+use crate::action_space::ActionSpace;
+use crate::action_tiles::ActionTiles;
 use crate::error::ConfigError;
 use crate::fixed::floor_i32;
 use heapless::Vec;
@@ -149,6 +154,8 @@ pub struct TileCoder<const TILINGS: usize> {
     table_size: u32,
     /// Tiles per tiling in the exact layout (0 when hashed).
     tiles_per_tiling: u32,
+    /// The action tiling, when actions are generalised over.
+    action_tiles: Option<ActionTiles<TILINGS>>,
 }
 
 impl<const TILINGS: usize> TileCoder<TILINGS> {
@@ -228,7 +235,40 @@ impl<const TILINGS: usize> TileCoder<TILINGS> {
                 tiles_per_tiling = stride as u32;
             }
         }
-        Ok(TileCoder { dims: prepared, layout, actions, table_size: table_size as u32, tiles_per_tiling })
+        Ok(TileCoder { dims: prepared, layout, actions, table_size: table_size as u32, tiles_per_tiling, action_tiles: None })
+    }
+
+    /// The same coder, generalising over actions: the values of `space`
+    /// (whose joint actions are this coder's actions) are tile-coded with
+    /// one tile width per action dimension ([`crate::action_tiles`]).
+    ///
+    /// Errors: the exact layout (action tiles are hashed only); a space with
+    /// another number of joint actions; the errors of [`ActionTiles::new`].
+    pub fn with_action_tiles(mut self, space: &ActionSpace, widths: &[f32]) -> Result<Self, ConfigError> {
+        if self.layout != Layout::Hashed {
+            return Err(ConfigError::new("layout", 0.0, "the hashed layout when actions are tile-coded"));
+        }
+        if space.joint_count() != self.actions {
+            return Err(ConfigError::new(
+                "actions",
+                space.joint_count() as f32,
+                "the coder's number of joint actions",
+            ));
+        }
+        self.action_tiles = Some(ActionTiles::new(space, widths, self.dims.len())?);
+        Ok(self)
+    }
+
+    /// The action tiling, if actions are generalised over.
+    pub fn action_tiles(&self) -> Option<&ActionTiles<TILINGS>> {
+        self.action_tiles.as_ref()
+    }
+
+    /// The weight index of action-tile combination `combo` in `tiling`
+    /// (only meaningful with [`with_action_tiles`](Self::with_action_tiles)).
+    #[inline]
+    pub fn combo_feature(&self, code: &StateCode<TILINGS>, tiling: usize, combo: u32) -> u32 {
+        murmur_finish(murmur_mix(code.per_tiling[tiling], combo)) & (self.table_size - 1)
     }
 
     /// Number of state dimensions.
@@ -314,7 +354,13 @@ impl<const TILINGS: usize> TileCoder<TILINGS> {
     #[inline]
     pub fn feature(&self, code: &StateCode<TILINGS>, tiling: usize, action: u32) -> u32 {
         match self.layout {
-            Layout::Hashed => murmur_finish(murmur_mix(code.per_tiling[tiling], action)) & (self.table_size - 1),
+            Layout::Hashed => {
+                let word = match &self.action_tiles {
+                    Some(at) => at.combo_of_action(tiling, action),
+                    None => action,
+                };
+                murmur_finish(murmur_mix(code.per_tiling[tiling], word)) & (self.table_size - 1)
+            }
             Layout::Exact => code.per_tiling[tiling] + action,
         }
     }
@@ -333,7 +379,7 @@ impl<const TILINGS: usize> TileCoder<TILINGS> {
 /// dimension `i`: `c = q − ((q − b) mod T)` with `b = j·(2i + 1)`, wrapped
 /// modulo `period` when the dimension wraps.
 #[inline]
-fn tile_start(q: i32, j: i32, i: i32, t: i32, period: i32) -> i32 {
+pub(crate) fn tile_start(q: i32, j: i32, i: i32, t: i32, period: i32) -> i32 {
     let b = j * (2 * i + 1);
     let c = q - (q - b).rem_euclid(t);
     if period > 0 {

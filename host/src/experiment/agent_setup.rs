@@ -45,7 +45,7 @@ pub fn build_agent(spec: &TaskSpec, policy: PolicyKind) -> anyhow::Result<HostAg
         }
     };
     let weights = vec![Q16::ZERO; size].into_boxed_slice();
-    Agent::new(
+    let mut agent = Agent::new(
         &spec.state,
         spec.motor.clone(),
         policy,
@@ -53,5 +53,9 @@ pub fn build_agent(spec: &TaskSpec, policy: PolicyKind) -> anyhow::Result<HostAg
         layout,
         weights,
     )
-    .map_err(err)
+    .map_err(err)?;
+    if let Some(widths) = &spec.action_tiles {
+        agent.generalise_actions(widths).map_err(err)?;
+    }
+    Ok(agent)
 }

@@ -7,6 +7,8 @@
 //! - State: the 10-D mirrored observation of §3.4 with GRL's tile widths
 //!   (`cfg/leosim/sarsa.yaml`, §3.9): angles 0.28 rad (torso 0.14 rad),
 //!   rates 10 rad/s (torso 5 rad/s); 16 tilings.
+//! - Actions tile-coded too (6.67 V tiles, [`LEO_ACTION_TILE_WIDTH`]), as
+//!   GRL's LEO learner generalises over actions.
 //! - Weight table: hashed, 2^22 weights (16 MiB of Q16.16 per agent); see
 //!   [`LEO_TABLE_LOG2`].
 //! - Learning parameters: GRL's LEO values per 30 Hz step, γ 0.9962
@@ -30,6 +32,11 @@ use rand_core::RngCore;
 /// 3600 s run (108 000 steps × 16 tilings) touches far fewer distinct tiles
 /// than the table has slots per action.
 pub const LEO_TABLE_LOG2: u32 = 22;
+/// Tile width of each learned voltage \[V\]: GRL generalises over actions
+/// (`generalizeActions` true, voltage scale 0.15 ↔ tile width 6.67 V,
+/// grl-facts §3.9), so neighbouring voltage levels (3.57 V apart) share
+/// about half their tiles and 343 joint actions learn like far fewer.
+pub const LEO_ACTION_TILE_WIDTH: f32 = 6.67;
 /// Voltage limit of the learned actions \[V\] (grl-facts §2.2: 10.69 V).
 pub const LEO_VOLTAGE: f32 = 10.7;
 /// Voltage levels per learned joint (§3.9).
@@ -95,6 +102,7 @@ impl LeoTask {
             state: leo_state_dims(),
             motor: ActionSpace::new(&[level.clone(), level.clone(), level]).expect("valid action space"),
             table: WeightTable::Hashed { log2_size: LEO_TABLE_LOG2 },
+            action_tiles: Some(vec![LEO_ACTION_TILE_WIDTH; ACTION_DIM]),
             params,
             test_interval: 10,
             default_seconds: 14_666.0,

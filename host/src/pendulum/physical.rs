@@ -193,6 +193,7 @@ impl PhysicalPendulumTask {
             motor: ActionSpace::new(&[ActionDim::from_levels(&[-v, 0.0, v]).expect("valid levels")])
                 .expect("valid action space"),
             table: WeightTable::Exact,
+            action_tiles: None,
             params: SarsaParams { init: WeightInit::Uniform { min: 0.0, max: 1.0 }, ..SarsaParams::default() },
             test_interval: 10,
             default_seconds: 1500.0,

@@ -192,6 +192,7 @@ impl SimulatedPendulumTask {
             motor: ActionSpace::new(&[ActionDim::from_levels(&[-limit, 0.0, limit]).expect("valid levels")])
                 .expect("valid action space"),
             table: WeightTable::Exact,
+            action_tiles: None,
             params: SarsaParams { init: WeightInit::Uniform { min: 0.0, max: 1.0 }, ..SarsaParams::default() },
             test_interval: 10,
             default_seconds: 3000.0,
