@@ -33,7 +33,7 @@ pub fn run(args: PaperArgs) -> Result<(), CliError> {
     )?;
     set_threads(args.trial.threads)?;
     let bar = steps_bar(leo::expected_steps(&o), "Section VIII (LEO)");
-    let r = leo::run(&o, &|n| bar.inc(n))?;
+    let (r, best) = leo::run(&o, &|n| bar.inc(n))?;
     bar.finish_and_clear();
     let command = format!(
         "pada paper leo --trials {} --seconds {} --seed {}",
@@ -48,8 +48,23 @@ pub fn run(args: PaperArgs) -> Result<(), CliError> {
         ),
     ])?;
     draw(&r, &out)?;
+    // The gait of the best learner of the whole run: its weights and 10 s
+    // of its greedy policy as a strip, an animation and CSV.
+    if let Some(mut b) = best {
+        let policy = r.configs[b.config].policy;
+        let spec = crate::task::Task::spec(&crate::leo::rl::LeoTask::default()).clone();
+        crate::weights::save(&out.path().join("best.weights"), &spec, policy, b.switched, &b.agent)?;
+        let (frames, fell) = super::render::record_agent(&mut b.agent, 10.0)?;
+        let source = format!("{}, trial {} (best end performance)", name(&r, b.config), b.trial);
+        let title = super::render::gait_title(&source, &frames, fell);
+        out.write_all(&super::render::gait_files(&frames, 12, &title)?)?;
+        println!("{title}");
+    }
     println!("{report}");
-    println!("wrote {}/report.md and the figures", out.path().display());
+    println!(
+        "wrote {}/report.md, the figures, best.weights and the gait (gait.svg/png, gait-animation.svg)",
+        out.path().display()
+    );
     Ok(())
 }
 

@@ -3,6 +3,7 @@
 //! `pada run --task leo --save-weights FILE`.
 
 use crate::cli::RenderArgs;
+use crate::experiment::HostAgent;
 use crate::error::{usage, CliError};
 use crate::leo::constants::*;
 use crate::leo::model::Body;
@@ -51,8 +52,15 @@ pub fn stick_figure(plant: &LeoPlant) -> Vec<([f32; 2], [f32; 2])> {
 /// records every control step.
 pub fn record(args: &RenderArgs) -> anyhow::Result<(Vec<Frame>, bool)> {
     let task = LeoTask::default();
+    let (_, mut agent) = crate::weights::load(&args.policy, task.spec())?;
+    record_agent(&mut agent, args.seconds)
+}
+
+/// Runs `agent`'s greedy policy on a fresh LEO for up to `seconds` (or
+/// until it falls) and records every control step.
+pub fn record_agent(agent: &mut HostAgent, seconds: f64) -> anyhow::Result<(Vec<Frame>, bool)> {
+    let task = LeoTask::default();
     let spec = task.spec();
-    let (_, mut agent) = crate::weights::load(&args.policy, spec)?;
     agent.set_mode(Mode::Testing);
     let mut plant = task.plant();
     let mut rng = rand_pcg::Pcg64::seed_from_u64(1);
@@ -61,7 +69,7 @@ pub fn record(args: &RenderArgs) -> anyhow::Result<(Vec<Frame>, bool)> {
     let err = |e: pada_core::error::StepError| anyhow::anyhow!("{e}");
     let mut d = agent.start_episode(&obs, &mut rng).map_err(err)?;
     let period = spec.control_period_s;
-    let steps = ((args.seconds / period).round() as u32).max(1);
+    let steps = ((seconds / period).round() as u32).max(1);
     let frame = |plant: &LeoPlant, k: u32| {
         let segments = stick_figure(plant);
         Frame {
@@ -126,12 +134,7 @@ pub fn strip_svg(frames: &[Frame], n: usize, title: &str) -> anyhow::Result<Stri
                 )))
                 .map_err(plot_err)?;
             for (i, (a, b)) in f.segments.iter().enumerate() {
-                // Torso and arm dark, left leg blue, right leg red.
-                let c = match i {
-                    0 | 1 => RGBColor(40, 40, 40),
-                    2..=4 => RGBColor(30, 90, 200),
-                    _ => RGBColor(200, 50, 40),
-                };
+                let c = segment_colour(i);
                 chart
                     .draw_series(std::iter::once(PathElement::new(
                         vec![(a[0], a[1]), (b[0], b[1])],
@@ -144,6 +147,107 @@ pub fn strip_svg(frames: &[Frame], n: usize, title: &str) -> anyhow::Result<Stri
             .map_err(|e| anyhow::anyhow!("drawing SVG: {e}"))?;
     }
     Ok(svg)
+}
+
+/// Colour of segment `i` of [`stick_figure`]: torso and arm dark, left
+/// leg blue, right leg red.
+fn segment_colour(i: usize) -> RGBColor {
+    match i {
+        0 | 1 => RGBColor(40, 40, 40),
+        2..=4 => RGBColor(30, 90, 200),
+        _ => RGBColor(200, 50, 40),
+    }
+}
+
+/// Every frame as an animated SVG that plays in real time and loops: one
+/// group per frame, shown during its control period by a discrete SMIL
+/// `visibility` animation. The view follows the hip; ground ticks every
+/// 0.1 m show the motion. Written by hand because plotters draws still
+/// images only.
+pub fn animated_svg(frames: &[Frame], period: f64, title: &str) -> String {
+    use std::fmt::Write as _;
+    let (w, h, scale) = (480.0f32, 360.0f32, 600.0f32); // px, px, px per m
+    let ground_y = h - 30.0;
+    let n = frames.len().max(1);
+    let dur = n as f64 * period;
+    let mut svg = String::new();
+    let _ = write!(
+        svg,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" viewBox=\"0 0 {w} {h}\">\n\
+         <rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n\
+         <text x=\"8\" y=\"20\" font-family=\"sans-serif\" font-size=\"14\">{}</text>\n",
+        xml_escape(title)
+    );
+    for (i, f) in frames.iter().enumerate() {
+        let cx = f.hip_x;
+        let px = |p: [f32; 2]| (w / 2.0 + (p[0] - cx) * scale, ground_y - p[1] * scale);
+        let _ = write!(svg, "<g visibility=\"hidden\">");
+        let (t0, t1) = (i as f64 / n as f64, (i + 1) as f64 / n as f64);
+        let _ = write!(
+            svg,
+            "<animate attributeName=\"visibility\" calcMode=\"discrete\" values=\"hidden;visible;hidden\" \
+             keyTimes=\"0;{t0:.6};{t1:.6}\" dur=\"{dur:.3}s\" repeatCount=\"indefinite\"/>"
+        );
+        let _ = write!(svg, "<line x1=\"0\" y1=\"{ground_y}\" x2=\"{w}\" y2=\"{ground_y}\" stroke=\"black\"/>");
+        let first = ((cx - w / 2.0 / scale) / 0.1).floor() as i32;
+        for k in first..=first + (w / scale / 0.1) as i32 + 1 {
+            let (x, _) = px([k as f32 * 0.1, 0.0]);
+            let _ = write!(svg, "<line x1=\"{x:.1}\" y1=\"{ground_y}\" x2=\"{x:.1}\" y2=\"{:.1}\" stroke=\"gray\"/>", ground_y + 8.0);
+        }
+        for (j, (a, b)) in f.segments.iter().enumerate() {
+            let ((x1, y1), (x2, y2)) = (px(*a), px(*b));
+            let c = segment_colour(j);
+            let _ = write!(
+                svg,
+                "<line x1=\"{x1:.1}\" y1=\"{y1:.1}\" x2=\"{x2:.1}\" y2=\"{y2:.1}\" stroke=\"rgb({},{},{})\" stroke-width=\"5\" stroke-linecap=\"round\"/>",
+                c.0, c.1, c.2
+            );
+        }
+        let _ = write!(
+            svg,
+            "<text x=\"8\" y=\"40\" font-family=\"sans-serif\" font-size=\"12\">t = {:.2} s, walked {:.2} m</text></g>\n",
+            f.time, f.walked
+        );
+    }
+    svg.push_str("</svg>\n");
+    svg
+}
+
+fn xml_escape(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+}
+
+/// The gait's files: `gait.svg` and `gait.png` (a strip of `strip_frames`
+/// frames), `gait-animation.svg` (every control step, looping) and
+/// `gait.csv` (time, hip x, walked distance per step).
+pub fn gait_files(
+    frames: &[Frame],
+    strip_frames: usize,
+    title: &str,
+) -> anyhow::Result<Vec<(String, Vec<u8>)>> {
+    let svg = strip_svg(frames, strip_frames, title)?;
+    let png = svg_to_png(&svg)?;
+    let period = LeoTask::default().spec().control_period_s;
+    let animation = animated_svg(frames, period, title);
+    let mut csv = String::from("time_s,hip_x_m,walked_m\n");
+    for f in frames {
+        csv += &format!("{},{},{}\n", f.time, f.hip_x, f.walked);
+    }
+    Ok(vec![
+        ("gait.svg".to_string(), svg.into_bytes()),
+        ("gait.png".to_string(), png),
+        ("gait-animation.svg".to_string(), animation.into_bytes()),
+        ("gait.csv".to_string(), csv.into_bytes()),
+    ])
+}
+
+/// The title line of a recorded gait.
+pub fn gait_title(source: &str, frames: &[Frame], fell: bool) -> String {
+    let (walked, time) = frames.last().map(|f| (f.walked, f.time)).unwrap_or((0.0, 0.0));
+    format!(
+        "LEO, greedy policy of {source}: {walked:.2} m in {time:.2} s{}",
+        if fell { ", fell" } else { "" }
+    )
 }
 
 /// Runs `pada render`.
@@ -162,31 +266,12 @@ pub fn run(args: RenderArgs) -> Result<(), CliError> {
     }
     let out = OutDir::check(&args.out)?;
     let (frames, fell) = record(&args)?;
-    let last = frames.last().expect("at least the first frame");
-    let title = format!(
-        "LEO, greedy policy of {}: {:.2} m in {:.2} s{}",
-        args.policy
-            .file_name()
-            .map(|f| f.to_string_lossy())
-            .unwrap_or_default(),
-        last.walked,
-        last.time,
-        if fell { ", fell" } else { "" }
-    );
-    let svg = strip_svg(&frames, args.frames as usize, &title)?;
-    let png = svg_to_png(&svg)?;
-    let mut csv = String::from("time_s,hip_x_m,walked_m\n");
-    for f in &frames {
-        csv += &format!("{},{},{}\n", f.time, f.hip_x, f.walked);
-    }
-    out.write_all(&[
-        ("gait.svg".to_string(), svg.into_bytes()),
-        ("gait.png".to_string(), png),
-        ("gait.csv".to_string(), csv.into_bytes()),
-    ])?;
+    let source = args.policy.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default();
+    let title = gait_title(&source, &frames, fell);
+    out.write_all(&gait_files(&frames, args.frames as usize, &title)?)?;
     println!("{title}");
     println!(
-        "wrote {}/gait.svg, gait.png, gait.csv",
+        "wrote {}/gait.svg, gait.png, gait-animation.svg, gait.csv",
         out.path().display()
     );
     Ok(())

@@ -8,7 +8,7 @@
 //! each without and with the switch at half the learning time (the paper's
 //! 7,333 s of 14,666 s).
 
-use crate::experiment::{run_configs, RunConfig};
+use crate::experiment::{run_trial_keep, HostAgent, RunConfig, TrialResult};
 use crate::leo::rl::LeoTask;
 use crate::paper::pendulum::{mean_curve, ConfigResult};
 use crate::summary::RunSummary;
@@ -116,12 +116,49 @@ pub fn expected_steps(o: &LeoOptions) -> u64 {
         .sum()
 }
 
-/// Runs Section VIII.
-pub fn run(o: &LeoOptions, progress: &(dyn Fn(u64) + Sync)) -> anyhow::Result<LeoResults> {
+/// The learner of the trial with the best end performance of the whole
+/// experiment, kept to draw its gait.
+pub struct BestTrial {
+    /// Index into [`LeoResults::configs`].
+    pub config: usize,
+    /// Trial index within the configuration.
+    pub trial: u32,
+    /// Its end performance.
+    pub end_performance: f64,
+    /// Whether it had switched back to SARSA(λ).
+    pub switched: bool,
+    /// The learned agent.
+    pub agent: HostAgent,
+}
+
+/// Runs Section VIII: every trial of every configuration in parallel.
+/// Returns the results and the best trial's learner (`None` only when no
+/// trial has a finite end performance).
+pub fn run(o: &LeoOptions, progress: &(dyn Fn(u64) + Sync)) -> anyhow::Result<(LeoResults, Option<BestTrial>)> {
+    use rayon::prelude::*;
     let start = std::time::Instant::now();
     let task = LeoTask::default();
     let cfgs = run_configs_of(o);
-    let results = run_configs(&task, &cfgs, progress)?;
+    let jobs: Vec<(usize, u32)> =
+        cfgs.iter().enumerate().flat_map(|(c, cfg)| (0..cfg.trials).map(move |t| (c, t))).collect();
+    // Only the best learner so far is kept (16 MiB each), not all of them.
+    let best: std::sync::Mutex<Option<BestTrial>> = std::sync::Mutex::new(None);
+    let flat: Vec<TrialResult> = jobs
+        .par_iter()
+        .map(|&(c, t)| {
+            let (r, agent, switched) = run_trial_keep(&task, &cfgs[c], t, progress)?;
+            let e = r.end_performance;
+            let mut b = best.lock().unwrap_or_else(|p| p.into_inner());
+            if e.is_finite() && b.as_ref().is_none_or(|b| e > b.end_performance) {
+                *b = Some(BestTrial { config: c, trial: t, end_performance: e, switched, agent });
+            }
+            Ok(r)
+        })
+        .collect::<anyhow::Result<_>>()?;
+    let mut results: Vec<Vec<TrialResult>> = cfgs.iter().map(|_| Vec::new()).collect();
+    for (&(c, _), r) in jobs.iter().zip(flat) {
+        results[c].push(r);
+    }
     let wall_s = start.elapsed().as_secs_f64();
     let configs: Vec<ConfigResult> = cfgs
         .iter()
@@ -133,12 +170,13 @@ pub fn run(o: &LeoOptions, progress: &(dyn Fn(u64) + Sync)) -> anyhow::Result<Le
         })
         .collect();
     let env_steps = configs.iter().map(|c| c.summary.env_steps).sum();
-    Ok(LeoResults {
+    let results = LeoResults {
         options: *o,
         switched: cfgs.iter().map(|c| c.switch_at_s.is_some()).collect(),
         configs,
         wall_s,
         env_steps,
         threads: rayon::current_num_threads(),
-    })
+    };
+    Ok((results, best.into_inner().unwrap_or_else(|p| p.into_inner())))
 }
