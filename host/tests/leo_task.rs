@@ -68,12 +68,40 @@ fn run_task_leo_json_end_to_end_then_render() {
         "4",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    for f in ["gait.svg", "gait.png", "gait.csv"] {
+    for f in ["gait.svg", "gait.png", "gait.csv", "gait-animation.svg"] {
         let len = std::fs::metadata(r.join(f)).unwrap().len();
         assert!(len > 100, "{f}: {len} bytes");
     }
     let png = std::fs::read(r.join("gait.png")).unwrap();
     assert_eq!(&png[1..4], b"PNG");
+    // The animation: one group per recorded step (the CSV's rows), each
+    // shown in its own slice of one loop, in order.
+    let csv_rows = std::fs::read_to_string(r.join("gait.csv")).unwrap().lines().count() - 1;
+    let anim = std::fs::read_to_string(r.join("gait-animation.svg")).unwrap();
+    assert_eq!(anim.matches("<g visibility=\"hidden\">").count(), csv_rows);
+    let starts: Vec<f64> = anim
+        .split("keyTimes=\"0;")
+        .skip(1)
+        .map(|t| t.split(';').next().unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(starts.len(), csv_rows);
+    assert!(starts.windows(2).all(|w| w[0] < w[1] && w[1] < 1.0), "{starts:?}");
+}
+
+#[test]
+fn render_refuses_a_weights_file_of_another_task() {
+    // A pendulum agent's weights are not LEO's: refused, naming the field.
+    let dir = tempfile::tempdir().unwrap();
+    let w = dir.path().join("pendulum.pdw");
+    let o = pada(&[
+        "run", "--task", "pendulum", "--algo", "sarsa", "--trials", "1", "--seconds", "6",
+        "--out", dir.path().join("run").to_str().unwrap(), "--save-weights", w.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = pada(&["render", "--policy", w.to_str().unwrap(), "--out", dir.path().join("r").to_str().unwrap()]);
+    assert!(!o.status.success());
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("another configuration") && e.contains("task"), "{e}");
 }
 
 #[test]
