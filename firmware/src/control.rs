@@ -377,11 +377,12 @@ where
         Ok(())
     }
 
-    /// Restores a checked state (see [`check_learner_state`](Self::check_learner_state)).
-    /// The agent's episode ends (traces are not saved); the next Start
-    /// brings the robot to its start and begins a new one.
+    /// Restores a state that passed [`check_learner_state`](Self::check_learner_state)
+    /// (the caller's to call first: each part below checks itself again, but
+    /// only the whole check makes the restore all or nothing). The agent's
+    /// episode ends (traces are not saved); the next Start brings the robot
+    /// to its start and begins a new one.
     fn restore_learner_state(&mut self, state: &LearnerState) -> Result<(), ConfigError> {
-        self.check_learner_state(state)?;
         let rng = Pcg32::from_state(state.rng)?;
         self.fatigue.restore(&state.joints).map_err(fatigue_error)?;
         let agent = self.agent_mut();
