@@ -1272,7 +1272,8 @@ mod tests {
         // apart.)
         let params = Robot::Pendulum33.params();
         assert_eq!(config::config_hash(Robot::Pendulum33, PolicyKind::Integrator { delta: 0.5 }, &params), Ok(c.config_hash()));
-        let cases: [(&str, fn(&mut LearnerState)); 6] = [
+        type Change = fn(&mut LearnerState);
+        let cases: [(&str, Change); 6] = [
             ("epsilon", |s| s.agent.epsilon = 2.0),
             ("policy.kind", |s| s.agent.policy.kind = PolicyKind::Integrator { delta: 0.5 }),
             ("joints", |s| {
