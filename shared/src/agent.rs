@@ -16,6 +16,11 @@
 //!
 //! Floats enter only as observations and rewards, checked for finiteness
 //! before anything changes: a NaN state is an error that changes no weight.
+//!
+//! What the agent carries between episodes besides its weights — counters,
+//! ε, mode, the policy's state — is plain data ([`AgentState`]): a
+//! checkpoint saves it ([`crate::checkpoint`]) and
+//! [`Agent::restore_state`] puts it back after [`Agent::check_state`].
 
 use crate::action_space::{ActionSpace, Levels, Output, MAX_ACTION_DIMS};
 use crate::error::{check_range, ConfigError, StepError};

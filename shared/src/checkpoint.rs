@@ -87,6 +87,7 @@
 //! CRC-32 is CRC-32/ISO-HDLC (the zlib/Ethernet CRC) from the `crc` crate,
 //! one 1 KB table in flash, shared with the telemetry frames.
 
+use crate::action_space::MAX_ACTION_DIMS;
 use crate::agent::{AgentState, AgentStats, Mode};
 use crate::error::ConfigError;
 use crate::fatigue::JointFatigueState;
@@ -152,6 +153,9 @@ mod at {
 }
 
 const _: () = assert!(at::FATIGUE + MAX_JOINTS * at::JOINT_LEN == STATE_LEN);
+// The record has four action dimensions: previous levels and outputs.
+const _: () = assert!(MAX_ACTION_DIMS == 4 && at::PREVIOUS + MAX_ACTION_DIMS <= at::RESERVED_A);
+const _: () = assert!(at::OUTPUT + 4 * MAX_ACTION_DIMS == at::EPSILON);
 const _: () = assert!(STATE_LEN % 4 == 0);
 const _: () = assert!(at::USER + 4 * USER_COUNTERS == at::FATIGUE);
 
@@ -290,7 +294,12 @@ impl Default for LearnerState {
                 stats: AgentStats::default(),
                 epsilon: 0.0,
                 mode: Mode::Learning,
-                policy: PolicyState { kind: PolicyKind::Sarsa, switched: false, previous: [0; 4], output: [0.0; 4] },
+                policy: PolicyState {
+                    kind: PolicyKind::Sarsa,
+                    switched: false,
+                    previous: [0; MAX_ACTION_DIMS],
+                    output: [0.0; MAX_ACTION_DIMS],
+                },
             },
             rng: RngState::default(),
             joints: Vec::new(),
@@ -407,8 +416,8 @@ impl LearnerState {
         if !r.zero(at::RESERVED_A, 2) || !r.zero(at::RESERVED_B, 4) {
             return Err(ConfigError::new("state.reserved", 0.0, "reserved bytes 0"));
         }
-        let mut previous = [0u8; 4];
-        previous.copy_from_slice(&bytes[at::PREVIOUS..at::PREVIOUS + 4]);
+        let mut previous = [0u8; MAX_ACTION_DIMS];
+        previous.copy_from_slice(&bytes[at::PREVIOUS..at::PREVIOUS + MAX_ACTION_DIMS]);
         let output = core::array::from_fn(|i| r.f32(at::OUTPUT + 4 * i));
         let stats = AgentStats {
             steps: r.u64(at::STEPS),
