@@ -412,9 +412,10 @@ mod tests {
 
     #[test]
     fn same_seed_same_weights_as_the_host_would_draw() {
-        // The host uses rand_pcg::Pcg32::seed_from_u64 as well.
-        let build = || {
-            let mut rng = rand_pcg::Pcg32::seed_from_u64(DEFAULT_SEED);
+        // The firmware draws from pada_core's Pcg32, the host from
+        // rand_pcg::Pcg32::seed_from_u64: the same weights (uniform
+        // initialisation, so every weight is a draw).
+        fn build<R: rand_core::RngCore>(rng: &mut R) -> u32 {
             let mut agent = FirmwareAgent::new(
                 &Robot::Pendulum33.state_dims(),
                 Robot::Pendulum33.action_space(),
@@ -424,9 +425,12 @@ mod tests {
                 vec![Q16::ZERO; WEIGHTS].into_boxed_slice(),
             )
             .unwrap();
-            agent.reset_weights(&mut rng);
+            agent.reset_weights(rng);
             agent.weights_checksum()
-        };
-        assert_eq!(build(), build());
+        }
+        let firmware = build(&mut pada_core::rng::Pcg32::seed_from_u64(DEFAULT_SEED));
+        let host = build(&mut rand_pcg::Pcg32::seed_from_u64(DEFAULT_SEED));
+        assert_eq!(firmware, host);
+        assert_ne!(firmware, build(&mut rand_pcg::Pcg32::seed_from_u64(DEFAULT_SEED + 1)));
     }
 }

@@ -21,10 +21,20 @@
 //!    observation, reward, action, TD error), the finished episode, state
 //!    changes and faults.
 //!
-//! Randomness: the agent's generator ([`rand_pcg::Pcg32`] from a seed) is
-//! used by the agent only — weight initialisation and action choice — so a
-//! host build of the same agent, fed the reported observations and rewards,
-//! draws the same numbers and takes the same actions.
+//! Randomness: the agent's generator ([`pada_core::rng::Pcg32`] from a
+//! seed, output-identical to the host's `rand_pcg::Pcg32`) is used by the
+//! agent only — weight initialisation and action choice — so a host build of
+//! the same agent, fed the reported observations and rewards, draws the same
+//! numbers and takes the same actions.
+//!
+//! Saved learning: [`Controller::save_checkpoint`] writes the weights and
+//! the learner's state — the agent's counters, ε, mode and policy, the
+//! fatigue counter of every servo, the generator, the episode counters — and
+//! [`Controller::load_checkpoint`] (at boot and on the host's command)
+//! restores them when the configuration matches and every field is in range
+//! for the running learner, so that a board that resets continues where it
+//! was. Anything else is refused and counted
+//! ([`Controller::checkpoints_refused`]), and the learner stays as it was.
 
 use crate::bus::BusConfig;
 use crate::config::{self, FirmwareAgent, Robot, RobotConfig, MAX_OBS, MAX_SERVOS};
@@ -35,15 +45,16 @@ use crate::pendulum::Pendulum;
 use crate::servo::estimated_torque;
 use heapless::Vec;
 use pada_core::agent::{Decision, EpisodeEnd, Mode};
+use pada_core::checkpoint::{self, CheckpointStore, LearnerState, LoadOutcome, SaveError, Saved};
 use pada_core::dynamixel::{table::PresentState, ErrorFlags};
 use pada_core::error::ConfigError;
-use pada_core::fatigue::{FatigueCounter, GearboxParams, PAPER_WINDOW_STEPS};
+use pada_core::fatigue::{FatigueCounter, FatigueError, GearboxParams, PAPER_WINDOW_STEPS};
 use pada_core::fixed::Q16;
 use pada_core::policy::PolicyKind;
+use pada_core::rng::Pcg32;
 use pada_core::safety::{Command, Event, RunMode, Safety, SafetyConfig, State, Transition};
 use pada_core::wire::{self, NackReason, StepKind};
 use rand_core::SeedableRng;
-use rand_pcg::Pcg32;
 
 /// One servo's part of a period's readings.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -135,6 +146,14 @@ pub fn safety_config(soft_limits: Vec<pada_core::safety::SoftLimit, { pada_core:
     }
 }
 
+/// A fatigue error as a configuration error (same name and range).
+fn fatigue_error(e: FatigueError) -> ConfigError {
+    match e {
+        FatigueError::InvalidParameter { param, value, valid } => ConfigError::new(param, value as f32, valid),
+        _ => ConfigError::new("fatigue", 0.0, "finite torques"),
+    }
+}
+
 /// The control loop's state: agent, safety machine, observer, fatigue.
 pub struct Controller<W> {
     robot: Robot,
@@ -165,6 +184,33 @@ pub struct Controller<W> {
     supply: [Option<f32>; MAX_SERVOS],
     temps: [u8; MAX_SERVOS],
     steps: u32,
+    /// Checkpoints found but not loaded since boot.
+    checkpoints_refused: u32,
+    /// Why the last learner state was refused.
+    last_refusal: Option<ConfigError>,
+}
+
+/// The record has room for every servo's fatigue counter.
+const _: () = assert!(MAX_SERVOS <= checkpoint::MAX_JOINTS);
+
+/// Why a checkpoint operation of the controller failed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CheckpointError<E> {
+    /// Torque is on: checkpoints are saved and loaded only with torque off
+    /// (an erase stalls the CPU; a load replaces the learner).
+    Busy,
+    /// The save failed; the previous checkpoint is intact.
+    Save(SaveError<E>),
+    /// Reading the store failed.
+    Store(E),
+}
+
+/// The user counters of the firmware's learner-state record.
+mod user {
+    /// Episodes started since the first boot (the next episode's index).
+    pub const EPISODES: usize = 0;
+    /// Learning episodes since the last test episode.
+    pub const SINCE_TEST: usize = 1;
 }
 
 impl<W> Controller<W>
@@ -210,6 +256,8 @@ where
             supply: [None; MAX_SERVOS],
             temps: [0; MAX_SERVOS],
             steps: 0,
+            checkpoints_refused: 0,
+            last_refusal: None,
         };
         controller.build(policy, weights)?;
         Ok(controller)
@@ -286,6 +334,158 @@ where
             return None;
         }
         Some(self.agent_mut().weights_mut())
+    }
+
+    /// The learner's state besides its weights, as a checkpoint saves it:
+    /// the agent's ([`pada_core::agent::AgentState`]), the generator, every
+    /// servo's fatigue counter, and the episode counters (user counters 0:
+    /// episodes started, 1: learning episodes since the last test).
+    pub fn learner_state(&self) -> LearnerState {
+        let mut user = [0u32; checkpoint::USER_COUNTERS];
+        user[user::EPISODES] = self.episodes;
+        user[user::SINCE_TEST] = self.since_test;
+        LearnerState {
+            agent: self.agent().state(),
+            rng: self.rng.state(),
+            // Fits: MAX_SERVOS <= MAX_JOINTS (checked at compile time).
+            joints: Vec::from_slice(&self.fatigue.state()).unwrap_or_default(),
+            user,
+        }
+    }
+
+    /// Checks that `state` can be restored into this controller; the error
+    /// names the first field out of range and its valid range: the agent's
+    /// ([`pada_core::agent::Agent::check_state`]), the fatigue counters (one
+    /// per servo, [`FatigueCounter::check_state`]), the generator's
+    /// increment, learning episodes since the last test within the robot's
+    /// test interval, unused user counters 0.
+    pub fn check_learner_state(&self, state: &LearnerState) -> Result<(), ConfigError> {
+        self.agent().check_state(&state.agent)?;
+        self.fatigue.check_state(&state.joints).map_err(fatigue_error)?;
+        state.rng.check()?;
+        let since_test = state.user[user::SINCE_TEST];
+        if since_test > self.config.test_interval {
+            return Err(ConfigError::new(
+                "since_test",
+                since_test as f32,
+                "learning episodes since the last test <= the robot's test interval",
+            ));
+        }
+        if let Some(i) = (user::SINCE_TEST + 1..checkpoint::USER_COUNTERS).find(|&i| state.user[i] != 0) {
+            return Err(ConfigError::new("user", state.user[i] as f32, "0 (unused)").at(i));
+        }
+        Ok(())
+    }
+
+    /// Restores a state that passed [`check_learner_state`](Self::check_learner_state)
+    /// (the caller's to call first: each part below checks itself again, but
+    /// only the whole check makes the restore all or nothing). The agent's
+    /// episode ends (traces are not saved); the next Start brings the robot
+    /// to its start and begins a new one.
+    fn restore_learner_state(&mut self, state: &LearnerState) -> Result<(), ConfigError> {
+        let rng = Pcg32::from_state(state.rng)?;
+        self.fatigue.restore(&state.joints).map_err(fatigue_error)?;
+        let agent = self.agent_mut();
+        agent.restore_state(&state.agent)?;
+        let policy = agent.policy().built_kind();
+        let previous = agent.policy().learner_space().encode(&agent.policy().previous());
+        self.policy = policy;
+        self.rng = rng;
+        self.episodes = state.user[user::EPISODES];
+        self.since_test = state.user[user::SINCE_TEST];
+        self.last_action = previous;
+        self.last_output = [0.0; pada_core::action_space::MAX_ACTION_DIMS];
+        self.episode_return = 0.0;
+        // Torque is off (the callers check): no episode runs.
+        self.phase = Phase::Stopped;
+        Ok(())
+    }
+
+    /// Saves the weights and the learner's state ([`learner_state`](Self::learner_state))
+    /// into `store` (the slot not holding the newest checkpoint); only while
+    /// torque is off.
+    pub fn save_checkpoint<S: CheckpointStore>(&self, store: &mut S) -> Result<Saved, CheckpointError<S::Error>> {
+        if self.torque_enabled() {
+            return Err(CheckpointError::Busy);
+        }
+        let state = self.learner_state();
+        checkpoint::save(store, self.config_hash, &state, self.weights()).map_err(CheckpointError::Save)
+    }
+
+    /// Loads the newest checkpoint of `store` — weights and learner state —
+    /// if it was saved with this configuration and its state passes
+    /// [`check_learner_state`](Self::check_learner_state); only while torque
+    /// is off. Otherwise nothing changes and the outcome says why
+    /// ([`LoadOutcome::InvalidState`] for a refused state:
+    /// [`last_refusal`](Self::last_refusal) names the field); every
+    /// checkpoint found but not loaded counts in
+    /// [`checkpoints_refused`](Self::checkpoints_refused).
+    ///
+    /// If the store fails while the weights are copied, the learner is
+    /// rebuilt fresh from the seed (as after `SetPolicy`), never left half
+    /// loaded.
+    pub fn load_checkpoint<S: CheckpointStore>(&mut self, store: &S) -> Result<LoadOutcome, CheckpointError<S::Error>> {
+        if self.torque_enabled() {
+            return Err(CheckpointError::Busy);
+        }
+        self.last_refusal = None;
+        let weight_count = self.weights().len();
+        let found = match checkpoint::find(store, self.config_hash, weight_count).map_err(CheckpointError::Store)? {
+            Ok(found) => found,
+            Err(outcome) => {
+                if outcome != LoadOutcome::NoCheckpoint {
+                    self.checkpoints_refused = self.checkpoints_refused.saturating_add(1);
+                }
+                return Ok(outcome);
+            }
+        };
+        if let Err(e) = self.check_learner_state(&found.state) {
+            self.checkpoints_refused = self.checkpoints_refused.saturating_add(1);
+            self.last_refusal = Some(e);
+            return Ok(LoadOutcome::InvalidState);
+        }
+        let read = checkpoint::read_weights(store, &found, self.agent_mut().weights_mut());
+        let outcome = match read {
+            Ok(outcome) => outcome,
+            Err(e) => {
+                self.rebuild();
+                return Err(CheckpointError::Store(e));
+            }
+        };
+        if let LoadOutcome::Loaded { .. } = outcome {
+            // Checked above, so this restores.
+            if let Err(e) = self.restore_learner_state(&found.state) {
+                self.last_refusal = Some(e);
+            }
+        } else {
+            self.checkpoints_refused = self.checkpoints_refused.saturating_add(1);
+        }
+        Ok(outcome)
+    }
+
+    /// A fresh learner with the running policy (generator reseeded, weights
+    /// initialised).
+    fn rebuild(&mut self) {
+        if let Some(agent) = self.agent.take() {
+            // The running policy built before, so it builds again.
+            let _ = self.build(self.policy, agent.into_weights());
+        }
+    }
+
+    /// Checkpoints found but not loaded since boot (another configuration
+    /// or size, another format version, corrupt slots, or a learner state
+    /// out of range); an empty store is not counted.
+    pub fn checkpoints_refused(&self) -> u32 {
+        self.checkpoints_refused
+    }
+
+    /// Why the last load's learner state was refused by
+    /// [`check_learner_state`](Self::check_learner_state) (the field and its
+    /// valid range); `None` when the last load refused nothing for that
+    /// reason (an undecodable record is [`LoadOutcome::InvalidState`] with
+    /// `None` here).
+    pub fn last_refusal(&self) -> Option<ConfigError> {
+        self.last_refusal
     }
 
     /// The agent's counters.
@@ -898,7 +1098,8 @@ mod tests {
         assert!(steps.len() > 300);
 
         let robot = Robot::Pendulum33;
-        let mut rng = Pcg32::seed_from_u64(seed);
+        // The host's generator: the firmware's own must draw the same.
+        let mut rng = rand_pcg::Pcg32::seed_from_u64(seed);
         let mut agent = FirmwareAgent::new(
             &robot.state_dims(),
             robot.action_space(),
@@ -927,5 +1128,201 @@ mod tests {
             }
         }
         assert_eq!(agent.weights_checksum(), c.agent().weights_checksum());
+    }
+
+    // -----------------------------------------------------------------------
+    // Saved learning
+    // -----------------------------------------------------------------------
+
+    type Store = pada_core::checkpoint::RamStore<{ checkpoint::slot_len(WEIGHTS) }>;
+
+    /// `periods` periods of the crude pendulum of the replay test, from
+    /// period `k0`; the Step records.
+    fn run_pendulum(c: &mut Controller<Box<[Q16]>>, angle: &mut f32, k0: u32, periods: u32) -> std::vec::Vec<wire::Step> {
+        let clock = Clock(Cell::new(0));
+        let mut out = PeriodOutput::default();
+        let mut steps = std::vec::Vec::new();
+        for k in k0..k0 + periods {
+            let counts = (*angle / (2.0 * PI) * 4096.0).round() as i64;
+            c.period(&pendulum_readings(counts.rem_euclid(65536) as u16, k * 30), &clock, &mut out);
+            if let Some(s) = out.step.take() {
+                steps.push(s);
+            }
+            let u = c.applied[0];
+            *angle += 0.02 * u - 0.05 * libm::sinf(*angle);
+        }
+        steps
+    }
+
+    fn stop(c: &mut Controller<Box<[Q16]>>) {
+        assert_eq!(c.command(&wire::ToChip::Stop).0, Ok(()));
+        let mut out = PeriodOutput::default();
+        c.period(&pendulum_readings(0, 0), &Clock(Cell::new(0)), &mut out);
+        assert!(!out.torque);
+    }
+
+    #[test]
+    fn the_generator_draws_as_the_hosts_rand_pcg() {
+        use rand_core::RngCore;
+        for seed in [0, 1, 11, config::DEFAULT_SEED, u64::MAX] {
+            let mut mine = Pcg32::seed_from_u64(seed);
+            let mut host = rand_pcg::Pcg32::seed_from_u64(seed);
+            for _ in 0..10_000 {
+                assert_eq!(mine.next_u32(), host.next_u32());
+            }
+            assert_eq!(mine.next_u64(), host.next_u64());
+        }
+    }
+
+    #[test]
+    fn a_checkpoint_carries_the_learner_across_a_reset() {
+        let mut store = Store::new();
+        let mut a = Controller::new(Robot::Pendulum33, PolicyKind::Pada { delta: 0.5 }, table(), 11).unwrap();
+        start(&mut a, RunMode::Learning);
+        // Only with torque off.
+        assert_eq!(a.save_checkpoint(&mut store), Err(CheckpointError::Busy));
+        assert_eq!(a.load_checkpoint(&store), Err(CheckpointError::Busy));
+        let mut angle = 0.0;
+        let before = run_pendulum(&mut a, &mut angle, 0, 1500);
+        assert!(before.len() > 300);
+        stop(&mut a);
+        assert!(a.fatigue().joint(0).unwrap().reengagements() > 0);
+        assert_eq!(a.save_checkpoint(&mut store), Ok(Saved { generation: 1, slot: 0 }));
+        let saved = a.learner_state();
+        assert_eq!(saved.user[user::EPISODES], a.episodes);
+        assert!(a.episodes >= 3);
+
+        // The board resets: it boots with SARSA and another seed, and loads.
+        let mut b = Controller::new(Robot::Pendulum33, PolicyKind::Sarsa, table(), 99).unwrap();
+        assert_ne!(b.agent().weights_checksum(), a.agent().weights_checksum());
+        assert_eq!(b.load_checkpoint(&store), Ok(LoadOutcome::Loaded { generation: 1, slot: 0 }));
+        assert_eq!(b.checkpoints_refused(), 0);
+        assert_eq!(b.learner_state(), saved);
+        assert_eq!(b.weights(), a.weights());
+        assert_eq!(b.policy(), PolicyKind::Pada { delta: 0.5 });
+        assert_eq!(b.fatigue().state(), a.fatigue().state());
+
+        // It continues: episode numbers go on, and what it does replays on a
+        // host agent restored from the same checkpoint.
+        start(&mut b, RunMode::Learning);
+        let mut angle = 0.0;
+        let after = run_pendulum(&mut b, &mut angle, 0, 1500);
+        assert!(after.len() > 300);
+        assert_eq!(after[0].kind, StepKind::Start);
+        assert_eq!(after[0].episode, saved.user[user::EPISODES]);
+        assert!(b.agent_stats().steps > saved.agent.stats.steps);
+
+        let mut state = LearnerState::default();
+        let mut weights = table();
+        assert!(matches!(checkpoint::load(&store, b.config_hash(), &mut state, &mut weights), Ok(LoadOutcome::Loaded { .. })));
+        let robot = Robot::Pendulum33;
+        let mut agent =
+            FirmwareAgent::new(&robot.state_dims(), robot.action_space(), PolicyKind::Sarsa, robot.params(), config::LAYOUT, weights)
+                .unwrap();
+        agent.restore_state(&state.agent).unwrap();
+        let mut rng = Pcg32::from_state(state.rng).unwrap();
+        for s in &after {
+            agent.set_mode(if s.mode == RunMode::Testing { Mode::Testing } else { Mode::Learning });
+            match s.kind {
+                StepKind::Start => assert_eq!(agent.start_episode(&s.state, &mut rng).unwrap().action, s.action),
+                StepKind::Step => assert_eq!(agent.step(s.reward, &s.state, &mut rng).unwrap().action, s.action),
+                StepKind::Absorbing => agent.end_episode(s.reward, EpisodeEnd::Absorbing, &mut rng).unwrap(),
+                StepKind::Timeout => agent.end_episode(s.reward, EpisodeEnd::Timeout(&s.state), &mut rng).unwrap(),
+            }
+        }
+        assert_eq!(agent.weights_checksum(), b.agent().weights_checksum());
+
+        // The next save goes to the other slot and carries on the counters.
+        stop(&mut b);
+        assert_eq!(b.save_checkpoint(&mut store), Ok(Saved { generation: 2, slot: 1 }));
+        let mut c = Controller::new(Robot::Pendulum33, PolicyKind::Sarsa, table(), 5).unwrap();
+        assert_eq!(c.load_checkpoint(&store), Ok(LoadOutcome::Loaded { generation: 2, slot: 1 }));
+        assert_eq!(c.learner_state(), b.learner_state());
+    }
+
+    #[test]
+    fn refused_checkpoints_are_counted_and_change_nothing() {
+        let mut c = Controller::new(Robot::Pendulum33, PolicyKind::Sarsa, table(), 3).unwrap();
+        start(&mut c, RunMode::Learning);
+        let mut angle = 0.0;
+        run_pendulum(&mut c, &mut angle, 0, 600);
+        stop(&mut c);
+        let (state, checksum) = (c.learner_state(), c.agent().weights_checksum());
+        let unchanged = |c: &Controller<Box<[Q16]>>| {
+            assert_eq!(c.learner_state(), state);
+            assert_eq!(c.agent().weights_checksum(), checksum);
+        };
+
+        // Nothing there: not a refusal.
+        let mut store = Store::new();
+        assert_eq!(c.load_checkpoint(&store), Ok(LoadOutcome::NoCheckpoint));
+        assert_eq!(c.checkpoints_refused(), 0);
+
+        // Another robot's checkpoint.
+        let leo = Controller::new(Robot::Leo, PolicyKind::Sarsa, table(), 1).unwrap();
+        leo.save_checkpoint(&mut store).unwrap();
+        let expected = LoadOutcome::ConfigMismatch { expected: c.config_hash(), found: leo.config_hash() };
+        assert_eq!(c.load_checkpoint(&store), Ok(expected));
+        assert_eq!(c.checkpoints_refused(), 1);
+        unchanged(&c);
+
+        // The right configuration, a state out of range: refused by name.
+        // (An integrator with Δ = 0.5 has the pendulum's −3/0/+3 V levels,
+        // so the configuration hash matches; the state record tells them
+        // apart.)
+        let params = Robot::Pendulum33.params();
+        assert_eq!(config::config_hash(Robot::Pendulum33, PolicyKind::Integrator { delta: 0.5 }, &params), Ok(c.config_hash()));
+        type Change = fn(&mut LearnerState);
+        let cases: [(&str, Change); 6] = [
+            ("epsilon", |s| s.agent.epsilon = 2.0),
+            ("policy.kind", |s| s.agent.policy.kind = PolicyKind::Integrator { delta: 0.5 }),
+            ("joints", |s| {
+                s.joints.truncate(1);
+            }),
+            ("rng.increment", |s| s.rng.increment = 2),
+            ("since_test", |s| s.user[user::SINCE_TEST] = 11),
+            ("user", |s| s.user[3] = 1),
+        ];
+        for (i, (field, change)) in cases.iter().enumerate() {
+            let mut bad = state.clone();
+            change(&mut bad);
+            let mut store = Store::new();
+            checkpoint::save(&mut store, c.config_hash(), &bad, &vec![Q16(1); WEIGHTS]).unwrap();
+            assert_eq!(c.load_checkpoint(&store), Ok(LoadOutcome::InvalidState), "{field}");
+            assert_eq!(c.last_refusal().map(|e| e.param), Some(*field));
+            assert_eq!(c.checkpoints_refused(), 2 + i as u32);
+            unchanged(&c);
+        }
+
+        // A format-1 checkpoint (weights without the learner's state).
+        let mut store = Store::new();
+        let v1 = checkpoint::Header {
+            version: 1,
+            config_hash: c.config_hash(),
+            weight_count: WEIGHTS as u32,
+            generation: 4,
+            payload_crc: checkpoint::crc32(&[0u8; WEIGHTS * 4]),
+            state_len: 0,
+        };
+        let slot = store.slot_mut(0).unwrap();
+        slot[..checkpoint::HEADER_LEN].copy_from_slice(&v1.to_bytes());
+        slot[checkpoint::HEADER_LEN..checkpoint::HEADER_LEN + WEIGHTS * 4].fill(0);
+        assert_eq!(c.load_checkpoint(&store), Ok(LoadOutcome::UnsupportedVersion { found: 1 }));
+        assert_eq!(c.last_refusal(), None);
+        assert_eq!(c.checkpoints_refused(), 8);
+        unchanged(&c);
+
+        // Garbage.
+        store.slot_mut(0).unwrap().fill(0);
+        assert_eq!(c.load_checkpoint(&store), Ok(LoadOutcome::Corrupt));
+        assert_eq!(c.checkpoints_refused(), 9);
+        unchanged(&c);
+
+        // And a good one still loads.
+        let mut store = Store::new();
+        c.save_checkpoint(&mut store).unwrap();
+        assert!(matches!(c.load_checkpoint(&store), Ok(LoadOutcome::Loaded { .. })));
+        assert_eq!(c.checkpoints_refused(), 9);
+        unchanged(&c);
     }
 }

@@ -2,10 +2,10 @@
 //! RX-28 servos, without breaking the robot while it learns.
 //!
 //! Boot: clocks and pins ([`board`]), the weight table in CCM RAM, the
-//! controller for the robot chosen at build time, the checkpoint from flash
-//! if its configuration matches, a fault if the watchdog reset the chip,
-//! then the tasks of [`tasks`]. Logs go out over RTT (defmt), telemetry
-//! over USART2 (pada_core::wire frames).
+//! controller for the robot chosen at build time, the checkpoint (weights and
+//! learner state) from flash if its configuration matches, a fault if the
+//! watchdog reset the chip, then the tasks of [`tasks`]. Logs go out over
+//! RTT (defmt), telemetry over USART2 (pada_core::wire frames).
 #![no_std]
 #![no_main]
 

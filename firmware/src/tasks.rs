@@ -20,12 +20,12 @@ use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 use embassy_time::{Duration, Instant, Ticker};
 use heapless::Vec;
-use pada_core::checkpoint::{self, LoadOutcome};
+use pada_core::checkpoint::LoadOutcome;
 use pada_core::safety::Transition;
 use pada_core::wire::{self, FrameDecoder, FrameEncoder, NackReason, ToChip, ToHost, MAX_FRAME_LEN};
 use pada_firmware::bus::{BusConfig, BusStats, ServoBus};
 use pada_firmware::config::{WeightTable, MAX_SERVOS};
-use pada_firmware::control::{Controller, PeriodOutput, Readings, ServoRead};
+use pada_firmware::control::{CheckpointError, Controller, PeriodOutput, Readings, ServoRead};
 use pada_firmware::io::{ByteSink, ByteSource, CycleCounter, Sensors};
 use pada_firmware::servo::Joint;
 use pada_firmware::timing::LoopTiming;
@@ -392,14 +392,14 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
                 Err(NackReason::Busy)
             } else {
                 stalled = true;
-                let hash = cl.ctl.config_hash();
-                let result = with_long_watchdog(|| checkpoint::save(&mut cl.flash, hash, cl.ctl.weights())).await;
+                let result = with_long_watchdog(|| cl.ctl.save_checkpoint(&mut cl.flash)).await;
                 match result {
                     Ok(saved) => {
                         info!("checkpoint saved: generation {=u32}, slot {=u8}", saved.generation, saved.slot);
                         send_reliable(ToHost::Checkpoint(wire::CheckpointReport::Saved(saved))).await;
                         Ok(())
                     }
+                    Err(CheckpointError::Busy) => Err(NackReason::Busy),
                     Err(e) => {
                         warn!("checkpoint save failed: {}", defmt::Debug2Format(&e));
                         send_reliable(ToHost::Checkpoint(wire::CheckpointReport::SaveFailed)).await;
@@ -408,22 +408,21 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
                 }
             }
         }
-        ToChip::LoadCheckpoint => {
-            let hash = cl.ctl.config_hash();
-            match cl.ctl.weights_mut() {
-                None => Err(NackReason::Busy),
-                Some(weights) => match checkpoint::load(&cl.flash, hash, weights) {
-                    Ok(outcome) => {
-                        send_reliable(ToHost::Checkpoint(wire::CheckpointReport::Load(outcome))).await;
-                        match outcome {
-                            LoadOutcome::Loaded { .. } => Ok(()),
-                            _ => Err(NackReason::CheckpointFailed),
-                        }
-                    }
-                    Err(_) => Err(NackReason::CheckpointFailed),
-                },
+        ToChip::LoadCheckpoint => match cl.ctl.load_checkpoint(&cl.flash) {
+            Ok(outcome) => {
+                log_load(&cl.ctl, outcome);
+                send_reliable(ToHost::Checkpoint(wire::CheckpointReport::Load(outcome))).await;
+                match outcome {
+                    LoadOutcome::Loaded { .. } => Ok(()),
+                    _ => Err(NackReason::CheckpointFailed),
+                }
             }
-        }
+            Err(CheckpointError::Busy) => Err(NackReason::Busy),
+            Err(e) => {
+                warn!("checkpoint unreadable: {}", defmt::Debug2Format(&e));
+                Err(NackReason::CheckpointFailed)
+            }
+        },
         ToChip::ReadWeights { offset, count } => {
             let total = cl.ctl.weights().len() as u32;
             match offset.checked_add(count) {
@@ -457,20 +456,49 @@ async fn with_long_watchdog<T>(op: impl FnOnce() -> T) -> T {
     result
 }
 
-/// Loads the checkpoint at boot and tells the host what happened.
+/// What a load found, in the log.
+fn log_load(ctl: &Controller<&'static mut WeightTable>, outcome: LoadOutcome) {
+    match outcome {
+        LoadOutcome::Loaded { generation, slot } => {
+            let stats = ctl.agent_stats();
+            info!(
+                "checkpoint loaded: generation {=u32} from slot {=u8}; {=u32} episodes, {=u64} agent steps, policy {}",
+                generation,
+                slot,
+                stats.episodes,
+                stats.steps,
+                ctl.policy()
+            );
+        }
+        LoadOutcome::NoCheckpoint => info!("no checkpoint in flash; fresh learner"),
+        LoadOutcome::InvalidState => match ctl.last_refusal() {
+            Some(e) => warn!(
+                "checkpoint ignored ({=u32} refused since boot): learner state {} out of range, valid is {}",
+                ctl.checkpoints_refused(),
+                e.param,
+                e.valid
+            ),
+            None => warn!("checkpoint ignored ({=u32} refused since boot): learner state unreadable", ctl.checkpoints_refused()),
+        },
+        outcome => warn!("checkpoint ignored ({=u32} refused since boot): {}", ctl.checkpoints_refused(), outcome),
+    }
+}
+
+/// Loads the checkpoint (weights and learner state) at boot and tells the
+/// host what happened: a `Checkpoint` report when loaded, a `Warning` when
+/// one was found but ignored.
 pub async fn boot_checkpoint(ctl: &mut Controller<&'static mut WeightTable>, flash: &FlashStore) {
-    let hash = ctl.config_hash();
-    let Some(weights) = ctl.weights_mut() else { return };
-    match checkpoint::load(flash, hash, weights) {
-        Ok(outcome @ LoadOutcome::Loaded { generation, slot }) => {
-            info!("checkpoint loaded: generation {=u32} from slot {=u8}", generation, slot);
-            send_reliable(ToHost::Checkpoint(wire::CheckpointReport::Load(outcome))).await;
-        }
-        Ok(LoadOutcome::NoCheckpoint) => info!("no checkpoint in flash; fresh weights"),
+    match ctl.load_checkpoint(flash) {
         Ok(outcome) => {
-            warn!("checkpoint ignored: {}", outcome);
-            send_reliable(ToHost::Warning(wire::Warning::CheckpointIgnored(outcome))).await;
+            log_load(ctl, outcome);
+            match outcome {
+                LoadOutcome::Loaded { .. } => {
+                    send_reliable(ToHost::Checkpoint(wire::CheckpointReport::Load(outcome))).await
+                }
+                LoadOutcome::NoCheckpoint => {}
+                _ => send_reliable(ToHost::Warning(wire::Warning::CheckpointIgnored(outcome))).await,
+            }
         }
-        Err(e) => warn!("checkpoint unreadable: {}", e),
+        Err(e) => warn!("checkpoint unreadable: {}", defmt::Debug2Format(&e)),
     }
 }

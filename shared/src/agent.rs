@@ -16,12 +16,17 @@
 //!
 //! Floats enter only as observations and rewards, checked for finiteness
 //! before anything changes: a NaN state is an error that changes no weight.
+//!
+//! What the agent carries between episodes besides its weights — counters,
+//! ε, mode, the policy's state — is plain data ([`AgentState`]): a
+//! checkpoint saves it ([`crate::checkpoint`]) and
+//! [`Agent::restore_state`] puts it back after [`Agent::check_state`].
 
 use crate::action_space::{ActionSpace, Levels, Output, MAX_ACTION_DIMS};
 use crate::action_tiles::{ActionTiles, MAX_ACTION_COMBOS};
 use crate::error::{check_range, ConfigError, StepError};
 use crate::fixed::{Frac, Q16};
-use crate::policy::{uniform_below, Candidates, Policy, PolicyKind};
+use crate::policy::{uniform_below, Candidates, Policy, PolicyKind, PolicyState};
 use crate::tile_coding::{Layout, StateCode, StateDim, TileCoder, MAX_STATE_DIMS};
 use crate::trace::{Trace, TraceKind};
 use heapless::Vec;
@@ -157,6 +162,30 @@ pub struct AgentStats {
     pub trace_drops: u32,
     /// The last TD error δ.
     pub last_td_error: Q16,
+}
+
+/// What an agent carries from one episode to the next, besides its
+/// weights, as plain data: what a checkpoint saves so that a reset board
+/// continues learning where it was ([`Agent::state`],
+/// [`Agent::restore_state`]).
+///
+/// Not in it: the eligibility trace and the pair being played, which live
+/// only within an episode (restoring ends the episode), and what the
+/// configuration fixes (α, γ, λ, the tile coder, the action space).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct AgentState {
+    /// The counters (steps, updates, explorations, episodes, saturations,
+    /// trace drops, last TD error).
+    pub stats: AgentStats,
+    /// The exploration rate ε, `0 ≤ ε ≤ 1`.
+    pub epsilon: f32,
+    /// Learning or testing.
+    pub mode: Mode,
+    /// The policy: its kind with Δ or α, the switch back to SARSA, the
+    /// previous action and the filter's or integrator's memory.
+    pub policy: PolicyState,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -354,6 +383,59 @@ where
     /// (Section VIII).
     pub fn switch_to_sarsa(&mut self) -> Result<(), StepError> {
         self.policy.switch_to_sarsa()
+    }
+
+    /// The agent's state besides its weights, as plain data
+    /// ([`AgentState`]).
+    pub fn state(&self) -> AgentState {
+        AgentState { stats: self.stats(), epsilon: self.params.epsilon, mode: self.mode, policy: self.policy.state() }
+    }
+
+    /// Checks that `state` can be restored into this agent; the error names
+    /// the first field out of range and the valid range:
+    ///
+    /// - `epsilon`: finite, `0 ≤ ε ≤ 1`;
+    /// - `stats.explorations`, `stats.updates`: at most `stats.steps` (each
+    ///   is counted with a decision);
+    /// - the policy ([`Policy::check_state`]): its kind's Δ or α in range
+    ///   ([`PolicyKind::validate`]: `delta`, `lowpass alpha`), a kind whose
+    ///   learner means the same as the running one (`policy.kind`), the
+    ///   switch back only for PADA and the low-pass filter
+    ///   (`policy.switched`), the previous action's level in each dimension
+    ///   below that dimension's number of levels (`policy.previous[i]`), the
+    ///   filter's or integrator's memory inside the motor's range
+    ///   (`policy.output[i]`).
+    pub fn check_state(&self, state: &AgentState) -> Result<(), ConfigError> {
+        check_range("epsilon", state.epsilon, 0.0, 1.0, "0 <= epsilon <= 1")?;
+        let s = &state.stats;
+        if s.explorations > s.steps {
+            return Err(ConfigError::new("stats.explorations", s.explorations as f32, "explorations <= steps"));
+        }
+        if s.updates > s.steps {
+            return Err(ConfigError::new("stats.updates", s.updates as f32, "updates <= steps"));
+        }
+        self.policy.check_state(&state.policy)
+    }
+
+    /// Restores a state taken by [`state`](Self::state) (of this agent or
+    /// of one with the same configuration, e.g. from a checkpoint), after
+    /// [`check_state`](Self::check_state); a refused state changes nothing.
+    ///
+    /// Restoring **ends the current episode**: eligibility traces are not
+    /// saved (they only matter within an episode, and an episode cut by a
+    /// reset cannot be continued anyway), so the trace is cleared and the
+    /// next call must be [`start_episode`](Self::start_episode), which also
+    /// puts the policy back at rest. The weights are not touched here.
+    pub fn restore_state(&mut self, state: &AgentState) -> Result<(), ConfigError> {
+        self.check_state(state)?;
+        self.policy.restore(&state.policy)?;
+        self.set_epsilon(state.epsilon)?;
+        self.mode = state.mode;
+        self.stats = state.stats;
+        self.trace.set_drops(state.stats.trace_drops);
+        self.current = None;
+        self.trace.clear();
+        Ok(())
     }
 
     /// The action policy.

@@ -314,6 +314,27 @@ pub struct Reengagement {
     pub damage: f64,
 }
 
+/// One joint's fatigue counters as plain data ([`JointFatigue::state`],
+/// [`JointFatigue::restore`]): what a checkpoint keeps so that a reset
+/// board goes on counting where it was.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct JointFatigueState {
+    /// Sign of the last non-zero torque: −1, +1, or 0 before the first one.
+    pub last_sign: i8,
+    /// Control steps seen.
+    pub steps: u64,
+    /// Re-engagements so far.
+    pub reengagements: u64,
+    /// Total damage J in Q16.48 units ([`DAMAGE_FRAC_BITS`]).
+    pub damage_raw: u64,
+    /// Re-engagements inside the window (0 without window).
+    pub window_reengagements: u64,
+    /// Window damage in Q16.48 units (0 without window).
+    pub window_damage_raw: u64,
+}
+
 /// Damage over the MTBF window of a joint (part of [`FatigueReport`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -455,6 +476,83 @@ impl JointFatigue {
         self.damage_raw = 0;
         self.window_reengagements = 0;
         self.window_damage_raw = 0;
+    }
+
+    /// The counters as plain data.
+    pub fn state(&self) -> JointFatigueState {
+        JointFatigueState {
+            last_sign: self.last_sign,
+            steps: self.steps,
+            reengagements: self.reengagements,
+            damage_raw: self.damage_raw,
+            window_reengagements: self.window_reengagements,
+            window_damage_raw: self.window_damage_raw,
+        }
+    }
+
+    /// Checks that `state` is one this joint could have reached (with its
+    /// window); the error names the field and its valid range:
+    ///
+    /// - `last_sign` is −1, 0 or +1, and 0 only before any re-engagement;
+    /// - `reengagements ≤ steps − 1` (the first non-zero torque is none);
+    /// - damage only with re-engagements;
+    /// - without a window both window fields are 0; with a window of N
+    ///   steps, `window_reengagements ≤ min(steps, N) − 1` and
+    ///   `≤ reengagements`, and `window_damage_raw ≤ damage_raw`.
+    pub fn check_state(&self, state: &JointFatigueState) -> Result<(), FatigueError> {
+        let s = state;
+        if !(-1..=1).contains(&s.last_sign) {
+            return Err(invalid("last_sign", s.last_sign as f64, "-1, 0 or +1"));
+        }
+        if s.reengagements > s.steps.saturating_sub(1) {
+            return Err(invalid("reengagements", s.reengagements as f64, "reengagements <= steps - 1"));
+        }
+        if s.last_sign == 0 && s.reengagements > 0 {
+            return Err(invalid("last_sign", 0.0, "-1 or +1 once there were re-engagements"));
+        }
+        if s.damage_raw > 0 && s.reengagements == 0 {
+            return Err(invalid("damage_raw", s.damage_raw as f64, "0 without re-engagements"));
+        }
+        match self.window_len {
+            None => {
+                if s.window_reengagements != 0 {
+                    return Err(invalid("window_reengagements", s.window_reengagements as f64, "0 without a window"));
+                }
+                if s.window_damage_raw != 0 {
+                    return Err(invalid("window_damage_raw", s.window_damage_raw as f64, "0 without a window"));
+                }
+            }
+            Some(n) => {
+                let in_window = s.steps.min(n as u64).saturating_sub(1);
+                if s.window_reengagements > in_window.min(s.reengagements) {
+                    return Err(invalid(
+                        "window_reengagements",
+                        s.window_reengagements as f64,
+                        "window_reengagements <= min(steps, window) - 1 and <= reengagements",
+                    ));
+                }
+                if s.window_damage_raw > s.damage_raw {
+                    return Err(invalid("window_damage_raw", s.window_damage_raw as f64, "window_damage_raw <= damage_raw"));
+                }
+                if s.window_damage_raw > 0 && s.window_reengagements == 0 {
+                    return Err(invalid("window_damage_raw", s.window_damage_raw as f64, "0 without re-engagements in the window"));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Restores the counters (model and window stay); a state refused by
+    /// [`check_state`](Self::check_state) changes nothing.
+    pub fn restore(&mut self, state: &JointFatigueState) -> Result<(), FatigueError> {
+        self.check_state(state)?;
+        self.last_sign = state.last_sign;
+        self.steps = state.steps;
+        self.reengagements = state.reengagements;
+        self.damage_raw = state.damage_raw;
+        self.window_reengagements = state.window_reengagements;
+        self.window_damage_raw = state.window_damage_raw;
+        Ok(())
     }
 
     /// The precomputed model of this joint's gearbox.
@@ -600,6 +698,39 @@ impl<const JOINTS: usize> FatigueCounter<JOINTS> {
     /// Forgets the run on every joint; keeps parameters, period and window.
     pub fn reset(&mut self) {
         self.joints.iter_mut().for_each(JointFatigue::reset);
+    }
+
+    /// Every joint's counters as plain data, in joint order.
+    pub fn state(&self) -> [JointFatigueState; JOINTS] {
+        core::array::from_fn(|i| self.joints[i].state())
+    }
+
+    /// Checks that `states` fits this counter: one per joint, each valid for
+    /// its joint ([`JointFatigue::check_state`]), all with the same step
+    /// count (every update steps every joint).
+    pub fn check_state(&self, states: &[JointFatigueState]) -> Result<(), FatigueError> {
+        if states.len() != JOINTS {
+            return Err(invalid("joints", states.len() as f64, "as many joint states as the counter has joints"));
+        }
+        for (joint, state) in self.joints.iter().zip(states) {
+            joint.check_state(state)?;
+        }
+        if let Some(first) = states.first() {
+            if let Some(other) = states.iter().find(|s| s.steps != first.steps) {
+                return Err(invalid("steps", other.steps as f64, "the same step count on every joint"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Restores every joint's counters; all or nothing (see
+    /// [`check_state`](Self::check_state)).
+    pub fn restore(&mut self, states: &[JointFatigueState]) -> Result<(), FatigueError> {
+        self.check_state(states)?;
+        for (joint, state) in self.joints.iter_mut().zip(states) {
+            joint.restore(state)?;
+        }
+        Ok(())
     }
 
     /// The gearbox parameters shared by all joints.

@@ -21,8 +21,11 @@
 //! - [`wire`]: the telemetry and command protocol between chip and host
 //!   (postcard + CRC-32 + COBS), so both ends decode exactly what the other
 //!   encodes;
-//! - [`checkpoint`]: learned weights in two alternating flash slots that
-//!   survive a torn write;
+//! - [`checkpoint`]: learned weights and the learner's state (counters, ε,
+//!   policy, fatigue counters, generator) in two alternating flash slots
+//!   that survive a torn write;
+//! - [`rng`]: PCG32, output-identical to `rand_pcg::Pcg32`, with a state
+//!   that can be saved and restored;
 //! - [`safety`]: the Idle → Learning/Testing → Fault state machine that owns
 //!   torque enable;
 //! - [`rx28`]: the RX-28 servo's voltage-driven motor model (shared by the
@@ -46,6 +49,7 @@ pub mod error;
 pub mod fatigue;
 pub mod fixed;
 pub mod policy;
+pub mod rng;
 pub mod rx28;
 pub mod safety;
 pub mod tile_coding;

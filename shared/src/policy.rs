@@ -184,11 +184,80 @@ pub fn uniform_below<R: RngCore + ?Sized>(rng: &mut R, n: u32) -> u32 {
     ((rng.next_u32() as u64 * n as u64) >> 32) as u32
 }
 
+/// A policy's state as plain data ([`Policy::state`], [`Policy::restore`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct PolicyState {
+    /// The kind the policy was built as, with its Δ or α.
+    pub kind: PolicyKind,
+    /// Whether it was switched back to plain SARSA.
+    pub switched: bool,
+    /// The learner's previous action, as levels of the learner's action
+    /// space (0 in unused dimensions).
+    pub previous: Levels,
+    /// The last applied output, the low-pass filter's or integrator's memory
+    /// (0 in unused dimensions).
+    pub output: Output,
+}
+
+/// The number that stands for a policy kind in a checkpoint:
+/// 0 sarsa, 1 lowpass, 2 markov-lowpass, 3 integrator, 4 markov-integrator,
+/// 5 pada.
+pub fn kind_code(kind: &PolicyKind) -> u8 {
+    match kind {
+        PolicyKind::Sarsa => 0,
+        PolicyKind::LowPass { .. } => 1,
+        PolicyKind::MarkovLowPass { .. } => 2,
+        PolicyKind::Integrator { .. } => 3,
+        PolicyKind::MarkovIntegrator { .. } => 4,
+        PolicyKind::Pada { .. } => 5,
+    }
+}
+
+/// Kinds whose learners mean the same by an action and a state: SARSA, PADA
+/// and the low-pass filter choose motor levels on the plain state; each of
+/// the others is a family of its own.
+fn family(kind: &PolicyKind) -> u8 {
+    match kind {
+        PolicyKind::Sarsa | PolicyKind::Pada { .. } | PolicyKind::LowPass { .. } => 0,
+        PolicyKind::MarkovLowPass { .. } => 1,
+        PolicyKind::Integrator { .. } => 2,
+        PolicyKind::MarkovIntegrator { .. } => 3,
+    }
+}
+
+/// The parameter of a kind (α or Δ; 0 for SARSA).
+pub fn kind_parameter(kind: &PolicyKind) -> f32 {
+    match *kind {
+        PolicyKind::Sarsa => 0.0,
+        PolicyKind::LowPass { alpha } | PolicyKind::MarkovLowPass { alpha } => alpha,
+        PolicyKind::Integrator { delta } | PolicyKind::MarkovIntegrator { delta } | PolicyKind::Pada { delta } => delta,
+    }
+}
+
+/// The kind of a [`kind_code`] with its parameter; `None` for an unknown
+/// code. The parameter is not checked here ([`PolicyKind::validate`]).
+pub fn kind_from_code(code: u8, parameter: f32) -> Option<PolicyKind> {
+    Some(match code {
+        0 => PolicyKind::Sarsa,
+        1 => PolicyKind::LowPass { alpha: parameter },
+        2 => PolicyKind::MarkovLowPass { alpha: parameter },
+        3 => PolicyKind::Integrator { delta: parameter },
+        4 => PolicyKind::MarkovIntegrator { delta: parameter },
+        5 => PolicyKind::Pada { delta: parameter },
+        _ => return None,
+    })
+}
+
 /// An action policy with its memory (previous action, filter state or
 /// integrated command).
 #[derive(Debug, Clone)]
 pub struct Policy {
+    /// The kind in force (plain SARSA after a switch back).
     kind: PolicyKind,
+    /// The kind the policy was built (or restored) as.
+    built: PolicyKind,
     motor: ActionSpace,
     learner: ActionSpace,
     /// PADA's reach per dimension and level: the contiguous levels within Δ.
@@ -229,14 +298,116 @@ impl Policy {
                 reach[i][p] = (lo as u8, hi as u8);
             }
         }
-        let mut policy = Policy { kind, motor, learner, reach, prev: [0; MAX_ACTION_DIMS], output: [0.0; MAX_ACTION_DIMS] };
+        let mut policy =
+            Policy { kind, built: kind, motor, learner, reach, prev: [0; MAX_ACTION_DIMS], output: [0.0; MAX_ACTION_DIMS] };
         policy.reset();
         Ok(policy)
     }
 
-    /// The kind, with its parameter.
+    /// The kind in force, with its parameter ([`PolicyKind::Sarsa`] after
+    /// [`switch_to_sarsa`](Self::switch_to_sarsa)).
     pub fn kind(&self) -> PolicyKind {
         self.kind
+    }
+
+    /// The kind the policy was built (or restored) as, with its parameter;
+    /// unchanged by a switch back to SARSA.
+    pub fn built_kind(&self) -> PolicyKind {
+        self.built
+    }
+
+    /// Whether PADA or the low-pass filter was switched back to plain SARSA
+    /// (Section VIII).
+    pub fn switched(&self) -> bool {
+        self.kind != self.built
+    }
+
+    /// The policy's state as plain data (for a checkpoint).
+    pub fn state(&self) -> PolicyState {
+        PolicyState { kind: self.built, switched: self.switched(), previous: self.prev, output: self.output }
+    }
+
+    /// Checks that `state` can be restored into this policy; the error names
+    /// the field and its valid range. See [`restore`](Self::restore).
+    pub fn check_state(&self, state: &PolicyState) -> Result<(), ConfigError> {
+        self.restored(state).map(|_| ())
+    }
+
+    /// Restores a policy state: the kind with its parameter, the switch back
+    /// to SARSA, the previous action and the filter's or integrator's
+    /// memory. The kind may differ from the one built when its learner means
+    /// the same by an action and a state: SARSA, PADA and the low-pass
+    /// filter (any Δ or α) stand in for each other, as do Markov low-pass
+    /// filters of any α, and integrators of a Δ that gives the same
+    /// increments; otherwise, or with any field out of range, nothing
+    /// changes.
+    pub fn restore(&mut self, state: &PolicyState) -> Result<(), ConfigError> {
+        *self = self.restored(state)?;
+        Ok(())
+    }
+
+    /// This policy with `state` restored, or why it cannot be.
+    fn restored(&self, state: &PolicyState) -> Result<Policy, ConfigError> {
+        let mut p = if state.kind == self.built {
+            let mut p = self.clone();
+            p.kind = p.built;
+            p
+        } else {
+            let p = Policy::new(state.kind, self.motor.clone())?;
+            if family(&state.kind) != family(&self.built)
+                || p.learner != self.learner
+                || p.extension_len() != self.extension_len()
+            {
+                return Err(ConfigError::new(
+                    "policy.kind",
+                    kind_code(&state.kind) as f32,
+                    "a policy with the running learner's actions and state (sarsa, pada, lowpass alike; the integrators and Markov variants only as configured)",
+                ));
+            }
+            p
+        };
+        if state.switched {
+            if !matches!(state.kind, PolicyKind::Pada { .. } | PolicyKind::LowPass { .. }) {
+                return Err(ConfigError::new(
+                    "policy.switched",
+                    1.0,
+                    "false unless the policy is pada or lowpass (only they switch back to sarsa)",
+                ));
+            }
+            p.kind = PolicyKind::Sarsa;
+        }
+        for i in 0..MAX_ACTION_DIMS {
+            let level = state.previous[i];
+            if i < p.learner.dims() {
+                if level as usize >= p.learner.dim(i).len() {
+                    return Err(ConfigError::new(
+                        "policy.previous",
+                        level as f32,
+                        "a level index below the dimension's number of levels",
+                    )
+                    .at(i));
+                }
+            } else if level != 0 {
+                return Err(ConfigError::new("policy.previous", level as f32, "0 for an unused action dimension").at(i));
+            }
+            let out = state.output[i];
+            if i < p.motor.dims() {
+                let d = p.motor.dim(i);
+                if !(out.is_finite() && out >= d.min() && out <= d.max()) {
+                    return Err(ConfigError::new(
+                        "policy.output",
+                        out,
+                        "finite and inside the motor's range [min, max]",
+                    )
+                    .at(i));
+                }
+            } else if out.to_bits() != 0 {
+                return Err(ConfigError::new("policy.output", out, "0 for an unused action dimension").at(i));
+            }
+        }
+        p.prev = state.previous;
+        p.output = state.output;
+        Ok(p)
     }
 
     /// The actions the learner chooses among (the motor's levels, or the
@@ -338,7 +509,7 @@ impl Policy {
     /// (Section VIII); the learner's actions and state stay the same, so the
     /// learned values carry over. Plain SARSA switches to itself.
     pub fn switch_to_sarsa(&mut self) -> Result<(), StepError> {
-        match self.kind {
+        match self.built {
             PolicyKind::Sarsa | PolicyKind::Pada { .. } | PolicyKind::LowPass { .. } => {
                 self.kind = PolicyKind::Sarsa;
                 Ok(())

@@ -90,6 +90,11 @@ impl<const TILINGS: usize, const CAP: usize> Trace<TILINGS, CAP> {
         self.drops
     }
 
+    /// Sets the drop counter (restoring a saved agent).
+    pub fn set_drops(&mut self, drops: u32) {
+        self.drops = drops;
+    }
+
     /// Adds the features of the current (state, action) as the newest entry,
     /// with eligibility 1; older entries move one step down.
     pub fn push(&mut self, features: &[u32; TILINGS]) {

@@ -28,8 +28,8 @@
 //! | [`ToChip::SetPolicy`] | host → chip | [`PolicySpec`] | one of the six policies and its α/Δ |
 //! | [`ToChip::SwitchToSarsa`] | host → chip | — | end of the exploration phase (Section VIII) |
 //! | [`ToChip::SetEpsilon`] | host → chip | `f32` | exploration rate |
-//! | [`ToChip::SaveCheckpoint`] | host → chip | — | weights to flash |
-//! | [`ToChip::LoadCheckpoint`] | host → chip | — | weights from flash |
+//! | [`ToChip::SaveCheckpoint`] | host → chip | — | weights and learner state to flash |
+//! | [`ToChip::LoadCheckpoint`] | host → chip | — | weights and learner state from flash |
 //! | [`ToChip::ReadWeights`] | host → chip | offset `u32`, count `u32` | answered by `Weights` chunks |
 //! | [`ToChip::ClearFault`] | host → chip | — | Fault → Idle |
 //!
@@ -310,7 +310,8 @@ pub struct Log {
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Warning {
     /// The checkpoint found at boot was not loaded (the outcome says why:
-    /// configuration mismatch, size mismatch, corruption, format version).
+    /// configuration mismatch, size mismatch, corruption, format version, a
+    /// learner state out of range).
     CheckpointIgnored(LoadOutcome),
     /// Frames that could not be sent since the last warning.
     TelemetryDropped {
@@ -390,9 +391,11 @@ pub enum ToChip {
     SwitchToSarsa,
     /// Set the exploration rate ε.
     SetEpsilon(f32),
-    /// Save the weights to flash.
+    /// Save the weights and the learner's state to flash
+    /// ([`crate::checkpoint`]).
     SaveCheckpoint,
-    /// Load the weights from flash.
+    /// Load the weights and the learner's state from flash, if the
+    /// configuration matches and the state is in range.
     LoadCheckpoint,
     /// Send weights `offset .. offset + count`.
     ReadWeights {

@@ -1,7 +1,9 @@
-//! Checkpoints: round trip, alternating slots, torn writes at every byte,
-//! configuration and size mismatches, corruption.
+//! Checkpoints: round trip, alternating slots, torn writes at every byte
+//! (state record, weights and header), configuration and size mismatches,
+//! corruption. The learner-state record itself: `learner_state.rs`.
 
 use pada_core::checkpoint::*;
+use pada_core::fatigue::JointFatigueState;
 use pada_core::fixed::Q16;
 
 const N: usize = 100;
@@ -12,101 +14,143 @@ fn weights(seed: i32) -> Vec<Q16> {
     (0..N as i32).map(|i| Q16(i.wrapping_mul(0x0101_0101).wrapping_add(seed) ^ (seed << 7))).collect()
 }
 
+/// A learner state that differs with `seed` in every part of the record.
+fn state(seed: u32) -> LearnerState {
+    let mut s = LearnerState::default();
+    s.agent.stats.steps = 1000 * seed as u64;
+    s.agent.stats.episodes = seed;
+    s.agent.epsilon = 0.05;
+    s.rng.state = 0x1234_5678_9abc_def0 ^ seed as u64;
+    s.rng.increment = 0x0f0f_0f0f_0f0f_0f0f | 1;
+    s.user = [seed, 2 * seed, 0, 7];
+    for j in 0..3u64 {
+        let f = JointFatigueState { last_sign: 1, steps: 50 + seed as u64, reengagements: j + seed as u64, damage_raw: 99 * j, ..Default::default() };
+        s.joints.push(f).unwrap();
+    }
+    s
+}
+
+/// Saves `weights(seed)` with `state(seed)`.
+fn save_seed<S: CheckpointStore>(store: &mut S, hash: u32, seed: u32) -> Result<Saved, SaveError<S::Error>> {
+    save(store, hash, &state(seed), &weights(seed as i32))
+}
+
+/// Loads into fresh buffers: (outcome, state, weights).
+fn load_all(store: &impl CheckpointStore, hash: u32) -> (LoadOutcome, LearnerState, Vec<Q16>) {
+    let mut st = LearnerState::default();
+    let mut out = vec![Q16(5); N];
+    let outcome = load(store, hash, &mut st, &mut out).unwrap_or_else(|_| panic!("store error"));
+    (outcome, st, out)
+}
+
 #[test]
 fn save_then_load_round_trips() {
     let mut store = Store::new();
-    let w = weights(1);
-    assert_eq!(save(&mut store, 42, &w), Ok(Saved { generation: 1, slot: 0 }));
-    let mut out = vec![Q16::ZERO; N];
-    assert_eq!(load(&store, 42, &mut out), Ok(LoadOutcome::Loaded { generation: 1, slot: 0 }));
-    assert_eq!(out, w);
+    assert_eq!(save_seed(&mut store, 42, 1), Ok(Saved { generation: 1, slot: 0 }));
+    let (outcome, st, out) = load_all(&store, 42);
+    assert_eq!(outcome, LoadOutcome::Loaded { generation: 1, slot: 0 });
+    assert_eq!(out, weights(1));
+    assert_eq!(st, state(1));
 }
 
 #[test]
 fn saves_alternate_slots_and_load_takes_the_newest() {
     let mut store = Store::new();
-    let mut out = vec![Q16::ZERO; N];
     for g in 1..=6u32 {
-        let w = weights(g as i32);
-        let saved = save(&mut store, 42, &w).unwrap();
+        let saved = save_seed(&mut store, 42, g).unwrap();
         assert_eq!(saved, Saved { generation: g, slot: ((g - 1) % 2) as u8 });
-        assert_eq!(load(&store, 42, &mut out), Ok(LoadOutcome::Loaded { generation: g, slot: saved.slot }));
-        assert_eq!(out, w);
+        let (outcome, st, out) = load_all(&store, 42);
+        assert_eq!(outcome, LoadOutcome::Loaded { generation: g, slot: saved.slot });
+        assert_eq!(out, weights(g as i32));
+        assert_eq!(st, state(g));
     }
 }
 
 #[test]
 fn empty_store_has_no_checkpoint_and_weights_stay() {
     let store = Store::new();
-    let mut out = vec![Q16(5); N];
-    assert_eq!(load(&store, 42, &mut out), Ok(LoadOutcome::NoCheckpoint));
+    let (outcome, st, out) = load_all(&store, 42);
+    assert_eq!(outcome, LoadOutcome::NoCheckpoint);
     assert!(out.iter().all(|w| *w == Q16(5)));
+    assert_eq!(st, LearnerState::default());
 }
 
 #[test]
 fn config_mismatch_is_reported_and_weights_stay() {
     let mut store = Store::new();
-    save(&mut store, config_hash(b"pendulum; tilings 16"), &weights(1)).unwrap();
-    let mut out = vec![Q16(5); N];
+    save_seed(&mut store, config_hash(b"pendulum; tilings 16"), 1).unwrap();
     let running = config_hash(b"pendulum; tilings 8");
-    assert_eq!(
-        load(&store, running, &mut out),
-        Ok(LoadOutcome::ConfigMismatch { expected: running, found: config_hash(b"pendulum; tilings 16") })
-    );
+    let (outcome, st, out) = load_all(&store, running);
+    assert_eq!(outcome, LoadOutcome::ConfigMismatch { expected: running, found: config_hash(b"pendulum; tilings 16") });
     assert!(out.iter().all(|w| *w == Q16(5)));
+    assert_eq!(st, LearnerState::default());
 }
 
 #[test]
 fn size_mismatch_is_reported() {
     let mut store = Store::new();
-    save(&mut store, 42, &weights(1)[..50]).unwrap();
-    let mut out = vec![Q16(5); N];
-    assert_eq!(load(&store, 42, &mut out), Ok(LoadOutcome::SizeMismatch { expected: N as u32, found: 50 }));
+    save(&mut store, 42, &state(1), &weights(1)[..50]).unwrap();
+    let (outcome, st, out) = load_all(&store, 42);
+    assert_eq!(outcome, LoadOutcome::SizeMismatch { expected: N as u32, found: 50 });
     assert!(out.iter().all(|w| *w == Q16(5)));
+    assert_eq!(st, LearnerState::default());
 }
 
 #[test]
 fn too_large_is_refused_before_touching_the_store() {
-    let mut store = RamStore::<64>::new();
-    assert_eq!(save(&mut store, 1, &weights(1)), Err(SaveError::TooLarge { needed: slot_len(N), capacity: 64 }));
+    let mut store = RamStore::<600>::new();
+    assert_eq!(save_seed(&mut store, 1, 1), Err(SaveError::TooLarge { needed: slot_len(N), capacity: 600 }));
     assert!(store.slot(0).unwrap().iter().all(|&b| b == 0xFF));
 }
 
 #[test]
 fn a_corrupted_payload_is_rejected() {
-    // The only checkpoint: every single-bit flip of its payload is caught.
-    for byte in [HEADER_LEN, HEADER_LEN + 1, HEADER_LEN + 200, slot_len(N) - 1] {
+    // The only checkpoint: a single-bit flip in the state record or the
+    // weights is caught.
+    let state_at = HEADER_LEN;
+    let weights_at = HEADER_LEN + STATE_LEN;
+    for byte in [state_at, state_at + 1, state_at + 33, state_at + 200, weights_at - 1, weights_at, weights_at + 200, slot_len(N) - 1] {
         let mut store = Store::new();
-        save(&mut store, 42, &weights(1)).unwrap();
+        save_seed(&mut store, 42, 1).unwrap();
         store.slot_mut(0).unwrap()[byte] ^= 0x10;
-        let mut out = vec![Q16(5); N];
-        assert_eq!(load(&store, 42, &mut out), Ok(LoadOutcome::Corrupt), "flip at {byte}");
+        let (outcome, st, out) = load_all(&store, 42);
+        assert_eq!(outcome, LoadOutcome::Corrupt, "flip at {byte}");
         assert!(out.iter().all(|w| *w == Q16(5)));
+        assert_eq!(st, LearnerState::default());
         assert_eq!(inspect(&store, 0), Ok(SlotStatus::Invalid(HeaderError::Corrupt)));
     }
 }
 
 #[test]
 fn a_corrupted_newest_checkpoint_falls_back_to_the_older() {
-    let mut store = Store::new();
-    let (w1, w2) = (weights(1), weights(2));
-    save(&mut store, 42, &w1).unwrap();
-    save(&mut store, 42, &w2).unwrap();
-    store.slot_mut(1).unwrap()[HEADER_LEN + 17] ^= 0x01;
-    let mut out = vec![Q16::ZERO; N];
-    assert_eq!(load(&store, 42, &mut out), Ok(LoadOutcome::Loaded { generation: 1, slot: 0 }));
-    assert_eq!(out, w1);
-    // The next save overwrites the corrupted slot, not the good one.
-    assert_eq!(save(&mut store, 42, &w2), Ok(Saved { generation: 2, slot: 1 }));
+    for byte in [HEADER_LEN + 17, HEADER_LEN + STATE_LEN + 17] {
+        let mut store = Store::new();
+        save_seed(&mut store, 42, 1).unwrap();
+        save_seed(&mut store, 42, 2).unwrap();
+        store.slot_mut(1).unwrap()[byte] ^= 0x01;
+        let (outcome, st, out) = load_all(&store, 42);
+        assert_eq!(outcome, LoadOutcome::Loaded { generation: 1, slot: 0 }, "flip at {byte}");
+        assert_eq!(out, weights(1));
+        assert_eq!(st, state(1));
+        // The next save overwrites the corrupted slot, not the good one.
+        assert_eq!(save_seed(&mut store, 42, 2), Ok(Saved { generation: 2, slot: 1 }));
+    }
 }
 
 #[test]
 fn a_future_format_is_reported() {
     let mut store = Store::new();
-    let h = Header { version: FORMAT_VERSION + 1, config_hash: 1, weight_count: 0, generation: 1, payload_crc: 0 };
+    let h = Header {
+        version: FORMAT_VERSION + 1,
+        config_hash: 1,
+        weight_count: 0,
+        generation: 1,
+        payload_crc: 0,
+        state_len: 0,
+    };
     store.write_bytes(0, &h.to_bytes());
-    let mut out = vec![Q16::ZERO; N];
-    assert_eq!(load(&store, 1, &mut out), Ok(LoadOutcome::UnsupportedVersion { found: FORMAT_VERSION + 1 }));
+    let (outcome, ..) = load_all(&store, 1);
+    assert_eq!(outcome, LoadOutcome::UnsupportedVersion { found: FORMAT_VERSION + 1 });
 }
 
 /// Helper: raw writes into a RAM store.
@@ -161,49 +205,51 @@ impl CheckpointStore for TornStore {
     }
 }
 
+/// Bytes `save` writes, in order: the state record, the weights, the header.
+const WRITTEN: usize = STATE_LEN + N * 4 + HEADER_LEN;
+
 #[test]
 fn a_torn_second_save_at_every_byte_keeps_the_first() {
-    let (w1, w2) = (weights(1), weights(2));
-    let total = slot_len(N);
-    for budget in 0..total {
+    // Budgets 0..STATE_LEN cut the save inside the state record, then inside
+    // the weights, then inside the header.
+    assert_eq!(WRITTEN, slot_len(N));
+    for budget in 0..WRITTEN {
         let mut base = Store::new();
-        save(&mut base, 42, &w1).unwrap();
+        save_seed(&mut base, 42, 1).unwrap();
         let mut torn = TornStore { inner: base, budget, dead: false };
-        let r = save(&mut torn, 42, &w2);
+        let r = save_seed(&mut torn, 42, 2);
         assert!(r.is_err(), "budget {budget}: a torn save must not report success");
-        // After the power cut: the first checkpoint loads.
-        let mut out = vec![Q16::ZERO; N];
-        assert_eq!(
-            load(&torn.inner, 42, &mut out),
-            Ok(LoadOutcome::Loaded { generation: 1, slot: 0 }),
-            "budget {budget}"
-        );
-        assert_eq!(out, w1, "budget {budget}");
+        // After the power cut: the first checkpoint loads, state and weights.
+        let (outcome, st, out) = load_all(&torn.inner, 42);
+        assert_eq!(outcome, LoadOutcome::Loaded { generation: 1, slot: 0 }, "budget {budget}");
+        assert_eq!(out, weights(1), "budget {budget}");
+        assert_eq!(st, state(1), "budget {budget}");
         // And the next save goes to the torn slot again and succeeds.
         let mut store = torn.inner;
-        assert_eq!(save(&mut store, 42, &w2), Ok(Saved { generation: 2, slot: 1 }), "budget {budget}");
+        assert_eq!(save_seed(&mut store, 42, 2), Ok(Saved { generation: 2, slot: 1 }), "budget {budget}");
+        assert_eq!(load_all(&store, 42).1, state(2), "budget {budget}");
     }
     // With the whole budget the save completes.
     let mut base = Store::new();
-    save(&mut base, 42, &w1).unwrap();
-    let mut full = TornStore { inner: base, budget: total, dead: false };
-    assert_eq!(save(&mut full, 42, &w2), Ok(Saved { generation: 2, slot: 1 }));
+    save_seed(&mut base, 42, 1).unwrap();
+    let mut full = TornStore { inner: base, budget: WRITTEN, dead: false };
+    assert_eq!(save_seed(&mut full, 42, 2), Ok(Saved { generation: 2, slot: 1 }));
 }
 
 #[test]
 fn a_torn_third_save_keeps_the_second() {
     // The same from the other slot: torn writes into slot 0 while slot 1
     // holds the newest.
-    let total = slot_len(N);
-    for budget in (0..total).step_by(7) {
+    for budget in (0..WRITTEN).step_by(7) {
         let mut base = Store::new();
-        save(&mut base, 42, &weights(1)).unwrap();
-        save(&mut base, 42, &weights(2)).unwrap();
+        save_seed(&mut base, 42, 1).unwrap();
+        save_seed(&mut base, 42, 2).unwrap();
         let mut torn = TornStore { inner: base, budget, dead: false };
-        assert!(save(&mut torn, 42, &weights(3)).is_err());
-        let mut out = vec![Q16::ZERO; N];
-        assert_eq!(load(&torn.inner, 42, &mut out), Ok(LoadOutcome::Loaded { generation: 2, slot: 1 }));
+        assert!(save_seed(&mut torn, 42, 3).is_err());
+        let (outcome, st, out) = load_all(&torn.inner, 42);
+        assert_eq!(outcome, LoadOutcome::Loaded { generation: 2, slot: 1 });
         assert_eq!(out, weights(2));
+        assert_eq!(st, state(2));
     }
 }
 
@@ -211,17 +257,26 @@ fn a_torn_third_save_keeps_the_second() {
 fn garbage_slots_are_corrupt_not_empty() {
     let mut store = Store::new();
     store.slot_mut(0).unwrap().fill(0x00);
-    let mut out = vec![Q16::ZERO; N];
-    assert_eq!(load(&store, 1, &mut out), Ok(LoadOutcome::Corrupt));
+    assert_eq!(load_all(&store, 1).0, LoadOutcome::Corrupt);
     // A valid checkpoint next to garbage still loads.
-    save(&mut store, 1, &weights(9)).unwrap();
-    assert!(matches!(load(&store, 1, &mut out), Ok(LoadOutcome::Loaded { generation: 1, .. })));
+    save_seed(&mut store, 1, 9).unwrap();
+    assert!(matches!(load_all(&store, 1).0, LoadOutcome::Loaded { generation: 1, .. }));
 }
 
 #[test]
 fn header_claiming_more_weights_than_fit_is_corrupt() {
     let mut store = Store::new();
-    let h = Header { version: FORMAT_VERSION, config_hash: 1, weight_count: u32::MAX, generation: 5, payload_crc: 0 };
+    let h = Header {
+        version: FORMAT_VERSION,
+        config_hash: 1,
+        weight_count: u32::MAX,
+        generation: 5,
+        payload_crc: 0,
+        state_len: STATE_LEN as u32,
+    };
+    store.write_bytes(0, &h.to_bytes());
+    assert_eq!(inspect(&store, 0), Ok(SlotStatus::Invalid(HeaderError::Corrupt)));
+    let h = Header { weight_count: 0, state_len: u32::MAX, ..h };
     store.write_bytes(0, &h.to_bytes());
     assert_eq!(inspect(&store, 0), Ok(SlotStatus::Invalid(HeaderError::Corrupt)));
 }

@@ -113,8 +113,9 @@ fn all_to_host() -> Vec<ToHost> {
         LoadOutcome::NoCheckpoint,
         LoadOutcome::ConfigMismatch { expected: 5, found: 6 },
         LoadOutcome::SizeMismatch { expected: 5, found: 6 },
-        LoadOutcome::UnsupportedVersion { found: 2 },
+        LoadOutcome::UnsupportedVersion { found: 1 },
         LoadOutcome::Corrupt,
+        LoadOutcome::InvalidState,
     ] {
         v.push(ToHost::Checkpoint(CheckpointReport::Load(o)));
     }
