@@ -56,6 +56,10 @@ pub const MAX_OBS: usize = 10;
 /// The weight table's layout.
 pub const LAYOUT: Layout = Layout::Hashed;
 
+/// Tile width of LEO's learned voltages \[V\] (grl-facts §3.9: voltage
+/// scale 0.15 ↔ 6.67 V).
+pub const LEO_ACTION_TILE_WIDTH: f32 = 6.67;
+
 /// The agent the firmware runs.
 pub type FirmwareAgent<W> = Agent<W, TILINGS, TRACE>;
 /// The weight table.
@@ -268,6 +272,31 @@ impl Robot {
         }
     }
 
+    /// Tile widths of the learner's action dimensions when the agent
+    /// generalises over actions: LEO's voltages in 6.67 V tiles, as GRL's
+    /// LEO learner and the host's LEO task (grl-facts §3.9,
+    /// `generalizeActions`); the pendulums keep one weight set per action.
+    pub fn action_tiles(self) -> Option<[f32; 3]> {
+        match self {
+            Robot::Pendulum33 | Robot::Pendulum20 => None,
+            Robot::Leo => Some([LEO_ACTION_TILE_WIDTH; 3]),
+        }
+    }
+
+    /// The robot's agent learning with `policy` on `weights` (weights not
+    /// yet initialised): the one place the firmware, its tests and the
+    /// host's replay build it.
+    pub fn agent<W>(self, policy: PolicyKind, weights: W) -> Result<FirmwareAgent<W>, ConfigError>
+    where
+        W: AsRef<[Q16]> + AsMut<[Q16]>,
+    {
+        let mut agent = FirmwareAgent::new(&self.state_dims(), self.action_space(), policy, self.params(), LAYOUT, weights)?;
+        if let Some(widths) = self.action_tiles() {
+            agent.generalise_actions(&widths)?;
+        }
+        Ok(agent)
+    }
+
     /// SARSA(λ) parameters.
     pub fn params(self) -> SarsaParams {
         match self {
@@ -297,7 +326,8 @@ pub const CONFIG_HASH_VERSION: u32 = 1;
 /// robot, table size and layout, tilings, trace capacity, every state
 /// dimension the tile coder sees (the observation plus a Markov policy's
 /// extension), the learner's action levels (all levels, or an integrator's
-/// −Δ/0/+Δ), and α, γ, λ and the trace settings.
+/// −Δ/0/+Δ) and their tile widths if actions are tile-coded, and α, γ, λ
+/// and the trace settings.
 ///
 /// Policies that share the learner's layout share the hash: weights learned
 /// with PADA, SARSA or the low-pass filter load into each other (PADA
@@ -323,6 +353,12 @@ pub fn config_hash(robot: Robot, policy: PolicyKind, params: &SarsaParams) -> Re
     }
     for i in 0..policy.extension_len() {
         dim(policy.extension_dim(i)?);
+    }
+    if let Some(widths) = robot.action_tiles() {
+        h.write_str("action tiles");
+        for w in widths {
+            h.write_f32(w);
+        }
     }
     let space = policy.learner_space();
     for i in 0..space.dims() {
@@ -360,15 +396,10 @@ mod tests {
         for robot in Robot::ALL {
             for policy in policies {
                 let mut table = vec![Q16::ZERO; WEIGHTS];
-                let agent = FirmwareAgent::new(
-                    &robot.state_dims(),
-                    robot.action_space(),
-                    policy,
-                    robot.params(),
-                    LAYOUT,
-                    &mut table[..],
-                );
+                let agent = robot.agent(policy, &mut table[..]);
                 assert!(agent.is_ok(), "{robot:?} {policy:?}: {:?}", agent.err());
+                let tiled = agent.ok().and_then(|a| a.coder().action_tiles().map(|t| t.combos()));
+                assert_eq!(tiled.is_some(), robot == Robot::Leo, "{robot:?}: action tiles {tiled:?}");
             }
         }
     }

@@ -268,14 +268,7 @@ where
     fn build(&mut self, policy: PolicyKind, weights: W) -> Result<(), ConfigError> {
         let params = self.robot.params();
         let hash = config::config_hash(self.robot, policy, &params)?;
-        let mut agent = FirmwareAgent::new(
-            &self.robot.state_dims(),
-            self.robot.action_space(),
-            policy,
-            params,
-            config::LAYOUT,
-            weights,
-        )?;
+        let mut agent = self.robot.agent(policy, weights)?;
         self.rng = Pcg32::seed_from_u64(self.seed);
         agent.reset_weights(&mut self.rng);
         self.agent = Some(agent);
@@ -1100,15 +1093,7 @@ mod tests {
         let robot = Robot::Pendulum33;
         // The host's generator: the firmware's own must draw the same.
         let mut rng = rand_pcg::Pcg32::seed_from_u64(seed);
-        let mut agent = FirmwareAgent::new(
-            &robot.state_dims(),
-            robot.action_space(),
-            PolicyKind::Pada { delta: 0.5 },
-            robot.params(),
-            config::LAYOUT,
-            table(),
-        )
-        .unwrap();
+        let mut agent = robot.agent(PolicyKind::Pada { delta: 0.5 }, table()).unwrap();
         agent.reset_weights(&mut rng);
         for s in &steps {
             agent.set_mode(if s.mode == RunMode::Testing { Mode::Testing } else { Mode::Learning });
@@ -1216,9 +1201,7 @@ mod tests {
         let mut weights = table();
         assert!(matches!(checkpoint::load(&store, b.config_hash(), &mut state, &mut weights), Ok(LoadOutcome::Loaded { .. })));
         let robot = Robot::Pendulum33;
-        let mut agent =
-            FirmwareAgent::new(&robot.state_dims(), robot.action_space(), PolicyKind::Sarsa, robot.params(), config::LAYOUT, weights)
-                .unwrap();
+        let mut agent = robot.agent(PolicyKind::Sarsa, weights).unwrap();
         agent.restore_state(&state.agent).unwrap();
         let mut rng = Pcg32::from_state(state.rng).unwrap();
         for s in &after {

@@ -15,7 +15,7 @@ use pada_core::agent::{EpisodeEnd, Mode};
 use pada_core::fixed::Q16;
 use pada_core::policy::PolicyKind;
 use pada_core::wire::{Episode, RunMode, Step, StepKind};
-use pada_firmware::config::{FirmwareAgent, Robot, LAYOUT, WEIGHTS};
+use pada_firmware::config::{Robot, WEIGHTS};
 use rand_core::SeedableRng;
 use rand_pcg::Pcg32;
 use serde::Serialize;
@@ -59,14 +59,7 @@ pub struct ReplayReport {
 pub fn replay(robot: Robot, policy: PolicyKind, seed: u64, records: &[Record]) -> ReplayReport {
     let mut report = ReplayReport::default();
     let table = vec![Q16::ZERO; WEIGHTS].into_boxed_slice();
-    let agent = FirmwareAgent::new(
-        &robot.state_dims(),
-        robot.action_space(),
-        policy,
-        robot.params(),
-        LAYOUT,
-        table,
-    );
+    let agent = robot.agent(policy, table);
     let mut agent = match agent {
         Ok(a) => a,
         Err(e) => {
