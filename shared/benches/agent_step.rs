@@ -34,6 +34,14 @@ fn pendulum(policy: PolicyKind) -> (Agent<Box<[Q16]>, TILINGS, TRACE>, Vec<[f32;
 /// 6.67 V action tiles (GRL's `generalizeActions`), 16 tilings, 2^22
 /// weights (GRL used 2^23).
 fn leo(policy: PolicyKind) -> (Agent<Box<[Q16]>, TILINGS, TRACE>, Vec<[f32; 10]>) {
+    let (mut agent, xs) = leo_untiled(policy);
+    agent.generalise_actions(&[6.67; 3]).unwrap();
+    (agent, xs)
+}
+
+/// LEO without generalisation over actions (one weight set per joint
+/// action): the greedy choice hashes all 343 × 16 (action, tiling) pairs.
+fn leo_untiled(policy: PolicyKind) -> (Agent<Box<[Q16]>, TILINGS, TRACE>, Vec<[f32; 10]>) {
     let angle = StateDim::new(-PI, PI, 0.28).unwrap();
     let rate = StateDim::new(-30.0, 30.0, 10.0).unwrap();
     let obs = [
@@ -43,8 +51,7 @@ fn leo(policy: PolicyKind) -> (Agent<Box<[Q16]>, TILINGS, TRACE>, Vec<[f32; 10]>
     ];
     let space = ActionSpace::repeated(ActionDim::uniform(-10.7, 10.7, 7).unwrap(), 3).unwrap();
     let weights = vec![Q16::ZERO; 1 << 22].into_boxed_slice();
-    let mut agent = Agent::new(&obs, space, policy, params(), Layout::Hashed, weights).unwrap();
-    agent.generalise_actions(&[6.67; 3]).unwrap();
+    let agent = Agent::new(&obs, space, policy, params(), Layout::Hashed, weights).unwrap();
     (agent, states(10, &[1.0, 30.0, 2.0, 30.0, 2.0, 30.0, 2.0, 30.0, 2.0, 30.0]))
 }
 
@@ -67,11 +74,12 @@ fn states(dims: usize, scale: &[f32]) -> Vec<[f32; 10]> {
 fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("agent_step");
     type Build = fn(PolicyKind) -> (Agent<Box<[Q16]>, TILINGS, TRACE>, Vec<[f32; 10]>);
-    let configs: [(&str, Build, usize, PolicyKind); 4] = [
+    let configs: [(&str, Build, usize, PolicyKind); 5] = [
         ("pendulum/sarsa", pendulum, 2, PolicyKind::Sarsa),
         ("pendulum/pada", pendulum, 2, PolicyKind::Pada { delta: 0.5 }),
         ("leo/sarsa", leo, 10, PolicyKind::Sarsa),
         ("leo/pada", leo, 10, PolicyKind::Pada { delta: 1.0 / 6.0 }),
+        ("leo/sarsa-untiled-actions", leo_untiled, 10, PolicyKind::Sarsa),
     ];
     for (name, build, dims, policy) in configs {
         let (mut agent, xs) = build(policy);
