@@ -33,6 +33,7 @@ use crate::tile_coding::tile_start;
 /// agent's greedy choice keeps on the stack: `TILINGS × 128 × 4` bytes
 /// (8 KiB with 16 tilings).
 pub const MAX_ACTION_COMBOS: usize = 128;
+const _: () = assert!(MAX_ACTION_COMBOS.is_power_of_two() && MAX_LEVELS.is_power_of_two());
 
 /// The precomputed action tiling of one action space.
 #[derive(Debug, Clone, PartialEq)]
@@ -118,6 +119,15 @@ impl<const TILINGS: usize> ActionTiles<TILINGS> {
     /// The tile widths, one per action dimension.
     pub fn widths(&self) -> &[f32] {
         &self.widths[..self.dims]
+    }
+
+    /// What level `level` of action dimension `d` adds to the combination
+    /// index in tiling `j` (0 for a dimension the space does not have).
+    #[inline(always)]
+    pub fn part(&self, j: usize, d: usize, level: u8) -> u32 {
+        // MAX_LEVELS is a power of two and every level is below it: the
+        // mask changes nothing but lets the compiler drop the bounds check.
+        self.part[j][d & (MAX_ACTION_DIMS - 1)][level as usize & (MAX_LEVELS - 1)] as u32
     }
 
     /// The combination that `levels` falls into in tiling `j`.

@@ -518,8 +518,19 @@ where
     fn q_sum(&self, code: &StateCode<TILINGS>, action: u32) -> i64 {
         let w = self.weights.as_ref();
         let mut sum = 0i64;
-        for j in 0..TILINGS {
-            sum += w[self.coder.feature(code, j, action) as usize].0 as i64;
+        // The action-tile test once, not per tiling (the greedy loop's
+        // inner body on the chip).
+        match self.coder.action_tiles() {
+            None => {
+                for j in 0..TILINGS {
+                    sum += w[self.coder.action_feature(code, j, action) as usize].0 as i64;
+                }
+            }
+            Some(_) => {
+                for j in 0..TILINGS {
+                    sum += w[self.coder.feature(code, j, action) as usize].0 as i64;
+                }
+            }
         }
         sum
     }
@@ -585,7 +596,11 @@ where
     }
 
     /// [`greedy`](Self::greedy) with action tiles: a table of the
-    /// `TILINGS × combos` active weights, then 16 table reads per candidate.
+    /// `TILINGS × combos` active weights, then per candidate one table read
+    /// per tiling. The candidates are visited in `Candidates::for_each`'s
+    /// order (first dimension fastest), so ties break exactly as there;
+    /// the other dimensions' share of each tiling's combination index is
+    /// summed once per run of the first dimension.
     fn greedy_tiled<R: RngCore + ?Sized>(
         &self,
         code: &StateCode<TILINGS>,
@@ -593,6 +608,7 @@ where
         at: &ActionTiles<TILINGS>,
         rng: &mut R,
     ) -> Levels {
+        const MASK: usize = MAX_ACTION_COMBOS - 1;
         let w = self.weights.as_ref();
         let mut table = [[0i32; MAX_ACTION_COMBOS]; TILINGS];
         for (j, row) in table.iter_mut().enumerate() {
@@ -600,25 +616,39 @@ where
                 *slot = w[self.coder.combo_feature(code, j, c as u32) as usize].0;
             }
         }
-        let mut best = candidates.lo;
+        // Unused dimensions have lo = hi = 0 and contribute 0.
+        let (lo, hi) = (candidates.lo, candidates.hi);
+        let mut best = lo;
         let mut best_sum = i64::MIN;
         let mut ties = 0u32;
-        candidates.for_each(|levels| {
-            let mut sum = 0i64;
-            for (j, row) in table.iter().enumerate() {
-                sum += row[at.combo(j, levels) as usize] as i64;
-            }
-            if sum > best_sum {
-                best_sum = sum;
-                best = *levels;
-                ties = 1;
-            } else if sum == best_sum {
-                ties += 1;
-                if uniform_below(rng, ties) == 0 {
-                    best = *levels;
+        let mut base = [0u32; TILINGS];
+        for l3 in lo[3]..=hi[3] {
+            for l2 in lo[2]..=hi[2] {
+                for l1 in lo[1]..=hi[1] {
+                    for (j, b) in base.iter_mut().enumerate() {
+                        *b = at.part(j, 1, l1) + at.part(j, 2, l2) + at.part(j, 3, l3);
+                    }
+                    for l0 in lo[0]..=hi[0] {
+                        let mut sum = 0i64;
+                        for (j, row) in table.iter().enumerate() {
+                            // base + part < combos ≤ MAX_ACTION_COMBOS (a
+                            // power of two): the mask only drops the check.
+                            sum += row[(base[j] + at.part(j, 0, l0)) as usize & MASK] as i64;
+                        }
+                        if sum > best_sum {
+                            best_sum = sum;
+                            best = [l0, l1, l2, l3];
+                            ties = 1;
+                        } else if sum == best_sum {
+                            ties += 1;
+                            if uniform_below(rng, ties) == 0 {
+                                best = [l0, l1, l2, l3];
+                            }
+                        }
+                    }
                 }
             }
-        });
+        }
         best
     }
 

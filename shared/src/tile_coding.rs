@@ -353,14 +353,18 @@ impl<const TILINGS: usize> TileCoder<TILINGS> {
     /// The weight index of `action` in `tiling` for an encoded state.
     #[inline]
     pub fn feature(&self, code: &StateCode<TILINGS>, tiling: usize, action: u32) -> u32 {
+        match &self.action_tiles {
+            Some(at) => self.combo_feature(code, tiling, at.combo_of_action(tiling, action)),
+            None => self.action_feature(code, tiling, action),
+        }
+    }
+
+    /// [`feature`](Self::feature) of a coder without action tiles: the
+    /// joint action index is the hashed word (or the exact offset).
+    #[inline(always)]
+    pub fn action_feature(&self, code: &StateCode<TILINGS>, tiling: usize, action: u32) -> u32 {
         match self.layout {
-            Layout::Hashed => {
-                let word = match &self.action_tiles {
-                    Some(at) => at.combo_of_action(tiling, action),
-                    None => action,
-                };
-                murmur_finish(murmur_mix(code.per_tiling[tiling], word)) & (self.table_size - 1)
-            }
+            Layout::Hashed => murmur_finish(murmur_mix(code.per_tiling[tiling], action)) & (self.table_size - 1),
             Layout::Exact => code.per_tiling[tiling] + action,
         }
     }

@@ -97,3 +97,39 @@ fn learning_one_voltage_teaches_its_neighbour_but_not_a_far_one() {
     let (near, far) = (q([3, 3, 4, 0]), q([3, 3, 6, 0]));
     assert!(far.abs() < near / 4.0, "near {near}, far {far}, target {}", q([3, 3, 3, 0]));
 }
+
+#[test]
+fn tiled_greedy_breaks_ties_as_the_plain_candidate_walk() {
+    // Weights from {0, 16, 32} raw units: many exact ties, and Q (the sum
+    // over 16 tilings / 16) is exact, so equal Q means equal sums. The
+    // reference walks the joint actions in index order (first dimension
+    // fastest, as Candidates::for_each) with the same reservoir rule.
+    let mut rng = Pcg32::seed_from_u64(11);
+    let mut agent = leo_like(PolicyKind::Sarsa);
+    for w in agent.weights_mut().iter_mut() {
+        *w = Q16((rng.next_u32() % 3) as i32 * 16);
+    }
+    agent.set_mode(Mode::Testing);
+    let mut tied_choices = 0;
+    for _ in 0..40 {
+        let obs = random_obs(&mut rng);
+        let mut reference_rng = rng.clone();
+        let (mut best, mut best_q, mut ties) = (0u32, Q16(i32::MIN), 0u32);
+        for a in 0..343 {
+            let q = agent.q_value(&obs, a).unwrap();
+            if q > best_q {
+                (best, best_q, ties) = (a, q, 1);
+            } else if q == best_q {
+                ties += 1;
+                if pada_core::policy::uniform_below(&mut reference_rng, ties) == 0 {
+                    best = a;
+                }
+            }
+        }
+        let d = agent.start_episode(&obs, &mut rng).unwrap();
+        assert_eq!(d.action, best, "ties {ties}");
+        tied_choices += (ties > 1) as u32;
+        agent.end_episode(0.0, EpisodeEnd::Absorbing, &mut rng).unwrap();
+    }
+    assert!(tied_choices > 10, "only {tied_choices} of 40 choices were among ties");
+}
