@@ -2,6 +2,8 @@
 //! (state record, weights and header), configuration and size mismatches,
 //! corruption. The learner-state record itself: `learner_state.rs`.
 
+mod support;
+use support::TornStore;
 use pada_core::checkpoint::*;
 use pada_core::fatigue::JointFatigueState;
 use pada_core::fixed::Q16;
@@ -163,48 +165,6 @@ impl WriteBytes for Store {
     }
 }
 
-/// A store that loses power after `budget` more bytes have been written:
-/// the write in progress is cut at that byte and every later operation fails.
-struct TornStore {
-    inner: Store,
-    budget: usize,
-    dead: bool,
-}
-
-#[derive(Debug, PartialEq)]
-struct PowerLost;
-
-impl CheckpointStore for TornStore {
-    type Error = PowerLost;
-    fn capacity(&self) -> usize {
-        self.inner.capacity()
-    }
-    fn read(&self, slot: u8, offset: usize, buf: &mut [u8]) -> Result<(), PowerLost> {
-        self.inner.read(slot, offset, buf).map_err(|_| PowerLost)
-    }
-    fn erase(&mut self, slot: u8) -> Result<(), PowerLost> {
-        if self.dead {
-            return Err(PowerLost);
-        }
-        self.inner.erase(slot).map_err(|_| PowerLost)
-    }
-    fn write(&mut self, slot: u8, offset: usize, data: &[u8]) -> Result<(), PowerLost> {
-        if self.dead {
-            return Err(PowerLost);
-        }
-        let n = data.len().min(self.budget);
-        self.inner.write(slot, offset, &data[..n]).map_err(|_| PowerLost)?;
-        self.budget -= n;
-        if n < data.len() || self.budget == 0 {
-            self.dead = true;
-            if n < data.len() {
-                return Err(PowerLost);
-            }
-        }
-        Ok(())
-    }
-}
-
 /// Bytes `save` writes, in order: the state record, the weights, the header.
 const WRITTEN: usize = STATE_LEN + N * 4 + HEADER_LEN;
 
@@ -216,7 +176,7 @@ fn a_torn_second_save_at_every_byte_keeps_the_first() {
     for budget in 0..WRITTEN {
         let mut base = Store::new();
         save_seed(&mut base, 42, 1).unwrap();
-        let mut torn = TornStore { inner: base, budget, dead: false };
+        let mut torn = TornStore::new(base, budget);
         let r = save_seed(&mut torn, 42, 2);
         assert!(r.is_err(), "budget {budget}: a torn save must not report success");
         // After the power cut: the first checkpoint loads, state and weights.
@@ -232,7 +192,7 @@ fn a_torn_second_save_at_every_byte_keeps_the_first() {
     // With the whole budget the save completes.
     let mut base = Store::new();
     save_seed(&mut base, 42, 1).unwrap();
-    let mut full = TornStore { inner: base, budget: WRITTEN, dead: false };
+    let mut full = TornStore::new(base, WRITTEN);
     assert_eq!(save_seed(&mut full, 42, 2), Ok(Saved { generation: 2, slot: 1 }));
 }
 
@@ -244,7 +204,7 @@ fn a_torn_third_save_keeps_the_second() {
         let mut base = Store::new();
         save_seed(&mut base, 42, 1).unwrap();
         save_seed(&mut base, 42, 2).unwrap();
-        let mut torn = TornStore { inner: base, budget, dead: false };
+        let mut torn = TornStore::new(base, budget);
         assert!(save_seed(&mut torn, 42, 3).is_err());
         let (outcome, st, out) = load_all(&torn.inner, 42);
         assert_eq!(outcome, LoadOutcome::Loaded { generation: 2, slot: 1 });

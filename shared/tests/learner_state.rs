@@ -11,6 +11,8 @@
 //! - a save torn inside the state record keeps the previous checkpoint;
 //! - a configuration mismatch leaves weights and state untouched.
 
+mod support;
+use support::TornStore;
 use pada_core::action_space::{ActionDim, ActionSpace};
 use pada_core::agent::{Agent, AgentState, AgentStats, EpisodeEnd, Mode, SarsaParams};
 use pada_core::checkpoint::*;
@@ -605,47 +607,6 @@ fn a_version_1_checkpoint_is_refused_not_loaded_without_its_state() {
 // Torn writes
 // ---------------------------------------------------------------------------
 
-/// A store that loses power after `budget` more bytes have been written.
-struct TornStore {
-    inner: Store,
-    budget: usize,
-    dead: bool,
-}
-
-#[derive(Debug, PartialEq)]
-struct PowerLost;
-
-impl CheckpointStore for TornStore {
-    type Error = PowerLost;
-    fn capacity(&self) -> usize {
-        self.inner.capacity()
-    }
-    fn read(&self, slot: u8, offset: usize, buf: &mut [u8]) -> Result<(), PowerLost> {
-        self.inner.read(slot, offset, buf).map_err(|_| PowerLost)
-    }
-    fn erase(&mut self, slot: u8) -> Result<(), PowerLost> {
-        if self.dead {
-            return Err(PowerLost);
-        }
-        self.inner.erase(slot).map_err(|_| PowerLost)
-    }
-    fn write(&mut self, slot: u8, offset: usize, data: &[u8]) -> Result<(), PowerLost> {
-        if self.dead {
-            return Err(PowerLost);
-        }
-        let n = data.len().min(self.budget);
-        self.inner.write(slot, offset, &data[..n]).map_err(|_| PowerLost)?;
-        self.budget -= n;
-        if n < data.len() || self.budget == 0 {
-            self.dead = true;
-            if n < data.len() {
-                return Err(PowerLost);
-            }
-        }
-        Ok(())
-    }
-}
-
 #[test]
 fn a_save_torn_inside_the_state_record_keeps_the_previous_checkpoint() {
     let mut a = trained(PolicyKind::Pada { delta: 0.5 }, 6, 500);
@@ -661,7 +622,7 @@ fn a_save_torn_inside_the_state_record_keeps_the_previous_checkpoint() {
     // weights and of the header (written last).
     let budgets = (0..=STATE_LEN).chain([STATE_LEN + 1, STATE_LEN + 2000, slot_len(WEIGHTS) - HEADER_LEN + 5, slot_len(WEIGHTS) - 1]);
     for budget in budgets {
-        let mut torn = TornStore { inner: base.clone(), budget, dead: false };
+        let mut torn = TornStore::new(base.clone(), budget);
         assert!(save(&mut torn, HASH, &second, a.agent.weights()).is_err(), "budget {budget}");
         let mut b = new_learner(PolicyKind::Sarsa, 42);
         assert_eq!(b.load(&torn.inner, HASH), LoadOutcome::Loaded { generation: 1, slot: 0 }, "budget {budget}");
