@@ -45,7 +45,6 @@ pub struct ActionTiles<const TILINGS: usize> {
     /// adds to the combination index in tiling `j`.
     part: [[[u8; MAX_LEVELS]; MAX_ACTION_DIMS]; TILINGS],
     combos: u32,
-    widths: [f32; MAX_ACTION_DIMS],
 }
 
 impl<const TILINGS: usize> ActionTiles<TILINGS> {
@@ -65,60 +64,51 @@ impl<const TILINGS: usize> ActionTiles<TILINGS> {
                 "one tile width per action dimension",
             ));
         }
-        let t = TILINGS as i32;
-        let mut tiles = [1u32; MAX_ACTION_DIMS];
-        let mut k = [[[0u8; MAX_LEVELS]; MAX_ACTION_DIMS]; TILINGS];
-        let mut levels = [1u8; MAX_ACTION_DIMS];
-        let mut stored_widths = [0.0f32; MAX_ACTION_DIMS];
         for (d, &w) in widths.iter().enumerate() {
             if !(w.is_finite() && w > 0.0) {
                 return Err(ConfigError::new("action tile width", w, "finite and > 0").at(d));
             }
-            stored_widths[d] = w;
+        }
+        // Tile of value `v` of dimension `d` in tiling `j`, counted from the
+        // tile of the dimension's lowest level (levels ascend, so ≥ 0).
+        let tile_of = |d: usize, j: usize, v: f32| -> u32 {
+            let (dim, t) = (space.dim(d), TILINGS as i32);
+            let scale = TILINGS as f32 / widths[d];
+            let start = |v: f32| tile_start(floor_i32((v - dim.min()) * scale), j as i32, (first_coordinate + d) as i32, t, 0);
+            ((start(v) - start(dim.min())) / t) as u32
+        };
+        let mut levels = [1u8; MAX_ACTION_DIMS];
+        let mut stride = [0u32; MAX_ACTION_DIMS];
+        let mut combos = 1u32;
+        for d in 0..space.dims() {
             let dim = space.dim(d);
             levels[d] = dim.len() as u8;
-            let scale = TILINGS as f32 / w;
-            let coordinate = (first_coordinate + d) as i32;
-            for j in 0..TILINGS {
-                let start = |v: f32| tile_start(floor_i32((v - dim.min()) * scale), j as i32, coordinate, t, 0);
-                let lowest = start(dim.min());
-                for (l, &v) in dim.values().iter().enumerate() {
-                    // Levels ascend, so every start is ≥ the lowest one.
-                    let tile = ((start(v) - lowest) / t) as u32;
-                    if tile >= MAX_ACTION_COMBOS as u32 {
-                        return Err(too_many(tile + 1));
-                    }
-                    k[j][d][l] = tile as u8;
-                    tiles[d] = tiles[d].max(tile + 1);
-                }
-            }
+            stride[d] = combos;
+            let tiles = (0..TILINGS).flat_map(|j| dim.values().iter().map(move |&v| (j, v))).map(|(j, v)| tile_of(d, j, v) + 1).max();
+            combos = combos.saturating_mul(tiles.unwrap_or(1));
+        }
+        if combos > MAX_ACTION_COMBOS as u32 {
+            return Err(ConfigError::new(
+                "action tile combinations",
+                combos as f32,
+                "at most 128 per tiling (use wider action tiles or fewer levels)",
+            ));
         }
         let mut part = [[[0u8; MAX_LEVELS]; MAX_ACTION_DIMS]; TILINGS];
-        let mut stride = 1u32;
-        for d in 0..space.dims() {
-            for j in 0..TILINGS {
-                for l in 0..levels[d] as usize {
-                    // stride · k < combos ≤ MAX_ACTION_COMBOS (checked below
-                    // before any part is used), so u8 holds it.
-                    part[j][d][l] = (k[j][d][l] as u32 * stride).min(u8::MAX as u32) as u8;
+        for (j, part_j) in part.iter_mut().enumerate() {
+            for d in 0..space.dims() {
+                for (l, &v) in space.dim(d).values().iter().enumerate() {
+                    // tile · stride < combos ≤ MAX_ACTION_COMBOS: fits a u8.
+                    part_j[d][l] = (tile_of(d, j, v) * stride[d]) as u8;
                 }
             }
-            stride = stride.saturating_mul(tiles[d]);
         }
-        if stride > MAX_ACTION_COMBOS as u32 {
-            return Err(too_many(stride));
-        }
-        Ok(ActionTiles { dims: space.dims(), levels, part, combos: stride, widths: stored_widths })
+        Ok(ActionTiles { dims: space.dims(), levels, part, combos })
     }
 
     /// Combinations per tiling (every combination index is below this).
     pub fn combos(&self) -> u32 {
         self.combos
-    }
-
-    /// The tile widths, one per action dimension.
-    pub fn widths(&self) -> &[f32] {
-        &self.widths[..self.dims]
     }
 
     /// What level `level` of action dimension `d` adds to the combination
@@ -133,33 +123,21 @@ impl<const TILINGS: usize> ActionTiles<TILINGS> {
     /// The combination that `levels` falls into in tiling `j`.
     #[inline]
     pub fn combo(&self, j: usize, levels: &Levels) -> u32 {
-        let mut c = 0u32;
-        for d in 0..self.dims {
-            c += self.part[j][d][levels[d] as usize] as u32;
-        }
-        c
+        (0..MAX_ACTION_DIMS).map(|d| self.part(j, d, levels[d])).sum()
     }
 
     /// The combination of joint action `action` (first dimension fastest)
     /// in tiling `j`.
     #[inline]
     pub fn combo_of_action(&self, j: usize, mut action: u32) -> u32 {
-        let mut c = 0u32;
+        let mut levels = [0u8; MAX_ACTION_DIMS];
         for d in 0..self.dims {
             let n = self.levels[d] as u32;
-            c += self.part[j][d][(action % n) as usize] as u32;
+            levels[d] = (action % n) as u8;
             action /= n;
         }
-        c
+        self.combo(j, &levels)
     }
-}
-
-fn too_many(n: u32) -> ConfigError {
-    ConfigError::new(
-        "action tile combinations",
-        n as f32,
-        "at most 128 per tiling (use wider action tiles or fewer levels)",
-    )
 }
 
 #[cfg(test)]

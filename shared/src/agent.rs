@@ -526,9 +526,9 @@ where
                     sum += w[self.coder.action_feature(code, j, action) as usize].0 as i64;
                 }
             }
-            Some(_) => {
+            Some(at) => {
                 for j in 0..TILINGS {
-                    sum += w[self.coder.feature(code, j, action) as usize].0 as i64;
+                    sum += w[self.coder.combo_feature(code, j, at.combo_of_action(j, action)) as usize].0 as i64;
                 }
             }
         }

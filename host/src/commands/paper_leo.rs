@@ -52,8 +52,8 @@ pub fn run(args: PaperArgs) -> Result<(), CliError> {
     // of its greedy policy as a strip, an animation and CSV.
     if let Some(mut b) = best {
         let policy = r.configs[b.config].policy;
-        let spec = crate::task::Task::spec(&crate::leo::rl::LeoTask::default()).clone();
-        crate::weights::save(&out.path().join("best.weights"), &spec, policy, b.switched, &b.agent)?;
+        let task = crate::leo::rl::LeoTask::default();
+        crate::weights::save(&out.path().join("best.weights"), crate::task::Task::spec(&task), policy, b.switched, &b.agent)?;
         let (frames, fell) = super::render::record_agent(&mut b.agent, 10.0)?;
         let source = format!("{}, trial {} (best end performance)", name(&r, b.config), b.trial);
         let title = super::render::gait_title(&source, &frames, fell);

@@ -227,8 +227,7 @@ pub fn gait_files(
 ) -> anyhow::Result<Vec<(String, Vec<u8>)>> {
     let svg = strip_svg(frames, strip_frames, title)?;
     let png = svg_to_png(&svg)?;
-    let period = LeoTask::default().spec().control_period_s;
-    let animation = animated_svg(frames, period, title);
+    let animation = animated_svg(frames, CONTROL_PERIOD as f64, title);
     let mut csv = String::from("time_s,hip_x_m,walked_m\n");
     for f in frames {
         csv += &format!("{},{},{}\n", f.time, f.hip_x, f.walked);

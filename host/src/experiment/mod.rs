@@ -12,7 +12,7 @@ pub mod trial;
 
 pub use agent_setup::{build_agent, HostAgent, TILINGS, TRACE};
 pub use metrics::{end_performance, rise_time};
-pub use runner::{run_configs, run_trials, run_trials_observed, RunConfig};
+pub use runner::{run_configs, run_configs_keeping, run_trials, run_trials_observed, FinishedTrial, RunConfig};
 pub use trial::{
     run_trial, run_trial_keep, run_trial_observed, TestPoint, TrialObserver, TrialResult,
 };

@@ -3,7 +3,7 @@
 //! results do not depend on scheduling.
 
 use super::agent_setup::HostAgent;
-use super::trial::{run_trial, run_trial_observed, TrialObserver, TrialResult};
+use super::trial::{run_trial, run_trial_keep, run_trial_observed, TrialObserver, TrialResult};
 use crate::task::Task;
 use pada_core::policy::PolicyKind;
 use rayon::prelude::*;
@@ -77,6 +77,31 @@ pub fn run_configs<T: Task>(
     cfgs: &[RunConfig],
     progress: &(dyn Fn(u64) + Sync),
 ) -> anyhow::Result<Vec<Vec<TrialResult>>> {
+    run_configs_keeping(task, cfgs, progress, &|_| {})
+}
+
+/// A finished trial's learner, handed to [`run_configs_keeping`]'s `keep`.
+pub struct FinishedTrial<'a> {
+    /// Index of its configuration in `cfgs`.
+    pub config: usize,
+    /// Trial index within the configuration.
+    pub trial: u32,
+    /// Its result.
+    pub result: &'a TrialResult,
+    /// The learned agent.
+    pub agent: HostAgent,
+    /// Whether it had switched back to SARSA(λ).
+    pub switched: bool,
+}
+
+/// [`run_configs`], offering each trial's learner to `keep` as it finishes
+/// (from the worker thread); a learner `keep` does not take is dropped.
+pub fn run_configs_keeping<T: Task>(
+    task: &T,
+    cfgs: &[RunConfig],
+    progress: &(dyn Fn(u64) + Sync),
+    keep: &(dyn Fn(FinishedTrial) + Sync),
+) -> anyhow::Result<Vec<Vec<TrialResult>>> {
     let jobs: Vec<(usize, u32)> = cfgs
         .iter()
         .enumerate()
@@ -84,7 +109,11 @@ pub fn run_configs<T: Task>(
         .collect();
     let results: Vec<TrialResult> = jobs
         .par_iter()
-        .map(|&(c, t)| run_trial(task, &cfgs[c], t, progress))
+        .map(|&(c, t)| {
+            let (result, agent, switched) = run_trial_keep(task, &cfgs[c], t, progress)?;
+            keep(FinishedTrial { config: c, trial: t, result: &result, agent, switched });
+            Ok(result)
+        })
         .collect::<anyhow::Result<_>>()?;
     let mut out: Vec<Vec<TrialResult>> = cfgs
         .iter()

@@ -8,7 +8,7 @@
 //! each without and with the switch at half the learning time (the paper's
 //! 7,333 s of 14,666 s).
 
-use crate::experiment::{run_trial_keep, HostAgent, RunConfig, TrialResult};
+use crate::experiment::{run_configs_keeping, FinishedTrial, HostAgent, RunConfig};
 use crate::leo::rl::LeoTask;
 use crate::paper::pendulum::{mean_curve, ConfigResult};
 use crate::summary::RunSummary;
@@ -135,30 +135,18 @@ pub struct BestTrial {
 /// Returns the results and the best trial's learner (`None` only when no
 /// trial has a finite end performance).
 pub fn run(o: &LeoOptions, progress: &(dyn Fn(u64) + Sync)) -> anyhow::Result<(LeoResults, Option<BestTrial>)> {
-    use rayon::prelude::*;
     let start = std::time::Instant::now();
     let task = LeoTask::default();
     let cfgs = run_configs_of(o);
-    let jobs: Vec<(usize, u32)> =
-        cfgs.iter().enumerate().flat_map(|(c, cfg)| (0..cfg.trials).map(move |t| (c, t))).collect();
     // Only the best learner so far is kept (16 MiB each), not all of them.
     let best: std::sync::Mutex<Option<BestTrial>> = std::sync::Mutex::new(None);
-    let flat: Vec<TrialResult> = jobs
-        .par_iter()
-        .map(|&(c, t)| {
-            let (r, agent, switched) = run_trial_keep(&task, &cfgs[c], t, progress)?;
-            let e = r.end_performance;
-            let mut b = best.lock().unwrap_or_else(|p| p.into_inner());
-            if e.is_finite() && b.as_ref().is_none_or(|b| e > b.end_performance) {
-                *b = Some(BestTrial { config: c, trial: t, end_performance: e, switched, agent });
-            }
-            Ok(r)
-        })
-        .collect::<anyhow::Result<_>>()?;
-    let mut results: Vec<Vec<TrialResult>> = cfgs.iter().map(|_| Vec::new()).collect();
-    for (&(c, _), r) in jobs.iter().zip(flat) {
-        results[c].push(r);
-    }
+    let results = run_configs_keeping(&task, &cfgs, progress, &|f: FinishedTrial| {
+        let e = f.result.end_performance;
+        let mut b = best.lock().unwrap_or_else(|p| p.into_inner());
+        if e.is_finite() && b.as_ref().is_none_or(|b| e > b.end_performance) {
+            *b = Some(BestTrial { config: f.config, trial: f.trial, end_performance: e, switched: f.switched, agent: f.agent });
+        }
+    })?;
     let wall_s = start.elapsed().as_secs_f64();
     let configs: Vec<ConfigResult> = cfgs
         .iter()
