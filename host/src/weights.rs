@@ -12,8 +12,8 @@
 //! CRC-32/ISO-HDLC                 u32 little endian, of everything before
 //! ```
 
+use crate::experiment::task::{TaskSpec, WeightTable};
 use crate::experiment::{HostAgent, TILINGS};
-use crate::task::{TaskSpec, WeightTable};
 use pada_core::checkpoint::crc32;
 use pada_core::fixed::Q16;
 use pada_core::policy::PolicyKind;

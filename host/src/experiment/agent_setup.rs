@@ -5,7 +5,7 @@
 //! prunes entries below 0.01 after 49 steps, so 64 never drops one), and a
 //! weight table laid out as the task asks ([`WeightTable`]).
 
-use crate::task::{TaskSpec, WeightTable};
+use crate::experiment::task::{TaskSpec, WeightTable};
 use pada_core::agent::Agent;
 use pada_core::fixed::Q16;
 use pada_core::policy::{Policy, PolicyKind};

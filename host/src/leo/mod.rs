@@ -18,6 +18,7 @@
 //! panics; non-finite action voltages are read as 0 V and flagged.
 
 pub mod constants;
+pub mod gait;
 pub mod model;
 pub mod rl;
 pub mod task;

@@ -1,4 +1,4 @@
-//! LEO as a task of the experiment runner ([`crate::task::Task`]): the
+//! LEO as a task of the experiment runner ([`crate::experiment::task::Task`]): the
 //! walking task of Section VIII learned with SARSA(λ), PADA or the low-pass
 //! filter through the same code as the pendulums.
 //!
@@ -19,7 +19,7 @@
 
 use super::task::{Observation, ACTION_DIM, OBS_DIM};
 use super::{LeoConfig, LeoEnv, Terminal};
-use crate::task::{Plant, Step, Task, TaskSpec, WeightTable};
+use crate::experiment::task::{Plant, Step, Task, TaskSpec, WeightTable};
 use pada_core::action_space::{ActionDim, ActionSpace, Output, MAX_ACTION_DIMS};
 use pada_core::agent::{SarsaParams, WeightInit};
 use pada_core::tile_coding::StateDim;

@@ -20,8 +20,8 @@
 //! and an MTBF near 10⁴ s instead.
 
 use super::{swing_up_reward, wrap_angle};
+use crate::experiment::task::{Plant, Step, Task, TaskSpec, WeightTable};
 use crate::integrator::{rk4_step, SinNear};
-use crate::task::{Plant, Step, Task, TaskSpec, WeightTable};
 use pada_core::action_space::{ActionDim, ActionSpace, Output, MAX_ACTION_DIMS};
 use pada_core::agent::{SarsaParams, WeightInit};
 use pada_core::tile_coding::StateDim;
@@ -224,7 +224,7 @@ impl Task for PhysicalPendulumTask {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::task::Plant;
+    use crate::experiment::task::Plant;
 
     fn rollout(substeps: u32) -> [f64; 2] {
         let p = PhysicalPendulumParams {

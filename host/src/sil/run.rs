@@ -896,7 +896,7 @@ impl Session<'_> {
         SilSummary {
             task: cfg.task,
             robot: cfg.task.robot().name(),
-            policy: crate::algo::label(&cfg.policy),
+            policy: crate::experiment::algo::label(&cfg.policy),
             seed: DEFAULT_SEED,
             elf: cfg.elf.display().to_string(),
             plant: self.rig.describe(),
