@@ -102,6 +102,9 @@ pub struct PeriodOutput {
     pub transitions: Vec<Transition, 8>,
     /// Cycles of the agent call, if there was one.
     pub agent_cycles: Option<u32>,
+    /// The gearbox torque of each servo the fatigue counter saw this
+    /// period \[N·m\] (the robot's estimate; 0 with torque off).
+    pub torques: [f32; MAX_SERVOS],
 }
 
 /// A host command's result, for the `Ack`/`Nack`.
@@ -448,6 +451,7 @@ where
             return Ok(LoadOutcome::InvalidState);
         }
         let read = checkpoint::read_weights(store, &found, self.agent_mut().weights_mut());
+        self.agent_mut().rehash();
         let outcome = match read {
             Ok(outcome) => outcome,
             Err(e) => {
@@ -588,6 +592,7 @@ where
         out.transitions.clear();
         out.speeds.clear();
         out.agent_cycles = None;
+        out.torques = [0.0; MAX_SERVOS];
         self.steps = self.steps.wrapping_add(1);
         let now = readings.time_ms;
         let joints = self.config.joints;
@@ -683,6 +688,7 @@ where
             self.robot.gear_torques(&self.applied, &mut torques);
             torques[n..].fill(0.0);
             let _ = self.fatigue.update(&torques);
+            out.torques = torques;
         }
         out.torque = torque;
     }

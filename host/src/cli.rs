@@ -98,6 +98,14 @@ pub struct RunArgs {
     /// a checksum; read by `pada render`).
     #[arg(long, value_name = "FILE")]
     pub save_weights: Option<PathBuf>,
+    /// Run a board's own learner instead of the host's: the firmware's
+    /// controller built for the host, with the board's learner profile
+    /// (table layout, size, weight format), its sensors (servo counts,
+    /// differenced rates, the encoder) and its episode logic, against the
+    /// task's plant (physical-pendulum or leo). What it learns is what the
+    /// board will learn.
+    #[arg(long, value_enum, value_name = "NAME")]
+    pub board: Option<crate::board::BoardName>,
     /// Seed and threads.
     #[command(flatten)]
     pub trial: TrialOptions,

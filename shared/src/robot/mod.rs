@@ -136,7 +136,9 @@ impl RobotSpec {
 
     /// The control period \[s\].
     pub fn period_s(&self) -> f64 {
-        self.period_us as f64 * 1e-6
+        // Divided, not multiplied by 1e-6: 30 000 µs is then exactly the
+        // double nearest 0.03.
+        self.period_us as f64 / 1e6
     }
 
     /// The learner's motor: [`motor_dims`](Self::motor_dims) dimensions of
