@@ -209,7 +209,9 @@ mod tests {
         let unit = table::POSITION_RANGE_RAD as f64 / table::POSITION_MAX as f64;
         assert!((before.0 as f64 - (512.0 + START_JOINT_ANGLES[Joint::HipRight as usize] as f64 / unit)).abs() <= 1.5);
         assert!((before.1 as f64 - (512.0 + START_JOINT_ANGLES[Joint::KneeRight as usize] as f64 / unit)).abs() <= 1.5);
-        assert_eq!(before.2 .0, encoder_count(-START_PHI as f64));
+        // (The first control period at 0 V tips the torso by a few mrad.)
+        let pitch = before.2 .0 as i32 - encoder_count(-START_PHI as f64) as i32;
+        assert!(pitch.abs() <= 5, "{pitch} counts from the start pitch");
         assert_ne!(before.2 .1 & contact::LEFT, 0);
         // Held: a second passes, nothing moves, whatever is commanded.
         rig.drive(0, hip_r, true, 10.0);

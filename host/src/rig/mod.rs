@@ -87,6 +87,7 @@ pub fn position_raw(angle: f64) -> u16 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::PI;
 
     #[test]
     fn encoder_counts_wrap_like_a_16_bit_timer() {
