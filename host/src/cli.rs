@@ -106,6 +106,16 @@ pub struct RunArgs {
     /// board will learn.
     #[arg(long, value_enum, value_name = "NAME")]
     pub board: Option<crate::board::BoardName>,
+    /// With --board: a hashed table of 2^N weights instead of the board's
+    /// (placed in CCM, then SRAM on an F405), to see what a board would
+    /// learn with more or less memory. The firmware builds only the boards'
+    /// own profiles.
+    #[arg(long, value_name = "N", requires = "board", value_parser = clap::value_parser!(u32).range(8..=26))]
+    pub table_log2: Option<u32>,
+    /// With --board: store weights in 16 or 32 bits (16: stochastic
+    /// rounding, the robot's range; see pada_core::weights).
+    #[arg(long, value_name = "BITS", requires = "board", value_parser = ["16", "32"])]
+    pub weight_bits: Option<String>,
     /// Seed and threads.
     #[command(flatten)]
     pub trial: TrialOptions,

@@ -35,7 +35,7 @@ use pada_core::fixed::Q16;
 use pada_core::policy::PolicyKind;
 use pada_core::profile::{LearnerProfile, TILINGS};
 use pada_core::robot::Robot;
-use pada_core::weights::WeightStore;
+use pada_core::weights::{Half, WeightFormat, WeightStore};
 use pada_core::wire::{RunMode, StepKind, ToChip};
 use pada_firmware::config::hardware;
 use pada_firmware::control::{Controller, PeriodOutput, Readings};
@@ -107,14 +107,26 @@ pub fn run_board_trial(
 ) -> anyhow::Result<BoardTrial> {
     let n = table_len(&profile, cfg.policy)?;
     let seed = trial_seed(cfg.seed, trial);
+    // On the host a table split over CCM and SRAM is one slice: `Split`
+    // addresses the same weights in the same order.
     match (profile.robot, profile.format) {
-        (Robot::Pendulum33, pada_core::weights::WeightFormat::Q16) => {
+        (Robot::Pendulum33, WeightFormat::Q16) => {
             let mut rig = PendulumRig::with_operator(PhysicalPendulumParams::default());
             run::<Pendulum33, _>(profile, vec![Q16::ZERO; n].into_boxed_slice(), &mut rig, cfg, trial, seed, progress)
         }
-        (Robot::Leo, pada_core::weights::WeightFormat::Q16) => {
+        (Robot::Leo, WeightFormat::Q16) => {
             let mut rig = LeoRig::new(ModelOptions::default())?;
             run::<Leo, _>(profile, vec![Q16::ZERO; n].into_boxed_slice(), &mut rig, cfg, trial, seed, progress)
+        }
+        (Robot::Leo, WeightFormat::Half { shift: pada_core::robot::leo::HALF_SHIFT }) => {
+            let mut rig = LeoRig::new(ModelOptions::default())?;
+            let table = Half::<_, { pada_core::robot::leo::HALF_SHIFT as u32 }>::new(vec![0i16; n].into_boxed_slice());
+            run::<Leo, _>(profile, table, &mut rig, cfg, trial, seed, progress)
+        }
+        (Robot::Pendulum33, WeightFormat::Half { shift: pada_core::robot::pendulum::HALF_SHIFT }) => {
+            let mut rig = PendulumRig::with_operator(PhysicalPendulumParams::default());
+            let table = Half::<_, { pada_core::robot::pendulum::HALF_SHIFT as u32 }>::new(vec![0i16; n].into_boxed_slice());
+            run::<Pendulum33, _>(profile, table, &mut rig, cfg, trial, seed, progress)
         }
         (robot, format) => bail!("no board runner for {} with {format:?} weights", robot.name()),
     }

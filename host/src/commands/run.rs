@@ -15,6 +15,7 @@ use crate::summary::{board_files, BoardSummary};
 use pada_core::profile::{Board, TILINGS};
 use pada_core::robot::Robot;
 use pada_core::tile_coding::Layout;
+use pada_core::weights::WeightFormat;
 use crate::experiment::{build_agent, run_trials, run_trials_observed, RunConfig};
 use crate::output::OutDir;
 use crate::progress::steps_bar;
@@ -42,7 +43,24 @@ fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
             )));
         }
     }
-    let profile = board.profile(robot);
+    let mut profile = board.profile(robot);
+    let format = match args.weight_bits.as_deref() {
+        Some("16") => WeightFormat::Half { shift: robot.spec().half_shift },
+        Some(_) => WeightFormat::Q16,
+        None => profile.format,
+    };
+    if args.table_log2.is_some() || format != profile.format {
+        let log2 = match (args.table_log2, profile.layout, profile.weights()) {
+            (Some(n), _, _) => n,
+            (None, Layout::Hashed, Some(n)) => n.trailing_zeros(),
+            _ => return Err(usage(format!(
+                "--weight-bits without --table-log2 needs a hashed board table; {} has an exact one for {}",
+                board.name(),
+                robot.name()
+            ))),
+        };
+        profile = profile.with_hashed_table(log2, format);
+    }
     let policy = policy_kind(args.algo, args.alpha, args.delta).map_err(|e| usage(e.0))?;
     // The task as the runner describes it, with the board's table: the
     // summary's keys and parameters are `pada run`'s.

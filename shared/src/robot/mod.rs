@@ -126,6 +126,9 @@ pub struct RobotSpec {
     pub action_tiles: Option<&'static [f32]>,
     /// SARSA(λ) parameters.
     pub params: SarsaParams,
+    /// The shift of 16-bit weights ([`crate::weights::WeightFormat::Half`])
+    /// for this robot: its Q-values stay within ±2^(shift − 1).
+    pub half_shift: u8,
 }
 
 impl RobotSpec {
