@@ -735,6 +735,11 @@ where
         let dims = self.robot.observe(&mut obs);
         let (reward, absorbing) = (self.robot.reward(&self.applied), self.robot.absorbing());
         let timeout = steps >= self.spec.episode_steps;
+        // A footstep: the policy's memory moves with the joints before the
+        // next decision.
+        if let (true, Some(map)) = (self.robot.footstep(), self.spec.footstep_remap) {
+            self.agent_mut().remap_memory(&map);
+        }
         let t0 = cycles.cycles();
         let (kind, result) = {
             let Some(agent) = self.agent.as_mut() else { return };

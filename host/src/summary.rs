@@ -62,10 +62,16 @@ pub struct RunSummary {
     pub end_performance: Estimate,
     /// Rise time over trials \[s\] (Section VI).
     pub rise_time_s: Estimate,
-    /// Predicted MTBF from the first 1200 actions \[s\] (Eqs. 3–7).
+    /// Predicted MTBF from the first 1200 actions \[s\] (Eqs. 3–7), the
+    /// paper's definition: gearbox torques from the commanded action.
     pub mtbf_s: Estimate,
-    /// Backlash re-engagements within those actions.
+    /// Backlash re-engagements within those actions (the paper's).
     pub window_reengagements: Estimate,
+    /// Predicted MTBF from the first 1200 actions \[s\] from the simulated
+    /// gear torques.
+    pub physical_mtbf_s: Estimate,
+    /// Re-engagements of the simulated gear torques within those actions.
+    pub physical_window_reengagements: Estimate,
     /// Distance walked in the last 10% of the test runs \[m\] (walking
     /// tasks only).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -136,6 +142,8 @@ impl RunSummary {
             rise_time_s: Estimate::of(&col(|r| r.rise_time_s)),
             mtbf_s: Estimate::of(&col(|r| r.mtbf_s)),
             window_reengagements: Estimate::of(&col(|r| r.window_reengagements as f64)),
+            physical_mtbf_s: Estimate::of(&col(|r| r.physical_mtbf_s)),
+            physical_window_reengagements: Estimate::of(&col(|r| r.physical_window_reengagements as f64)),
             end_walked_m: walking.then(|| Estimate::of(&col(|r| r.end_walked_m.unwrap_or(f64::NAN)))),
             end_speed_m_s: walking.then(|| Estimate::of(&col(|r| r.end_speed_m_s.unwrap_or(f64::NAN)))),
             learning_falls: Estimate::of(&col(|r| r.learning_falls as f64)),

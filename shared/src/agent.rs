@@ -397,6 +397,14 @@ where
         self.policy.switch_to_sarsa()
     }
 
+    /// Moves the policy's memory between action dimensions when the joints
+    /// they drive swap roles ([`Policy::remap`]; LEO's footstep,
+    /// [`crate::robot::RobotSpec::footstep_remap`]). Call it after the
+    /// observation that shows the swap and before the next decision.
+    pub fn remap_memory(&mut self, map: &[Option<u8>; MAX_ACTION_DIMS]) {
+        self.policy.remap(map);
+    }
+
     /// The agent's state besides its weights, as plain data
     /// ([`AgentState`]).
     pub fn state(&self) -> AgentState {

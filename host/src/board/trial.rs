@@ -60,8 +60,10 @@ pub struct BoardTrial {
     /// The final weights' checksum (FNV-1a of the stored bytes).
     pub weights_checksum: u32,
     /// The predicted MTBF from the board's own torque estimate (the RX-28
-    /// model for LEO, the linear voltage law for the pendulum) over the
-    /// same first learning actions \[s\].
+    /// model at the measured rate for LEO, the linear voltage law for the
+    /// pendulum) over the same first learning actions \[s\]. (The result's
+    /// `mtbf_s` is the paper's, from the commanded voltages;
+    /// `physical_mtbf_s` is from the simulation's gear torques.)
     pub board_estimated_mtbf_s: f64,
     /// Control periods run, with the waits between episodes.
     pub periods: u64,
@@ -169,8 +171,10 @@ fn run<R: RobotAdapter, W: WeightStore>(
     anyhow::ensure!(ids.len() <= COUNTED, "at most {COUNTED} counted joints");
     let window = Some(PAPER_WINDOW_STEPS);
     let fatigue = |_: ()| FatigueCounter::<COUNTED>::new(GearboxParams::TABLE_I, period_s, window);
+    let mut paper = fatigue(()).map_err(|e| anyhow!("{e}"))?;
     let mut simulated = fatigue(()).map_err(|e| anyhow!("{e}"))?;
     let mut estimated = fatigue(()).map_err(|e| anyhow!("{e}"))?;
+    let mut volts_of = [0.0f32; 256];
 
     let budget = (cfg.seconds / period_s).round() as u64;
     let switch_step = cfg.switch_at_s.map(|s| (s / period_s).round() as u64);
@@ -203,6 +207,7 @@ fn run<R: RobotAdapter, W: WeightStore>(
         for &(id, speed) in &out.speeds {
             let volts = pada_core::dynamixel::table::ratio_from_moving_speed(speed) as f64 * supply;
             rig.drive(t, id, out.torque, volts);
+            volts_of[id as usize] = if out.torque { volts as f32 } else { 0.0 };
         }
         let mut learning_action = false;
         if let Some(s) = &out.step {
@@ -216,12 +221,15 @@ fn run<R: RobotAdapter, W: WeightStore>(
         k += 1;
         rig.advance_to(k * period_us);
         if learning_action {
+            let mut com = [0.0f32; COUNTED];
             let mut sim = [0.0f32; COUNTED];
             let mut est = [0.0f32; COUNTED];
             for (c, (j, id)) in counted.clone().zip(&ids).enumerate() {
+                com[c] = R::ROBOT.commanded_gear_torque(volts_of[*id as usize]);
                 sim[c] = rig.gear_torque(*id);
                 est[c] = out.torques[j];
             }
+            paper.update(&com).map_err(|e| anyhow!("{e}"))?;
             simulated.update(&sim).map_err(|e| anyhow!("{e}"))?;
             estimated.update(&est).map_err(|e| anyhow!("{e}"))?;
             learning_steps += 1;
@@ -275,8 +283,10 @@ fn run<R: RobotAdapter, W: WeightStore>(
         seed,
         end_performance: end_performance(&returns).unwrap_or(f64::NAN),
         rise_time_s: rise_time(&times, &returns).unwrap_or(f64::NAN),
-        mtbf_s: simulated.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
-        window_reengagements: simulated.joints().iter().filter_map(|j| j.window_reengagements()).sum(),
+        mtbf_s: paper.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
+        window_reengagements: paper.joints().iter().filter_map(|j| j.window_reengagements()).sum(),
+        physical_mtbf_s: simulated.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
+        physical_window_reengagements: simulated.joints().iter().filter_map(|j| j.window_reengagements()).sum(),
         learning_steps,
         test_steps,
         learning_falls,

@@ -7,8 +7,12 @@
 //! - End performance and rise time follow from it ([`super::metrics`]).
 //! - The predicted MTBF is the fatigue counter's windowed MTBF over the
 //!   first [`PAPER_WINDOW_STEPS`] learning actions (end of Section IV),
-//!   from the torques the plant applies to its gearboxes (Eqs. 3–7); the
-//!   robot's MTBF is its weakest joint's.
+//!   counted per physical gearbox (Eqs. 3–7); the robot's MTBF is its
+//!   weakest gearbox's. Two of them: **the paper's** (`mtbf_s`), from the
+//!   commanded action as Section IV takes it, linear in the voltage
+//!   ([`Plant::commanded_torques`]); and **the physical** one
+//!   (`physical_mtbf_s`), from the gear torques the simulation computes
+//!   ([`Plant::gearbox_torques`]).
 
 use super::agent_setup::{build_agent, HostAgent};
 use super::metrics::{end_performance, rise_time};
@@ -52,11 +56,18 @@ pub struct TrialResult {
     pub end_performance: f64,
     /// Rise time \[s of learning time\].
     pub rise_time_s: f64,
-    /// Predicted MTBF from the first 1200 learning actions \[s\]
-    /// (infinite when nothing re-engaged).
+    /// Predicted MTBF from the first 1200 learning actions \[s\], the
+    /// paper's definition: torques from the commanded action (infinite when
+    /// nothing re-engaged).
     pub mtbf_s: f64,
-    /// Backlash re-engagements within those actions (all joints).
+    /// Backlash re-engagements within those actions (all gearboxes), the
+    /// paper's definition.
     pub window_reengagements: u64,
+    /// Predicted MTBF from the first 1200 learning actions \[s\], from the
+    /// simulated gear torques.
+    pub physical_mtbf_s: f64,
+    /// Re-engagements of the simulated gear torques within those actions.
+    pub physical_window_reengagements: u64,
     /// Learning steps taken.
     pub learning_steps: u64,
     /// Test-run steps taken.
@@ -132,12 +143,14 @@ pub fn run_trial_observed<T: Task>(
         Some(PAPER_WINDOW_STEPS),
     )
     .map_err(|e| anyhow!("{e}"))?;
+    let physical = fatigue.clone();
     let mut t = Trial {
         spec,
         agent,
         plant: task.plant(),
         rng,
         fatigue,
+        physical,
         obs: [0.0; MAX_STATE_DIMS],
         switch_step: cfg
             .switch_at_s
@@ -179,6 +192,13 @@ pub fn run_trial_observed<T: Task>(
         end_performance: end_performance(&returns).unwrap_or(f64::NAN),
         rise_time_s: rise_time(&times, &returns).unwrap_or(f64::NAN),
         mtbf_s: t.fatigue.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
+        physical_mtbf_s: t.physical.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
+        physical_window_reengagements: t
+            .physical
+            .joints()
+            .iter()
+            .filter_map(|j| j.window_reengagements())
+            .sum(),
         window_reengagements: t
             .fatigue
             .joints()
@@ -205,7 +225,10 @@ struct Trial<'a, 'o, P: Plant> {
     agent: HostAgent,
     plant: P,
     rng: Pcg64,
+    /// Per gearbox, from the commanded action (the paper's MTBF).
     fatigue: FatigueCounter<MAX_ACTION_DIMS>,
+    /// Per gearbox, from the simulated gear torques (the physical MTBF).
+    physical: FatigueCounter<MAX_ACTION_DIMS>,
     obs: [f32; MAX_STATE_DIMS],
     /// Learning step at which the policy switches back to SARSA(λ).
     switch_step: Option<u64>,
@@ -244,7 +267,7 @@ impl<P: Plant> Trial<'_, '_, P> {
             .fatigue
             .joints()
             .iter()
-            .take(motors.min(wire::MAX_JOINTS))
+            .take(self.spec.gearboxes.min(wire::MAX_JOINTS))
             .map(|j| wire::JointFatigue {
                 damage: j.damage(),
                 reengagements: j.reengagements().min(u32::MAX as u64) as u32,
@@ -349,8 +372,16 @@ impl<P: Plant> Trial<'_, '_, P> {
         for k in 1..=spec.episode_steps {
             let command = &d.output[..motors];
             let step = self.plant.step(command, &mut self.obs[..n]);
+            // A footstep: the policy's memory moves with the joints before
+            // the next decision (the robot's definition).
+            if let (true, Some(map)) = (self.plant.footstep(), spec.footstep_remap) {
+                self.agent.remap_memory(&map);
+            }
             if learning {
                 self.fatigue
+                    .update(&self.plant.commanded_torques(command))
+                    .map_err(|e| anyhow!("{e}"))?;
+                self.physical
                     .update(&self.plant.gearbox_torques(command))
                     .map_err(|e| anyhow!("{e}"))?;
                 self.learning_steps += 1;

@@ -71,6 +71,8 @@ const fn spec(robot: Robot, period_us: u32) -> RobotSpec {
         levels: MotorLevels::Listed(&LEVELS),
         action_tiles: None,
         params: PARAMS,
+        gearboxes: 1,
+        footstep_remap: None,
         half_shift: HALF_SHIFT,
     }
 }
