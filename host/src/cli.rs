@@ -42,6 +42,9 @@ pub enum Command {
     Sil(commands::sil::SilArgs),
     /// Decode telemetry from a board's serial port or a recorded stream.
     Capture(commands::capture::CaptureArgs),
+    /// A live page in the browser of a board's, a recording's or a live
+    /// run's telemetry (decoded and recorded as capture does).
+    Watch(commands::watch::WatchArgs),
     /// Draw a learned LEO gait (saved weights) as a strip of stick figures.
     Render(RenderArgs),
 }
@@ -254,7 +257,7 @@ where
                     Ok(())
                 }
                 ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => Err(usage(
-                    "no command given: valid commands are run, demo, paper, mtbf, render, sil, capture (see pada --help)",
+                    "no command given: valid commands are run, demo, paper, mtbf, render, sil, capture, watch (see pada --help)",
                 )),
                 _ => Err(usage(clap_one_line(&e))),
             };
@@ -267,6 +270,7 @@ where
         Command::Mtbf(a) => commands::mtbf::run(a),
         Command::Sil(a) => commands::sil::run(a),
         Command::Capture(a) => commands::capture::run(a),
+        Command::Watch(a) => commands::watch::run(a),
         Command::Render(a) => commands::render::run(a),
     }
 }

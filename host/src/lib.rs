@@ -26,4 +26,5 @@ pub mod task;
 pub mod tasks;
 pub mod telemetry;
 pub mod torque_log;
+pub mod watch;
 pub mod weights;
