@@ -44,6 +44,7 @@ pub enum Command {
     Capture(commands::capture::CaptureArgs),
     /// A live page in the browser of a board's, a recording's or a live
     /// run's telemetry (decoded and recorded as capture does).
+    #[command(allow_negative_numbers = true)]
     Watch(commands::watch::WatchArgs),
     /// Draw a learned LEO gait (saved weights) as a strip of stick figures.
     Render(RenderArgs),
