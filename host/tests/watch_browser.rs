@@ -147,7 +147,10 @@ impl Page {
 
     /// A PNG screenshot of the viewport.
     fn screenshot(&mut self) -> Vec<u8> {
-        let r = self.call("Page.captureScreenshot", serde_json::json!({ "format": "png" }));
+        let r = self.call(
+            "Page.captureScreenshot",
+            serde_json::json!({ "format": "png" }),
+        );
         base64::engine::general_purpose::STANDARD
             .decode(r["data"].as_str().unwrap())
             .unwrap()
@@ -202,8 +205,22 @@ fn chromium_shows_the_plots_of_a_live_run_and_they_change_as_it_learns() {
     // weights), so 2400 s of learning keeps it going for the whole test.
     let mut run = Command::new(env!("CARGO_BIN_EXE_pada"))
         .args([
-            "run", "--task", "leo", "--algo", "pada", "--delta", "0.1667", "--trials", "1",
-            "--threads", "1", "--seconds", "2400", "--telemetry", &target, "--out",
+            "run",
+            "--task",
+            "leo",
+            "--algo",
+            "pada",
+            "--delta",
+            "0.1667",
+            "--trials",
+            "1",
+            "--threads",
+            "1",
+            "--seconds",
+            "2400",
+            "--telemetry",
+            &target,
+            "--out",
         ])
         .arg(dir.path().join("run"))
         .stdout(Stdio::null())
@@ -221,15 +238,22 @@ fn chromium_shows_the_plots_of_a_live_run_and_they_change_as_it_learns() {
     // Every plot has something to draw: two test runs and a finished
     // episode.
     let first = w.wait_for(300, "two test runs", |s| {
-        s["learning"]["curve"].as_array().is_some_and(|c| c.len() >= 2) && !s["last_episode"].is_null()
+        s["learning"]["curve"]
+            .as_array()
+            .is_some_and(|c| c.len() >= 2)
+            && !s["last_episode"].is_null()
     });
-    assert!(first["ended"].is_null(), "the run ended before the browser looked");
+    assert!(
+        first["ended"].is_null(),
+        "the run ended before the browser looked"
+    );
 
     let browser = Browser::open(&w.url);
     let mut page = browser.page(&w.url);
     let deadline = Instant::now() + Duration::from_secs(30);
     // (The target can still show about:blank for a moment.)
-    let loaded = "JSON.stringify(document.readyState === 'complete' && location.href.startsWith('http') \
+    let loaded =
+        "JSON.stringify(document.readyState === 'complete' && location.href.startsWith('http') \
                   && document.querySelectorAll('figure.plot').length === 4)";
     while page.eval(loaded) != true {
         assert!(Instant::now() < deadline, "the page did not load");
@@ -253,30 +277,61 @@ fn chromium_shows_the_plots_of_a_live_run_and_they_change_as_it_learns() {
     let out = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
     std::fs::write(out.join("watch-browser-1.png"), &shot1).unwrap();
     std::fs::write(out.join("watch-browser-2.png"), &shot2).unwrap();
-    assert!(state["ended"].is_null(), "learning stopped before the second screenshot");
+    assert!(
+        state["ended"].is_null(),
+        "learning stopped before the second screenshot"
+    );
     drop(run);
 
     // The live part was replaced in place (a newer state version).
-    assert_ne!(dom1["version"], dom2["version"], "the page did not refresh itself");
+    assert_ne!(
+        dom1["version"], dom2["version"],
+        "the page did not refresh itself"
+    );
     let (a, b) = (Shot::new(&shot1), Shot::new(&shot2));
-    let ids = ["plot-returns", "plot-damage", "plot-reengagements", "plot-episode"];
+    let ids = [
+        "plot-returns",
+        "plot-damage",
+        "plot-reengagements",
+        "plot-episode",
+    ];
     for (i, id) in ids.iter().enumerate() {
         for dom in [&dom1, &dom2] {
             let p = &dom["plots"][i];
             assert_eq!(p["id"], *id, "{dom}");
             assert_eq!(p["svg"], 1, "{id}: no SVG in the DOM");
-            assert!(p["drawn"].as_u64().unwrap() >= 10, "{id}: nothing drawn: {p}");
-            assert!(p["w"].as_f64().unwrap() >= 300.0 && p["h"].as_f64().unwrap() >= 200.0, "{p}");
+            assert!(
+                p["drawn"].as_u64().unwrap() >= 10,
+                "{id}: nothing drawn: {p}"
+            );
+            assert!(
+                p["w"].as_f64().unwrap() >= 300.0 && p["h"].as_f64().unwrap() >= 200.0,
+                "{p}"
+            );
         }
         // The box is where the DOM says (same layout in both).
         assert_eq!(dom1["plots"][i]["y"], dom2["plots"][i]["y"], "{id} moved");
         let (r1, r2) = (a.region(&dom1["plots"][i]), b.region(&dom2["plots"][i]));
-        assert!(!r1.is_empty() && r1.len() == r2.len(), "{id} is off the screenshot");
+        assert!(
+            !r1.is_empty() && r1.len() == r2.len(),
+            "{id} is off the screenshot"
+        );
         let ink = |r: &[[u8; 4]]| {
-            r.iter().filter(|c| c[0] < 200 || c[1] < 200 || c[2] < 200).count() as f64 / r.len() as f64
+            r.iter()
+                .filter(|c| c[0] < 200 || c[1] < 200 || c[2] < 200)
+                .count() as f64
+                / r.len() as f64
         };
-        assert!(ink(&r1) > 0.01 && ink(&r2) > 0.01, "{id}: blank ({}, {})", ink(&r1), ink(&r2));
+        assert!(
+            ink(&r1) > 0.01 && ink(&r2) > 0.01,
+            "{id}: blank ({}, {})",
+            ink(&r1),
+            ink(&r2)
+        );
         let changed = r1.iter().zip(&r2).filter(|(x, y)| x != y).count();
-        assert!(changed > 100, "{id}: only {changed} pixels changed between the screenshots");
+        assert!(
+            changed > 100,
+            "{id}: only {changed} pixels changed between the screenshots"
+        );
     }
 }

@@ -15,7 +15,14 @@ use std::time::Duration;
 use watch_common::{capture_json, pada_run, Watch};
 
 /// The fields `/api/state` shares with `pada capture --json`.
-const CAPTURE_FIELDS: [&str; 6] = ["source", "ended", "link", "bad_frames", "messages", "latest"];
+const CAPTURE_FIELDS: [&str; 6] = [
+    "source",
+    "ended",
+    "link",
+    "bad_frames",
+    "messages",
+    "latest",
+];
 
 fn assert_same_as_capture(state: &serde_json::Value, capture: &serde_json::Value) {
     for f in CAPTURE_FIELDS {
@@ -53,7 +60,11 @@ fn a_recorded_run_shows_what_capture_and_the_run_itself_report() {
     ]);
     let s = w.wait_for(60, "end of file", |s| !s["ended"].is_null());
     assert_same_as_capture(&s, &capture);
-    assert!(s["link"]["frames"].as_u64().unwrap() > 10_000, "{}", watch_common::short(&s));
+    assert!(
+        s["link"]["frames"].as_u64().unwrap() > 10_000,
+        "{}",
+        watch_common::short(&s)
+    );
     assert_eq!(s["bad_frames"], 0);
 
     // The page's numbers are the run's own: end performance, rise time and
@@ -64,7 +75,11 @@ fn a_recorded_run_shows_what_capture_and_the_run_itself_report() {
         assert!((a - b).abs() <= tol * b.abs().max(1.0), "{a} vs {b}");
     };
     // Returns travel as f32.
-    close(&s["learning"]["end_performance"], &trial["end_performance"], 1e-5);
+    close(
+        &s["learning"]["end_performance"],
+        &trial["end_performance"],
+        1e-5,
+    );
     close(&s["learning"]["rise_time_s"], &trial["rise_time_s"], 1e-9);
     close(&s["fatigue"]["robot_window_mtbf_s"], &trial["mtbf_s"], 1e-9);
     assert_eq!(s["fatigue"]["window_actions_seen"], 1200);
@@ -88,9 +103,19 @@ fn a_recorded_run_shows_what_capture_and_the_run_itself_report() {
     // The page and its parts.
     let (status, page) = w.get("");
     assert_eq!(status, 200);
-    for id in ["plot-returns", "plot-damage", "plot-reengagements", "plot-episode"] {
-        let at = page.find(&format!("id=\"{id}\"")).unwrap_or_else(|| panic!("{id} missing"));
-        assert!(page[at..].starts_with(&format!("id=\"{id}\"><svg")), "{id} holds no SVG");
+    for id in [
+        "plot-returns",
+        "plot-damage",
+        "plot-reengagements",
+        "plot-episode",
+    ] {
+        let at = page
+            .find(&format!("id=\"{id}\""))
+            .unwrap_or_else(|| panic!("{id} missing"));
+        assert!(
+            page[at..].starts_with(&format!("id=\"{id}\"><svg")),
+            "{id} holds no SVG"
+        );
     }
     assert!(page.contains("end-performance window"), "no window marked");
     assert!(page.contains("pada Δ=0.5"), "no policy shown");
@@ -103,7 +128,10 @@ fn a_recorded_run_shows_what_capture_and_the_run_itself_report() {
     for p in ["returns", "damage", "reengagements", "episode"] {
         let (status, svg) = w.get(&format!("plot/{p}.svg"));
         assert_eq!(status, 200, "{p}");
-        assert!(svg.starts_with("<svg") && (svg.contains("<polyline") || svg.contains("<path")), "{p}");
+        assert!(
+            svg.starts_with("<svg") && (svg.contains("<polyline") || svg.contains("<path")),
+            "{p}"
+        );
     }
 
     // Ctrl-C: the summary as capture prints it, and the same CSV.
@@ -114,7 +142,11 @@ fn a_recorded_run_shows_what_capture_and_the_run_itself_report() {
     assert!(summary["requests"].as_u64().unwrap() >= 8);
     let a = std::fs::read_to_string(&capture_csv).unwrap();
     let b = std::fs::read_to_string(&watch_csv).unwrap();
-    assert_eq!(without_time(&a), without_time(&b), "watch --out differs from capture --out");
+    assert_eq!(
+        without_time(&a),
+        without_time(&b),
+        "watch --out differs from capture --out"
+    );
 }
 
 /// Frame boundaries (start, end with the 0x00).
@@ -139,7 +171,10 @@ fn a_corrupted_recording_counts_the_same_losses_as_capture() {
     let n = f.len();
     // Bytes changed in 5 frames, 2 frames cut out, 2 bursts of garbage,
     // and a cut-off frame at the very end.
-    let corrupt: Vec<usize> = [0.1, 0.3, 0.5, 0.7, 0.9].iter().map(|x| (n as f64 * x) as usize).collect();
+    let corrupt: Vec<usize> = [0.1, 0.3, 0.5, 0.7, 0.9]
+        .iter()
+        .map(|x| (n as f64 * x) as usize)
+        .collect();
     let dropped = [n / 4, 3 * n / 4];
     let garbage = [n / 3, 2 * n / 3];
     let mut out = Vec::new();
@@ -171,7 +206,10 @@ fn a_corrupted_recording_counts_the_same_losses_as_capture() {
     assert!(s["link"]["seq_gaps"].as_u64().unwrap() >= 7);
     // The page shows the losses and still draws every plot.
     let (_, page) = w.get("");
-    assert!(page.contains(&format!("lost {}", s["bad_frames"])), "losses not shown");
+    assert!(
+        page.contains(&format!("lost {}", s["bad_frames"])),
+        "losses not shown"
+    );
     assert_eq!(page.matches("<svg").count(), 4);
 }
 
@@ -190,10 +228,15 @@ fn bad_requests_get_a_4xx_and_the_page_keeps_being_served() {
     let head = agent.head(&w.url).call().unwrap();
     assert_eq!(head.status().as_u16(), 200);
     // Not HTTP at all, and a request line cut short by a hang-up.
-    let addr = w.url.trim_start_matches("http://").trim_end_matches('/').to_string();
+    let addr = w
+        .url
+        .trim_start_matches("http://")
+        .trim_end_matches('/')
+        .to_string();
     let mut raw = TcpStream::connect(&addr).unwrap();
     raw.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
-    raw.write_all(b"\x16\x03\x01 hello, this is not HTTP\r\n\r\n").unwrap();
+    raw.write_all(b"\x16\x03\x01 hello, this is not HTTP\r\n\r\n")
+        .unwrap();
     let mut answer = String::new();
     let _ = raw.read_to_string(&mut answer);
     assert!(answer.starts_with("HTTP/1.1 400"), "{answer:?}");
@@ -210,13 +253,22 @@ fn slow_and_closed_viewers_do_not_slow_the_decoder() {
     let dir = tempfile::tempdir().unwrap();
     let bin = dir.path().join("run.bin");
     // A longer run: about 1.2 MB of frames.
-    pada_run("pendulum", "1000", bin.to_str().unwrap(), &dir.path().join("run"));
+    pada_run(
+        "pendulum",
+        "1000",
+        bin.to_str().unwrap(),
+        &dir.path().join("run"),
+    );
     let bytes = std::fs::read(&bin).unwrap();
     let capture = capture_json(&bin, None);
     // From standard input, so the viewers are in place before a byte is
     // decoded.
     let mut w = Watch::start_with(&["--file", "-"], Stdio::piped());
-    let addr = w.url.trim_start_matches("http://").trim_end_matches('/').to_string();
+    let addr = w
+        .url
+        .trim_start_matches("http://")
+        .trim_end_matches('/')
+        .to_string();
     // Viewers that ask for the page many times and never read: each
     // answer is over 100 kB, so 200 of them overfill the sockets and the
     // workers answering them wait.
@@ -231,7 +283,8 @@ fn slow_and_closed_viewers_do_not_slow_the_decoder() {
     // Viewers that ask and hang up at once.
     for _ in 0..20 {
         let mut s = TcpStream::connect(&addr).unwrap();
-        s.write_all(b"GET /api/state HTTP/1.1\r\nHost: x\r\n\r\n").unwrap();
+        s.write_all(b"GET /api/state HTTP/1.1\r\nHost: x\r\n\r\n")
+            .unwrap();
         drop(s);
     }
     std::thread::sleep(Duration::from_millis(300));
@@ -292,7 +345,9 @@ fn a_live_run_over_tcp_and_a_sender_that_stalls() {
         state_dims: 2,
         joints: 1,
     });
-    sender.write_all(enc.encode(&hello, &mut buf).unwrap()).unwrap();
+    sender
+        .write_all(enc.encode(&hello, &mut buf).unwrap())
+        .unwrap();
     let s = w.wait_for(10, "the hello", |s| s["messages"]["hello"] == 1);
     assert_eq!(s["stalled"], false);
     let s = w.wait_for(10, "the stall", |s| s["stalled"] == true);
@@ -318,7 +373,11 @@ fn a_serial_port_is_a_source_too() {
     let slave = ptsname(&master, Vec::new()).unwrap().into_string().unwrap();
     {
         // Raw mode before anything is written (as in the capture test).
-        let fd = std::fs::OpenOptions::new().read(true).write(true).open(&slave).unwrap();
+        let fd = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .open(&slave)
+            .unwrap();
         let mut t = rustix::termios::tcgetattr(&fd).unwrap();
         t.make_raw();
         rustix::termios::tcsetattr(&fd, rustix::termios::OptionalActions::Now, &t).unwrap();
@@ -330,7 +389,9 @@ fn a_serial_port_is_a_source_too() {
         m.write_all(chunk).unwrap();
     }
     let want = capture["link"]["frames"].as_u64().unwrap();
-    let s = w.wait_for(60, "every frame", |s| s["link"]["frames"].as_u64() == Some(want));
+    let s = w.wait_for(60, "every frame", |s| {
+        s["link"]["frames"].as_u64() == Some(want)
+    });
     assert_eq!(s["link"], capture["link"]);
     assert_eq!(s["latest"], capture["latest"]);
     assert_eq!(s["source"], slave.as_str());
@@ -351,14 +412,26 @@ fn bad_command_lines_are_one_line_usage_errors() {
     let busy_addr = busy.local_addr().unwrap().to_string();
     let d = dir.path().to_str().unwrap();
     for (args, says) in [
-        (vec!["--listen", "tcp:10.0.0.1:9000"], "only the loopback interface"),
+        (
+            vec!["--listen", "tcp:10.0.0.1:9000"],
+            "only the loopback interface",
+        ),
         (vec!["--listen", "127.0.0.1:9000"], "expected tcp:HOST:PORT"),
         (vec!["--file", d], "is a directory"),
         (vec!["--file", "/no/such/file"], "cannot open"),
-        (vec!["--file", "-", "--seconds", "-1"], "--seconds -1 is out of range"),
-        (vec!["--file", "-", "--serve", "nonsense"], "--serve nonsense: not a HOST:PORT"),
+        (
+            vec!["--file", "-", "--seconds", "-1"],
+            "--seconds -1 is out of range",
+        ),
+        (
+            vec!["--file", "-", "--serve", "nonsense"],
+            "--serve nonsense: not a HOST:PORT",
+        ),
         (vec!["--file", "-", "--serve", &busy_addr], "cannot listen"),
-        (vec!["--port", "/dev/null", "--baud", "0"], "--baud 0 is out of range"),
+        (
+            vec!["--port", "/dev/null", "--baud", "0"],
+            "--baud 0 is out of range",
+        ),
         (vec![], "required"),
     ] {
         let o = pada(&args);

@@ -155,9 +155,14 @@ pub fn run(args: WatchArgs) -> Result<(), CliError> {
         let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
     }
     let decoder_stop = Arc::new(AtomicBool::new(false));
-    let decoder = source::spawn(source, recorder.clone(), shared.clone(), decoder_stop.clone())
-        .context("cannot start the decoder thread")
-        .map_err(CliError::Runtime)?;
+    let decoder = source::spawn(
+        source,
+        recorder.clone(),
+        shared.clone(),
+        decoder_stop.clone(),
+    )
+    .context("cannot start the decoder thread")
+    .map_err(CliError::Runtime)?;
 
     let tty = std::io::stderr().is_terminal();
     let every = if tty {
@@ -228,7 +233,8 @@ pub fn run(args: WatchArgs) -> Result<(), CliError> {
     };
     drop(rec);
     if args.json {
-        let text = serde_json::to_string_pretty(&summary).map_err(|e| CliError::Runtime(e.into()))?;
+        let text =
+            serde_json::to_string_pretty(&summary).map_err(|e| CliError::Runtime(e.into()))?;
         let mut out = std::io::stdout().lock();
         writeln!(out, "{text}")
             .and_then(|_| out.flush())
@@ -285,7 +291,9 @@ fn open(args: &WatchArgs) -> Result<(Source, String), CliError> {
         eprintln!("watch: waiting for a telemetry sender on tcp:{bound}");
         return Ok((Source::Listener(l), format!("tcp:{bound}")));
     }
-    Err(usage("give --port DEVICE, --file FILE or --listen tcp:HOST:PORT"))
+    Err(usage(
+        "give --port DEVICE, --file FILE or --listen tcp:HOST:PORT",
+    ))
 }
 
 fn status(recorder: &Mutex<Recorder>, tty: bool, last: bool) {

@@ -171,9 +171,8 @@ pub fn live(state: &WatchState, clock: Clock) -> String {
         to_svg(&EpisodePlot(s)),
     ];
     for (id, svg) in PLOT_IDS.iter().zip(svgs) {
-        let svg = svg.unwrap_or_else(|e| {
-            format!("<p>cannot draw: {}</p>", escape(&format!("{e:#}")))
-        });
+        let svg =
+            svg.unwrap_or_else(|e| format!("<p>cannot draw: {}</p>", escape(&format!("{e:#}"))));
         let _ = write!(h, "<figure class=\"plot\" id=\"{id}\">{svg}</figure>");
     }
     h.push_str("</div><div class=\"tables\">");
@@ -211,7 +210,11 @@ fn tables(h: &mut String, s: &WatchState, state_name: &str) {
 <tr><th>end performance (last {} runs)</th><td class=\"n\">{}</td></tr>\
 <tr><th>rise time</th><td class=\"n\">{} s</td></tr>\
 <tr><th>control period</th><td class=\"n\">{}</td></tr></table>",
-        escape(&s.policy.as_ref().map_or("unknown".into(), |p| p.label.clone())),
+        escape(
+            &s.policy
+                .as_ref()
+                .map_or("unknown".into(), |p| p.label.clone())
+        ),
         s.latest.learning_episodes,
         s.latest.test_episodes,
         num(l.learning_time_s, 0),
@@ -242,7 +245,10 @@ fn tables(h: &mut String, s: &WatchState, state_name: &str) {
         );
     }
     let provisional = if f.window_actions_seen < f.window_actions {
-        format!(" (provisional: {} of {} actions)", f.window_actions_seen, f.window_actions)
+        format!(
+            " (provisional: {} of {} actions)",
+            f.window_actions_seen, f.window_actions
+        )
     } else {
         String::new()
     };
@@ -280,7 +286,10 @@ fn tables(h: &mut String, s: &WatchState, state_name: &str) {
         s.safety
             .fault
             .as_ref()
-            .map_or("none".into(), |f| escape(&format!("{}: {}", f.cause, f.detail))),
+            .map_or("none".into(), |f| escape(&format!(
+                "{}: {}",
+                f.cause, f.detail
+            ))),
         s.messages.fault,
     );
     for f in s.safety.history.iter().rev().take(5) {

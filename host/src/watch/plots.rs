@@ -51,7 +51,11 @@ fn tick(v: f64) -> String {
     }
     let s = format!("{v:.3}");
     let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s == "-0" { "0".into() } else { s.to_string() }
+    if s == "-0" {
+        "0".into()
+    } else {
+        s.to_string()
+    }
 }
 
 /// Draws "waiting for …" where a plot has nothing yet.
@@ -126,7 +130,9 @@ impl Figure for ReturnsPlot<'_> {
                 )])
                 .map_err(plot_err)?
                 .label(format!("end-performance window ({k} runs)"))
-                .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 14, y + 5)], shade.filled()));
+                .legend(move |(x, y)| {
+                    Rectangle::new([(x, y - 5), (x + 14, y + 5)], shade.filled())
+                });
             let dash = RGBColor(200, 120, 0);
             chart
                 .draw_series(DashedLineSeries::new(
@@ -137,7 +143,9 @@ impl Figure for ReturnsPlot<'_> {
                 ))
                 .map_err(plot_err)?
                 .label(format!("end performance {end:.1}"))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], dash.stroke_width(2)));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 14, y)], dash.stroke_width(2))
+                });
         }
         let black = RGBColor(0, 0, 0);
         chart
@@ -177,9 +185,13 @@ impl Figure for DamagePlot<'_> {
     where
         DB::ErrorType: 'static,
     {
-        fatigue_plot(root, self.0, "Damage J per gearbox (Eq. 7)", "damage J", |p, i| {
-            p.damage[i]
-        })
+        fatigue_plot(
+            root,
+            self.0,
+            "Damage J per gearbox (Eq. 7)",
+            "damage J",
+            |p, i| p.damage[i],
+        )
     }
 }
 
@@ -291,10 +303,16 @@ impl Figure for EpisodePlot<'_> {
             "Last episode ({} {}{}): applied action per joint",
             e.mode,
             e.episode,
-            e.total_return.map(|r| format!(", return {r:.1}")).unwrap_or_default()
+            e.total_return
+                .map(|r| format!(", return {r:.1}"))
+                .unwrap_or_default()
         );
         let x = range(e.steps.iter().map(|s| s.t_s).chain([0.0]));
-        let y = range(e.steps.iter().flat_map(|s| s.output.iter().map(|&v| v as f64)));
+        let y = range(
+            e.steps
+                .iter()
+                .flat_map(|s| s.output.iter().map(|&v| v as f64)),
+        );
         let mut chart = ChartBuilder::on(root)
             .caption(caption, (FONT, 16))
             .margin(8)
@@ -329,7 +347,9 @@ impl Figure for EpisodePlot<'_> {
                 .draw_series(LineSeries::new(pts, c.stroke_width(2)))
                 .map_err(plot_err)?
                 .label(format!("joint {i}"))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], c.stroke_width(2)));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 14, y)], c.stroke_width(2))
+                });
             let marks: Vec<(f64, f64)> = e
                 .steps
                 .windows(2)
@@ -337,7 +357,11 @@ impl Figure for EpisodePlot<'_> {
                 .filter_map(|w| w[0].output.get(i).map(|&v| (w[1].t_s, v as f64)))
                 .collect();
             chart
-                .draw_series(marks.into_iter().map(|p| Circle::new(p, 4, c.stroke_width(2))))
+                .draw_series(
+                    marks
+                        .into_iter()
+                        .map(|p| Circle::new(p, 4, c.stroke_width(2))),
+                )
                 .map_err(plot_err)?;
         }
         chart

@@ -183,7 +183,11 @@ pub fn handle(rq: Request, shared: &Shared) {
         return;
     }
     if rq.url().len() > MAX_URL {
-        return error(rq, 414, &format!("request target longer than {MAX_URL} bytes"));
+        return error(
+            rq,
+            414,
+            &format!("request target longer than {MAX_URL} bytes"),
+        );
     }
     let path = rq.url().split(['?', '#']).next().unwrap_or("").to_string();
     let svg = |f: anyhow::Result<String>| match f {

@@ -445,8 +445,7 @@ impl WatchState {
             let reengaged = (0..n)
                 .map(|i| previous.is_some_and(|p| reeng[i] > p[i]))
                 .collect();
-            if !s.output.is_empty() || matches!(s.kind, StepKind::Absorbing | StepKind::Timeout)
-            {
+            if !s.output.is_empty() || matches!(s.kind, StepKind::Absorbing | StepKind::Timeout) {
                 if cur.steps.len() == EPISODE_STEPS {
                     cur.steps.remove(0);
                     cur.dropped += 1;
@@ -485,7 +484,8 @@ impl WatchState {
         let window_time = self.period_s.map(|p| p * seen);
         let mut joints = Vec::with_capacity(n);
         for i in 0..n {
-            let (damage, reengagements) = last.map_or((0.0, 0), |p| (p.damage[i], p.reengagements[i]));
+            let (damage, reengagements) =
+                last.map_or((0.0, 0), |p| (p.damage[i], p.reengagements[i]));
             let mtbf_s = mtbf(l.learning_time_s, damage);
             let window_damage = match (self.window_start, self.window_end) {
                 (Some(a), Some(b)) => Some(b[i] - a[i]),
@@ -567,7 +567,12 @@ mod tests {
     }
 
     fn feed(s: &mut WatchState, frames: Vec<Decoded<ToHost>>) {
-        s.apply(&frames, LinkStats::default(), MessageCounts::default(), &Latest::default());
+        s.apply(
+            &frames,
+            LinkStats::default(),
+            MessageCounts::default(),
+            &Latest::default(),
+        );
     }
 
     #[test]
@@ -577,7 +582,13 @@ mod tests {
         let mut frames = vec![step(0, StepKind::Start, RunMode::Learning, 0.0, 0)];
         for k in 1..=1500u32 {
             // 1e-6 of damage per action; re-engaging every 10th.
-            frames.push(step(k, StepKind::Step, RunMode::Learning, k as f64 * 1e-6, k / 10));
+            frames.push(step(
+                k,
+                StepKind::Step,
+                RunMode::Learning,
+                k as f64 * 1e-6,
+                k / 10,
+            ));
         }
         feed(&mut s, frames);
         assert_eq!(s.period_from, Some("steps"));
@@ -645,7 +656,14 @@ mod tests {
         assert_eq!(s.learning.end_performance, Some(-800.0));
         assert_eq!(s.learning.end_window_runs, 1);
         let p = s.policy.as_ref().unwrap();
-        assert_eq!((p.built, p.parameter, p.parameter_name), ("pada", Some(0.5), Some("delta")));
-        assert!(p.label.starts_with("sarsa (switched from pada Δ=0.5"), "{}", p.label);
+        assert_eq!(
+            (p.built, p.parameter, p.parameter_name),
+            ("pada", Some(0.5), Some("delta"))
+        );
+        assert!(
+            p.label.starts_with("sarsa (switched from pada Δ=0.5"),
+            "{}",
+            p.label
+        );
     }
 }

@@ -66,7 +66,8 @@ impl Watch {
                         let addr = rest.split('/').next().unwrap();
                         w.url = format!("http://{addr}/");
                     }
-                    if let Some(rest) = l.strip_prefix("watch: waiting for a telemetry sender on ") {
+                    if let Some(rest) = l.strip_prefix("watch: waiting for a telemetry sender on ")
+                    {
                         w.listen = Some(rest.trim().to_string());
                     }
                 }
@@ -75,9 +76,16 @@ impl Watch {
                 return w;
             }
             if let Some(status) = w.child.as_mut().unwrap().try_wait().unwrap() {
-                panic!("pada watch exited early ({status}): {:?}", w.stderr.lock().unwrap());
+                panic!(
+                    "pada watch exited early ({status}): {:?}",
+                    w.stderr.lock().unwrap()
+                );
             }
-            assert!(Instant::now() < deadline, "no URL printed: {:?}", w.stderr.lock().unwrap());
+            assert!(
+                Instant::now() < deadline,
+                "no URL printed: {:?}",
+                w.stderr.lock().unwrap()
+            );
             std::thread::sleep(Duration::from_millis(20));
         }
     }
@@ -95,7 +103,12 @@ impl Watch {
     }
 
     /// Polls `/api/state` until `done` holds (at most `secs` seconds).
-    pub fn wait_for(&self, secs: u64, what: &str, done: impl Fn(&serde_json::Value) -> bool) -> serde_json::Value {
+    pub fn wait_for(
+        &self,
+        secs: u64,
+        what: &str,
+        done: impl Fn(&serde_json::Value) -> bool,
+    ) -> serde_json::Value {
         let deadline = Instant::now() + Duration::from_secs(secs);
         loop {
             let s = self.state();
@@ -148,7 +161,10 @@ pub fn agent() -> ureq::Agent {
 
 /// GET `url`: status and body.
 pub fn get(url: &str) -> (u16, String) {
-    let mut r = agent().get(url).call().unwrap_or_else(|e| panic!("GET {url}: {e}"));
+    let mut r = agent()
+        .get(url)
+        .call()
+        .unwrap_or_else(|e| panic!("GET {url}: {e}"));
     let status = r.status().as_u16();
     let body = r
         .body_mut()
@@ -175,8 +191,21 @@ pub fn short(s: &serde_json::Value) -> String {
 pub fn pada_run(task: &str, seconds: &str, telemetry: &str, out: &Path) -> Output {
     let o = Command::new(env!("CARGO_BIN_EXE_pada"))
         .args([
-            "run", "--task", task, "--algo", "pada", "--trials", "1", "--threads", "1",
-            "--seconds", seconds, "--json", "--telemetry", telemetry, "--out",
+            "run",
+            "--task",
+            task,
+            "--algo",
+            "pada",
+            "--trials",
+            "1",
+            "--threads",
+            "1",
+            "--seconds",
+            seconds,
+            "--json",
+            "--telemetry",
+            telemetry,
+            "--out",
         ])
         .arg(out)
         .output()
