@@ -301,7 +301,21 @@ fn slow_and_closed_viewers_do_not_slow_the_decoder() {
         assert!(v.peer_addr().is_ok());
     }
     drop(slow);
-    assert_eq!(w.get("").0, 200);
+    // Many viewers at once, each polling as the page does.
+    let viewers: Vec<_> = (0..12)
+        .map(|_| {
+            let url = w.url.clone();
+            std::thread::spawn(move || {
+                for path in ["", "live", "api/state", "live", "plot/damage.svg"] {
+                    assert_eq!(watch_common::get(&format!("{url}{path}")).0, 200, "{path}");
+                }
+            })
+        })
+        .collect();
+    for v in viewers {
+        v.join().unwrap();
+    }
+    assert_eq!(w.state()["link"], capture["link"]);
 }
 
 #[test]
@@ -440,4 +454,22 @@ fn bad_command_lines_are_one_line_usage_errors() {
         assert_eq!(err.trim().lines().count(), 1, "{args:?}: {err}");
         assert!(err.contains(says), "{args:?}: {err}");
     }
+}
+
+#[test]
+fn the_firmware_s_own_recording_shows_its_safety_state() {
+    // Recorded from the firmware in QEMU with wire protocol 2 (before the
+    // Policy message): it still decodes; the state comes from its State
+    // frames, and the policy is unknown.
+    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/sil-pendulum-3s.bin");
+    let capture = capture_json(Path::new(file), None);
+    let w = Watch::start(&["--file", file]);
+    let s = w.wait_for(60, "end of file", |s| !s["ended"].is_null());
+    assert_same_as_capture(&s, &capture);
+    assert_eq!(s["hello"]["protocol"], 2);
+    assert!(s["messages"]["state"].as_u64().unwrap() >= 1);
+    assert!(s["safety"]["state"].is_string(), "{}", watch_common::short(&s));
+    assert!(s["policy"].is_null());
+    let (_, page) = w.get("");
+    assert!(page.contains("unknown (no Policy frame yet)"));
 }

@@ -312,3 +312,23 @@ fn status(recorder: &Mutex<Recorder>, tty: bool, last: bool) {
     }
     let _ = err.flush();
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[test]
+    fn the_page_is_served_on_loopback_unless_told_otherwise() {
+        let cli = crate::cli::Cli::try_parse_from(["pada", "watch", "--file", "x.bin"]).unwrap();
+        let crate::cli::Command::Watch(args) = cli.command else {
+            panic!("not watch");
+        };
+        assert!(parse_serve(&args.serve).unwrap().ip().is_loopback());
+        assert!(parse_listen("tcp:[::1]:9000").is_ok());
+        assert!(parse_listen("tcp:localhost:9000").is_ok());
+        for bad in ["tcp:0.0.0.0:9000", "tcp:192.168.1.2:9000", "9000", "tcp:"] {
+            assert_eq!(parse_listen(bad).unwrap_err().exit_code(), 2, "{bad}");
+        }
+    }
+}

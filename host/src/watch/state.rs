@@ -666,4 +666,59 @@ mod tests {
             p.label
         );
     }
+
+    #[test]
+    fn a_fault_is_shown_with_its_cause_until_the_state_leaves_fault() {
+        use pada_core::safety::{FaultCause, State};
+        use pada_core::wire::{Fault, StateChange};
+        let cause = FaultCause::ServoTimeout {
+            servo: 3,
+            attempts: 4,
+        };
+        let msg = |msg| Decoded {
+            seq: 0,
+            gap: None,
+            msg,
+        };
+        let mut s = WatchState::new("test".into());
+        feed(
+            &mut s,
+            vec![
+                msg(ToHost::State(StateChange {
+                    step: 10,
+                    from: State::Learning,
+                    to: State::Fault(cause),
+                })),
+                msg(ToHost::Fault(Fault {
+                    step: 10,
+                    time_ms: 500,
+                    cause,
+                })),
+            ],
+        );
+        assert_eq!(s.safety.state.as_deref(), Some("Fault"));
+        let f = s.safety.fault.as_ref().unwrap();
+        assert_eq!(f.cause, "servo-timeout");
+        assert!(f.detail.contains("servo: 3"), "{}", f.detail);
+        assert_eq!((f.step, f.time_ms), (10, 500));
+        feed(
+            &mut s,
+            vec![msg(ToHost::State(StateChange {
+                step: 12,
+                from: State::Fault(cause),
+                to: State::Idle,
+            }))],
+        );
+        assert_eq!(s.safety.state.as_deref(), Some("Idle"));
+        assert!(s.safety.fault.is_none());
+        assert_eq!(s.safety.history.len(), 1);
+        let page = crate::watch::page::live(
+            &s,
+            crate::watch::page::Clock {
+                wall_s: 1.0,
+                since_data_s: Some(0.5),
+            },
+        );
+        assert!(page.contains("servo-timeout") && !page.contains("banner fault"));
+    }
 }
