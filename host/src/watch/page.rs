@@ -79,12 +79,17 @@ pub fn page(state: &WatchState, clock: Clock) -> String {
 <noscript><meta http-equiv=\"refresh\" content=\"2\"></noscript>\
 <style>{STYLE}</style></head>\n<body>\n<main id=\"live\">{live}</main>\n\
 <script>\n\
-// Replaces the live part with the server's rendering, once a second.\n\
+// Replaces the live part with the server's rendering once a second (one\n\
+// request at a time; one that takes over 5 s is given up).\n\
 const live = document.getElementById('live');\n\
-let failures = 0;\n\
+let failures = 0, busy = false;\n\
 async function refresh() {{\n\
+  if (busy) return;\n\
+  busy = true;\n\
+  const abort = new AbortController();\n\
+  const timer = setTimeout(() => abort.abort(), 5000);\n\
   try {{\n\
-    const r = await fetch('/live', {{ cache: 'no-store' }});\n\
+    const r = await fetch('/live', {{ cache: 'no-store', signal: abort.signal }});\n\
     if (!r.ok) throw new Error(r.status);\n\
     live.innerHTML = await r.text();\n\
     failures = 0;\n\
@@ -95,10 +100,12 @@ async function refresh() {{\n\
       b.textContent = 'lost the connection to pada watch (it has ended?): showing the last state';\n\
       live.prepend(b);\n\
     }}\n\
+  }} finally {{\n\
+    clearTimeout(timer);\n\
+    busy = false;\n\
   }}\n\
-  setTimeout(refresh, {REFRESH_MS});\n\
 }}\n\
-setTimeout(refresh, {REFRESH_MS});\n\
+setInterval(refresh, {REFRESH_MS});\n\
 </script>\n</body></html>\n",
         source = escape(&state.source),
     )

@@ -234,11 +234,13 @@ where
     }
     root.fill(&WHITE).map_err(plot_err)?;
     let x = range(h.with_last().map(|p| p.time_s));
-    let y = range(
-        h.with_last()
-            .flat_map(|p| (0..n).map(move |i| value(p, i)))
-            .chain([0.0]),
-    );
+    // Counters only grow from 0: the axis starts at 0 exactly.
+    let top = h
+        .with_last()
+        .flat_map(|p| (0..n).map(move |i| value(p, i)))
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, f64::max);
+    let y = 0.0..if top > 0.0 { top * 1.06 } else { 1.0 };
     let mut chart = ChartBuilder::on(root)
         .caption(title, (FONT, 18))
         .margin(8)
