@@ -461,15 +461,49 @@ fn the_firmware_s_own_recording_shows_its_safety_state() {
     // Recorded from the firmware in QEMU with wire protocol 2 (before the
     // Policy message): it still decodes; the state comes from its State
     // frames, and the policy is unknown.
-    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/sil-pendulum-3s.bin");
+    let file = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/data/sil-pendulum-3s.bin"
+    );
     let capture = capture_json(Path::new(file), None);
     let w = Watch::start(&["--file", file]);
     let s = w.wait_for(60, "end of file", |s| !s["ended"].is_null());
     assert_same_as_capture(&s, &capture);
     assert_eq!(s["hello"]["protocol"], 2);
     assert!(s["messages"]["state"].as_u64().unwrap() >= 1);
-    assert!(s["safety"]["state"].is_string(), "{}", watch_common::short(&s));
+    assert!(
+        s["safety"]["state"].is_string(),
+        "{}",
+        watch_common::short(&s)
+    );
     assert!(s["policy"].is_null());
     let (_, page) = w.get("");
     assert!(page.contains("unknown (no Policy frame yet)"));
+}
+
+#[test]
+fn a_csv_that_cannot_be_written_ends_the_watch_with_an_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let (bin, _) = recorded_run(dir.path());
+    let o = Command::new(env!("CARGO_BIN_EXE_pada"))
+        .args([
+            "watch",
+            "--serve",
+            "127.0.0.1:0",
+            "--seconds",
+            "60",
+            "--out",
+            "/dev/full",
+            "--file",
+        ])
+        .arg(&bin)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    let last = err.trim().lines().last().unwrap();
+    assert!(
+        last.starts_with("error: ") && last.contains("cannot write the CSV"),
+        "{err}"
+    );
 }

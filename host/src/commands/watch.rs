@@ -184,6 +184,11 @@ pub fn run(args: WatchArgs) -> Result<(), CliError> {
         {
             break "time limit";
         }
+        // A failure (a read error, the CSV not written) ends the command as
+        // it ends `pada capture`; the stream's normal end does not.
+        if shared.failed.load(Ordering::SeqCst) {
+            break "failed";
+        }
         let ended = shared.snapshot_ended();
         if let (Some(why), false) = (&ended, told_end) {
             told_end = true;
@@ -251,6 +256,13 @@ pub fn run(args: WatchArgs) -> Result<(), CliError> {
             link.frames_missed,
             summary.requests
         );
+    }
+    if shared.failed.load(Ordering::SeqCst) {
+        return Err(CliError::Runtime(anyhow::anyhow!(
+            "the stream of {} failed: {}",
+            summary.source,
+            summary.ended
+        )));
     }
     Ok(())
 }

@@ -36,6 +36,8 @@ pub struct Shared {
     last_data_ms: AtomicU64,
     /// Requests answered.
     pub requests: AtomicU64,
+    /// Set when decoding ended in a failure (a read error, the CSV).
+    pub failed: std::sync::atomic::AtomicBool,
     /// The last rendering of `/live`, reused within the same second.
     live_cache: Mutex<Option<(LiveKey, Arc<String>)>>,
 }
@@ -50,6 +52,7 @@ impl Shared {
             started: Instant::now(),
             last_data_ms: AtomicU64::new(0),
             requests: AtomicU64::new(0),
+            failed: std::sync::atomic::AtomicBool::new(false),
             live_cache: Mutex::new(None),
         }
     }

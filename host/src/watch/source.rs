@@ -32,6 +32,30 @@ pub fn listen(addr: SocketAddr) -> std::io::Result<TcpListener> {
     Ok(l)
 }
 
+/// Why decoding ended.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct End {
+    /// In words, as `pada capture` says it (`end of file`, …).
+    pub reason: String,
+    /// Whether it was a failure (a read error, the CSV not written) rather
+    /// than the stream's end; `pada watch` then exits with 1.
+    pub failed: bool,
+}
+
+fn ended(reason: impl Into<String>) -> End {
+    End {
+        reason: reason.into(),
+        failed: false,
+    }
+}
+
+fn failed(reason: String) -> End {
+    End {
+        reason,
+        failed: true,
+    }
+}
+
 /// Reads `source` until it ends or `stop` is set, recording every frame
 /// and updating the shared state after every chunk; returns why it ended.
 pub fn decode(
@@ -39,7 +63,7 @@ pub fn decode(
     recorder: &Mutex<Recorder>,
     shared: &Shared,
     stop: &AtomicBool,
-) -> String {
+) -> End {
     let mut buf = vec![0u8; 4096];
     let mut frames = Vec::new();
     let mut source = source;
@@ -47,11 +71,11 @@ pub fn decode(
     let mut stream: Option<TcpStream> = None;
     loop {
         if stop.load(Ordering::SeqCst) {
-            return "interrupted".into();
+            return ended("interrupted");
         }
         let n = match &mut source {
             Source::Port(p) => match p.read(&mut buf) {
-                Ok(0) => return "the port closed".into(),
+                Ok(0) => return ended("the port closed"),
                 Ok(n) => n,
                 Err(e)
                     if matches!(
@@ -61,13 +85,13 @@ pub fn decode(
                 {
                     0
                 }
-                Err(e) => return format!("the port went away ({e})"),
+                Err(e) => return ended(format!("the port went away ({e})")),
             },
             Source::Reader(r) => match r.read(&mut buf) {
-                Ok(0) => return "end of file".into(),
+                Ok(0) => return ended("end of file"),
                 Ok(n) => n,
                 Err(e) if e.kind() == std::io::ErrorKind::Interrupted => 0,
-                Err(e) => return format!("read error ({e})"),
+                Err(e) => return failed(format!("read error ({e})")),
             },
             Source::Listener(l) => match stream.as_mut() {
                 None => match l.accept() {
@@ -76,7 +100,7 @@ pub fn decode(
                             .set_nonblocking(false)
                             .and_then(|_| s.set_read_timeout(Some(POLL)));
                         if let Err(e) = ready {
-                            return format!("cannot read from the sender {peer} ({e})");
+                            return failed(format!("cannot read from the sender {peer} ({e})"));
                         }
                         eprintln!("watch: telemetry sender connected from {peer}");
                         stream = Some(s);
@@ -86,10 +110,10 @@ pub fn decode(
                         std::thread::sleep(POLL / 2);
                         0
                     }
-                    Err(e) => return format!("cannot accept a sender ({e})"),
+                    Err(e) => return failed(format!("cannot accept a sender ({e})")),
                 },
                 Some(s) => match s.read(&mut buf) {
-                    Ok(0) => return "the sender closed the connection".into(),
+                    Ok(0) => return ended("the sender closed the connection"),
                     Ok(n) => n,
                     Err(e)
                         if matches!(
@@ -101,7 +125,7 @@ pub fn decode(
                     {
                         0
                     }
-                    Err(e) => return format!("the connection failed ({e})"),
+                    Err(e) => return ended(format!("the connection failed ({e})")),
                 },
             },
         };
@@ -113,7 +137,7 @@ pub fn decode(
         let mut rec = recorder.lock().unwrap_or_else(|e| e.into_inner());
         let t = shared.started.elapsed().as_secs_f64();
         if let Err(e) = rec.feed(&buf[..n], t, &mut frames) {
-            return format!("cannot write the CSV ({e})");
+            return failed(format!("cannot write the CSV ({e})"));
         }
         let (link, counts) = (rec.stats(), rec.counts());
         let latest = rec.latest().clone();
@@ -136,11 +160,14 @@ pub fn spawn(
     std::thread::Builder::new()
         .name("watch-decoder".into())
         .spawn(move || {
-            let why = decode(source, &recorder, &shared, &stop);
+            let end = decode(source, &recorder, &shared, &stop);
+            if end.failed {
+                shared.failed.store(true, Ordering::SeqCst);
+            }
             shared
                 .state
                 .lock()
                 .unwrap_or_else(|e| e.into_inner())
-                .end(why);
+                .end(end.reason);
         })
 }
