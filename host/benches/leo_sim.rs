@@ -18,7 +18,7 @@ use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use pada::experiment::build_agent;
 use pada::leo::rl::LeoTask;
 use pada::leo::{LeoConfig, LeoEnv, Terminal};
-use pada::task::{Plant, Task};
+use pada::experiment::task::{Plant, Task};
 use pada_core::agent::EpisodeEnd;
 use pada_core::policy::PolicyKind;
 use rand_core::{RngCore, SeedableRng};

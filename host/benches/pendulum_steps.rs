@@ -5,11 +5,11 @@
 //! `cargo bench -p pada --bench pendulum_steps`
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use pada::experiment::task::{Plant, Task};
 use pada::experiment::{run_trial, RunConfig};
 use pada::pendulum::{
     PhysicalPendulumTask, SimulatedPendulum, SimulatedPendulumParams, SimulatedPendulumTask,
 };
-use pada::task::{Plant, Task};
 use pada_core::policy::PolicyKind;
 use std::hint::black_box;
 

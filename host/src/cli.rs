@@ -1,10 +1,10 @@
 //! The command line (clap derive) and its dispatch. Every clap error is
 //! turned into one line with exit code 2.
 
-use crate::algo::Algo;
 use crate::commands;
 use crate::error::{usage, CliError};
-use crate::tasks::TaskName;
+use crate::experiment::algo::Algo;
+use crate::experiment::tasks::TaskName;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::ffi::OsString;
 use std::path::PathBuf;

@@ -5,10 +5,10 @@
 
 #![warn(missing_docs)]
 
-pub mod algo;
 pub mod capture;
 pub mod cli;
 pub mod commands;
+pub mod display;
 pub mod error;
 pub mod experiment;
 pub mod integrator;
@@ -22,8 +22,6 @@ pub mod seed;
 pub mod sil;
 pub mod stats;
 pub mod summary;
-pub mod task;
-pub mod tasks;
 pub mod telemetry;
 pub mod torque_log;
 pub mod watch;

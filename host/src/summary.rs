@@ -1,9 +1,9 @@
 //! The summary of a run (`summary.json`) and the per-trial CSV files.
 
-use crate::algo::{algo_of, parameter_of, Algo};
+use crate::experiment::algo::{algo_of, parameter_of, Algo};
 use crate::experiment::{RunConfig, TrialResult, TILINGS, TRACE};
 use crate::stats::Estimate;
-use crate::task::TaskSpec;
+use crate::experiment::task::TaskSpec;
 use pada_core::agent::WeightInit;
 use pada_core::fatigue::PAPER_WINDOW_STEPS;
 use serde::Serialize;

@@ -12,8 +12,8 @@
 //! CRC-32/ISO-HDLC                 u32 little endian, of everything before
 //! ```
 
+use crate::experiment::task::{TaskSpec, WeightTable};
 use crate::experiment::{HostAgent, TILINGS};
-use crate::task::{TaskSpec, WeightTable};
 use pada_core::checkpoint::crc32;
 use pada_core::fixed::Q16;
 use pada_core::policy::PolicyKind;
@@ -63,6 +63,7 @@ impl WeightsHeader {
             tilings: TILINGS,
             table: match (&spec.table, &spec.action_tiles) {
                 (WeightTable::Exact, _) => "exact".into(),
+                (WeightTable::ExactOf { weights }, _) => format!("exact in {weights}"),
                 (WeightTable::Hashed { log2_size }, None) => format!("hashed 2^{log2_size}"),
                 (WeightTable::Hashed { log2_size }, Some(w)) => {
                     format!("hashed 2^{log2_size}, action tiles {w:?}")

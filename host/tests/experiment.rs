@@ -1,10 +1,10 @@
 //! The experiment runner on short trials: reproducibility, PADA Δ = 1 as
 //! SARSA(λ), learning that improves, and the fatigue window.
 
-use pada::algo::{policy_kind, Algo};
+use pada::experiment::algo::{policy_kind, Algo};
+use pada::experiment::task::Task;
 use pada::experiment::{run_trials, RunConfig, TrialResult};
 use pada::pendulum::{PhysicalPendulumTask, SimulatedPendulumTask};
-use pada::task::Task;
 use pada_core::fatigue::PAPER_WINDOW_STEPS;
 use pada_core::policy::PolicyKind;
 

@@ -4,7 +4,7 @@
 
 use pada::experiment::build_agent;
 use pada::leo::rl::{leo_params, LeoTask};
-use pada::task::Task;
+use pada::experiment::task::Task;
 use pada::weights::{decode, encode, load, save, WeightsHeader};
 use pada_core::fixed::Q16;
 use pada_core::policy::PolicyKind;

@@ -1,16 +1,16 @@
 //! `pada demo`: the README's main job — SARSA(λ) against PADA Δ = 0.5 on
 //! the simulated pendulum of Section VII, next to the paper's numbers.
 
-use super::run::{fmt_estimate, fmt_mtbf};
 use crate::cli::{check_seconds, set_threads, DemoArgs};
+use crate::display::{fmt_estimate, fmt_mtbf};
 use crate::error::CliError;
+use crate::experiment::task::Task;
 use crate::experiment::{run_configs, RunConfig};
 use crate::output::OutDir;
 use crate::paper::numbers::*;
 use crate::pendulum::SimulatedPendulumTask;
 use crate::progress::steps_bar;
 use crate::summary::{run_files, RunSummary};
-use crate::task::Task;
 use pada_core::policy::PolicyKind;
 use std::time::Instant;
 

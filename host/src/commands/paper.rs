@@ -1,16 +1,15 @@
 //! `pada paper pendulum`: the whole of Section VII — data, report.md and
 //! the figures — in one directory.
 
-use crate::algo::{algo_of, label, parameter_of};
 use crate::cli::{check_seconds, set_threads, PaperArgs, PaperExperiment};
 use crate::error::CliError;
+use crate::experiment::algo::{algo_of, parameter_of};
 use crate::output::OutDir;
+use crate::paper::figure_data::{curves, point};
 use crate::paper::numbers::{PHYS_TRIALS, SIM_TRIALS};
 use crate::paper::pendulum::{self, ConfigResult, PendulumOptions, PendulumResults};
 use crate::paper::report;
-use crate::plot::figures::{
-    Curve, LearningCurves, Measure, MtbfSweep, PerformanceVsMtbf, SweepPoint,
-};
+use crate::plot::figures::{LearningCurves, Measure, MtbfSweep, PerformanceVsMtbf, SweepPoint};
 use crate::plot::save;
 use crate::progress::steps_bar;
 
@@ -97,27 +96,6 @@ fn headline(r: &PendulumResults) -> String {
     )
 }
 
-pub(crate) fn point(c: &ConfigResult) -> SweepPoint {
-    SweepPoint {
-        algo: c.algo(),
-        param: parameter_of(&c.policy).unwrap_or(1.0) as f64,
-        mtbf_s: c.summary.mtbf_s,
-        end: c.summary.end_performance,
-        rise_s: c.summary.rise_time_s,
-    }
-}
-
-pub(crate) fn curves(cs: &[ConfigResult], pick: impl Fn(&ConfigResult) -> bool) -> Vec<Curve> {
-    cs.iter()
-        .filter(|c| pick(c))
-        .map(|c| Curve {
-            label: label(&c.policy),
-            algo: algo_of(&c.policy),
-            points: c.curve.clone(),
-        })
-        .collect()
-}
-
 fn draw_figures(r: &PendulumResults, out: &OutDir) -> anyhow::Result<()> {
     let dir = out.path();
     let sarsa = &r.simulated[0].summary;
@@ -173,9 +151,10 @@ fn draw_figures(r: &PendulumResults, out: &OutDir) -> anyhow::Result<()> {
             title: "Learning curves, simulated pendulum".into(),
             curves: curves(&r.simulated, |c| {
                 let p = parameter_of(&c.policy);
-                matches!(algo_of(&c.policy), crate::algo::Algo::Sarsa)
-                    || (algo_of(&c.policy) == crate::algo::Algo::Lowpass && p == Some(0.834))
-                    || (algo_of(&c.policy) == crate::algo::Algo::Pada && p == Some(0.5))
+                matches!(algo_of(&c.policy), crate::experiment::algo::Algo::Sarsa)
+                    || (algo_of(&c.policy) == crate::experiment::algo::Algo::Lowpass
+                        && p == Some(0.834))
+                    || (algo_of(&c.policy) == crate::experiment::algo::Algo::Pada && p == Some(0.5))
             }),
             sarsa_end: sarsa.end_performance.mean,
             sarsa_rise_s: sarsa.rise_time_s.mean,

@@ -2,12 +2,12 @@
 //! paper's numbers, Fig. 7-style learning curves and Fig. 8-style end
 //! performance against MTBF.
 
-use super::paper::{curves, point};
-use super::run::{fmt_estimate, fmt_mtbf};
-use crate::algo::label;
 use crate::cli::{check_seconds, set_threads, PaperArgs};
+use crate::display::{fmt_estimate, fmt_mtbf};
 use crate::error::CliError;
+use crate::experiment::algo::label;
 use crate::output::OutDir;
+use crate::paper::figure_data::{curves, point};
 use crate::paper::leo::{self, LeoOptions, LeoResults};
 use crate::paper::objective::Objective;
 use crate::plot::figures::{LearningCurves, Measure, PerformanceVsMtbf, SweepPoint};
@@ -53,11 +53,21 @@ pub fn run(args: PaperArgs) -> Result<(), CliError> {
     if let Some(mut b) = best {
         let policy = r.configs[b.config].policy;
         let task = crate::leo::rl::LeoTask::default();
-        crate::weights::save(&out.path().join("best.weights"), crate::task::Task::spec(&task), policy, b.switched, &b.agent)?;
-        let (frames, fell) = super::render::record_agent(&mut b.agent, 10.0)?;
-        let source = format!("{}, trial {} (best end performance)", name(&r, b.config), b.trial);
-        let title = super::render::gait_title(&source, &frames, fell);
-        out.write_all(&super::render::gait_files(&frames, 12, &title)?)?;
+        crate::weights::save(
+            &out.path().join("best.weights"),
+            crate::experiment::task::Task::spec(&task),
+            policy,
+            b.switched,
+            &b.agent,
+        )?;
+        let (frames, fell) = crate::leo::gait::record_agent(&mut b.agent, 10.0)?;
+        let source = format!(
+            "{}, trial {} (best end performance)",
+            name(&r, b.config),
+            b.trial
+        );
+        let title = crate::leo::gait::gait_title(&source, &frames, fell);
+        out.write_all(&crate::leo::gait::gait_files(&frames, 12, &title)?)?;
         println!("{title}");
     }
     println!("{report}");

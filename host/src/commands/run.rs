@@ -1,15 +1,16 @@
 //! `pada run`: trials of one algorithm on one task, with a progress bar,
 //! `summary.json`, `trials.csv` and per-trial learning curves.
 
-use crate::algo::{label, policy_kind, Algo};
 use crate::cli::{check_seconds, set_threads, RunArgs};
+use crate::display::{fmt_estimate, fmt_mtbf};
 use crate::error::{usage, CliError};
+use crate::experiment::algo::{label, policy_kind, Algo};
+use crate::experiment::task::Task;
+use crate::experiment::tasks::{visit_task, TaskVisitor};
 use crate::experiment::{build_agent, run_trials, run_trials_observed, RunConfig};
 use crate::output::OutDir;
 use crate::progress::steps_bar;
 use crate::summary::{run_files, RunSummary};
-use crate::task::Task;
-use crate::tasks::{visit_task, TaskVisitor};
 use crate::telemetry::{parse_target, TelemetrySink};
 use pada_core::wire::{self, ToHost};
 use std::path::PathBuf;
@@ -158,29 +159,4 @@ pub fn print_summary(s: &RunSummary, label: &str) {
         "  wall {:.1} s, {:.0} env steps/s on {} threads",
         s.wall_s, s.env_steps_per_s, s.threads
     );
-}
-
-/// `mean ± ci` with `digits` decimals, `n/a` for a missing interval.
-pub fn fmt_estimate(mean: f64, ci: f64, digits: usize, unit: &str) -> String {
-    if !mean.is_finite() {
-        return format!("{mean}{unit}");
-    }
-    if ci.is_finite() {
-        format!("{mean:.digits$} ± {ci:.digits$}{unit}")
-    } else {
-        format!("{mean:.digits$}{unit} (no interval)")
-    }
-}
-
-/// An MTBF in seconds: plain below 10⁶ s, scientific above.
-pub fn fmt_mtbf(mean: f64, ci: f64) -> String {
-    if !mean.is_finite() {
-        return "infinite (no re-engagement in the window)".to_string();
-    }
-    let ci_s = |c: f64| if c.is_finite() { c } else { f64::NAN };
-    if mean.abs() >= 1e6 {
-        format!("{:.3e} ± {:.2e} s", mean, ci_s(ci))
-    } else {
-        format!("{:.0} ± {:.0} s", mean, ci_s(ci))
-    }
 }

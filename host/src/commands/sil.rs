@@ -1,9 +1,9 @@
 //! `pada sil`: the firmware image learns inside QEMU against the simulated
 //! plant (docs/sil.md).
 
-use crate::algo::{label, policy_kind, Algo};
 use crate::cli::check_seconds;
 use crate::error::{usage, CliError};
+use crate::experiment::algo::{label, policy_kind, Algo};
 use crate::output::OutDir;
 use crate::sil::{self, fault, SilConfig, SilSummary, SilTask};
 use anyhow::{anyhow, Context};

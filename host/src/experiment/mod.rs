@@ -2,17 +2,32 @@
 //! greedy test runs, their end performance, rise time and predicted MTBF,
 //! and means with 95% confidence intervals across trials run in parallel.
 //!
-//! Generic over [`crate::task::Task`], so every task (the pendulums now,
-//! LEO later) runs through the same code.
+//! Generic over [`task::Task`], so every task (the pendulums, LEO) runs
+//! through the same code:
+//!
+//! | module | what |
+//! |---|---|
+//! | [`task`] | what the runner needs from a task: its description and plants |
+//! | [`tasks`] | the tasks the command line knows, by name |
+//! | [`algo`] | the six algorithms of Section V by their command-line names |
+//! | [`agent_setup`] | the host's agent for a task and a policy |
+//! | [`trial`] | one trial: learning with periodic greedy test runs |
+//! | [`runner`] | trials and configurations in parallel |
+//! | [`metrics`] | end performance and rise time (Section VI) |
 
 pub mod agent_setup;
+pub mod algo;
 pub mod metrics;
 pub mod runner;
+pub mod task;
+pub mod tasks;
 pub mod trial;
 
 pub use agent_setup::{build_agent, HostAgent, TILINGS, TRACE};
 pub use metrics::{end_performance, rise_time};
-pub use runner::{run_configs, run_configs_keeping, run_trials, run_trials_observed, FinishedTrial, RunConfig};
+pub use runner::{
+    run_configs, run_configs_keeping, run_trials, run_trials_observed, FinishedTrial, RunConfig,
+};
 pub use trial::{
     run_trial, run_trial_keep, run_trial_observed, TestPoint, TrialObserver, TrialResult,
 };

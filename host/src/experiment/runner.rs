@@ -4,7 +4,7 @@
 
 use super::agent_setup::HostAgent;
 use super::trial::{run_trial, run_trial_keep, run_trial_observed, TrialObserver, TrialResult};
-use crate::task::Task;
+use crate::experiment::task::Task;
 use pada_core::policy::PolicyKind;
 use rayon::prelude::*;
 

@@ -1,6 +1,6 @@
 //! One trial (Section VI): learning for a given simulated time, with a
 //! greedy test run before learning and after every
-//! [`TaskSpec::test_interval`](crate::task::TaskSpec) learning episodes.
+//! [`TaskSpec::test_interval`](crate::experiment::task::TaskSpec) learning episodes.
 //!
 //! - The learning curve is the test-run return against learning time (the
 //!   simulated time of learning episodes only; test runs do not count).
@@ -13,8 +13,8 @@
 use super::agent_setup::{build_agent, HostAgent};
 use super::metrics::{end_performance, rise_time};
 use super::runner::RunConfig;
+use crate::experiment::task::{Plant, Task, TaskSpec};
 use crate::seed::{trial_rng, trial_seed};
-use crate::task::{Plant, Task, TaskSpec};
 use anyhow::anyhow;
 use pada_core::action_space::MAX_ACTION_DIMS;
 use pada_core::agent::{Decision, EpisodeEnd, Mode};

@@ -12,7 +12,7 @@ use crate::experiment::{run_configs_keeping, FinishedTrial, HostAgent, RunConfig
 use crate::leo::rl::LeoTask;
 use crate::paper::pendulum::{mean_curve, ConfigResult};
 use crate::summary::RunSummary;
-use crate::task::Task;
+use crate::experiment::task::Task;
 use pada_core::policy::PolicyKind;
 use serde::Serialize;
 

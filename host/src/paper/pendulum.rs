@@ -11,13 +11,13 @@
 //! is SARSA(λ) itself, bit for bit (a test checks it): Δ = 0.5 is the only
 //! value that restricts.
 
-use crate::algo::{algo_of, Algo};
+use crate::experiment::algo::{algo_of, Algo};
+use crate::experiment::task::Task;
 use crate::experiment::{run_configs, RunConfig, TrialResult};
 use crate::paper::objective::{Objective, Verdict};
 use crate::pendulum::{PhysicalPendulumTask, SimulatedPendulumTask};
 use crate::stats::Estimate;
 use crate::summary::RunSummary;
-use crate::task::Task;
 use pada_core::policy::PolicyKind;
 use serde::Serialize;
 

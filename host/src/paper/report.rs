@@ -3,7 +3,7 @@
 
 use super::numbers::*;
 use super::pendulum::{ConfigResult, PendulumResults};
-use crate::algo::{label, parameter_of, Algo};
+use crate::experiment::algo::{label, parameter_of, Algo};
 use crate::stats::Estimate;
 use std::fmt::Write;
 

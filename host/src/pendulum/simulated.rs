@@ -15,8 +15,8 @@
 //! torque. Episodes start hanging down at rest (θ = π).
 
 use super::{swing_up_reward, wrap_angle};
+use crate::experiment::task::{Plant, Step, Task, TaskSpec, WeightTable};
 use crate::integrator::{rk4_step, SinNear};
-use crate::task::{Plant, Step, Task, TaskSpec, WeightTable};
 use pada_core::action_space::{ActionDim, ActionSpace, Output, MAX_ACTION_DIMS};
 use pada_core::agent::{SarsaParams, WeightInit};
 use pada_core::tile_coding::StateDim;
@@ -193,6 +193,7 @@ impl SimulatedPendulumTask {
                 .expect("valid action space"),
             table: WeightTable::Exact,
             action_tiles: None,
+            profile: None,
             params: SarsaParams { init: WeightInit::Uniform { min: 0.0, max: 1.0 }, ..SarsaParams::default() },
             test_interval: 10,
             default_seconds: 3000.0,
@@ -223,7 +224,7 @@ impl Task for SimulatedPendulumTask {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::task::Plant;
+    use crate::experiment::task::Plant;
     use rand_core::SeedableRng;
     use rand_pcg::Pcg64;
 

@@ -9,7 +9,7 @@
 //!   bands, SARSA(λ)'s end performance and rise time as lines.
 
 use super::{plot_err, Figure, FONT};
-use crate::algo::Algo;
+use crate::experiment::algo::Algo;
 use crate::paper::pendulum::CurvePoint;
 use crate::stats::Estimate;
 use plotters::coord::Shift;

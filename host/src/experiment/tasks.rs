@@ -1,9 +1,9 @@
 //! The tasks the command line knows, by name. A new task (LEO) adds a
 //! variant here and an arm in [`visit_task`]; everything else is generic.
 
+use crate::experiment::task::Task;
 use crate::leo::rl::LeoTask;
 use crate::pendulum::{PhysicalPendulumTask, SimulatedPendulumTask};
-use crate::task::Task;
 use std::fmt;
 
 /// A task name on the command line.
