@@ -530,6 +530,17 @@ where
         }
     }
 
+    /// The `Policy` report of the learner now: the built policy with its
+    /// α/Δ and whether it switched back to SARSA(λ).
+    pub fn policy_report(&self) -> wire::PolicyReport {
+        let policy = self.agent().policy();
+        wire::PolicyReport {
+            step: self.agent_stats().steps as u32,
+            built: policy.built_kind().into(),
+            switched_to_sarsa: policy.switched(),
+        }
+    }
+
     /// At boot, after a reset by the independent watchdog: a fault.
     pub fn watchdog_reset(&mut self) -> Transition {
         self.safety.on(Event::WatchdogReset)

@@ -42,6 +42,10 @@ pub enum Command {
     Sil(commands::sil::SilArgs),
     /// Decode telemetry from a board's serial port or a recorded stream.
     Capture(commands::capture::CaptureArgs),
+    /// A live page in the browser of a board's, a recording's or a live
+    /// run's telemetry (decoded and recorded as capture does).
+    #[command(allow_negative_numbers = true)]
+    Watch(commands::watch::WatchArgs),
     /// Draw a learned LEO gait (saved weights) as a strip of stick figures.
     Render(RenderArgs),
 }
@@ -272,7 +276,7 @@ where
                     Ok(())
                 }
                 ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => Err(usage(
-                    "no command given: valid commands are run, demo, paper, mtbf, render, sil, capture (see pada --help)",
+                    "no command given: valid commands are run, demo, paper, mtbf, render, sil, capture, watch (see pada --help)",
                 )),
                 _ => Err(usage(clap_one_line(&e))),
             };
@@ -285,6 +289,7 @@ where
         Command::Mtbf(a) => commands::mtbf::run(a),
         Command::Sil(a) => commands::sil::run(a),
         Command::Capture(a) => commands::capture::run(a),
+        Command::Watch(a) => commands::watch::run(a),
         Command::Render(a) => commands::render::run(a),
     }
 }

@@ -26,4 +26,5 @@ pub mod stats;
 pub mod summary;
 pub mod telemetry;
 pub mod torque_log;
+pub mod watch;
 pub mod weights;

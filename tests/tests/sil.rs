@@ -84,6 +84,22 @@ fn the_firmware_in_qemu_replays_bit_for_bit_on_the_host_and_its_link_is_clean() 
     // the agent's Q16.16 resolution, or in a greedy test episode, which
     // does not learn, would change no weight).
     let stream = std::fs::read(dir.path().join("telemetry.bin")).unwrap();
+    // The firmware reports the policy it was set to (the wire's Policy
+    // frame, which pada watch shows).
+    let mut decoder = pada_core::wire::HostDecoder::new();
+    let policies: Vec<pada_core::wire::PolicyReport> = decoder
+        .feed(&stream)
+        .filter_map(|r| match r.ok()?.msg {
+            pada_core::wire::ToHost::Policy(p) => Some(p),
+            _ => None,
+        })
+        .collect();
+    // At boot (SARSA), then after the run's SetPolicy.
+    assert_eq!(policies.len(), 2, "{policies:?}");
+    assert_eq!(PolicyKind::from(policies[0].built), PolicyKind::Sarsa);
+    let last = policies.last().expect("the firmware sent a Policy frame");
+    assert_eq!(PolicyKind::from(last.built), policy, "{policies:?}");
+    assert!(!last.switched_to_sarsa);
     let mut recs = records(&stream);
     assert!(replay(&Board::F405.profile(Robot::Pendulum33), policy, DEFAULT_SEED, &recs).identical);
     let k = recs

@@ -166,6 +166,7 @@ pub fn run_trial_observed<T: Task>(
     };
 
     let budget = (cfg.seconds / spec.control_period_s).round() as u64;
+    t.report_policy();
     t.test_run()?;
     while t.learning_steps < budget {
         let mut done = t.episode(true)?.1 as u64;
@@ -348,8 +349,23 @@ impl<P: Plant> Trial<'_, '_, P> {
         if self.switch_step.is_some_and(|s| self.learning_steps >= s) {
             self.agent.switch_to_sarsa().map_err(|e| anyhow!("{e}"))?;
             self.switch_step = None;
+            self.report_policy();
         }
         Ok(())
+    }
+
+    /// Reports the policy in force to the observer (at the start and after
+    /// the switch back to SARSA(λ)), as the firmware does.
+    fn report_policy(&mut self) {
+        let Some(observer) = self.observer.as_mut() else {
+            return;
+        };
+        let policy = self.agent.policy();
+        observer(ToHost::Policy(wire::PolicyReport {
+            step: self.calls,
+            built: policy.built_kind().into(),
+            switched_to_sarsa: policy.switched(),
+        }));
     }
 
     /// One episode to the time limit or an absorbing state; returns the

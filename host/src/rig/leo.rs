@@ -104,9 +104,11 @@ impl LeoRig {
 
     /// One control period with the voltages in force.
     fn step(&mut self) {
-        let mut u = [0.0; NUM_JOINTS];
-        for k in 0..NUM_JOINTS {
-            u[k] = if self.torque[k] { self.volts[k] } else { 0.0 };
+        let mut u = self.volts;
+        for (v, on) in u.iter_mut().zip(self.torque) {
+            if !on {
+                *v = 0.0;
+            }
         }
         self.model.set_voltages(u);
         self.periods += 1;

@@ -18,6 +18,11 @@
 //! - Reward `−1 − 3·E + 300·(L − L_prev) − 125·[fall]` ([`reward`],
 //!   [`step_energy`], §3.7); a fall is absorbing ([`is_fall`], §3.8).
 
+// Numbers are written as the reference prints them: the joint limits are
+// the reference's degrees in radians to six places (−0.785398 is −45°, not
+// meant as π/4).
+#![allow(clippy::approx_constant)]
+
 use super::filter::RateFilter;
 use super::{MotorLevels, Robot, RobotSpec};
 use crate::agent::{SarsaParams, WeightInit};
