@@ -237,8 +237,12 @@ pub fn print_summary(s: &RunSummary, label: &str) {
         fmt_estimate(s.rise_time_s.mean, s.rise_time_s.ci95, 0, " s")
     );
     println!(
-        "  MTBF (1200 actions)  {}",
+        "  MTBF (1200 actions)  {} (the paper's: torque from the commanded action)",
         fmt_mtbf(s.mtbf_s.mean, s.mtbf_s.ci95)
+    );
+    println!(
+        "  physical MTBF        {} (from the simulated gear torques)",
+        fmt_mtbf(s.physical_mtbf_s.mean, s.physical_mtbf_s.ci95)
     );
     if let (Some(w), Some(v)) = (&s.end_walked_m, &s.end_speed_m_s) {
         println!(
