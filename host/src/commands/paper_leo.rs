@@ -2,6 +2,7 @@
 //! paper's numbers, Fig. 7-style learning curves and Fig. 8-style end
 //! performance against MTBF.
 
+use crate::stdout::outln;
 use super::paper::{curves, point};
 use super::run::{fmt_estimate, fmt_mtbf};
 use crate::algo::label;
@@ -58,13 +59,13 @@ pub fn run(args: PaperArgs) -> Result<(), CliError> {
         let source = format!("{}, trial {} (best end performance)", name(&r, b.config), b.trial);
         let title = super::render::gait_title(&source, &frames, fell);
         out.write_all(&super::render::gait_files(&frames, 12, &title)?)?;
-        println!("{title}");
+        outln!("{title}")?;
     }
-    println!("{report}");
-    println!(
+    outln!("{report}")?;
+    outln!(
         "wrote {}/report.md, the figures, best.weights and the gait (gait.svg/png, gait-animation.svg)",
         out.path().display()
-    );
+    )?;
     Ok(())
 }
 

@@ -153,7 +153,7 @@ pub struct Episode {
 }
 
 /// Periodic health. Counters are totals since boot.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Health {
     /// Time since boot in ms.
     pub uptime_ms: u32,
