@@ -6,13 +6,10 @@
 //! body    = postcard( (seq: u32, message) )
 //! ```
 //!
-//! Encoding is postcard's own flavours stacked on the caller's buffer —
-//! [`postcard::ser_flavors::crc::CrcModifier`] over
-//! [`postcard::ser_flavors::Cobs`] over a slice — so the body is
-//! checksummed and COBS-encoded as postcard writes it, with no second
-//! frame-sized buffer on the chip's stack. Decoding collects the bytes of
-//! one frame up to its 0x00 and decodes them in place with the `cobs` crate
-//! (the one postcard itself uses).
+//! COBS is the `cobs` crate (the one postcard's own COBS flavour is built
+//! on): [`encode_frame`] serialises the body, appends the CRC and encodes
+//! into the caller's buffer; the decoder collects the bytes of one frame up
+//! to its 0x00 and decodes them in place.
 //!
 //! A frame is accepted only in its canonical form: its COBS encoding is the
 //! one the encoder writes (the same length for the decoded bytes) and its
@@ -23,7 +20,7 @@
 
 use crate::crc::CRC32;
 use core::marker::PhantomData;
-use postcard::ser_flavors::{crc::CrcModifier, Cobs, Flavor, Slice};
+use postcard::ser_flavors::Flavor;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
@@ -50,14 +47,21 @@ pub const fn cobs_max_len(n: usize) -> usize {
 }
 
 /// Length of the COBS encoding the encoder writes for `data` (without the
-/// 0x00): the `cobs` crate's own encoder state, counted, so the decoder's
-/// canonical check and the encoder cannot disagree.
+/// 0x00): the `cobs` crate's own encoder state machine, counted, so the
+/// decoder's canonical check and the encoder cannot disagree.
 fn cobs_len(data: &[u8]) -> usize {
+    if data.is_empty() {
+        return 0;
+    }
     let mut state = cobs::EncoderState::default();
     let mut len = 1;
-    for &b in data {
+    for (i, &b) in data.iter().enumerate() {
         len += match state.push(b) {
             cobs::PushResult::AddSingle(_) | cobs::PushResult::ModifyFromStartAndSkip(_) => 1,
+            // A full 254-byte block: the next block's code byte is written
+            // only if more data follows (`cobs::CobsEncoder` leaves no
+            // empty block at the end).
+            cobs::PushResult::ModifyFromStartAndPushAndSkip(_) if i + 1 == data.len() => 1,
             cobs::PushResult::ModifyFromStartAndPushAndSkip(_) => 2,
         };
     }
@@ -77,14 +81,26 @@ pub enum WireError {
 /// Encodes `msg` with sequence number `seq` into `out` and returns the
 /// frame, delimiter included. A buffer of [`MAX_FRAME_LEN`] bytes holds any
 /// [`ToHost`] or [`ToChip`] message.
+///
+/// The body is serialised into a [`MAX_BODY`]-byte buffer on the stack and
+/// COBS-encoded from there into `out` by the `cobs` crate. (postcard's own
+/// COBS and CRC flavours would encode straight into `out`, but their
+/// per-byte `try_push` is inlined into every field of every message: with
+/// them the F405 pendulum image was 12 kB larger, 184 716 B of flash
+/// against 172 544 B.)
 pub fn encode_frame<'b, M: Serialize>(msg: &M, seq: u32, out: &'b mut [u8]) -> Result<&'b [u8], WireError> {
-    let full = |e| match e {
-        postcard::Error::SerializeBufferFull => WireError::BufferTooSmall,
-        _ => WireError::Serialize,
+    let mut raw = [0u8; MAX_BODY + CRC_LEN];
+    let body_len = match postcard::to_slice(&(seq, msg), &mut raw[..MAX_BODY]) {
+        Ok(body) => body.len(),
+        Err(postcard::Error::SerializeBufferFull) => return Err(WireError::BufferTooSmall),
+        Err(_) => return Err(WireError::Serialize),
     };
-    let cobs = Cobs::try_new(Slice::new(out)).map_err(full)?;
-    let frame = postcard::serialize_with_flavor(&(seq, msg), CrcModifier::new(cobs, CRC32.digest())).map_err(full)?;
-    Ok(frame)
+    let crc = CRC32.checksum(&raw[..body_len]);
+    raw[body_len..body_len + CRC_LEN].copy_from_slice(&crc.to_le_bytes());
+    let raw = &raw[..body_len + CRC_LEN];
+    let n = cobs::try_encode(raw, out).map_err(|_| WireError::BufferTooSmall)?;
+    *out.get_mut(n).ok_or(WireError::BufferTooSmall)? = 0;
+    Ok(&out[..=n])
 }
 
 /// A postcard flavour that compares what is serialised with `expected`
@@ -466,17 +482,12 @@ mod tests {
 
     #[test]
     fn cobs_len_is_the_encoders_length() {
-        // The encoder is postcard's COBS flavour: push the bytes through it.
         let mut buf = [0u8; 700];
-        for len in [0usize, 1, 253, 254, 255, 508, 600] {
+        for len in [0usize, 1, 2, 253, 254, 255, 508, 509, 600] {
             for fill in [0u8, 1, 0x55] {
                 let data = [fill; 600];
                 let data = &data[..len];
-                let mut cobs = Cobs::try_new(Slice::new(&mut buf)).unwrap();
-                for &b in data {
-                    cobs.try_push(b).unwrap();
-                }
-                let n = cobs.finalize().unwrap().len() - 1;
+                let n = cobs::try_encode(data, &mut buf).unwrap();
                 assert_eq!(cobs_len(data), n, "len {len} fill {fill}");
                 assert!(n <= cobs_max_len(len));
             }
