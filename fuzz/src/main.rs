@@ -116,7 +116,7 @@ fn save_failure(name: &str, n: usize, input: &[u8], why: &str) {
 }
 
 fn parse_args(mut args: impl Iterator<Item = String>) -> Result<(f64, u64), String> {
-    let (mut seconds, mut seed) = (60.0, 1u64);
+    let (mut seconds, mut seed) = (60.0f64, 1u64);
     while let Some(a) = args.next() {
         match a.as_str() {
             "--seconds" => {
