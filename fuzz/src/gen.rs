@@ -88,9 +88,13 @@ pub struct Corpus {
 impl Corpus {
     /// Reads the recording; an empty corpus if it is missing.
     pub fn load() -> Corpus {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/sil-pendulum-3s.bin");
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../tests/data/sil-pendulum-3s.bin");
         let stream = std::fs::read(path).unwrap_or_default();
-        let frames = stream.split_inclusive(|&b| b == 0).map(<[u8]>::to_vec).collect();
+        let frames = stream
+            .split_inclusive(|&b| b == 0)
+            .map(<[u8]>::to_vec)
+            .collect();
         Corpus { frames }
     }
 }

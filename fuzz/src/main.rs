@@ -56,12 +56,18 @@ fn main() -> std::process::ExitCode {
             t.name(),
             report.inputs,
             report.inputs as f64 / report.elapsed.as_secs_f64(),
-            if report.failures == 0 { "ok".to_string() } else { format!("{} FAILED", report.failures) }
+            if report.failures == 0 {
+                "ok".to_string()
+            } else {
+                format!("{} FAILED", report.failures)
+            }
         );
         failed += report.failures;
     }
     if failed > 0 {
-        eprintln!("pada-fuzz: {failed} inputs broke an invariant; they are in target/fuzz-failures/");
+        eprintln!(
+            "pada-fuzz: {failed} inputs broke an invariant; they are in target/fuzz-failures/"
+        );
         return std::process::ExitCode::FAILURE;
     }
     std::process::ExitCode::SUCCESS
@@ -86,15 +92,16 @@ fn run(target: &mut dyn Target, rng: &mut rand_pcg::Pcg64, share: Duration) -> R
         for _ in 0..64 {
             let input = target.generate(rng);
             inputs += 1;
-            let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| target.check(&input)))
-                .unwrap_or_else(|p| {
-                    let what = p
-                        .downcast_ref::<String>()
-                        .cloned()
-                        .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
-                        .unwrap_or_default();
-                    Outcome::Failed(format!("panic: {what}"))
-                });
+            let outcome =
+                std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| target.check(&input)))
+                    .unwrap_or_else(|p| {
+                        let what = p
+                            .downcast_ref::<String>()
+                            .cloned()
+                            .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
+                            .unwrap_or_default();
+                        Outcome::Failed(format!("panic: {what}"))
+                    });
             if let Outcome::Failed(why) = outcome {
                 failures += 1;
                 if failures <= 10 {
@@ -104,7 +111,11 @@ fn run(target: &mut dyn Target, rng: &mut rand_pcg::Pcg64, share: Duration) -> R
         }
     }
     std::panic::set_hook(hook);
-    Report { inputs, failures, elapsed: start.elapsed() }
+    Report {
+        inputs,
+        failures,
+        elapsed: start.elapsed(),
+    }
 }
 
 fn save_failure(name: &str, n: usize, input: &[u8], why: &str) {
@@ -112,7 +123,11 @@ fn save_failure(name: &str, n: usize, input: &[u8], why: &str) {
     let _ = std::fs::create_dir_all(&dir);
     let path = dir.join(format!("{name}-{n}.bin"));
     let _ = std::fs::write(&path, input);
-    eprintln!("{name}: {why} (input of {} bytes in {})", input.len(), path.display());
+    eprintln!(
+        "{name}: {why} (input of {} bytes in {})",
+        input.len(),
+        path.display()
+    );
 }
 
 fn parse_args(mut args: impl Iterator<Item = String>) -> Result<(f64, u64), String> {
@@ -121,14 +136,20 @@ fn parse_args(mut args: impl Iterator<Item = String>) -> Result<(f64, u64), Stri
         match a.as_str() {
             "--seconds" => {
                 let v = args.next().ok_or("--seconds needs a value")?;
-                seconds = v.parse().map_err(|_| format!("--seconds {v}: not a number"))?;
+                seconds = v
+                    .parse()
+                    .map_err(|_| format!("--seconds {v}: not a number"))?;
                 if !(seconds.is_finite() && seconds > 0.0 && seconds <= 86_400.0) {
-                    return Err(format!("--seconds {v} is out of range: valid is 0 < S <= 86400"));
+                    return Err(format!(
+                        "--seconds {v} is out of range: valid is 0 < S <= 86400"
+                    ));
                 }
             }
             "--seed" => {
                 let v = args.next().ok_or("--seed needs a value")?;
-                seed = v.parse().map_err(|_| format!("--seed {v}: valid is an integer 0..=18446744073709551615"))?;
+                seed = v.parse().map_err(|_| {
+                    format!("--seed {v}: valid is an integer 0..=18446744073709551615")
+                })?;
             }
             other => return Err(format!("unknown argument `{other}`")),
         }

@@ -31,9 +31,15 @@ pub const DEFAULT_DELTA: f32 = 0.5;
 /// The policy of `algo` with `alpha` / `delta` (defaults
 /// [`DEFAULT_ALPHA`], [`DEFAULT_DELTA`]). A parameter the algorithm does not
 /// take, or one outside its range, is an error.
-pub fn policy_kind(algo: Algo, alpha: Option<f32>, delta: Option<f32>) -> Result<PolicyKind, AlgoError> {
+pub fn policy_kind(
+    algo: Algo,
+    alpha: Option<f32>,
+    delta: Option<f32>,
+) -> Result<PolicyKind, AlgoError> {
     if alpha.is_some() && !algo.takes_alpha() {
-        return Err(AlgoError(format!("--alpha applies only to lowpass and markov-lowpass, not to {algo}")));
+        return Err(AlgoError(format!(
+            "--alpha applies only to lowpass and markov-lowpass, not to {algo}"
+        )));
     }
     if delta.is_some() && !algo.takes_delta() {
         return Err(AlgoError(format!(
@@ -43,7 +49,9 @@ pub fn policy_kind(algo: Algo, alpha: Option<f32>, delta: Option<f32>) -> Result
     let a = alpha.unwrap_or(DEFAULT_ALPHA);
     let d = delta.unwrap_or(DEFAULT_DELTA);
     if algo.takes_alpha() && !(a.is_finite() && a > 0.0 && a <= 1.0) {
-        return Err(AlgoError(format!("--alpha {a} is out of range: valid is 0 < alpha <= 1")));
+        return Err(AlgoError(format!(
+            "--alpha {a} is out of range: valid is 0 < alpha <= 1"
+        )));
     }
     if algo.takes_delta() && !(d.is_finite() && d > 0.0 && d <= 1.0) {
         return Err(AlgoError(format!(
@@ -79,12 +87,20 @@ mod tests {
 
     #[test]
     fn parameters_map_and_are_checked() {
-        assert_eq!(policy_kind(Algo::Pada, None, Some(0.5)), Ok(PolicyKind::Pada { delta: 0.5 }));
-        assert_eq!(policy_kind(Algo::LowPass, None, None), Ok(PolicyKind::LowPass { alpha: 0.834 }));
+        assert_eq!(
+            policy_kind(Algo::Pada, None, Some(0.5)),
+            Ok(PolicyKind::Pada { delta: 0.5 })
+        );
+        assert_eq!(
+            policy_kind(Algo::LowPass, None, None),
+            Ok(PolicyKind::LowPass { alpha: 0.834 })
+        );
         assert_eq!(policy_kind(Algo::Sarsa, None, None), Ok(PolicyKind::Sarsa));
         let e = policy_kind(Algo::LowPass, Some(1.5), None).unwrap_err().0;
         assert!(e.contains("0 < alpha <= 1"), "{e}");
-        let e = policy_kind(Algo::Integrator, None, Some(0.0)).unwrap_err().0;
+        let e = policy_kind(Algo::Integrator, None, Some(0.0))
+            .unwrap_err()
+            .0;
         assert!(e.contains("0 < delta <= 1"), "{e}");
         assert!(policy_kind(Algo::Pada, None, Some(f32::NAN)).is_err());
         let e = policy_kind(Algo::Sarsa, Some(0.5), None).unwrap_err().0;
@@ -95,7 +111,10 @@ mod tests {
     #[test]
     fn labels() {
         assert_eq!(label(&PolicyKind::Pada { delta: 0.5 }), "pada Δ=0.5");
-        assert_eq!(label(&PolicyKind::LowPass { alpha: 0.834 }), "lowpass α=0.834");
+        assert_eq!(
+            label(&PolicyKind::LowPass { alpha: 0.834 }),
+            "lowpass α=0.834"
+        );
         assert_eq!(label(&PolicyKind::Sarsa), "sarsa");
         for a in Algo::ALL {
             assert_eq!(algo_of(&policy_kind(a, None, None).unwrap()), a);
@@ -105,12 +124,17 @@ mod tests {
     #[test]
     fn the_command_line_names_are_the_cores_and_serialise_as_them() {
         for a in Algo::ALL {
-            assert_eq!(serde_json::to_string(&a).unwrap(), format!("\"{}\"", a.name()));
+            assert_eq!(
+                serde_json::to_string(&a).unwrap(),
+                format!("\"{}\"", a.name())
+            );
         }
         use clap::builder::TypedValueParser;
         let cmd = clap::Command::new("t");
         let parsed = algo_parser().parse_ref(&cmd, None, std::ffi::OsStr::new("markov-lowpass"));
         assert_eq!(parsed.unwrap(), Algo::MarkovLowPass);
-        assert!(algo_parser().parse_ref(&cmd, None, std::ffi::OsStr::new("lowpas")).is_err());
+        assert!(algo_parser()
+            .parse_ref(&cmd, None, std::ffi::OsStr::new("lowpas"))
+            .is_err());
     }
 }

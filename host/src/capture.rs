@@ -449,7 +449,11 @@ mod tests {
         assert!(rec.finish(1.0).unwrap());
         assert_eq!((rec.stats().frames, rec.stats().truncated), (1, 1));
         assert!(!rec.stats().is_clean());
-        assert!(rec.status_line().contains("other 1"), "{}", rec.status_line());
+        assert!(
+            rec.status_line().contains("other 1"),
+            "{}",
+            rec.status_line()
+        );
         assert!(!rec.finish(1.0).unwrap(), "counted once");
     }
 

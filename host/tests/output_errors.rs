@@ -33,7 +33,10 @@ fn assert_output_error(out: &Output, what: &str) {
     assert_eq!(out.status.code(), Some(1), "{what}: {err}");
     let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("error: ")).collect();
     assert_eq!(lines.len(), 1, "{what}: {err}");
-    assert!(lines[0].contains("cannot write to standard output"), "{what}: {err}");
+    assert!(
+        lines[0].contains("cannot write to standard output"),
+        "{what}: {err}"
+    );
     assert!(!err.contains("panicked"), "{what}: {err}");
 }
 
@@ -43,12 +46,31 @@ fn commands(dir: &Path) -> Vec<Vec<String>> {
     let log = torque_log(dir).display().to_string();
     let out = dir.join("run").display().to_string();
     vec![
-        vec!["capture".into(), "--file".into(), file.clone(), "--json".into()],
+        vec![
+            "capture".into(),
+            "--file".into(),
+            file.clone(),
+            "--json".into(),
+        ],
         vec!["mtbf".into(), "--torques".into(), log.clone()],
         vec!["mtbf".into(), "--torques".into(), log, "--json".into()],
-        ["run", "--task", "pendulum", "--algo", "sarsa", "--trials", "1", "--seconds", "30", "--threads", "1", "--out", &out]
-            .map(String::from)
-            .to_vec(),
+        [
+            "run",
+            "--task",
+            "pendulum",
+            "--algo",
+            "sarsa",
+            "--trials",
+            "1",
+            "--seconds",
+            "30",
+            "--threads",
+            "1",
+            "--out",
+            &out,
+        ]
+        .map(String::from)
+        .to_vec(),
     ]
 }
 
@@ -70,7 +92,13 @@ fn a_full_standard_output_is_one_line_and_exit_code_1_in_every_command() {
 fn a_closed_pipe_is_one_line_and_exit_code_1_in_every_command() {
     let dir = tempfile::tempdir().unwrap();
     for args in commands(dir.path()) {
-        let mut child = pada().args(&args).stdin(Stdio::null()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+        let mut child = pada()
+            .args(&args)
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
         // The reader goes away before anything is written (as `| true`).
         drop(child.stdout.take());
         let out = child.wait_with_output().unwrap();
@@ -81,10 +109,17 @@ fn a_closed_pipe_is_one_line_and_exit_code_1_in_every_command() {
 #[test]
 fn capture_of_a_directory_is_bad_input() {
     let dir = tempfile::tempdir().unwrap();
-    let out = pada().args(["capture", "--json", "--file"]).arg(dir.path()).output().unwrap();
+    let out = pada()
+        .args(["capture", "--json", "--file"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.starts_with("error: ") && err.contains("is a directory") && err.lines().count() == 1, "{err}");
+    assert!(
+        err.starts_with("error: ") && err.contains("is a directory") && err.lines().count() == 1,
+        "{err}"
+    );
     assert!(out.stdout.is_empty());
 }
 
@@ -92,11 +127,17 @@ fn capture_of_a_directory_is_bad_input() {
 fn a_read_error_ends_the_capture_with_its_summary_and_exit_code_1() {
     // Reading /proc/self/mem at offset 0 fails with EIO: a read error after
     // the file opened.
-    let out = pada().args(["capture", "--json", "--file", "/proc/self/mem"]).output().unwrap();
+    let out = pada()
+        .args(["capture", "--json", "--file", "/proc/self/mem"])
+        .output()
+        .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert!(json["ended"].as_str().unwrap().starts_with("read error"), "{json}");
+    assert!(
+        json["ended"].as_str().unwrap().starts_with("read error"),
+        "{json}"
+    );
     let lines: Vec<&str> = err.lines().filter(|l| l.starts_with("error: ")).collect();
     assert_eq!(lines.len(), 1, "{err}");
     assert!(lines[0].contains("read error"), "{err}");
@@ -109,8 +150,16 @@ fn a_stream_cut_off_at_the_end_reports_the_loss() {
     let dir = tempfile::tempdir().unwrap();
     let noise = dir.path().join("noise.bin");
     std::fs::write(&noise, vec![0x5Au8; 10 << 20]).unwrap();
-    let out = pada().args(["capture", "--json", "--file"]).arg(&noise).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = pada()
+        .args(["capture", "--json", "--file"])
+        .arg(&noise)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(json["link"]["truncated"], 1, "{json}");
     assert_eq!(json["bad_frames"], 1, "{json}");

@@ -40,7 +40,11 @@ fn state(rng: &mut impl RngCore) -> LearnerState {
     a.stats.last_td_error = Q16(rng.next_u32() as i32);
     a.epsilon = f32::from_bits(rng.next_u32());
     let name = PolicyName::ALL[below(rng, 6)];
-    a.policy.kind = name.with_parameter(if name == PolicyName::Sarsa { 0.0 } else { f32::from_bits(rng.next_u32()) });
+    a.policy.kind = name.with_parameter(if name == PolicyName::Sarsa {
+        0.0
+    } else {
+        f32::from_bits(rng.next_u32())
+    });
     a.policy.switched = rng.next_u32() & 1 == 1;
     a.policy.previous = (rng.next_u32()).to_le_bytes();
     a.policy.output = core::array::from_fn(|_| f32::from_bits(rng.next_u32()));
@@ -58,7 +62,10 @@ fn state(rng: &mut impl RngCore) -> LearnerState {
         };
         let _ = s.joints.push(j);
     }
-    s.wear = FlashWear { erases: [rng.next_u32() >> 8, rng.next_u32() >> 8], operating_s: rng.next_u64() >> 8 };
+    s.wear = FlashWear {
+        erases: [rng.next_u32() >> 8, rng.next_u32() >> 8],
+        operating_s: rng.next_u64() >> 8,
+    };
     s
 }
 
@@ -104,7 +111,9 @@ impl CheckpointStore for Torn {
             return Err(PowerLost);
         }
         let n = data.len().min(self.budget);
-        self.inner.write(slot, offset, &data[..n]).map_err(|_| PowerLost)?;
+        self.inner
+            .write(slot, offset, &data[..n])
+            .map_err(|_| PowerLost)?;
         self.budget -= n;
         if n < data.len() {
             self.dead = true;
@@ -125,15 +134,25 @@ fn load_all(store: &impl CheckpointStore) -> Option<(LoadOutcome, LearnerState, 
 /// Whether two states are the same, ignoring the flash wear (which `save`
 /// writes itself); compared as records, so that a NaN ε equals itself.
 fn same(a: &LearnerState, b: &LearnerState) -> bool {
-    LearnerState { wear: b.wear, ..a.clone() }.to_bytes() == b.to_bytes()
+    LearnerState {
+        wear: b.wear,
+        ..a.clone()
+    }
+    .to_bytes()
+        == b.to_bytes()
 }
 
 /// Invariant 2 for checkpoints: a loaded record is the one in the slot,
 /// byte for byte, and the weights are the slot's.
 fn reencodes(store: &Store, outcome: &LoadOutcome, st: &LearnerState) -> Outcome {
     if let LoadOutcome::Loaded { slot, .. } = *outcome {
-        let raw = store.slot(slot).map(|s| &s[HEADER_LEN..HEADER_LEN + STATE_LEN]);
-        ensure!(raw == Some(&st.to_bytes()[..]), "the loaded record re-encodes differently");
+        let raw = store
+            .slot(slot)
+            .map(|s| &s[HEADER_LEN..HEADER_LEN + STATE_LEN]);
+        ensure!(
+            raw == Some(&st.to_bytes()[..]),
+            "the loaded record re-encodes differently"
+        );
     }
     Outcome::Ok
 }
@@ -152,14 +171,23 @@ impl Target for Checkpoints {
     }
 
     fn check(&self, input: &[u8]) -> Outcome {
-        let Some((&[mode], rest)) = input.split_first_chunk::<1>() else { return Outcome::Ok };
-        let Some((seed, rest)) = rest.split_first_chunk::<8>() else { return Outcome::Ok };
-        let budget = rest.first_chunk::<4>().map_or(0, |b| u32::from_le_bytes(*b) as usize);
+        let Some((&[mode], rest)) = input.split_first_chunk::<1>() else {
+            return Outcome::Ok;
+        };
+        let Some((seed, rest)) = rest.split_first_chunk::<8>() else {
+            return Outcome::Ok;
+        };
+        let budget = rest
+            .first_chunk::<4>()
+            .map_or(0, |b| u32::from_le_bytes(*b) as usize);
         let mut rng = rand_pcg::Pcg64::seed_from_u64(u64::from_le_bytes(*seed));
         let (a, wa) = (state(&mut rng), weights(&mut rng));
         let (b, wb) = (state(&mut rng), weights(&mut rng));
         let mut store = Store::new();
-        ensure!(save(&mut store, HASH, &a, &wa).is_ok(), "the first save failed");
+        ensure!(
+            save(&mut store, HASH, &a, &wa).is_ok(),
+            "the first save failed"
+        );
         if below(&mut rng, 2) == 0 {
             // A generation about to wrap (a long-lived board, or a counter
             // that started high): the next saves must still be the newer.
@@ -167,7 +195,13 @@ impl Target for Checkpoints {
             if let Some(s) = store.slot_mut(0) {
                 let head: [u8; HEADER_LEN] = s[..HEADER_LEN].try_into().unwrap_or([0; HEADER_LEN]);
                 if let Ok(h) = Header::parse(&head) {
-                    s[..HEADER_LEN].copy_from_slice(&Header { generation: gen, ..h }.to_bytes());
+                    s[..HEADER_LEN].copy_from_slice(
+                        &Header {
+                            generation: gen,
+                            ..h
+                        }
+                        .to_bytes(),
+                    );
                 }
             }
         }
@@ -177,31 +211,56 @@ impl Target for Checkpoints {
                 if mode == 1 {
                     // A second checkpoint first, so the torn save overwrites
                     // the older of two.
-                    ensure!(save(&mut store, HASH, &a, &wa).is_ok(), "the second save failed");
+                    ensure!(
+                        save(&mut store, HASH, &a, &wa).is_ok(),
+                        "the second save failed"
+                    );
                 }
-                let mut torn = Torn { inner: store, budget, dead: false };
+                let mut torn = Torn {
+                    inner: store,
+                    budget,
+                    dead: false,
+                };
                 let saved = save(&mut torn, HASH, &b, &wb).is_ok();
                 let Some((outcome, st, w)) = load_all(&torn.inner) else {
                     return Outcome::Failed("load failed on a RAM store".into());
                 };
-                ensure!(matches!(outcome, LoadOutcome::Loaded { .. }), "cut after {budget} bytes: {outcome:?}");
+                ensure!(
+                    matches!(outcome, LoadOutcome::Loaded { .. }),
+                    "cut after {budget} bytes: {outcome:?}"
+                );
                 let old = same(&st, &a) && w == wa;
                 let new = same(&st, &b) && w == wb;
-                ensure!(old || new, "cut after {budget} bytes: neither the old nor the new checkpoint loaded");
-                ensure!(!saved || new, "the save reported success but the old checkpoint loaded");
+                ensure!(
+                    old || new,
+                    "cut after {budget} bytes: neither the old nor the new checkpoint loaded"
+                );
+                ensure!(
+                    !saved || new,
+                    "the save reported success but the old checkpoint loaded"
+                );
                 if let Outcome::Failed(f) = reencodes(&torn.inner, &outcome, &st) {
                     return Outcome::Failed(f);
                 }
                 // The next save after the power cut succeeds and loads.
                 let mut store = torn.inner;
-                ensure!(save(&mut store, HASH, &b, &wb).is_ok(), "saving after the cut failed");
+                ensure!(
+                    save(&mut store, HASH, &b, &wb).is_ok(),
+                    "saving after the cut failed"
+                );
                 let loaded = load_all(&store);
-                ensure!(loaded.is_some_and(|(_, st, w)| same(&st, &b) && w == wb), "the save after the cut does not load");
+                ensure!(
+                    loaded.is_some_and(|(_, st, w)| same(&st, &b) && w == wb),
+                    "the save after the cut does not load"
+                );
             }
             // Damaged slots: anything that loads is one of the saved
             // checkpoints, byte for byte.
             2 => {
-                ensure!(save(&mut store, HASH, &b, &wb).is_ok(), "the second save failed");
+                ensure!(
+                    save(&mut store, HASH, &b, &wb).is_ok(),
+                    "the second save failed"
+                );
                 for _ in 0..1 + below(&mut rng, 8) {
                     let slot = below(&mut rng, 2) as u8;
                     let at = below(&mut rng, SLOT);
@@ -213,7 +272,10 @@ impl Target for Checkpoints {
                     return Outcome::Failed("load failed on a RAM store".into());
                 };
                 if let LoadOutcome::Loaded { .. } = outcome {
-                    ensure!((same(&st, &a) && w == wa) || (same(&st, &b) && w == wb), "a damaged slot loaded");
+                    ensure!(
+                        (same(&st, &a) && w == wa) || (same(&st, &b) && w == wb),
+                        "a damaged slot loaded"
+                    );
                 }
                 return reencodes(&store, &outcome, &st);
             }
@@ -225,7 +287,10 @@ impl Target for Checkpoints {
                     }
                 }
                 if below(&mut rng, 2) == 0 {
-                    let payload: Vec<u8> = store.slot(0).map(|s| s[HEADER_LEN..slot_len(WEIGHTS)].to_vec()).unwrap_or_default();
+                    let payload: Vec<u8> = store
+                        .slot(0)
+                        .map(|s| s[HEADER_LEN..slot_len(WEIGHTS)].to_vec())
+                        .unwrap_or_default();
                     let h = Header {
                         version: FORMAT_VERSION,
                         config_hash: HASH,

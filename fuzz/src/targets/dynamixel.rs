@@ -6,7 +6,8 @@
 use super::{ensure, Outcome, Target};
 use crate::gen::{below, bytes, mutate};
 use pada_core::dynamixel::{
-    DecodeError, DecoderStats, ErrorFlags, Instruction, InstructionDecoder, Reply, StatusDecoder, StatusPacket,
+    DecodeError, DecoderStats, ErrorFlags, Instruction, InstructionDecoder, Reply, StatusDecoder,
+    StatusPacket,
 };
 use rand_core::RngCore;
 
@@ -24,7 +25,13 @@ impl<const N: usize> Status<N> {
 
 /// Valid packets, some from `id` with `params` parameter bytes, with bytes
 /// of noise between some of them.
-fn packets(rng: &mut rand_pcg::Pcg64, id: u8, params: usize, max_params: usize, status: bool) -> Vec<u8> {
+fn packets(
+    rng: &mut rand_pcg::Pcg64,
+    id: u8,
+    params: usize,
+    max_params: usize,
+    status: bool,
+) -> Vec<u8> {
     let mut out = Vec::new();
     let mut buf = [0u8; 300];
     for _ in 0..1 + below(rng, 5) {
@@ -32,7 +39,11 @@ fn packets(rng: &mut rand_pcg::Pcg64, id: u8, params: usize, max_params: usize, 
             let n = below(rng, 6);
             out.extend(bytes(rng, n));
         }
-        let (pid, n) = if below(rng, 2) == 0 { (id, params) } else { (below(rng, 254) as u8, below(rng, max_params + 1)) };
+        let (pid, n) = if below(rng, 2) == 0 {
+            (id, params)
+        } else {
+            (below(rng, 254) as u8, below(rng, max_params + 1))
+        };
         let data = bytes(rng, n);
         if status {
             if let Ok(p) = StatusPacket::<300>::new(pid, ErrorFlags(rng.next_u32() as u8), &data) {
@@ -42,9 +53,19 @@ fn packets(rng: &mut rand_pcg::Pcg64, id: u8, params: usize, max_params: usize, 
             }
         } else {
             let ins = match below(rng, 4) {
-                0 => Instruction::Read { addr: data.first().copied().unwrap_or(0), len: n as u8 },
-                1 if !data.is_empty() => Instruction::Write { addr: 30, data: &data },
-                2 => Instruction::SyncWrite { addr: 32, data_len: 2, entries: &data[..data.len() / 3 * 3] },
+                0 => Instruction::Read {
+                    addr: data.first().copied().unwrap_or(0),
+                    len: n as u8,
+                },
+                1 if !data.is_empty() => Instruction::Write {
+                    addr: 30,
+                    data: &data,
+                },
+                2 => Instruction::SyncWrite {
+                    addr: 32,
+                    data_len: 2,
+                    entries: &data[..data.len() / 3 * 3],
+                },
                 _ => Instruction::Ping,
             };
             if let Ok(b) = ins.encode(pid, &mut buf) {
@@ -58,10 +79,24 @@ fn packets(rng: &mut rand_pcg::Pcg64, id: u8, params: usize, max_params: usize, 
 /// Checks the counters against what the decoder returned and the bytes it
 /// was fed: every byte is in an accepted packet, skipped or buffered, and
 /// every refusal is counted once.
-fn check_counts(s: &DecoderStats, fed: usize, accepted_bytes: usize, buffered: usize, oks: u32, errs: [u32; 3]) -> Outcome {
-    ensure!(s.packets == oks, "packets {} counted, {oks} returned", s.packets);
+fn check_counts(
+    s: &DecoderStats,
+    fed: usize,
+    accepted_bytes: usize,
+    buffered: usize,
+    oks: u32,
+    errs: [u32; 3],
+) -> Outcome {
+    ensure!(
+        s.packets == oks,
+        "packets {} counted, {oks} returned",
+        s.packets
+    );
     let counted = [s.bad_checksums, s.bad_lengths, s.unexpected_ids];
-    ensure!(counted == errs, "refusals counted {counted:?}, returned {errs:?}");
+    ensure!(
+        counted == errs,
+        "refusals counted {counted:?}, returned {errs:?}"
+    );
     let kept = s.skipped_bytes as usize + accepted_bytes + buffered;
     ensure!(kept == fed, "{fed} bytes fed, {kept} accounted for (skipped {}, in packets {accepted_bytes}, buffered {buffered})", s.skipped_bytes);
     Outcome::Ok
@@ -121,12 +156,20 @@ impl<const N: usize> Target for Status<N> {
                         oks += 1;
                         // Invariant 2: it re-encodes to bytes that were fed.
                         let Ok(bytes) = p.encode(&mut buf) else {
-                            return Outcome::Failed(format!("accepted packet at byte {i} does not encode"));
+                            return Outcome::Failed(format!(
+                                "accepted packet at byte {i} does not encode"
+                            ));
                         };
-                        ensure!(contains(&stream[..=i], bytes), "accepted packet at byte {i} was never fed");
+                        ensure!(
+                            contains(&stream[..=i], bytes),
+                            "accepted packet at byte {i} was never fed"
+                        );
                         accepted += bytes.len();
                         if let Some(r) = reply {
-                            ensure!(p.id == r.id && p.params.len() == r.params as usize, "accepted {p:?}, expected {r:?}");
+                            ensure!(
+                                p.id == r.id && p.params.len() == r.params as usize,
+                                "accepted {p:?}, expected {r:?}"
+                            );
                         }
                     }
                     Err(e) => errs[kind(&e)] += 1,
@@ -134,7 +177,14 @@ impl<const N: usize> Target for Status<N> {
                 next = dec.poll();
             }
         }
-        check_counts(&dec.stats(), stream.len(), accepted, dec.buffered(), oks, errs)
+        check_counts(
+            &dec.stats(),
+            stream.len(),
+            accepted,
+            dec.buffered(),
+            oks,
+            errs,
+        )
     }
 }
 
@@ -187,12 +237,22 @@ impl<const N: usize> Target for Instructions<N> {
                     // back to the same packet.
                     if let Ok(ins) = p.instruction() {
                         let enc = ins.encode(p.id, &mut again);
-                        ensure!(enc.is_ok_and(|e| e == bytes), "{ins:?} parses but does not encode back");
+                        ensure!(
+                            enc.is_ok_and(|e| e == bytes),
+                            "{ins:?} parses but does not encode back"
+                        );
                     }
                 }
                 Err(e) => errs[kind(&e)] += 1,
             }
         }
-        check_counts(&dec.stats(), stream.len(), accepted, dec.buffered(), oks, errs)
+        check_counts(
+            &dec.stats(),
+            stream.len(),
+            accepted,
+            dec.buffered(),
+            oks,
+            errs,
+        )
     }
 }

@@ -40,7 +40,13 @@ pub trait Target {
 /// instruction packet decoders, checkpoint loading and torn saves.
 pub fn all(corpus: &Corpus) -> Vec<Box<dyn Target>> {
     vec![
-        Box::new(wire::Frames::<ToHost, { pada_core::wire::MAX_FRAME_LEN }>::new("wire-host", 12, corpus.frames.clone())),
+        Box::new(
+            wire::Frames::<ToHost, { pada_core::wire::MAX_FRAME_LEN }>::new(
+                "wire-host",
+                12,
+                corpus.frames.clone(),
+            ),
+        ),
         Box::new(wire::Frames::<ToChip, 64>::new("wire-chip", 11, Vec::new())),
         Box::new(dynamixel::Status::<32>::new("dynamixel-status")),
         Box::new(dynamixel::Instructions::<64>::new("dynamixel-instr")),

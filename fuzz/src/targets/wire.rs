@@ -20,7 +20,12 @@ pub struct Frames<M, const N: usize> {
 
 impl<M, const N: usize> Frames<M, N> {
     pub fn new(name: &'static str, variants: u8, corpus: Vec<Vec<u8>>) -> Self {
-        Frames { name, variants, corpus, _m: PhantomData }
+        Frames {
+            name,
+            variants,
+            corpus,
+            _m: PhantomData,
+        }
     }
 }
 
@@ -107,7 +112,10 @@ impl<M: DeserializeOwned + Serialize, const N: usize> Target for Frames<M, N> {
                     oks += 1;
                     // Invariant 2: an accepted frame re-encodes to its bytes.
                     let again = encode_frame(&d.msg, d.seq, &mut buf);
-                    ensure!(again.is_ok_and(|f| f == segment), "accepted frame at byte {i} re-encodes differently");
+                    ensure!(
+                        again.is_ok_and(|f| f == segment),
+                        "accepted frame at byte {i} re-encodes differently"
+                    );
                     let model_gap = match expected {
                         Some(e) if e != d.seq => {
                             gaps += 1;
@@ -121,7 +129,11 @@ impl<M: DeserializeOwned + Serialize, const N: usize> Target for Frames<M, N> {
                         }
                         _ => false,
                     };
-                    ensure!(d.gap.is_some() == model_gap, "gap of frame seq {} not as modelled", d.seq);
+                    ensure!(
+                        d.gap.is_some() == model_gap,
+                        "gap of frame seq {} not as modelled",
+                        d.seq
+                    );
                     expected = Some(d.seq.wrapping_add(1));
                 }
                 Err(e) => {
@@ -132,18 +144,43 @@ impl<M: DeserializeOwned + Serialize, const N: usize> Target for Frames<M, N> {
                         FrameError::Crc { .. } => 3,
                         FrameError::Decode => 4,
                         FrameError::NonCanonical => 5,
-                        FrameError::Truncated => return Outcome::Failed("Truncated before the end".into()),
+                        FrameError::Truncated => {
+                            return Outcome::Failed("Truncated before the end".into())
+                        }
                     };
                     errs[k] += 1;
                 }
             }
         }
         let s = dec.stats();
-        ensure!(s.bytes == input.len() as u64, "bytes {} of {}", s.bytes, input.len());
-        ensure!(s.frames == oks, "frames {} counted, {oks} returned", s.frames);
-        let counted = [s.oversize, s.cobs_errors, s.too_short, s.crc_errors, s.decode_errors, s.noncanonical];
-        ensure!(counted == errs, "losses counted {counted:?}, returned {errs:?}");
-        ensure!((s.frames + s.bad_frames()) as usize == segments, "{segments} frames, {} outcomes", s.frames + s.bad_frames());
+        ensure!(
+            s.bytes == input.len() as u64,
+            "bytes {} of {}",
+            s.bytes,
+            input.len()
+        );
+        ensure!(
+            s.frames == oks,
+            "frames {} counted, {oks} returned",
+            s.frames
+        );
+        let counted = [
+            s.oversize,
+            s.cobs_errors,
+            s.too_short,
+            s.crc_errors,
+            s.decode_errors,
+            s.noncanonical,
+        ];
+        ensure!(
+            counted == errs,
+            "losses counted {counted:?}, returned {errs:?}"
+        );
+        ensure!(
+            (s.frames + s.bad_frames()) as usize == segments,
+            "{segments} frames, {} outcomes",
+            s.frames + s.bad_frames()
+        );
         ensure!(
             (s.seq_gaps, s.frames_missed, s.seq_resyncs) == (gaps, missed, resyncs),
             "ledger {:?}, model {:?}",
@@ -152,8 +189,16 @@ impl<M: DeserializeOwned + Serialize, const N: usize> Target for Frames<M, N> {
         );
         // The end of the input: a frame in progress is lost, once.
         let cut = start < input.len();
-        ensure!(dec.finish().is_some() == cut, "finish with {} bytes pending", input.len() - start);
-        ensure!(dec.stats().truncated == cut as u32, "truncated counted {}", dec.stats().truncated);
+        ensure!(
+            dec.finish().is_some() == cut,
+            "finish with {} bytes pending",
+            input.len() - start
+        );
+        ensure!(
+            dec.stats().truncated == cut as u32,
+            "truncated counted {}",
+            dec.stats().truncated
+        );
         ensure!(dec.finish().is_none(), "a second finish counted again");
         Outcome::Ok
     }
