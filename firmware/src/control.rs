@@ -593,7 +593,7 @@ where
             return (result, Some(t));
         }
         let result = match *cmd {
-            wire::ToChip::SetPolicy(spec) => self.set_policy(spec.into()),
+            wire::ToChip::SetPolicy(spec) => self.set_policy(spec),
             wire::ToChip::SetEpsilon(e) => self.agent_mut().set_epsilon(e).map_err(|_| NackReason::InvalidParameter),
             wire::ToChip::SwitchToSarsa => {
                 self.agent_mut().switch_to_sarsa().map_err(|_| NackReason::InvalidParameter)

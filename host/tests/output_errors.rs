@@ -92,16 +92,16 @@ fn a_full_standard_output_is_one_line_and_exit_code_1_in_every_command() {
 fn a_closed_pipe_is_one_line_and_exit_code_1_in_every_command() {
     let dir = tempfile::tempdir().unwrap();
     for args in commands(dir.path()) {
-        let mut child = pada()
+        // The reader is gone before the command starts (as `| true` once
+        // `true` has exited): every write fails with EPIPE.
+        let (reader, writer) = rustix::pipe::pipe().unwrap();
+        drop(reader);
+        let out = pada()
             .args(&args)
             .stdin(Stdio::null())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
+            .stdout(Stdio::from(writer))
+            .output()
             .unwrap();
-        // The reader goes away before anything is written (as `| true`).
-        drop(child.stdout.take());
-        let out = child.wait_with_output().unwrap();
         assert_output_error(&out, &format!("{args:?} | true"));
     }
 }

@@ -63,7 +63,7 @@ fn saves_alternate_slots_and_load_takes_the_newest() {
     let mut store = Store::new();
     for g in 1..=6u32 {
         let saved = save_seed(&mut store, 42, g).unwrap();
-        assert_eq!(saved, Saved { generation: g, slot: ((g - 1) % 2) as u8, erases: (g + 1) / 2 });
+        assert_eq!(saved, Saved { generation: g, slot: ((g - 1) % 2) as u8, erases: g.div_ceil(2) });
         let (outcome, st, out) = load_all(&store, 42);
         assert_eq!(outcome, LoadOutcome::Loaded { generation: g, slot: saved.slot });
         assert_eq!(out, weights(g as i32));
