@@ -528,6 +528,15 @@ mod tests {
     }
 
     #[test]
+    fn fuzz_takes_seconds_and_seed_and_refuses_the_rest() {
+        assert_eq!(parse_args(&args("fuzz")), Ok(Task::Fuzz(vec![])));
+        assert_eq!(parse_args(&args("fuzz --seconds 90 --seed 7")), Ok(Task::Fuzz(args("--seconds 90 --seed 7"))));
+        for bad in ["fuzz --seconds 0", "fuzz --seconds nan", "fuzz --seconds", "fuzz --seed -1", "fuzz --release"] {
+            assert!(parse_args(&args(bad)).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
     fn firmware_defaults_to_debug_f405() {
         assert_eq!(
             parse_args(&args("firmware")),
