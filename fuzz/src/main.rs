@@ -156,3 +156,35 @@ fn parse_args(mut args: impl Iterator<Item = String>) -> Result<(f64, u64), Stri
     }
     Ok((seconds, seed))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_target_passes_a_few_hundred_inputs_and_replays_them() {
+        let corpus = gen::Corpus::load();
+        assert!(!corpus.frames.is_empty(), "the recorded stream is the wire corpus");
+        for (i, t) in targets::all(&corpus).iter_mut().enumerate() {
+            let mut rng = rand_pcg::Pcg64::seed_from_u64(i as u64);
+            for n in 0..300 {
+                let input = t.generate(&mut rng);
+                // The check is a function of the input alone, so a saved
+                // failing input replays.
+                for _ in 0..2 {
+                    if let Outcome::Failed(why) = t.check(&input) {
+                        panic!("{} input {n}: {why}", t.name());
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn arguments_are_checked() {
+        let a = |s: &str| parse_args(s.split_whitespace().map(String::from));
+        assert_eq!(a(""), Ok((60.0, 1)));
+        assert_eq!(a("--seconds 2.5 --seed 9"), Ok((2.5, 9)));
+        assert!(a("--seconds 0").is_err() && a("--seconds x").is_err() && a("--bogus").is_err());
+    }
+}
