@@ -301,7 +301,7 @@ impl<P: BusPort> ServoBus<P> {
                         *checksum_errors = checksum_errors.saturating_add(1);
                         corrupted = true;
                     }
-                    Err(DecodeError::UnexpectedId { .. } | DecodeError::BadLength { .. }) => {
+                    Err(DecodeError::UnexpectedId { .. } | DecodeError::BadLength { .. } | DecodeError::BroadcastStatus) => {
                         self.stats.stray_packets = self.stats.stray_packets.wrapping_add(1);
                     }
                 }

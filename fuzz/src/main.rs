@@ -1,4 +1,6 @@
-//! `pada-fuzz [--seconds S] [--seed K]`: drives every decoder that faces
+//! `pada-fuzz [--seconds S] [--seed K]` (or `pada-fuzz --replay FILE…` to
+//! run saved failing inputs again, each through the target its name
+//! starts with): drives every decoder that faces
 //! untrusted bytes with random and mutated-valid inputs for about `S`
 //! seconds in all (default 60, shared evenly between the targets) and
 //! checks four invariants:
@@ -31,7 +33,11 @@ use std::time::{Duration, Instant};
 use targets::{Outcome, Target};
 
 fn main() -> std::process::ExitCode {
-    let (seconds, seed) = match parse_args(std::env::args().skip(1)) {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.first().is_some_and(|a| a == "--replay") {
+        return replay(&args[1..]);
+    }
+    let (seconds, seed) = match parse_args(args.into_iter()) {
         Ok(a) => a,
         Err(e) => {
             eprintln!("pada-fuzz: error: {e}\nusage: pada-fuzz [--seconds S] [--seed K]");
@@ -66,11 +72,52 @@ fn main() -> std::process::ExitCode {
     }
     if failed > 0 {
         eprintln!(
-            "pada-fuzz: {failed} inputs broke an invariant; they are in target/fuzz-failures/"
+            "pada-fuzz: {failed} inputs broke an invariant; the first ten of each target are in \
+             target/fuzz-failures/ (again: cargo run --profile fuzz -p pada-fuzz -- --replay FILE...)"
         );
         return std::process::ExitCode::FAILURE;
     }
     std::process::ExitCode::SUCCESS
+}
+
+/// Runs each saved input (`<target>-<n>.bin`) through its target again.
+fn replay(files: &[String]) -> std::process::ExitCode {
+    let corpus = gen::Corpus::load();
+    let targets = targets::all(&corpus);
+    let mut failed = false;
+    for f in files {
+        let name = std::path::Path::new(f).file_name().and_then(|n| n.to_str()).unwrap_or("");
+        let Some(t) = targets.iter().find(|t| name.starts_with(&format!("{}-", t.name()))) else {
+            eprintln!("{f}: no target is named like it");
+            failed = true;
+            continue;
+        };
+        let input = match std::fs::read(f) {
+            Ok(b) => b,
+            Err(e) => {
+                eprintln!("{f}: cannot read: {e}");
+                failed = true;
+                continue;
+            }
+        };
+        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| t.check(&input)));
+        match outcome {
+            Ok(Outcome::Ok) => println!("{f}: ok"),
+            Ok(Outcome::Failed(why)) => {
+                println!("{f}: FAILED: {why}");
+                failed = true;
+            }
+            Err(_) => {
+                println!("{f}: FAILED: panic");
+                failed = true;
+            }
+        }
+    }
+    if failed {
+        std::process::ExitCode::FAILURE
+    } else {
+        std::process::ExitCode::SUCCESS
+    }
 }
 
 struct Report {

@@ -223,6 +223,27 @@ fn corrupted_streams_lose_only_the_corrupted_packets() {
 }
 
 #[test]
+fn a_status_packet_from_the_broadcast_id_is_refused() {
+    // Found by `cargo xtask fuzz`: the decoder accepted a status packet from
+    // ID 0xFE, which no servo sends and the encoder refuses.
+    let mut raw = vec![0xFF, 0xFF, BROADCAST_ID, 2, 0];
+    raw.push(checksum(&raw[2..]));
+    let good = encode_status(&Status::new(1, ErrorFlags::NONE, &[]).unwrap());
+    raw.extend(&good);
+    let mut dec = StatusDecoder::<64>::new();
+    let got = decode_all_status(&mut dec, &raw);
+    assert_eq!(got[0], Err(DecodeError::BroadcastStatus));
+    assert!(matches!(got.last(), Some(Ok(p)) if p.id == 1));
+    assert_eq!(dec.stats().unexpected_ids, 1);
+    assert_eq!(dec.stats().skipped_bytes as usize, raw.len() - good.len());
+    // Instructions to the broadcast ID are packets like any other.
+    let mut ins = InstructionDecoder::<64>::new();
+    let mut buf = [0u8; 16];
+    let sent = action(BROADCAST_ID, &mut buf).unwrap();
+    assert!(matches!(ins.feed(sent).next(), Some(Ok(p)) if p.id == BROADCAST_ID));
+}
+
+#[test]
 fn writes_without_data_are_refused_by_encoder_and_parser_alike() {
     // Regression (issue 16, defect 7): WRITE and REG_WRITE with no data
     // encoded, and the emulator's parser then refused them as BadParams.

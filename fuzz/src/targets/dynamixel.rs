@@ -106,7 +106,7 @@ fn kind(e: &DecodeError) -> usize {
     match e {
         DecodeError::BadChecksum { .. } => 0,
         DecodeError::BadLength { .. } => 1,
-        DecodeError::UnexpectedId { .. } => 2,
+        DecodeError::UnexpectedId { .. } | DecodeError::BroadcastStatus => 2,
     }
 }
 

@@ -19,7 +19,7 @@
 //! spurious header cannot hold back or swallow the real reply behind it,
 //! and garbage must match ID, LENGTH and checksum to pass.
 
-use super::packet::{checksum, ErrorFlags, InstructionPacket, StatusPacket, DEFAULT_PACKET_LEN};
+use super::packet::{checksum, ErrorFlags, InstructionPacket, StatusPacket, BROADCAST_ID, DEFAULT_PACKET_LEN};
 use core::marker::PhantomData;
 use heapless::Vec;
 
@@ -52,6 +52,9 @@ pub enum DecodeError {
         /// The ID in the header.
         got: u8,
     },
+    /// A status packet from the broadcast ID, which no servo answers from
+    /// (and which [`StatusPacket::encode`] refuses).
+    BroadcastStatus,
 }
 
 /// Decoder counters, for health telemetry. Every byte fed is in an accepted
@@ -68,7 +71,8 @@ pub struct DecoderStats {
     pub bad_checksums: u32,
     /// Headers with an impossible LENGTH, or not the expected reply's.
     pub bad_lengths: u32,
-    /// Headers from an unexpected ID.
+    /// Headers from an unexpected ID (for status packets, the broadcast ID
+    /// too).
     pub unexpected_ids: u32,
 }
 
@@ -85,17 +89,22 @@ pub struct Reply {
 
 /// A packet the decoder can build from the fields it found.
 pub trait FromRaw<const N: usize>: Sized {
+    /// Whether the broadcast ID may send this kind of packet (instructions:
+    /// yes; status packets: no servo answers from it).
+    const FROM_BROADCAST: bool;
     /// The packet with `id`, byte 4 (INSTRUCTION or ERROR) and `params`.
     fn from_raw(id: u8, byte4: u8, params: Vec<u8, N>) -> Self;
 }
 
 impl<const N: usize> FromRaw<N> for StatusPacket<N> {
+    const FROM_BROADCAST: bool = false;
     fn from_raw(id: u8, byte4: u8, params: Vec<u8, N>) -> Self {
         StatusPacket { id, error: ErrorFlags(byte4), params }
     }
 }
 
 impl<const N: usize> FromRaw<N> for InstructionPacket<N> {
+    const FROM_BROADCAST: bool = true;
     fn from_raw(id: u8, byte4: u8, params: Vec<u8, N>) -> Self {
         InstructionPacket { id, code: byte4, params }
     }
@@ -201,6 +210,11 @@ impl<P: FromRaw<N>, const N: usize> Decoder<P, N> {
                 // 0xFF 0xFF 0xFF: the header starts one byte later.
                 self.skip(1);
                 continue;
+            }
+            if self.buf[2] == BROADCAST_ID && !P::FROM_BROADCAST {
+                self.stats.unexpected_ids = self.stats.unexpected_ids.saturating_add(1);
+                self.skip(1);
+                return Some(Err(DecodeError::BroadcastStatus));
             }
             if self.len < 4 {
                 return None;
