@@ -85,7 +85,13 @@
 //! [`load`] writes the caller's state and weights only when the outcome is
 //! [`LoadOutcome::Loaded`]. A format-1 slot (weights only) is refused as
 //! [`LoadOutcome::UnsupportedVersion`] `{ found: 1 }`, never loaded without
-//! its state.
+//! its state; a record of version 1 (496 bytes, before the flash wear) is
+//! refused as [`LoadOutcome::InvalidState`].
+//!
+//! The newer of two valid slots is the one whose generation is ahead in
+//! serial-number arithmetic ([`is_newer`]), so saving goes on past
+//! `u32::MAX`. A store too small for a header that reads as erased flash
+//! holds no checkpoint ([`LoadOutcome::NoCheckpoint`]).
 //!
 //! # Flash wear
 //!
@@ -104,6 +110,15 @@
 //! learner-state record), [`store`] (the medium), [`wear`] (the erase
 //! budget). CRC-32 is [`crate::crc::CRC32`], shared with the telemetry
 //! frames.
+//!
+//! [`Q16`]: crate::fixed::Q16
+//! [`Mode`]: crate::agent::Mode
+//! [`kind_code`]: crate::policy::kind_code
+//! [`AgentState`]: crate::agent::AgentState
+//! [`JointFatigueState`]: crate::fatigue::JointFatigueState
+//! [`RngState::check`]: crate::rng::RngState::check
+//! [`RngState::increment`]: crate::rng::RngState::increment
+//! [`RngState::state`]: crate::rng::RngState::state
 
 pub mod record;
 pub mod slots;
