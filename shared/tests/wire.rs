@@ -200,6 +200,29 @@ fn round_trip<M: serde::Serialize + serde::de::DeserializeOwned + PartialEq + st
     }
 }
 
+/// CRC-32 of the postcard bytes of one of every message, both directions.
+fn layout_fingerprint() -> u32 {
+    let mut bytes = Vec::new();
+    for m in all_to_host() {
+        bytes.extend(body(&m));
+    }
+    for m in all_to_chip() {
+        bytes.extend(body(&m));
+    }
+    pada_core::crc::crc32(&bytes)
+}
+
+#[test]
+fn the_protocol_version_changes_with_the_layout() {
+    // A change of any message's layout changes this fingerprint: then bump
+    // PROTOCOL_VERSION and put the new pair here (with the docs that name
+    // the version: docs/sil.md, firmware/README.md, README.md).
+    assert_eq!((PROTOCOL_VERSION, layout_fingerprint()), (3, EXPECTED_FINGERPRINT), "{:#010x}", layout_fingerprint());
+}
+
+/// [`layout_fingerprint`] of protocol 3.
+const EXPECTED_FINGERPRINT: u32 = 0xb6e2_4b7e;
+
 #[test]
 fn every_chip_message_round_trips() {
     round_trip::<ToHost, MAX_FRAME_LEN>(&all_to_host());
