@@ -21,7 +21,7 @@ pub mod progress;
 pub mod seed;
 pub mod sil;
 pub mod stats;
-pub mod stdout;
+pub mod console;
 pub mod summary;
 pub mod task;
 pub mod tasks;

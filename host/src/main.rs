@@ -5,7 +5,7 @@ use std::io::Write;
 fn main() {
     // The last of standard output is flushed here, so that a full disk or a
     // closed pipe is still an error and not dropped at exit.
-    let result = pada::cli::run(std::env::args_os()).and_then(|()| pada::stdout::flush());
+    let result = pada::cli::run(std::env::args_os()).and_then(|()| pada::console::flush());
     let code = match result {
         Ok(()) => 0,
         Err(e) => {

@@ -165,3 +165,22 @@ fn a_stream_cut_off_at_the_end_reports_the_loss() {
     assert_eq!(json["bad_frames"], 1, "{json}");
     assert_eq!(json["link"]["frames"], 0);
 }
+
+#[test]
+fn a_full_standard_error_does_not_make_a_command_panic() {
+    // Status lines and messages go to stderr; when it cannot be written
+    // there is nowhere to report that, but the command must not panic.
+    let out = pada()
+        .args(["capture", "--file"])
+        .arg(recording())
+        .stderr(File::create("/dev/full").unwrap())
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let out = pada()
+        .args(["capture", "--file", "/nonexistent"])
+        .stderr(File::create("/dev/full").unwrap())
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2), "bad input still exits 2");
+}

@@ -8,7 +8,7 @@
 //! cut it itself, so it is not). A read error ends the capture with its
 //! summary and exit code 1.
 
-use crate::stdout::outln;
+use crate::console::{errln, outln};
 use crate::capture::Recorder;
 use crate::error::{usage, CliError};
 use anyhow::Context;
@@ -202,7 +202,7 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
             serde_json::to_string_pretty(&summary).map_err(|e| CliError::Runtime(e.into()))?
         )?;
     } else {
-        eprintln!(
+        errln!(
             "capture of {} ended ({}): {} frames, {} lost, {} sequence gaps ({} frames missing)",
             summary.source,
             summary.ended,

@@ -1,7 +1,7 @@
 //! `pada demo`: the README's main job — SARSA(λ) against PADA Δ = 0.5 on
 //! the simulated pendulum of Section VII, next to the paper's numbers.
 
-use crate::stdout::outln;
+use crate::console::outln;
 use super::run::{fmt_estimate, fmt_mtbf};
 use crate::cli::{check_seconds, set_threads, DemoArgs};
 use crate::error::CliError;

@@ -2,7 +2,7 @@
 //! torque log, per joint: backlash re-engagements, damage J and predicted
 //! MTBF, over the first N steps (the paper's window) and the whole log.
 
-use crate::stdout::outln;
+use crate::console::outln;
 use crate::cli::MtbfArgs;
 use crate::error::{usage, CliError};
 use crate::torque_log;

@@ -1,7 +1,7 @@
 //! `pada paper pendulum`: the whole of Section VII — data, report.md and
 //! the figures — in one directory.
 
-use crate::stdout::outln;
+use crate::console::outln;
 use crate::algo::{algo_of, label, parameter_of};
 use crate::cli::{check_seconds, set_threads, PaperArgs, PaperExperiment};
 use crate::error::CliError;

@@ -2,7 +2,7 @@
 //! paper's numbers, Fig. 7-style learning curves and Fig. 8-style end
 //! performance against MTBF.
 
-use crate::stdout::outln;
+use crate::console::outln;
 use super::paper::{curves, point};
 use super::run::{fmt_estimate, fmt_mtbf};
 use crate::algo::label;

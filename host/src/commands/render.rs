@@ -2,7 +2,7 @@
 //! PNG) and the trajectory as CSV, from weights saved by
 //! `pada run --task leo --save-weights FILE`.
 
-use crate::stdout::outln;
+use crate::console::outln;
 use crate::cli::RenderArgs;
 use crate::experiment::HostAgent;
 use crate::error::{usage, CliError};

@@ -1,7 +1,7 @@
 //! `pada run`: trials of one algorithm on one task, with a progress bar,
 //! `summary.json`, `trials.csv` and per-trial learning curves.
 
-use crate::stdout::outln;
+use crate::console::outln;
 use crate::algo::{label, policy_kind, Algo};
 use crate::cli::{check_seconds, set_threads, RunArgs};
 use crate::error::{usage, CliError};

@@ -1,7 +1,7 @@
 //! `pada sil`: the firmware image learns inside QEMU against the simulated
 //! plant (docs/sil.md).
 
-use crate::stdout::outln;
+use crate::console::{errln, outln};
 use crate::algo::{label, policy_kind, Algo};
 use crate::cli::check_seconds;
 use crate::error::{usage, CliError};
@@ -158,7 +158,7 @@ fn build_image(task: SilTask) -> Result<PathBuf, CliError> {
         SilTask::Pendulum => "pendulum",
         SilTask::Leo => "leo",
     };
-    eprintln!(
+    errln!(
         "pada sil: building the firmware for the emulated board (cargo xtask qemu --robot {robot})"
     );
     let output =
