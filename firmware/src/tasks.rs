@@ -20,7 +20,7 @@ use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 use embassy_time::{Duration, Instant, Ticker};
 use heapless::Vec;
-use pada_core::checkpoint::LoadOutcome;
+use pada_core::checkpoint::{LoadOutcome, SaveError};
 use pada_core::safety::Transition;
 use pada_core::wire::{self, FrameDecoder, FrameEncoder, NackReason, ToChip, ToHost, MAX_FRAME_LEN};
 use pada_firmware::bus::{BusConfig, BusStats, ServoBus};
@@ -325,6 +325,8 @@ pub async fn control(mut cl: ControlLoop) -> ! {
                 overruns: timing.overruns,
                 max_loop_us: timing.max_us,
                 telemetry_drops: drops,
+                checkpoint_erases: 0,
+                saves_refused: 0,
             };
             cl.ctl.health(&mut health);
             send(ToHost::Health(health), &mut skipped, &mut drops);
@@ -403,6 +405,11 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
                         Ok(())
                     }
                     Err(CheckpointError::Busy) => Err(NackReason::Busy),
+                    Err(CheckpointError::Save(SaveError::Wear(refusal))) => {
+                        warn!("checkpoint save refused to spare the flash: {}", refusal);
+                        send_reliable(ToHost::Checkpoint(wire::CheckpointReport::SaveFailed)).await;
+                        Err(NackReason::FlashWear)
+                    }
                     Err(e) => {
                         warn!("checkpoint save failed: {}", defmt::Debug2Format(&e));
                         send_reliable(ToHost::Checkpoint(wire::CheckpointReport::SaveFailed)).await;

@@ -68,7 +68,7 @@ pub struct RunArgs {
     #[arg(long, value_enum, default_value_t = TaskName::Pendulum)]
     pub task: TaskName,
     /// The algorithm (Section V).
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = crate::experiment::algo::algo_parser())]
     pub algo: Algo,
     /// Low-pass α of Eq. 8, 0 < α ≤ 1 (lowpass, markov-lowpass; default 0.834).
     #[arg(long)]

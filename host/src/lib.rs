@@ -23,6 +23,7 @@ pub mod rig;
 pub mod seed;
 pub mod sil;
 pub mod stats;
+pub mod console;
 pub mod summary;
 pub mod telemetry;
 pub mod torque_log;

@@ -458,9 +458,8 @@ fn bad_command_lines_are_one_line_usage_errors() {
 
 #[test]
 fn the_firmware_s_own_recording_shows_its_safety_state() {
-    // Recorded from the firmware in QEMU with wire protocol 2 (before the
-    // Policy message): it still decodes; the state comes from its State
-    // frames, and the policy is unknown.
+    // Recorded from the firmware in QEMU (`pada sil --seconds 3`): the
+    // state comes from its State frames, the policy from its Policy frames.
     let file = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../tests/data/sil-pendulum-3s.bin"
@@ -469,16 +468,14 @@ fn the_firmware_s_own_recording_shows_its_safety_state() {
     let w = Watch::start(&["--file", file]);
     let s = w.wait_for(60, "end of file", |s| !s["ended"].is_null());
     assert_same_as_capture(&s, &capture);
-    assert_eq!(s["hello"]["protocol"], 2);
+    assert_eq!(s["hello"]["protocol"], pada_core::wire::PROTOCOL_VERSION);
     assert!(s["messages"]["state"].as_u64().unwrap() >= 1);
     assert!(
         s["safety"]["state"].is_string(),
         "{}",
         watch_common::short(&s)
     );
-    assert!(s["policy"].is_null());
-    let (_, page) = w.get("");
-    assert!(page.contains("unknown (no Policy frame yet)"));
+    assert!(!s["policy"].is_null(), "{}", watch_common::short(&s));
 }
 
 #[test]

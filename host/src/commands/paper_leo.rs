@@ -2,6 +2,7 @@
 //! paper's numbers, Fig. 7-style learning curves and Fig. 8-style end
 //! performance against MTBF.
 
+use crate::console::outln;
 use crate::cli::{check_seconds, set_threads, PaperArgs};
 use crate::display::{fmt_estimate, fmt_mtbf};
 use crate::error::CliError;
@@ -68,13 +69,13 @@ pub fn run(args: PaperArgs) -> Result<(), CliError> {
         );
         let title = crate::leo::gait::gait_title(&source, &frames, fell);
         out.write_all(&crate::leo::gait::gait_files(&frames, 12, &title)?)?;
-        println!("{title}");
+        outln!("{title}")?;
     }
-    println!("{report}");
-    println!(
+    outln!("{report}")?;
+    outln!(
         "wrote {}/report.md, the figures, best.weights and the gait (gait.svg/png, gait-animation.svg)",
         out.path().display()
-    );
+    )?;
     Ok(())
 }
 

@@ -1,6 +1,7 @@
 //! `pada run`: trials of one algorithm on one task, with a progress bar,
 //! `summary.json`, `trials.csv` and per-trial learning curves.
 
+use crate::console::outln;
 use crate::cli::{check_seconds, set_threads, RunArgs};
 use crate::display::{fmt_estimate, fmt_mtbf};
 use crate::error::{usage, CliError};
@@ -98,10 +99,10 @@ fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
     let summary = BoardSummary::new(&task_spec, &cfg, &profile, &trials, wall);
     out.write_all(&board_files(&summary)?)?;
     if args.json {
-        println!("{}", summary.to_json());
+        outln!("{}", summary.to_json())?;
     } else {
-        print_summary(&summary.run, &label(&policy));
-        println!(
+        print_summary(&summary.run, &label(&policy))?;
+        outln!(
             "  board                {}: {} {} weights ({} KiB, {}-bit) in {}",
             board.name(),
             summary.profile.layout,
@@ -109,8 +110,8 @@ fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
             summary.profile.table_bytes / 1024,
             summary.profile.weight_bits,
             summary.profile.memory
-        );
-        println!("wrote {}", out.path().display());
+        )?;
+        outln!("wrote {}", out.path().display())?;
     }
     Ok(())
 }
@@ -119,7 +120,7 @@ fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
 fn run_config(args: &RunArgs, spec: &TaskSpec, policy: pada_core::policy::PolicyKind) -> Result<RunConfig, CliError> {
     let seconds = check_seconds("--seconds", args.seconds.unwrap_or(spec.default_seconds))?;
     if let Some(s) = args.switch_at {
-        if !matches!(args.algo, Algo::Lowpass | Algo::Pada) {
+        if !matches!(args.algo, Algo::LowPass | Algo::Pada) {
             return Err(usage(format!(
                 "--switch-at applies only to lowpass and pada (Section VIII), not to {}",
                 args.algo
@@ -206,60 +207,61 @@ impl TaskVisitor for RunVisitor {
         if let Some(sink) = telemetry {
             let totals = sink.finish()?;
             if !args.json {
-                println!(
+                outln!(
                     "telemetry: trial 0, {} frames ({} bytes) to {}",
                     totals.frames, totals.bytes, totals.target
-                );
+                )?;
             }
         }
         if args.json {
-            println!("{}", summary.to_json());
+            outln!("{}", summary.to_json())?;
         } else {
-            print_summary(&summary, &label(&policy));
-            println!("wrote {}", out.path().display());
+            print_summary(&summary, &label(&policy))?;
+            outln!("wrote {}", out.path().display())?;
         }
         Ok(())
     }
 }
 
 /// A short human-readable summary.
-pub fn print_summary(s: &RunSummary, label: &str) {
-    println!(
+pub fn print_summary(s: &RunSummary, label: &str) -> Result<(), CliError> {
+    outln!(
         "{}, {}: {} trials of {} s learning (seed {})",
         s.task, label, s.trials, s.parameters.seconds, s.parameters.seed
-    );
-    println!(
+    )?;
+    outln!(
         "  end performance      {}",
         fmt_estimate(s.end_performance.mean, s.end_performance.ci95, 1, "")
-    );
-    println!(
+    )?;
+    outln!(
         "  rise time            {}",
         fmt_estimate(s.rise_time_s.mean, s.rise_time_s.ci95, 0, " s")
-    );
-    println!(
+    )?;
+    outln!(
         "  MTBF (1200 actions)  {} (the paper's: torque from the commanded action)",
         fmt_mtbf(s.mtbf_s.mean, s.mtbf_s.ci95)
-    );
-    println!(
+    )?;
+    outln!(
         "  physical MTBF        {} (from the simulated gear torques)",
         fmt_mtbf(s.physical_mtbf_s.mean, s.physical_mtbf_s.ci95)
-    );
+    )?;
     if let (Some(w), Some(v)) = (&s.end_walked_m, &s.end_speed_m_s) {
-        println!(
+        outln!(
             "  walked (last 10%)    {}",
             fmt_estimate(w.mean, w.ci95, 2, " m")
-        );
-        println!(
+        )?;
+        outln!(
             "  speed (last 10%)     {}",
             fmt_estimate(v.mean, v.ci95, 3, " m/s")
-        );
+        )?;
     }
-    println!(
+    outln!(
         "  falls                {:.1} learning, {:.1} test runs per trial",
         s.learning_falls.mean, s.test_falls.mean
-    );
-    println!(
+    )?;
+    outln!(
         "  wall {:.1} s, {:.0} env steps/s on {} threads",
         s.wall_s, s.env_steps_per_s, s.threads
-    );
+    )?;
+    Ok(())
 }

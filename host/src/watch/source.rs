@@ -161,6 +161,20 @@ pub fn spawn(
         .name("watch-decoder".into())
         .spawn(move || {
             let end = decode(source, &recorder, &shared, &stop);
+            // The stream ended by itself (not Ctrl-C, which cuts the frame
+            // in progress itself): a frame cut off by the end counts as lost,
+            // as `pada capture` counts it.
+            if !stop.load(Ordering::SeqCst) {
+                let mut rec = recorder.lock().unwrap_or_else(|e| e.into_inner());
+                let t = shared.started.elapsed().as_secs_f64();
+                if let Err(e) = rec.finish(t) {
+                    shared.failed.store(true, Ordering::SeqCst);
+                    eprintln!("watch: cannot write the CSV ({e})");
+                }
+                let (link, counts, latest) = (rec.stats(), rec.counts(), rec.latest().clone());
+                drop(rec);
+                shared.state.lock().unwrap_or_else(|e| e.into_inner()).apply(&[], link, counts, &latest);
+            }
             if end.failed {
                 shared.failed.store(true, Ordering::SeqCst);
             }

@@ -536,7 +536,7 @@ fn state_name(s: &pada_core::safety::State) -> &'static str {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use pada_core::wire::{Episode, JointFatigue, PolicySpec, Step};
+    use pada_core::wire::{Episode, JointFatigue, Step};
 
     fn step(n: u32, kind: StepKind, mode: RunMode, damage: f64, reeng: u32) -> Decoded<ToHost> {
         Decoded {
@@ -634,7 +634,7 @@ mod tests {
             gap: None,
             msg: ToHost::Policy(PolicyReport {
                 step: 7,
-                built: PolicySpec::Pada(0.5),
+                built: pada_core::policy::PolicyKind::Pada { delta: 0.5 },
                 switched_to_sarsa: true,
             }),
         };
