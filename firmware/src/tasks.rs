@@ -20,7 +20,7 @@ use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 use embassy_time::{Duration, Instant, Ticker};
 use heapless::Vec;
-use pada_core::checkpoint::LoadOutcome;
+use pada_core::checkpoint::{CheckpointStore, LoadOutcome, SaveError};
 use pada_core::safety::Transition;
 use pada_core::wire::{self, FrameDecoder, FrameEncoder, NackReason, ToChip, ToHost, MAX_FRAME_LEN};
 use pada_firmware::bus::{BusConfig, BusStats, ServoBus};
@@ -393,8 +393,14 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
             if cl.ctl.torque_enabled() {
                 Err(NackReason::Busy)
             } else {
-                stalled = true;
-                let result = with_long_watchdog(|| cl.ctl.save_checkpoint(&mut cl.flash)).await;
+                // A checkpoint larger than a slot is refused before any
+                // erase: no long watchdog, no stalled period.
+                let result = if cl.ctl.checkpoint_bytes() <= cl.flash.capacity() {
+                    stalled = true;
+                    with_long_watchdog(|| cl.ctl.save_checkpoint(&mut cl.flash)).await
+                } else {
+                    cl.ctl.save_checkpoint(&mut cl.flash)
+                };
                 match result {
                     Ok(saved) => {
                         info!("checkpoint saved: generation {=u32}, slot {=u8}", saved.generation, saved.slot);
@@ -402,8 +408,19 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
                         Ok(())
                     }
                     Err(CheckpointError::Busy) => Err(NackReason::Busy),
+                    Err(CheckpointError::Save(SaveError::TooLarge { needed, capacity })) => {
+                        warn!(
+                            "checkpoint save refused ({=u32} failed since boot): it needs {=usize} bytes, a flash slot holds {=usize}",
+                            cl.ctl.saves_failed(),
+                            needed,
+                            capacity
+                        );
+                        let report = wire::CheckpointReport::TooLarge { needed: needed as u32, capacity: capacity as u32 };
+                        send_reliable(ToHost::Checkpoint(report)).await;
+                        Err(NackReason::CheckpointFailed)
+                    }
                     Err(e) => {
-                        warn!("checkpoint save failed: {}", defmt::Debug2Format(&e));
+                        warn!("checkpoint save failed ({=u32} since boot): {}", cl.ctl.saves_failed(), defmt::Debug2Format(&e));
                         send_reliable(ToHost::Checkpoint(wire::CheckpointReport::SaveFailed)).await;
                         Err(NackReason::CheckpointFailed)
                     }

@@ -72,7 +72,7 @@ pub use crate::safety::RunMode;
 
 /// Version of this protocol, sent in [`Hello`]; changes with any change of
 /// a message's layout.
-pub const PROTOCOL_VERSION: u16 = 2;
+pub const PROTOCOL_VERSION: u16 = 3;
 /// State dimensions a [`Step`] carries.
 pub const MAX_STATE_DIMS: usize = 16;
 /// Action dimensions (motor outputs) a [`Step`] carries.
@@ -283,6 +283,16 @@ pub enum CheckpointReport {
     SaveFailed,
     /// What a load found (at boot or on command).
     Load(LoadOutcome),
+    /// A save refused before flash was touched: the checkpoint (header,
+    /// learner state and weights) does not fit a slot — LEO's 8 MiB table
+    /// on the F429 against its 128 KiB flash sectors. (Appended last, so
+    /// the earlier variants keep their encoding.)
+    TooLarge {
+        /// Bytes the checkpoint needs.
+        needed: u32,
+        /// Bytes a slot holds.
+        capacity: u32,
+    },
 }
 
 /// Severity of a [`Log`].

@@ -107,6 +107,7 @@ fn all_to_host() -> Vec<ToHost> {
         ToHost::Ack(Ack { seq: 41 }),
         ToHost::Checkpoint(CheckpointReport::Saved(Saved { generation: 3, slot: 0 })),
         ToHost::Checkpoint(CheckpointReport::SaveFailed),
+        ToHost::Checkpoint(CheckpointReport::TooLarge { needed: 8_389_136, capacity: 131_072 }),
     ];
     for o in [
         LoadOutcome::Loaded { generation: 9, slot: 1 },
