@@ -257,7 +257,7 @@ pub async fn control(mut cl: ControlLoop) -> ! {
         // Host commands.
         while let Ok((seq, cmd)) = FROM_HOST.try_receive() {
             if handle_command(&mut cl, seq, &cmd, &mut weights_job).await {
-                // A flash operation stalled the CPU: restart the schedule
+                // A flash operation or a fresh learner stalled the loop: restart the schedule
                 // and do not count this period as an overrun.
                 ticker.reset();
                 readings.last_period_overran = false;
@@ -377,7 +377,8 @@ async fn report_transition(t: &Transition, ctl: &Ctl, time_ms: u32) {
     }
 }
 
-/// Carries out one host command; true if it stalled the CPU on flash.
+/// Carries out one host command; true if it stalled the loop (a flash
+/// operation, or a fresh learner on a large table).
 async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut Option<WeightsJob>) -> bool {
     let ack = |r: Result<(), NackReason>| match r {
         Ok(()) => ToHost::Ack(wire::Ack { seq }),
@@ -454,7 +455,20 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
             }
         }
         _ => {
-            let (result, transition) = cl.ctl.command(cmd);
+            // A new policy starts a fresh learner: every weight is written
+            // and the table's checksum recomputed. On the F429's 8 MiB LEO
+            // table that is 2^21 SDRAM writes and reads, some 0.3 s at
+            // 180 MHz by the estimate in firmware/README.md — longer than
+            // the watchdog's normal 250 ms. The controller allows it only
+            // with torque off, so the pause harms nothing; the schedule
+            // restarts after it, as after a flash operation.
+            let rebuilds = matches!(cmd, ToChip::SetPolicy(_)) && !cl.ctl.torque_enabled();
+            let (result, transition) = if rebuilds {
+                stalled = true;
+                with_long_watchdog(|| cl.ctl.command(cmd)).await
+            } else {
+                cl.ctl.command(cmd)
+            };
             if let Some(t) = transition.filter(|t| t.changed()) {
                 report_transition(&t, &cl.ctl, Instant::now().as_millis() as u32).await;
             }
@@ -465,7 +479,8 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
     stalled
 }
 
-/// Runs a flash operation with the watchdog's long timeout.
+/// Runs a long operation (flash, a fresh learner) with the watchdog's long
+/// timeout.
 async fn with_long_watchdog<T>(op: impl FnOnce() -> T) -> T {
     WATCHDOG_DONE.reset();
     WATCHDOG.send(WatchdogRequest::Extend(true)).await;
