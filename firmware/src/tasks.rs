@@ -457,7 +457,7 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
         _ => {
             // A new policy starts a fresh learner: every weight is written
             // and the table's checksum recomputed. On the F429's 8 MiB LEO
-            // table that is 2^21 SDRAM writes and reads, some 0.3 s at
+            // table that is 2^21 SDRAM writes and reads, about 0.7 s at
             // 180 MHz by the estimate in firmware/README.md — longer than
             // the watchdog's normal 250 ms. The controller allows it only
             // with torque off, so the pause harms nothing; the schedule
