@@ -9,9 +9,10 @@
 //! tasks of [`tasks`]. Logs go out over RTT (defmt), telemetry over the
 //! telemetry USART (pada_core::wire frames).
 //!
-//! If the table's memory fails its check, the board switches the servos'
-//! torque off, tells the host (`Warning::Text`) and does nothing else: a
-//! learner on broken memory would learn garbage.
+//! The servo-bus task starts first and switches the servos' torque off
+//! before anything slow. If the table's memory fails its check, the board
+//! tells the host (`Warning::Text`) and does nothing else: a learner on
+//! broken memory would learn garbage.
 #![no_std]
 #![no_main]
 
@@ -49,6 +50,14 @@ async fn main(spawner: Spawner) {
         PROFILE.board.name()
     );
 
+    // Torque off before anything slow: whatever the servos did before this
+    // boot (a watchdog reset leaves them turning at their last Moving
+    // Speed), they stop before the weight table is filled — about 0.7 s on
+    // the F429's 8 MiB table.
+    let joints = pada_firmware::config::hardware(ThisRobot::ROBOT).joints;
+    spawner.spawn(unwrap!(tasks::servo_bus(board.servo_port, joints)));
+    tasks::SERVOS_OFF.wait().await;
+
     let table_memory = match board.table_memory {
         Ok(memory) => memory,
         Err(fault) => {
@@ -59,8 +68,6 @@ async fn main(spawner: Spawner) {
                 fault.address,
                 fault.read
             );
-            let joints = pada_firmware::config::hardware(ThisRobot::ROBOT).joints;
-            spawner.spawn(unwrap!(tasks::servo_bus(board.servo_port, joints)));
             spawner.spawn(unwrap!(tasks::telemetry_tx(board.telemetry_tx)));
             let mut text = heapless::String::new();
             // Fits MAX_TEXT (56 characters); cut short if it did not.
@@ -109,10 +116,8 @@ async fn main(spawner: Spawner) {
         }
     }
 
-    let joints = ctl.config().joints;
     spawner.spawn(unwrap!(tasks::telemetry_tx(board.telemetry_tx)));
     spawner.spawn(unwrap!(tasks::telemetry_rx(board.telemetry_rx)));
-    spawner.spawn(unwrap!(tasks::servo_bus(board.servo_port, joints)));
     spawner.spawn(unwrap!(tasks::watchdog(board.watchdog, board.led)));
     spawner.spawn(unwrap!(tasks::control(tasks::ControlLoop {
         ctl,

@@ -76,11 +76,11 @@ impl Board {
         embassy_stm32::pac::RCC.csr().modify(|w| w.set_rmvf(true));
 
         let p = embassy_stm32::init(chip::clock_config());
-        let (r, table_memory_pins): (Resources, _) = chip::split(p);
+        let (r, table_memory_pins): (Resources, chip::TableMemoryPins) = chip::split(p);
         // Before anything else may touch the table (it needs the token).
         let table_memory = chip::start_table_memory(table_memory_pins);
 
-        // Servo bus: USART1, 1 Mbps, RX pulled up (the transceiver's
+        // Servo bus: 1 Mbps, RX pulled up (the transceiver's
         // receiver is off while the driver is on).
         let mut servo_config = usart::Config::default();
         servo_config.baudrate = SERVO_BAUD;
