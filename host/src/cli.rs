@@ -44,6 +44,8 @@ pub enum Command {
     Capture(commands::capture::CaptureArgs),
     /// Draw a learned LEO gait (saved weights) as a strip of stick figures.
     Render(RenderArgs),
+    /// The LEO model on its own: `pada leo passive` (the passive rollout).
+    Leo(commands::leo::LeoArgs),
 }
 
 /// Options shared by the commands that run trials.
@@ -254,7 +256,7 @@ where
                     Ok(())
                 }
                 ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => Err(usage(
-                    "no command given: valid commands are run, demo, paper, mtbf, render, sil, capture (see pada --help)",
+                    "no command given: valid commands are run, demo, paper, mtbf, render, sil, capture, leo (see pada --help)",
                 )),
                 _ => Err(usage(clap_one_line(&e))),
             };
@@ -268,5 +270,6 @@ where
         Command::Sil(a) => commands::sil::run(a),
         Command::Capture(a) => commands::capture::run(a),
         Command::Render(a) => commands::render::run(a),
+        Command::Leo(a) => commands::leo::run(a),
     }
 }

@@ -20,6 +20,7 @@
 pub mod constants;
 pub mod gait;
 pub mod model;
+pub mod passive;
 pub mod rl;
 pub mod stiction;
 /// The walking task's rules (§3): the robot's one definition in pada-core,

@@ -7,9 +7,9 @@
 //! the load stays below 0.2 N m. Rapier's per-DoF "friction loss" is the
 //! same constraint, but its projected Gauss–Seidel sweep solves the joints
 //! once, before the contacts, without warm start, so the contacts' impulses
-//! leave every joint a residual velocity of order h·(acceleration): a hip
-//! held by 50 N m still crept at 0.17 rad/s with 11 ms steps (measured;
-//! `README.md`). Here the friction is instead a small state machine per
+//! leave every joint a residual velocity of order h·(acceleration): the
+//! standing robot's hip, held by 50 N m, still crept at 0.18 rad/s with
+//! 11 ms steps and 0.04 rad/s with 1.4 ms steps (measured; `README.md`). Here the friction is instead a small state machine per
 //! joint that rapier's multibody integrates implicitly:
 //!
 //! - **stick**: the joint is tied to an anchor angle by a stiff spring and
@@ -26,17 +26,23 @@
 //! on its own; `model.rs` applies it.
 
 /// Pre-sliding stiffness of a held joint (N m/rad). At the full friction
-/// torque the tie deflects 0.2/1000 = 0.2 mrad, 25× less than one count of
-/// the RX-28's position sensor (300°/1024 = 5.1 mrad), so the servo could
-/// not tell the tie from a rigid hold. Stiffer ties change nothing
-/// measurable (`README.md`); rapier adds h²·k to the mass matrix, which
-/// stays well conditioned at this value.
-pub const STICK_STIFFNESS: f32 = 1000.0;
+/// torque the tie deflects 0.2/1e4 = 0.02 mrad, 250× less than one count
+/// of the RX-28's position sensor (300°/1024 = 5.1 mrad), so the servo
+/// could not tell the tie from a rigid hold. Rapier adds h²·k to the mass
+/// matrix (0.7 at 8.3 ms steps against link inertias of 1e-3…0.2), which
+/// stays well conditioned.
+pub const STICK_STIFFNESS: f32 = 1.0e4;
 
-/// Damping of the tie (N m s/rad): about critical for the armature alone
-/// (2·√(k·η·J_a·G²) = 2·√(1000 · 2.4e-3) ≈ 3.1), so a held joint does not
-/// ring on its tie.
-pub const STICK_DAMPING: f32 = 3.1;
+/// Damping of the tie (N m s/rad): at least critical, 2·√(k·J), for every
+/// inertia J a joint carries, up to the whole robot about its stance ankle
+/// (≈ 0.155 kg m² in the start pose, which needs 79). Over-damped, a held
+/// joint never rings on its tie, so the tie's torque does not overshoot the
+/// load and a load below the friction torque never breaks it: with 1e3
+/// N m/rad and critical damping for the armature alone, a 0.19 N m step on
+/// the arm rang past 0.2 N m and slipped at 40 physics steps per period
+/// (measured). The price is a lag of c/k = 10 ms before a tie carries a new
+/// load in full.
+pub const STICK_DAMPING: f32 = 100.0;
 
 /// What one joint's friction is doing.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -88,7 +94,7 @@ pub struct Stiction {
 }
 
 impl Stiction {
-    /// The RX-28's friction of `max_torque` with the tie of
+    /// A friction of `max_torque` with the tie of
     /// [`STICK_STIFFNESS`] and [`STICK_DAMPING`].
     pub fn new(max_torque: f32) -> Self {
         Self {
