@@ -356,7 +356,7 @@ pub struct ModelOptions {
     /// `LeoModel::correct_motor_lag`); on by default.
     pub motor_lag_correction: bool,
     /// Weld the torso to the world in its starting pose instead of the
-    /// planar joint (for the energy and joint-limit checks: the legs and
+    /// root joint (for the energy and joint-limit checks: the legs and
     /// the arm become a tree of pendulums).
     pub fixed_torso: bool,
 }
@@ -969,8 +969,9 @@ impl LeoModel {
         let (angles, rates) = self.joint_state();
         let root = mb.link(self.root_link).map(|l| l.joint.coords());
         let (x, z, pitch) = match (root, self.root_dof) {
-            // Free DoFs of the planar joint: coords[0] = x, coords[2] = z,
-            // coords[4] = rotation about y (not wrapped).
+            // Coordinates of the root joint: coords[0] = x, coords[1] = y
+            // (the lateral tie's), coords[2] = z, coords[4] = rotation
+            // about y (not wrapped).
             (Some(c), Some(_)) => (c[0], c[2], c[4]),
             _ => {
                 let pose = self.body_pose(Body::Torso);
@@ -1318,7 +1319,8 @@ impl LeoModel {
     /// armature a), time constant J/d ≈ 8–20 ms. Rapier integrates the
     /// damping implicitly (backward Euler), which over a step h makes the
     /// velocity decay by J/(J + h·d) instead of exp(−h·d/J): at h = 11 ms
-    /// a voltage step reaches ≈ 9% less speed after one control period.
+    /// a voltage step reaches ≈ 9% less speed after one control period
+    /// (≈ 7% at the 8.3 ms default).
     /// Backward Euler gives the exact decay if the inertia it sees is
     /// J' = h·d/(exp(h·d/J) − 1) < J, which changes neither the stall
     /// torque nor the no-load speed (inertia has no static effect). So once
