@@ -102,6 +102,9 @@ pub struct PeriodOutput {
     pub transitions: Vec<Transition, 8>,
     /// Cycles of the agent call, if there was one.
     pub agent_cycles: Option<u32>,
+    /// The gearbox torque of each servo the fatigue counter saw this
+    /// period \[N·m\] (the robot's estimate; 0 with torque off).
+    pub torques: [f32; MAX_SERVOS],
 }
 
 /// A host command's result, for the `Ack`/`Nack`.
@@ -448,6 +451,7 @@ where
             return Ok(LoadOutcome::InvalidState);
         }
         let read = checkpoint::read_weights(store, &found, self.agent_mut().weights_mut());
+        self.agent_mut().rehash();
         let outcome = match read {
             Ok(outcome) => outcome,
             Err(e) => {
@@ -526,6 +530,17 @@ where
         }
     }
 
+    /// The `Policy` report of the learner now: the built policy with its
+    /// α/Δ and whether it switched back to SARSA(λ).
+    pub fn policy_report(&self) -> wire::PolicyReport {
+        let policy = self.agent().policy();
+        wire::PolicyReport {
+            step: self.agent_stats().steps as u32,
+            built: policy.built_kind().into(),
+            switched_to_sarsa: policy.switched(),
+        }
+    }
+
     /// At boot, after a reset by the independent watchdog: a fault.
     pub fn watchdog_reset(&mut self) -> Transition {
         self.safety.on(Event::WatchdogReset)
@@ -588,6 +603,7 @@ where
         out.transitions.clear();
         out.speeds.clear();
         out.agent_cycles = None;
+        out.torques = [0.0; MAX_SERVOS];
         self.steps = self.steps.wrapping_add(1);
         let now = readings.time_ms;
         let joints = self.config.joints;
@@ -683,6 +699,7 @@ where
             self.robot.gear_torques(&self.applied, &mut torques);
             torques[n..].fill(0.0);
             let _ = self.fatigue.update(&torques);
+            out.torques = torques;
         }
         out.torque = torque;
     }
@@ -729,6 +746,11 @@ where
         let dims = self.robot.observe(&mut obs);
         let (reward, absorbing) = (self.robot.reward(&self.applied), self.robot.absorbing());
         let timeout = steps >= self.spec.episode_steps;
+        // A footstep: the policy's memory moves with the joints before the
+        // next decision.
+        if let (true, Some(map)) = (self.robot.footstep(), self.spec.footstep_remap) {
+            self.agent_mut().remap_memory(&map);
+        }
         let t0 = cycles.cycles();
         let (kind, result) = {
             let Some(agent) = self.agent.as_mut() else { return };

@@ -387,6 +387,7 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
     let result = match *cmd {
         ToChip::Ping => {
             send_reliable(ToHost::Hello(cl.ctl.hello())).await;
+            send_reliable(ToHost::Policy(cl.ctl.policy_report())).await;
             Ok(())
         }
         ToChip::SaveCheckpoint => {
@@ -414,6 +415,9 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
             Ok(outcome) => {
                 log_load(&cl.ctl, outcome);
                 send_reliable(ToHost::Checkpoint(wire::CheckpointReport::Load(outcome))).await;
+                if let LoadOutcome::Loaded { .. } = outcome {
+                    send_reliable(ToHost::Policy(cl.ctl.policy_report())).await;
+                }
                 match outcome {
                     LoadOutcome::Loaded { .. } => Ok(()),
                     _ => Err(NackReason::CheckpointFailed),
@@ -440,6 +444,10 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
             let (result, transition) = cl.ctl.command(cmd);
             if let Some(t) = transition.filter(|t| t.changed()) {
                 report_transition(&t, &cl.ctl, Instant::now().as_millis() as u32).await;
+            }
+            let changes_policy = matches!(cmd, ToChip::SetPolicy(_) | ToChip::SwitchToSarsa);
+            if changes_policy && result.is_ok() {
+                send_reliable(ToHost::Policy(cl.ctl.policy_report())).await;
             }
             result
         }

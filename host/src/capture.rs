@@ -374,6 +374,10 @@ pub fn describe(msg: &ToHost) -> (&'static str, String) {
         ToHost::Weights(w) => ("weights", format!("offset {} of {} ({} weights)", w.offset, w.total, w.weights.len())),
         ToHost::Ack(a) => ("ack", format!("seq {}", a.seq)),
         ToHost::Nack(n) => ("nack", format!("seq {} {:?}", n.seq, n.reason)),
+        ToHost::Policy(p) => (
+            "policy",
+            format!("{:?} switched {} at step {}", p.built, p.switched_to_sarsa, p.step),
+        ),
         ToHost::Step(_) => ("step", String::new()),
         ToHost::Episode(_) => ("episode", String::new()),
     }

@@ -484,6 +484,30 @@ impl Policy {
         self.output
     }
 
+    /// Moves the memory between action dimensions when the joints they
+    /// drive swap roles (LEO's footstep: stance and swing trade legs):
+    /// dimension `i` takes dimension `map[i]`'s previous action and filter
+    /// or integrator output, or, for `None`, starts at rest (the level and
+    /// output of 0, as at an episode's start). Unused dimensions are left
+    /// alone; an index out of range counts as `None`.
+    pub fn remap(&mut self, map: &[Option<u8>; MAX_ACTION_DIMS]) {
+        let (prev, output) = (self.prev, self.output);
+        let mut rest = self.clone();
+        rest.reset();
+        for i in 0..self.learner.dims() {
+            match map[i].map(|j| j as usize).filter(|&j| j < self.learner.dims()) {
+                Some(j) => {
+                    self.prev[i] = prev[j];
+                    self.output[i] = output[j];
+                }
+                None => {
+                    self.prev[i] = rest.prev[i];
+                    self.output[i] = rest.output[i];
+                }
+            }
+        }
+    }
+
     /// Number of state dimensions the policy appends (0, or one per motor
     /// for the Markov variants).
     pub fn extension_len(&self) -> usize {
@@ -655,6 +679,29 @@ mod tests {
                 for i in 0..3 {
                     prop_assert!((out[i] - prev[i]).abs() <= limit);
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn remap_moves_memory_between_dimensions_and_rests_the_rest() {
+        let level = ActionDim::uniform(-10.7, 10.7, 7).unwrap();
+        let motor = ActionSpace::repeated(level, 3).unwrap();
+        for kind in [PolicyKind::Pada { delta: 1.0 / 6.0 }, PolicyKind::LowPass { alpha: 0.5 }] {
+            let mut p = Policy::new(kind, motor.clone()).unwrap();
+            p.reset();
+            let out = p.apply(&[6, 0, 5, 0]);
+            p.remap(&[Some(1), Some(0), None, None]);
+            assert_eq!(&p.previous()[..3], &[0, 6, 3], "{kind:?}: hips swap, the knee rests at 0 V");
+            assert_eq!(p.output()[0], out[1]);
+            assert_eq!(p.output()[1], out[0]);
+            assert_eq!(p.output()[2], 0.0);
+            // PADA's next candidates follow the moved memory.
+            if let PolicyKind::Pada { .. } = kind {
+                let c = p.candidates();
+                assert_eq!((c.lo[0], c.hi[0]), (0, 1));
+                assert_eq!((c.lo[1], c.hi[1]), (5, 6));
+                assert_eq!((c.lo[2], c.hi[2]), (2, 4));
             }
         }
     }

@@ -21,6 +21,7 @@
 //! | [`ToHost::Weights`] | chip → host | [`WeightsChunk`] | in answer to `ReadWeights` |
 //! | [`ToHost::Ack`] | chip → host | [`Ack`] | a command was carried out |
 //! | [`ToHost::Nack`] | chip → host | [`Nack`] | a command was refused |
+//! | [`ToHost::Policy`] | chip → host | [`PolicyReport`] | after `Hello`, and whenever the policy or its α/Δ changes |
 //! | [`ToChip::Ping`] | host → chip | — | answered by `Hello` |
 //! | [`ToChip::Start`] | host → chip | [`RunMode`] | learn or test, torque on |
 //! | [`ToChip::Stop`] | host → chip | — | to Idle, torque off |
@@ -72,7 +73,7 @@ pub use crate::safety::RunMode;
 
 /// Version of this protocol, sent in [`Hello`]; changes with any change of
 /// a message's layout.
-pub const PROTOCOL_VERSION: u16 = 2;
+pub const PROTOCOL_VERSION: u16 = 3;
 /// State dimensions a [`Step`] carries.
 pub const MAX_STATE_DIMS: usize = 16;
 /// Action dimensions (motor outputs) a [`Step`] carries.
@@ -128,6 +129,9 @@ pub enum ToHost {
     Ack(Ack),
     /// A command was refused.
     Nack(Nack),
+    /// The action policy in force (protocol 3; appended last, so that
+    /// streams of protocol 2 still decode).
+    Policy(PolicyReport),
 }
 
 /// Sent at boot and in answer to [`ToChip::Ping`].
@@ -367,6 +371,23 @@ pub struct Nack {
     pub seq: u32,
     /// Why.
     pub reason: NackReason,
+}
+
+/// The action policy in force: sent after every [`Hello`] and whenever it
+/// changes (`SetPolicy`, `SwitchToSarsa`, a loaded checkpoint, the host
+/// runner's switch at `--switch-at`), so a viewer that joins knows what
+/// the learner restricts.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct PolicyReport {
+    /// Control step index when it took effect.
+    pub step: u32,
+    /// The policy the learner was built with, and its α (Eq. 8) or Δ
+    /// (Eq. 9).
+    pub built: PolicySpec,
+    /// Whether PADA or the low-pass filter has switched back to plain
+    /// SARSA(λ) (Section VIII); then `built` is what it explored with.
+    pub switched_to_sarsa: bool,
 }
 
 // ---------------------------------------------------------------------------

@@ -23,7 +23,7 @@
 
 use super::bus::{BusEmulator, BusStats, Reply};
 use super::fault::FaultSpec;
-use super::plant::{LeoStandIn, PendulumRig, Rig, SUPPLY_V};
+use crate::rig::{LeoStandIn, PendulumRig, Rig, SUPPLY_V};
 use super::qemu::{Emulator, QemuSetup};
 use super::replay::{replay, Record, ReplayReport};
 use super::twin::{twin, TwinReport};
