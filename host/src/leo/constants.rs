@@ -246,7 +246,7 @@ pub const SOLVER_ITERATIONS: usize = 1;
 /// pass, a second pass then removes all approach velocity, and so the
 /// penetration builds up at a rate set by the step (after 0.2 s of
 /// standing: 0.6 mm at 11 ms steps, 0.14 mm at 0.05 ms steps). With a soft
-/// contact the passive fall therefore kept moving as the step shrank (3 %
+/// contact the passive fall therefore kept moving as the step shrank (3–5 %
 /// between 48 and 192 steps per control period). At 100 Hz, ζ = 1 the
 /// penetration stays near g/ω² (tens of µm) at every step and the fall
 /// converges at first order (`README.md`); the reference's fraction of a
