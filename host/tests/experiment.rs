@@ -18,6 +18,7 @@ fn run<T: Task>(
     let cfg = RunConfig {
         policy,
         switch_at_s: None,
+        mtbf_budget_s: None,
         seconds,
         trials,
         seed,
@@ -130,6 +131,7 @@ fn switching_to_sarsa_changes_the_run_only_after_the_switch() {
     let cfg = RunConfig {
         policy: pada,
         switch_at_s: Some(60.0),
+        mtbf_budget_s: None,
         seconds: 120.0,
         trials: 1,
         seed: 4,

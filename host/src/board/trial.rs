@@ -285,6 +285,7 @@ fn run<R: RobotAdapter, W: WeightStore>(
         rise_time_s: rise_time(&times, &returns).unwrap_or(f64::NAN),
         mtbf_s: paper.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
         window_reengagements: paper.joints().iter().filter_map(|j| j.window_reengagements()).sum(),
+        run_mtbf_s: paper.robot_mtbf_s(),
         physical_mtbf_s: simulated.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
         physical_window_reengagements: simulated.joints().iter().filter_map(|j| j.window_reengagements()).sum(),
         learning_steps,
@@ -296,6 +297,7 @@ fn run<R: RobotAdapter, W: WeightStore>(
         end_speed_m_s: walked.map(|w| w / tail.iter().map(|p| p.duration_s).sum::<f64>()),
         saturations: stats.saturations,
         trace_drops: stats.trace_drops,
+        governor: None,
         curve,
     };
     Ok(BoardTrial {

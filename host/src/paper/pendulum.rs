@@ -140,6 +140,7 @@ pub fn expected_steps(o: &PendulumOptions) -> u64 {
         let cfg = RunConfig {
             policy: PolicyKind::Sarsa,
             switch_at_s: None,
+            mtbf_budget_s: None,
             seconds,
             trials,
             seed: 0,
@@ -227,6 +228,7 @@ fn run_task<T: Task>(
         .map(|&policy| RunConfig {
             policy,
             switch_at_s: None,
+            mtbf_budget_s: None,
             seconds,
             trials,
             seed,

@@ -24,6 +24,10 @@ pub fn color(algo: Algo) -> RGBColor {
         Algo::Integrator => RGBColor(214, 39, 40),
         Algo::MarkovIntegrator => RGBColor(255, 127, 14),
         Algo::Pada => RGBColor(44, 160, 44),
+        Algo::EpsilonPada => RGBColor(188, 189, 34),
+        Algo::OrnsteinUhlenbeck => RGBColor(148, 103, 189),
+        Algo::PinkNoise => RGBColor(227, 119, 194),
+        Algo::ActionPenalty => RGBColor(140, 86, 75),
     }
 }
 

@@ -64,7 +64,7 @@ pub(super) mod at {
     pub const GOV_BUDGET: usize = 520;
     pub const GOV_CALM: usize = 524;
     pub const GOV_MOVES: usize = 528;
-    pub const GOV_RESERVED_B: usize = 532;
+    pub const GOV_SINCE_MOVE: usize = 532;
     pub const GOV_STEPS: usize = 536;
     pub const GOV_OVER: usize = 544;
     pub const GOV_BUCKETS: usize = 552;
@@ -214,6 +214,7 @@ impl LearnerState {
             put(&mut b, at::GOV_BUDGET, &g.budget_bits.to_le_bytes());
             put(&mut b, at::GOV_CALM, &g.calm_steps.to_le_bytes());
             put(&mut b, at::GOV_MOVES, &g.moves.to_le_bytes());
+            put(&mut b, at::GOV_SINCE_MOVE, &g.since_move.to_le_bytes());
             put(&mut b, at::GOV_STEPS, &g.steps.to_le_bytes());
             put(&mut b, at::GOV_OVER, &g.over_budget_steps.to_le_bytes());
             for (j, row) in g.buckets.iter().enumerate() {
@@ -332,7 +333,7 @@ fn governor_of(r: &Record<'_>) -> Result<Option<GovernorState>, ConfigError> {
     let code = r.u8(at::GOV_RESTRICTS);
     let restricts = Restricts::from_code(code)
         .ok_or(ConfigError::new("governor.restricts", code as f32, "0 (pada delta) or 1 (lowpass alpha)"))?;
-    if !r.zero(at::GOV_RESERVED_A, 2) || !r.zero(at::GOV_RESERVED_B, 4) || !r.zero(at::GOV_END, STATE_LEN - at::GOV_END) {
+    if !r.zero(at::GOV_RESERVED_A, 2) || !r.zero(at::GOV_END, STATE_LEN - at::GOV_END) {
         return Err(ConfigError::new("governor.reserved", 0.0, "reserved bytes 0"));
     }
     let mut buckets = [[0u64; WINDOW_BUCKETS]; GOVERNED_JOINTS];
@@ -349,6 +350,7 @@ fn governor_of(r: &Record<'_>) -> Result<Option<GovernorState>, ConfigError> {
         filled: r.u8(at::GOV_FILLED),
         in_bucket: r.u8(at::GOV_IN_BUCKET),
         calm_steps: r.u32(at::GOV_CALM),
+        since_move: r.u32(at::GOV_SINCE_MOVE),
         moves: r.u32(at::GOV_MOVES),
         steps: r.u64(at::GOV_STEPS),
         over_budget_steps: r.u64(at::GOV_OVER),

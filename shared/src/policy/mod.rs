@@ -573,6 +573,102 @@ mod tests {
     }
 
     #[test]
+    fn epsilon_pada_restricts_only_exploration() {
+        let mut p = Policy::new(PolicyKind::EpsilonPada { delta: 1.0 / 6.0 }, leo_motor()).unwrap();
+        p.apply(&[3, 0, 6, 0]);
+        assert_eq!(p.candidates().count(), 343, "the greedy choice is free");
+        let e = p.explore_candidates();
+        assert_eq!(e.count(), 3 * 2 * 2);
+        assert_eq!((e.lo, e.hi), ([2, 0, 5, 0], [4, 1, 6, 0]));
+        // PADA restricts both.
+        let mut q = Policy::new(PolicyKind::Pada { delta: 1.0 / 6.0 }, leo_motor()).unwrap();
+        q.apply(&[3, 0, 6, 0]);
+        assert_eq!(q.candidates(), q.explore_candidates());
+    }
+
+    #[test]
+    fn noise_moves_the_greedy_level_and_clips_at_the_ends() {
+        let mut rng = Pcg32::seed_from_u64(4);
+        let mut p = Policy::new(PolicyKind::OrnsteinUhlenbeck { theta: 0.15, sigma: 0.3 }, leo_motor()).unwrap();
+        let (mut moved, mut steps) = (0, 0);
+        let mut previous = [3u8, 3, 3, 0];
+        let mut flips = 0;
+        for _ in 0..5000 {
+            let l = p.perturb(&[3, 0, 6, 0], &mut rng);
+            assert!(l[..3].iter().all(|&x| x < 7) && l[3] == 0);
+            moved += (l != [3, 0, 6, 0]) as u32;
+            // Correlated noise: consecutive choices of a dimension rarely
+            // jump from one side of the greedy level to the other.
+            flips += ((l[0] as i32 - 3).signum() * (previous[0] as i32 - 3).signum() < 0) as u32;
+            previous = l;
+            steps += 1;
+        }
+        assert!(moved > steps / 2, "{moved} of {steps} moved");
+        assert!(flips < steps / 20, "{flips} sign flips");
+        // A policy without noise returns the greedy levels as they are.
+        let mut s = Policy::new(PolicyKind::Sarsa, leo_motor()).unwrap();
+        assert_eq!(s.perturb(&[1, 2, 3, 0], &mut rng), [1, 2, 3, 0]);
+    }
+
+    #[test]
+    fn the_action_change_penalty_is_its_weight_times_the_squared_relative_change() {
+        let mut p = Policy::new(PolicyKind::ActionPenalty { weight: 2.0 }, pendulum_motor()).unwrap();
+        p.apply(&[2, 0, 0, 0]); // 0 → +1.5 N·m: half the range.
+        assert_eq!(p.penalty(), 2.0 * 0.25);
+        p.apply(&[0, 0, 0, 0]); // +1.5 → −1.5: the full range.
+        assert_eq!(p.penalty(), 2.0);
+        p.apply(&[0, 0, 0, 0]);
+        assert_eq!(p.penalty(), 0.0);
+        p.reset();
+        assert_eq!(p.penalty(), 0.0);
+        let mut s = Policy::new(PolicyKind::Sarsa, pendulum_motor()).unwrap();
+        s.apply(&[2, 0, 0, 0]);
+        assert_eq!(s.penalty(), 0.0, "only the penalty policy has one");
+    }
+
+    #[test]
+    fn set_parameter_moves_delta_and_alpha_and_refuses_the_rest() {
+        let mut p = Policy::new(PolicyKind::Pada { delta: 1.0 / 6.0 }, leo_motor()).unwrap();
+        p.apply(&[3, 3, 3, 0]);
+        assert_eq!(p.candidates().count(), 27);
+        p.set_parameter(2.0 / 6.0).unwrap();
+        assert_eq!(p.candidates().count(), 125);
+        assert_eq!(p.built_kind(), PolicyKind::Pada { delta: 2.0 / 6.0 });
+        assert_eq!(p.state().kind, PolicyKind::Pada { delta: 2.0 / 6.0 }, "a checkpoint keeps the Δ in force");
+        assert_eq!(p.set_parameter(-1.0).unwrap_err().param, "delta");
+        assert_eq!(p.candidates().count(), 125, "a refused value changes nothing");
+        let mut l = Policy::new(PolicyKind::LowPass { alpha: 0.9 }, pendulum_motor()).unwrap();
+        l.apply(&[2, 0, 0, 0]);
+        l.set_parameter(0.5).unwrap();
+        let before = l.output()[0];
+        assert_eq!(l.apply(&[2, 0, 0, 0])[0], 0.5 * 1.5 + 0.5 * before, "Eq. 8 runs on with the new α");
+        for k in [PolicyKind::Sarsa, PolicyKind::Integrator { delta: 0.5 }] {
+            assert_eq!(Policy::new(k, pendulum_motor()).unwrap().set_parameter(0.5).unwrap_err().param, "policy parameter");
+        }
+    }
+
+    #[test]
+    fn the_gentle_explorations_switch_back_to_sarsa() {
+        for k in [
+            PolicyKind::EpsilonPada { delta: 0.2 },
+            PolicyKind::OrnsteinUhlenbeck { theta: 0.2, sigma: 0.2 },
+            PolicyKind::PinkNoise { sigma: 0.3 },
+            PolicyKind::ActionPenalty { weight: 1.0 },
+        ] {
+            let mut p = Policy::new(k, leo_motor()).unwrap();
+            p.switch_to_sarsa().unwrap();
+            assert_eq!(p.kind(), PolicyKind::Sarsa, "{k:?}");
+            assert_eq!(p.exploration(), Exploration::EpsilonGreedy);
+            p.apply(&[6, 0, 3, 0]);
+            assert_eq!(p.penalty(), 0.0);
+            // Their checkpoints restore into a SARSA learner and back.
+            let mut s = Policy::new(PolicyKind::Sarsa, leo_motor()).unwrap();
+            s.restore(&p.state()).unwrap();
+            assert_eq!((s.built_kind(), s.switched()), (k, true));
+        }
+    }
+
+    #[test]
     fn parameters_are_validated() {
         let m = pendulum_motor;
         assert_eq!(Policy::new(PolicyKind::Pada { delta: -0.1 }, m()).unwrap_err().param, "delta");
@@ -580,6 +676,14 @@ mod tests {
         assert_eq!(Policy::new(PolicyKind::LowPass { alpha: 0.0 }, m()).unwrap_err().param, "lowpass alpha");
         assert_eq!(Policy::new(PolicyKind::MarkovLowPass { alpha: 1.5 }, m()).unwrap_err().param, "lowpass alpha");
         assert_eq!(Policy::new(PolicyKind::LowPass { alpha: f32::NAN }, m()).unwrap_err().param, "lowpass alpha");
+        assert_eq!(Policy::new(PolicyKind::EpsilonPada { delta: f32::NAN }, m()).unwrap_err().param, "delta");
+        for (theta, sigma, param) in [(0.0, 0.2, "theta"), (1.5, 0.2, "theta"), (0.2, 0.0, "sigma"), (0.2, 4.5, "sigma")] {
+            let k = PolicyKind::OrnsteinUhlenbeck { theta, sigma };
+            assert_eq!(Policy::new(k, m()).unwrap_err().param, param, "{k:?}");
+        }
+        assert_eq!(Policy::new(PolicyKind::PinkNoise { sigma: f32::INFINITY }, m()).unwrap_err().param, "sigma");
+        assert_eq!(Policy::new(PolicyKind::ActionPenalty { weight: -1.0 }, m()).unwrap_err().param, "weight");
+        assert_eq!(Policy::new(PolicyKind::ActionPenalty { weight: 1e5 }, m()).unwrap_err().param, "weight");
     }
 
     #[test]
