@@ -44,6 +44,9 @@ pub enum Command {
     Capture(commands::capture::CaptureArgs),
     /// Draw a learned LEO gait (saved weights) as a strip of stick figures.
     Render(RenderArgs),
+    /// Run one trial of a plan (written with --plan DIR), as a Slurm array
+    /// task or a Kubernetes indexed job.
+    Trial(commands::trial::TrialArgs),
 }
 
 /// Options shared by the commands that run trials.
@@ -101,6 +104,9 @@ pub struct RunArgs {
     /// Seed and threads.
     #[command(flatten)]
     pub trial: TrialOptions,
+    /// Plans, merges and Slurm (issue 14).
+    #[command(flatten)]
+    pub cluster: crate::plan::mode::ClusterOptions,
 }
 
 /// `pada render`.
@@ -177,6 +183,9 @@ pub struct PaperArgs {
     /// Seed and threads.
     #[command(flatten)]
     pub trial: TrialOptions,
+    /// Plans, merges and Slurm (issue 14).
+    #[command(flatten)]
+    pub cluster: crate::plan::mode::ClusterOptions,
 }
 
 /// `pada mtbf`.
@@ -254,7 +263,7 @@ where
                     Ok(())
                 }
                 ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => Err(usage(
-                    "no command given: valid commands are run, demo, paper, mtbf, render, sil, capture (see pada --help)",
+                    "no command given: valid commands are run, demo, paper, trial, mtbf, render, sil, capture (see pada --help)",
                 )),
                 _ => Err(usage(clap_one_line(&e))),
             };
@@ -268,5 +277,6 @@ where
         Command::Sil(a) => commands::sil::run(a),
         Command::Capture(a) => commands::capture::run(a),
         Command::Render(a) => commands::render::run(a),
+        Command::Trial(a) => commands::trial::run(a),
     }
 }

@@ -8,3 +8,4 @@ pub mod paper_leo;
 pub mod render;
 pub mod run;
 pub mod sil;
+pub mod trial;
