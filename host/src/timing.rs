@@ -112,6 +112,15 @@ impl RunTiming {
         }
     }
 
+    /// `2 threads` (local) or `at most 2 trials at once (slurm)`.
+    pub fn workers(&self) -> String {
+        if self.how == "local" {
+            format!("{} threads", self.threads)
+        } else {
+            format!("at most {} trials at once ({})", self.threads, self.how)
+        }
+    }
+
     /// `timing.json`'s bytes.
     pub fn to_json(&self) -> Vec<u8> {
         (serde_json::to_string_pretty(self).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))

@@ -214,3 +214,37 @@ fn print_next_steps(dir: &Path, plan: &Plan, written: Written, json: bool) {
     );
     println!("then merge:       {command} --merge {}", dir.display());
 }
+
+/// An experiment's trials, however they were obtained.
+pub enum Trials {
+    /// Only the plan was written (`--plan DIR`): nothing to report.
+    PlanWritten,
+    /// Every configuration's results, in trial order, and the run's timing.
+    Results(Vec<Vec<crate::experiment::TrialResult>>, RunTiming),
+}
+
+/// The trials of `experiment` as `mode` says: `local` runs them in this
+/// process (timed here); the other modes go through the experiment's plan.
+pub fn obtain(
+    mode: &Mode,
+    experiment: &super::Experiment,
+    json: bool,
+    local: impl FnOnce() -> anyhow::Result<Vec<Vec<crate::experiment::TrialResult>>>,
+) -> Result<Trials, CliError> {
+    if *mode == Mode::Local {
+        let start = std::time::Instant::now();
+        let results = local()?;
+        let wall_s = start.elapsed().as_secs_f64();
+        let steps = results
+            .iter()
+            .flatten()
+            .map(|r| r.learning_steps + r.test_steps)
+            .sum();
+        return Ok(Trials::Results(results, RunTiming::local(wall_s, steps)));
+    }
+    let plan = Plan::new(experiment.clone()).map_err(CliError::Runtime)?;
+    Ok(match from_plan(mode, &plan, json)? {
+        FromPlan::Written => Trials::PlanWritten,
+        FromPlan::Results { collected, timing } => Trials::Results(collected.per_config, timing),
+    })
+}
