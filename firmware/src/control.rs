@@ -6,8 +6,9 @@
 //! 1. the safety machine sees every servo answer, timeout, checksum error,
 //!    error bit, joint position and the last period's overrun — a fault
 //!    found here switches torque off in **this** period's output;
-//! 2. the robot's observer turns the readings into an observation and a
-//!    reward ([`crate::pendulum`], [`crate::leo`]);
+//! 2. the robot's adapter ([`RobotAdapter`]: [`crate::pendulum`],
+//!    [`crate::leo`]) turns the readings into the observation and reward of
+//!    the robot's one definition in `pada_core::robot`;
 //! 3. while torque is on: between episodes the robot is brought back to
 //!    its start (pendulum hanging still, LEO set upright); in an episode the
 //!    agent takes one step (`start_episode`, `step` or `end_episode` at an
@@ -15,8 +16,9 @@
 //!    episodes one greedy test episode is run (Section VI);
 //! 4. the learner's output and the held joints become voltages, the
 //!    voltages become Moving Speeds of each servo's measured supply;
-//! 5. the fatigue counter sees each servo's torque, estimated from voltage
-//!    and speed with the RX-28 model;
+//! 5. the fatigue counter sees each servo's gearbox torque as the robot's
+//!    definition estimates it from the applied voltage (and, for LEO, the
+//!    joint's rate through the RX-28 model);
 //! 6. telemetry records: the step (everything a host replay needs: kind,
 //!    observation, reward, action, TD error), the finished episode, state
 //!    changes and faults.
@@ -37,21 +39,21 @@
 //! ([`Controller::checkpoints_refused`]), and the learner stays as it was.
 
 use crate::bus::BusConfig;
-use crate::config::{self, FirmwareAgent, Robot, RobotConfig, MAX_OBS, MAX_SERVOS};
+use crate::config::{hardware, FirmwareAgent, LearnerProfile, RobotConfig, MAX_OBS, MAX_SERVOS, TILINGS};
 use crate::encoder::Unwrapper;
 use crate::io::CycleCounter;
-use crate::leo::{HoldGains, Leo};
-use crate::pendulum::Pendulum;
-use crate::servo::estimated_torque;
+use crate::robot::{RobotAdapter, Sensed};
 use heapless::Vec;
 use pada_core::agent::{Decision, EpisodeEnd, Mode};
 use pada_core::checkpoint::{self, CheckpointStore, LearnerState, LoadOutcome, SaveError, Saved};
 use pada_core::dynamixel::{table::PresentState, ErrorFlags};
 use pada_core::error::ConfigError;
 use pada_core::fatigue::{FatigueCounter, FatigueError, GearboxParams, PAPER_WINDOW_STEPS};
-use pada_core::fixed::Q16;
 use pada_core::policy::PolicyKind;
+use pada_core::profile::config_hash;
 use pada_core::rng::Pcg32;
+use pada_core::robot::RobotSpec;
+use pada_core::weights::WeightStore;
 use pada_core::safety::{Command, Event, RunMode, Safety, SafetyConfig, State, Transition};
 use pada_core::wire::{self, NackReason, StepKind};
 use rand_core::SeedableRng;
@@ -105,15 +107,6 @@ pub struct PeriodOutput {
 /// A host command's result, for the `Ack`/`Nack`.
 pub type CommandResult = Result<(), NackReason>;
 
-/// The robot's observer (one per controller, so the size difference of
-/// the variants costs nothing).
-#[derive(Debug, Clone)]
-#[allow(clippy::large_enum_variant)]
-enum Plant {
-    Pendulum(Pendulum),
-    Leo(Leo),
-}
-
 /// Where the episode cycle is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Phase {
@@ -154,9 +147,11 @@ fn fatigue_error(e: FatigueError) -> ConfigError {
     }
 }
 
-/// The control loop's state: agent, safety machine, observer, fatigue.
-pub struct Controller<W> {
-    robot: Robot,
+/// The control loop's state for robot `R` on weights `W`: agent, safety
+/// machine, the robot's adapter, fatigue.
+pub struct Controller<W, R> {
+    profile: LearnerProfile,
+    spec: &'static RobotSpec,
     config: RobotConfig,
     agent: Option<FirmwareAgent<W>>,
     policy: PolicyKind,
@@ -165,7 +160,7 @@ pub struct Controller<W> {
     rng: Pcg32,
     safety: Safety,
     fatigue: FatigueCounter<MAX_SERVOS>,
-    plant: Plant,
+    robot: R,
     encoder: Unwrapper,
     phase: Phase,
     /// The safety state at the end of the last period.
@@ -213,27 +208,34 @@ mod user {
     pub const SINCE_TEST: usize = 1;
 }
 
-impl<W> Controller<W>
+impl<W, R> Controller<W, R>
 where
-    W: AsRef<[Q16]> + AsMut<[Q16]>,
+    W: WeightStore,
+    R: RobotAdapter,
 {
-    /// A controller for `robot` learning with `policy` on `weights`,
-    /// initialised from `seed` (also the generator of every action).
-    pub fn new(robot: Robot, policy: PolicyKind, weights: W, seed: u64) -> Result<Self, ConfigError> {
-        let config = robot.config();
+    /// A controller for `R` with the board's learner `profile` (whose robot
+    /// must be `R`'s), learning with `policy` on `weights`, initialised from
+    /// `seed` (also the generator of every action).
+    pub fn new(profile: LearnerProfile, policy: PolicyKind, weights: W, seed: u64) -> Result<Self, ConfigError> {
+        if profile.robot != R::ROBOT {
+            return Err(ConfigError::new("profile.robot", profile.robot.code() as f32, "the controller's robot"));
+        }
+        if profile.weights().is_some_and(|n| n != weights.len()) {
+            return Err(ConfigError::new("weights", weights.len() as f32, "the profile's table size"));
+        }
+        let config = hardware(R::ROBOT);
         let mut soft_limits = Vec::new();
         for limit in config.soft_limits.iter().map_while(|l| *l) {
             let _ = soft_limits.push(limit);
         }
         let safety = Safety::new(safety_config(soft_limits))?;
-        let fatigue = FatigueCounter::new(GearboxParams::TABLE_I, config.period_s() as f64, Some(PAPER_WINDOW_STEPS))
+        let spec = R::spec();
+        let fatigue = FatigueCounter::new(GearboxParams::TABLE_I, spec.period_s(), Some(PAPER_WINDOW_STEPS))
             .map_err(|_| ConfigError::new("fatigue", 0.0, "Table I parameters"))?;
-        let plant = match robot {
-            Robot::Pendulum33 | Robot::Pendulum20 => Plant::Pendulum(Pendulum::new(&config)),
-            Robot::Leo => Plant::Leo(Leo::new(&config, HoldGains::default())),
-        };
         let mut controller = Controller {
-            robot,
+            profile,
+            spec,
+            robot: R::new(&config),
             config,
             agent: None,
             policy,
@@ -242,7 +244,6 @@ where
             rng: Pcg32::seed_from_u64(seed),
             safety,
             fatigue,
-            plant,
             encoder: Unwrapper::new(),
             phase: Phase::Stopped,
             last_state: State::Idle,
@@ -266,9 +267,8 @@ where
     /// A fresh agent with `policy` on `weights`: the generator is reseeded
     /// and the weights initialised, as a host build would do.
     fn build(&mut self, policy: PolicyKind, weights: W) -> Result<(), ConfigError> {
-        let params = self.robot.params();
-        let hash = config::config_hash(self.robot, policy, &params)?;
-        let mut agent = self.robot.agent(policy, weights)?;
+        let mut agent = self.spec.agent(policy, self.profile.layout, weights)?;
+        let hash = config_hash(&self.profile, &agent);
         self.rng = Pcg32::seed_from_u64(self.seed);
         agent.reset_weights(&mut self.rng);
         self.agent = Some(agent);
@@ -286,14 +286,24 @@ where
         self.agent.as_mut().unwrap_or_else(|| unreachable!())
     }
 
-    /// The robot.
-    pub fn robot(&self) -> Robot {
-        self.robot
-    }
-
-    /// The robot's fixed description.
+    /// The robot's hardware.
     pub fn config(&self) -> &RobotConfig {
         &self.config
+    }
+
+    /// The robot's learning task.
+    pub fn spec(&self) -> &'static RobotSpec {
+        self.spec
+    }
+
+    /// The board's learner profile.
+    pub fn profile(&self) -> &LearnerProfile {
+        &self.profile
+    }
+
+    /// The robot's adapter (for inspection).
+    pub fn robot(&self) -> &R {
+        &self.robot
     }
 
     /// The configuration hash of the running learner.
@@ -317,12 +327,12 @@ where
     }
 
     /// The weights.
-    pub fn weights(&self) -> &[Q16] {
+    pub fn weights(&self) -> &W {
         self.agent().weights()
     }
 
     /// The weights, to load a checkpoint into (only while torque is off).
-    pub fn weights_mut(&mut self) -> Option<&mut [Q16]> {
+    pub fn weights_mut(&mut self) -> Option<&mut W> {
         if self.torque_enabled() {
             return None;
         }
@@ -357,7 +367,7 @@ where
         self.fatigue.check_state(&state.joints).map_err(fatigue_error)?;
         state.rng.check()?;
         let since_test = state.user[user::SINCE_TEST];
-        if since_test > self.config.test_interval {
+        if since_test > self.spec.test_interval {
             return Err(ConfigError::new(
                 "since_test",
                 since_test as f32,
@@ -495,10 +505,13 @@ where
     /// pendulum's motor; LEO's hips and knees, which take turns as stance
     /// and swing joints).
     pub fn reported_joints(&self) -> core::ops::Range<usize> {
-        match self.robot {
-            Robot::Pendulum33 | Robot::Pendulum20 => 0..1,
-            Robot::Leo => crate::leo::joint::HIP_R..crate::leo::joint::KNEE_L + 1,
-        }
+        R::reported_joints()
+    }
+
+    /// Distance walked in the current (or last) episode \[m\], for a
+    /// walking robot.
+    pub fn walked_m(&self) -> Option<f32> {
+        self.robot.walked_m()
     }
 
     /// The `Hello` of this configuration.
@@ -507,8 +520,8 @@ where
             protocol: wire::PROTOCOL_VERSION,
             config_hash: self.config_hash,
             weight_count: self.weights().len() as u32,
-            period_us: self.config.period_us,
-            state_dims: self.robot.state_dims().len() as u8,
+            period_us: self.spec.period_us,
+            state_dims: self.spec.state.len() as u8,
             joints: self.reported_joints().len() as u8,
         }
     }
@@ -556,8 +569,7 @@ where
         if self.torque_enabled() {
             return Err(NackReason::Busy);
         }
-        let params = self.robot.params();
-        if config::config_hash(self.robot, policy, &params).is_err() {
+        if self.spec.check::<TILINGS>(policy, self.profile.layout, self.weights().len()).is_err() {
             return Err(NackReason::InvalidParameter);
         }
         let Some(agent) = self.agent.take() else {
@@ -625,21 +637,16 @@ where
                 // Just started, resumed or switched mode: the robot is
                 // wherever it is; bring it to its start first.
                 self.begin_reset();
-            } else if self.phase == Phase::Resetting && self.reset_done() {
+            } else if self.phase == Phase::Resetting && self.robot.reset_done() {
                 starting = true;
-                if let Plant::Leo(l) = &mut self.plant {
-                    l.start_episode();
-                }
+                self.robot.start_episode();
             }
         }
         self.last_state = state;
 
         // 3. Observe.
         let encoder_angle = readings.encoder.map(|c| self.config.encoder.angle(self.encoder.update(c)));
-        match &mut self.plant {
-            Plant::Pendulum(p) => p.sense(encoder_angle),
-            Plant::Leo(l) => l.sense(&angles, encoder_angle, readings.contacts, &self.applied),
-        }
+        self.robot.sense(&Sensed { angles, encoder_angle, contacts: readings.contacts, applied: self.applied });
 
         // 4. The agent's step, and the voltages.
         let mut volts = [0.0f32; MAX_SERVOS];
@@ -651,8 +658,11 @@ where
                 self.continue_episode(steps + 1, readings, cycles, out);
             }
             match self.phase {
-                Phase::Running { .. } => self.run_commands(&mut volts),
-                _ => self.reset_commands(&mut volts),
+                Phase::Running { .. } => {
+                    let dims = self.spec.motor_dims as usize;
+                    self.robot.commands(&self.last_output[..dims], &mut volts)
+                }
+                _ => self.robot.reset_commands(&mut volts),
             }
         }
 
@@ -666,18 +676,12 @@ where
             let _ = out.speeds.push((joint.id, speed));
         }
 
-        // 6. Fatigue from the estimated gearbox torque.
+        // 6. Fatigue from the estimated gearbox torque (servos past the
+        // robot's count stay at 0).
         if torque {
-            let mut speeds = [0.0f32; MAX_SERVOS];
-            match &self.plant {
-                Plant::Pendulum(p) => p.servo_speeds(&mut speeds),
-                Plant::Leo(l) => l.servo_speeds(&mut speeds),
-            }
             let mut torques = [0.0f32; MAX_SERVOS];
-            for i in 0..n {
-                let supply = self.supply[i].unwrap_or(nominal);
-                torques[i] = estimated_torque(self.applied[i], speeds[i], supply);
-            }
+            self.robot.gear_torques(&self.applied, &mut torques);
+            torques[n..].fill(0.0);
             let _ = self.fatigue.update(&torques);
         }
         out.torque = torque;
@@ -685,29 +689,12 @@ where
 
     fn begin_reset(&mut self) {
         self.phase = Phase::Resetting;
-        match &mut self.plant {
-            Plant::Pendulum(p) => p.begin_reset(),
-            Plant::Leo(l) => l.begin_reset(),
-        }
-    }
-
-    fn reset_done(&mut self) -> bool {
-        match &mut self.plant {
-            Plant::Pendulum(p) => p.reset_done(),
-            Plant::Leo(l) => l.reset_done(),
-        }
-    }
-
-    fn observe(&self, obs: &mut [f32; MAX_OBS]) -> usize {
-        match &self.plant {
-            Plant::Pendulum(p) => p.observe(obs),
-            Plant::Leo(l) => l.observe(obs),
-        }
+        self.robot.begin_reset();
     }
 
     fn start_episode(&mut self, mode: RunMode, readings: &Readings, cycles: &impl CycleCounter, out: &mut PeriodOutput) {
         // Every `test_interval` learning episodes, one greedy test episode.
-        let test = mode == RunMode::Testing || self.since_test >= self.config.test_interval;
+        let test = mode == RunMode::Testing || self.since_test >= self.spec.test_interval;
         self.episode_mode = if test { RunMode::Testing } else { RunMode::Learning };
         if test {
             if mode == RunMode::Learning {
@@ -719,7 +706,7 @@ where
         self.agent_mut().set_mode(if test { Mode::Testing } else { Mode::Learning });
         self.episode_return = 0.0;
         let mut obs = [0.0; MAX_OBS];
-        let dims = self.observe(&mut obs);
+        let dims = self.robot.observe(&mut obs);
         let t0 = cycles.cycles();
         let result = {
             let (agent, rng) = (self.agent.as_mut(), &mut self.rng);
@@ -739,12 +726,9 @@ where
 
     fn continue_episode(&mut self, steps: u32, readings: &Readings, cycles: &impl CycleCounter, out: &mut PeriodOutput) {
         let mut obs = [0.0; MAX_OBS];
-        let dims = self.observe(&mut obs);
-        let (reward, absorbing) = match &self.plant {
-            Plant::Pendulum(p) => (p.reward(self.applied[0]), false),
-            Plant::Leo(l) => (l.reward(), l.doomed()),
-        };
-        let timeout = steps >= self.config.episode_steps;
+        let dims = self.robot.observe(&mut obs);
+        let (reward, absorbing) = (self.robot.reward(&self.applied), self.robot.absorbing());
+        let timeout = steps >= self.spec.episode_steps;
         let t0 = cycles.cycles();
         let (kind, result) = {
             let Some(agent) = self.agent.as_mut() else { return };
@@ -833,20 +817,6 @@ where
         });
     }
 
-    fn run_commands(&self, volts: &mut [f32; MAX_SERVOS]) {
-        match &self.plant {
-            Plant::Pendulum(p) => p.commands(self.last_output[0], volts),
-            Plant::Leo(l) => l.commands(&self.last_output[..3], volts),
-        }
-    }
-
-    fn reset_commands(&self, volts: &mut [f32; MAX_SERVOS]) {
-        match &self.plant {
-            Plant::Pendulum(p) => p.reset_commands(volts),
-            Plant::Leo(l) => l.reset_commands(volts),
-        }
-    }
-
     /// Health fields the controller knows; the caller adds bus, loop and
     /// link counters.
     pub fn health(&self, health: &mut wire::Health) {
@@ -866,7 +836,11 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::WEIGHTS;
+    use pada_core::fixed::Q16;
+    use crate::config::{Board, Robot, TRACE};
+    use crate::leo::Leo;
+    use crate::pendulum::Pendulum33;
+    use pada_core::profile::PENDULUM_EXACT_WEIGHTS as WEIGHTS;
     use core::cell::Cell;
     use core::f32::consts::PI;
     use pada_core::safety::FaultCause;
@@ -880,8 +854,19 @@ mod tests {
         }
     }
 
+    /// The F405's learner for `robot`.
+    fn profile(robot: Robot) -> LearnerProfile {
+        Board::F405.profile(robot)
+    }
+
+    /// The F405's pendulum table (exact).
     fn table() -> Box<[Q16]> {
         vec![Q16::ZERO; WEIGHTS].into_boxed_slice()
+    }
+
+    /// The F405's LEO table.
+    fn leo_table() -> Box<[Q16]> {
+        vec![Q16::ZERO; profile(Robot::Leo).weights().unwrap()].into_boxed_slice()
     }
 
     /// A healthy pendulum reading: the servo answers, the encoder at `counts`.
@@ -891,7 +876,7 @@ mod tests {
         r
     }
 
-    fn start(c: &mut Controller<Box<[Q16]>>, mode: RunMode) {
+    fn start<R: RobotAdapter>(c: &mut Controller<Box<[Q16]>, R>, mode: RunMode) {
         let (result, t) = c.command(&wire::ToChip::Start(mode));
         assert_eq!(result, Ok(()));
         assert!(t.unwrap().torque_enable);
@@ -899,7 +884,7 @@ mod tests {
 
     #[test]
     fn idle_means_torque_off_and_zero_speed() {
-        let mut c = Controller::new(Robot::Pendulum33, PolicyKind::Sarsa, table(), 1).unwrap();
+        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 1).unwrap();
         let mut out = PeriodOutput::default();
         c.period(&pendulum_readings(0, 0), &Clock(Cell::new(0)), &mut out);
         assert!(!out.torque);
@@ -909,7 +894,7 @@ mod tests {
 
     #[test]
     fn pendulum_episodes_start_after_hanging_still_and_end_by_time() {
-        let mut c = Controller::new(Robot::Pendulum33, PolicyKind::Pada { delta: 0.5 }, table(), 7).unwrap();
+        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Pada { delta: 0.5 }, table(), 7).unwrap();
         start(&mut c, RunMode::Learning);
         let clock = Clock(Cell::new(0));
         let mut out = PeriodOutput::default();
@@ -942,7 +927,7 @@ mod tests {
 
     #[test]
     fn every_tenth_episode_is_a_test() {
-        let mut c = Controller::new(Robot::Pendulum33, PolicyKind::Sarsa, table(), 3).unwrap();
+        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 3).unwrap();
         start(&mut c, RunMode::Learning);
         let clock = Clock(Cell::new(0));
         let mut out = PeriodOutput::default();
@@ -960,7 +945,7 @@ mod tests {
 
     #[test]
     fn a_silent_servo_faults_and_torque_goes_off_in_the_same_period() {
-        let mut c = Controller::new(Robot::Pendulum33, PolicyKind::Sarsa, table(), 1).unwrap();
+        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 1).unwrap();
         start(&mut c, RunMode::Learning);
         let clock = Clock(Cell::new(0));
         let mut out = PeriodOutput::default();
@@ -987,7 +972,7 @@ mod tests {
 
     #[test]
     fn damaged_answers_fault_as_checksum_errors_in_the_period() {
-        let mut c = Controller::new(Robot::Pendulum33, PolicyKind::Sarsa, table(), 1).unwrap();
+        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 1).unwrap();
         start(&mut c, RunMode::Learning);
         let clock = Clock(Cell::new(0));
         let mut out = PeriodOutput::default();
@@ -1002,7 +987,7 @@ mod tests {
 
     #[test]
     fn servo_error_bits_and_overrun_streaks_fault() {
-        let mut c = Controller::new(Robot::Pendulum33, PolicyKind::Sarsa, table(), 1).unwrap();
+        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 1).unwrap();
         start(&mut c, RunMode::Learning);
         let clock = Clock(Cell::new(0));
         let mut out = PeriodOutput::default();
@@ -1012,7 +997,7 @@ mod tests {
         assert!(!out.torque);
         assert!(matches!(c.state(), State::Fault(FaultCause::ServoError { servo: 1, .. })));
 
-        let mut c = Controller::new(Robot::Pendulum33, PolicyKind::Sarsa, table(), 1).unwrap();
+        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 1).unwrap();
         start(&mut c, RunMode::Learning);
         let mut r = pendulum_readings(0, 0);
         r.last_period_overran = true;
@@ -1027,7 +1012,7 @@ mod tests {
 
     #[test]
     fn leo_soft_limit_faults() {
-        let mut c = Controller::new(Robot::Leo, PolicyKind::Sarsa, table(), 1).unwrap();
+        let mut c = Controller::<_, Leo>::new(profile(Robot::Leo), PolicyKind::Sarsa, leo_table(), 1).unwrap();
         start(&mut c, RunMode::Learning);
         let clock = Clock(Cell::new(0));
         let mut out = PeriodOutput::default();
@@ -1039,15 +1024,16 @@ mod tests {
         assert!(out.torque);
         assert_eq!(out.speeds.len(), 7);
         // Right knee bent forward by 40 counts ≈ +0.2 rad: beyond +2° + margin.
-        r.servos[crate::leo::joint::KNEE_R].state.as_mut().unwrap().position = 512 + 40;
+        let knee_r = pada_core::robot::leo::Joint::KneeRight as usize;
+        r.servos[knee_r].state.as_mut().unwrap().position = 512 + 40;
         c.period(&r, &clock, &mut out);
         assert!(!out.torque);
-        assert!(matches!(c.state(), State::Fault(FaultCause::SoftLimit { joint: 3, .. })));
+        assert!(matches!(c.state(), State::Fault(FaultCause::SoftLimit { joint: 4, .. })));
     }
 
     #[test]
     fn policy_changes_only_with_torque_off_and_reseed() {
-        let mut c = Controller::new(Robot::Pendulum33, PolicyKind::Sarsa, table(), 5).unwrap();
+        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 5).unwrap();
         let fresh = c.agent().weights_checksum();
         c.agent_mut().weights_mut()[0] = Q16(12345);
         assert_eq!(c.command(&wire::ToChip::SetPolicy(wire::PolicySpec::Pada(0.5))).0, Ok(()));
@@ -1072,7 +1058,7 @@ mod tests {
         // pendulum that moves with the commands, the Step records replayed
         // through a plain agent with the same seed.
         let seed = 11;
-        let mut c = Controller::new(Robot::Pendulum33, PolicyKind::Pada { delta: 0.5 }, table(), seed).unwrap();
+        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Pada { delta: 0.5 }, table(), seed).unwrap();
         start(&mut c, RunMode::Learning);
         let clock = Clock(Cell::new(0));
         let mut out = PeriodOutput::default();
@@ -1093,7 +1079,7 @@ mod tests {
         let robot = Robot::Pendulum33;
         // The host's generator: the firmware's own must draw the same.
         let mut rng = rand_pcg::Pcg32::seed_from_u64(seed);
-        let mut agent = robot.agent(PolicyKind::Pada { delta: 0.5 }, table()).unwrap();
+        let mut agent = robot.spec().agent::<_, TILINGS, TRACE>(PolicyKind::Pada { delta: 0.5 }, profile(robot).layout, table()).unwrap();
         agent.reset_weights(&mut rng);
         for s in &steps {
             agent.set_mode(if s.mode == RunMode::Testing { Mode::Testing } else { Mode::Learning });
@@ -1119,11 +1105,11 @@ mod tests {
     // Saved learning
     // -----------------------------------------------------------------------
 
-    type Store = pada_core::checkpoint::RamStore<{ checkpoint::slot_len(WEIGHTS) }>;
+    type Store = pada_core::checkpoint::RamStore<{ checkpoint::slot_len(WEIGHTS, 4) }>;
 
     /// `periods` periods of the crude pendulum of the replay test, from
     /// period `k0`; the Step records.
-    fn run_pendulum(c: &mut Controller<Box<[Q16]>>, angle: &mut f32, k0: u32, periods: u32) -> std::vec::Vec<wire::Step> {
+    fn run_pendulum(c: &mut Controller<Box<[Q16]>, Pendulum33>, angle: &mut f32, k0: u32, periods: u32) -> std::vec::Vec<wire::Step> {
         let clock = Clock(Cell::new(0));
         let mut out = PeriodOutput::default();
         let mut steps = std::vec::Vec::new();
@@ -1139,7 +1125,7 @@ mod tests {
         steps
     }
 
-    fn stop(c: &mut Controller<Box<[Q16]>>) {
+    fn stop(c: &mut Controller<Box<[Q16]>, Pendulum33>) {
         assert_eq!(c.command(&wire::ToChip::Stop).0, Ok(()));
         let mut out = PeriodOutput::default();
         c.period(&pendulum_readings(0, 0), &Clock(Cell::new(0)), &mut out);
@@ -1149,7 +1135,7 @@ mod tests {
     #[test]
     fn the_generator_draws_as_the_hosts_rand_pcg() {
         use rand_core::RngCore;
-        for seed in [0, 1, 11, config::DEFAULT_SEED, u64::MAX] {
+        for seed in [0, 1, 11, crate::config::DEFAULT_SEED, u64::MAX] {
             let mut mine = Pcg32::seed_from_u64(seed);
             let mut host = rand_pcg::Pcg32::seed_from_u64(seed);
             for _ in 0..10_000 {
@@ -1162,7 +1148,7 @@ mod tests {
     #[test]
     fn a_checkpoint_carries_the_learner_across_a_reset() {
         let mut store = Store::new();
-        let mut a = Controller::new(Robot::Pendulum33, PolicyKind::Pada { delta: 0.5 }, table(), 11).unwrap();
+        let mut a = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Pada { delta: 0.5 }, table(), 11).unwrap();
         start(&mut a, RunMode::Learning);
         // Only with torque off.
         assert_eq!(a.save_checkpoint(&mut store), Err(CheckpointError::Busy));
@@ -1178,7 +1164,7 @@ mod tests {
         assert!(a.episodes >= 3);
 
         // The board resets: it boots with SARSA and another seed, and loads.
-        let mut b = Controller::new(Robot::Pendulum33, PolicyKind::Sarsa, table(), 99).unwrap();
+        let mut b = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 99).unwrap();
         assert_ne!(b.agent().weights_checksum(), a.agent().weights_checksum());
         assert_eq!(b.load_checkpoint(&store), Ok(LoadOutcome::Loaded { generation: 1, slot: 0 }));
         assert_eq!(b.checkpoints_refused(), 0);
@@ -1201,7 +1187,7 @@ mod tests {
         let mut weights = table();
         assert!(matches!(checkpoint::load(&store, b.config_hash(), &mut state, &mut weights), Ok(LoadOutcome::Loaded { .. })));
         let robot = Robot::Pendulum33;
-        let mut agent = robot.agent(PolicyKind::Sarsa, weights).unwrap();
+        let mut agent = robot.spec().agent::<_, TILINGS, TRACE>(PolicyKind::Sarsa, profile(robot).layout, weights).unwrap();
         agent.restore_state(&state.agent).unwrap();
         let mut rng = Pcg32::from_state(state.rng).unwrap();
         for s in &after {
@@ -1218,20 +1204,20 @@ mod tests {
         // The next save goes to the other slot and carries on the counters.
         stop(&mut b);
         assert_eq!(b.save_checkpoint(&mut store), Ok(Saved { generation: 2, slot: 1 }));
-        let mut c = Controller::new(Robot::Pendulum33, PolicyKind::Sarsa, table(), 5).unwrap();
+        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 5).unwrap();
         assert_eq!(c.load_checkpoint(&store), Ok(LoadOutcome::Loaded { generation: 2, slot: 1 }));
         assert_eq!(c.learner_state(), b.learner_state());
     }
 
     #[test]
     fn refused_checkpoints_are_counted_and_change_nothing() {
-        let mut c = Controller::new(Robot::Pendulum33, PolicyKind::Sarsa, table(), 3).unwrap();
+        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 3).unwrap();
         start(&mut c, RunMode::Learning);
         let mut angle = 0.0;
         run_pendulum(&mut c, &mut angle, 0, 600);
         stop(&mut c);
         let (state, checksum) = (c.learner_state(), c.agent().weights_checksum());
-        let unchanged = |c: &Controller<Box<[Q16]>>| {
+        let unchanged = |c: &Controller<Box<[Q16]>, Pendulum33>| {
             assert_eq!(c.learner_state(), state);
             assert_eq!(c.agent().weights_checksum(), checksum);
         };
@@ -1242,7 +1228,7 @@ mod tests {
         assert_eq!(c.checkpoints_refused(), 0);
 
         // Another robot's checkpoint.
-        let leo = Controller::new(Robot::Leo, PolicyKind::Sarsa, table(), 1).unwrap();
+        let leo = Controller::<_, Leo>::new(profile(Robot::Leo), PolicyKind::Sarsa, leo_table(), 1).unwrap();
         leo.save_checkpoint(&mut store).unwrap();
         let expected = LoadOutcome::ConfigMismatch { expected: c.config_hash(), found: leo.config_hash() };
         assert_eq!(c.load_checkpoint(&store), Ok(expected));
@@ -1253,8 +1239,11 @@ mod tests {
         // (An integrator with Δ = 0.5 has the pendulum's −3/0/+3 V levels,
         // so the configuration hash matches; the state record tells them
         // apart.)
-        let params = Robot::Pendulum33.params();
-        assert_eq!(config::config_hash(Robot::Pendulum33, PolicyKind::Integrator { delta: 0.5 }, &params), Ok(c.config_hash()));
+        let integrator = Robot::Pendulum33
+            .spec()
+            .agent::<_, TILINGS, TRACE>(PolicyKind::Integrator { delta: 0.5 }, profile(Robot::Pendulum33).layout, table())
+            .unwrap();
+        assert_eq!(config_hash(&profile(Robot::Pendulum33), &integrator), c.config_hash());
         type Change = fn(&mut LearnerState);
         let cases: [(&str, Change); 6] = [
             ("epsilon", |s| s.agent.epsilon = 2.0),
@@ -1286,6 +1275,7 @@ mod tests {
             generation: 4,
             payload_crc: checkpoint::crc32(&[0u8; WEIGHTS * 4]),
             state_len: 0,
+            weight_bytes: 4,
         };
         let slot = store.slot_mut(0).unwrap();
         slot[..checkpoint::HEADER_LEN].copy_from_slice(&v1.to_bytes());

@@ -1,50 +1,31 @@
-//! LEO on the robot: its observation, reward, episode end and the held
-//! joints, as GRL's LEO walking task defines them (grl-facts §3), so the
-//! learner on the chip sees what the simulation's learner sees.
+//! LEO on the robot: an adapter from its servos, the boom's encoder and the
+//! foot switches to the one definition in `pada_core::robot::leo`, whose
+//! rules (rate filter, stance, mirrored observation, reward, falls, held
+//! joints) it applies as the simulation does.
 //!
-//! - Joints in GRL's raw order ([`joint`]): shoulder, hip R, hip L, knee R,
-//!   knee L, ankle R, ankle L. Angles from the servos' positions (calibrated
-//!   in [`crate::config`]); rates are position differences over the period
-//!   through GRL's Butterworth filter (§3.2).
-//! - Torso pitch φ = −(boom encoder angle) (§3.1), relative to the pose at
+//! - Joints in [`Joint`] order (the controller's servo table is in that
+//!   order; the servos' IDs are GRL's raw order, see
+//!   [`crate::config::hardware`]). Angles from the servos' positions; rates
+//!   are position differences over the period through GRL's Butterworth
+//!   filter (§3.2).
+//! - Torso angle φ = −(boom encoder angle) (§3.1), relative to the pose at
 //!   boot: **power LEO up with its torso vertical**.
-//! - Stance leg from the foot switches, footsteps and the step length L
-//!   (§3.3); observation mirrored by stance (§3.4):
-//!   `φ, φ̇, q_hip,st, q̇_hip,st, q_hip,sw, q̇_hip,sw, q_knee,st, q̇_knee,st,
-//!   q_knee,sw, q̇_knee,sw`.
-//! - Reward `−1 − 3·E + 300·(L − L_prev) − 125·[doomed]` (§3.7, the
-//!   effective weights), E the electrical energy of hips and knees.
-//! - Doomed to fall (absorbing): |φ| > 1 rad or |φ + q_hip,st| > 0.36π (§3.8).
-//! - Held joints (§3.5): shoulder to −15°, stance knee to 0, ankles to
-//!   3.72°, proportional (GRL has no D term; [`HoldGains`] allows one),
-//!   clipped to ±10.6919 V.
-//! - Between episodes (after a fall, or the time limit): every joint is held
-//!   in the start pose of §1.8 and the next episode starts once the torso
-//!   has been near its start pitch with a foot on the ground for 1 s — on
-//!   the boom a person sets LEO upright.
+//! - Between episodes (after a fall, or the time limit) every joint is held
+//!   in the start pose of §1.8, and the next episode starts once the torso
+//!   has been near its start angle with a foot on the ground for 1 s: on
+//!   the boom a person sets LEO upright. (The host's simulation does the
+//!   same: it puts the robot back in the start pose and holds it there until
+//!   the firmware starts the episode.)
 
 use crate::config::{RobotConfig, MAX_OBS, MAX_SERVOS};
-use crate::filter::Butterworth1;
-use crate::servo::rx28;
-
-/// Joint indices in GRL's raw order (grl-facts §3.1) = the order of
-/// [`crate::config::Robot::Leo`]'s servos.
-pub mod joint {
-    /// Shoulder (arm).
-    pub const SHOULDER: usize = 0;
-    /// Right hip.
-    pub const HIP_R: usize = 1;
-    /// Left hip.
-    pub const HIP_L: usize = 2;
-    /// Right knee.
-    pub const KNEE_R: usize = 3;
-    /// Left knee.
-    pub const KNEE_L: usize = 4;
-    /// Right ankle.
-    pub const ANKLE_R: usize = 5;
-    /// Left ankle.
-    pub const ANKLE_L: usize = 6;
-}
+use crate::robot::{RobotAdapter, Sensed};
+use core::ops::Range;
+use pada_core::robot::filter::RateFilter;
+use pada_core::robot::leo::{
+    ankle_x, estimated_gear_torque, is_fall, joint_rate_filter, joint_voltages, observe, pose_voltages, reward,
+    step_energy, torso_rate_filter, Joint, Leg, StanceTracker, StanceUpdate, NUM_JOINTS, START_JOINT_ANGLES, START_PHI,
+};
+use pada_core::robot::Robot;
 
 /// Foot switch bits of [`crate::io::Sensors::contacts`].
 pub mod contact {
@@ -62,170 +43,99 @@ pub mod contact {
     pub const LEFT: u8 = TOE_L | HEEL_L;
 }
 
-use joint::*;
-
-/// Which leg stands.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Leg {
-    /// Left leg on the ground.
-    Left,
-    /// Right leg on the ground.
-    Right,
-}
-
-impl Leg {
-    fn hip(self) -> usize {
-        match self {
-            Leg::Left => HIP_L,
-            Leg::Right => HIP_R,
-        }
-    }
-    fn knee(self) -> usize {
-        match self {
-            Leg::Left => KNEE_L,
-            Leg::Right => KNEE_R,
-        }
-    }
-    fn other(self) -> Leg {
-        match self {
-            Leg::Left => Leg::Right,
-            Leg::Right => Leg::Left,
-        }
-    }
-}
-
-/// Upper-leg length \[m\] (grl-facts §1.3).
-const UPPER_LEG: f32 = 0.116;
-/// Lower-leg length \[m\].
-const LOWER_LEG: f32 = 0.1045;
-/// Reward weights (§3.7).
-const REWARD_TIME: f32 = -1.0;
-const REWARD_ENERGY: f32 = -3.0;
-const REWARD_PROGRESS: f32 = 300.0;
-const REWARD_FALL: f32 = -125.0;
-/// Footstep length clip \[m\].
-const MAX_STEP: f32 = 10.2;
-/// Stance thigh beyond this from vertical is a fall \[rad\] (0.36π).
-const THIGH_LIMIT: f32 = 0.36 * core::f32::consts::PI;
-/// Torso pitch beyond this is a fall \[rad\].
-const TORSO_LIMIT: f32 = 1.0;
-
-/// Set points of the held joints \[rad\] (§3.5).
-const SHOULDER_SET: f32 = -0.261_799;
-const STANCE_KNEE_SET: f32 = 0.0;
-const ANKLE_SET: f32 = 0.064_926_2;
-
-/// The start pose (§1.8) in joint order: the hold between episodes.
-const START_POSE: [f32; MAX_SERVOS] = [-0.261_799, 0.82, 0.10, -1.27, 0.0, 0.0, 0.0];
-/// Start torso pitch φ (§1.8: torso 0.10 ⇒ φ = −0.10).
-const START_PHI: f32 = -0.10;
 /// The next episode waits for |φ − φ_start| below this \[rad\] …
 const READY_PHI: f32 = 0.15;
 /// … with a foot on the ground, for this long \[µs\].
 const READY_TIME_US: u32 = 1_000_000;
 
-/// Gains of the held joints \[V/rad\], \[V·s/rad\].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct HoldGains {
-    /// Shoulder and stance knee: 5 · 14/3.3 (§3.5).
-    pub kp_shoulder_knee: f32,
-    /// Ankles: 10 · 14/3.3.
-    pub kp_ankle: f32,
-    /// Damping on every held joint (0 in GRL).
-    pub kd: f32,
-}
+const _: () = assert!(NUM_JOINTS == MAX_SERVOS);
 
-impl Default for HoldGains {
-    fn default() -> Self {
-        HoldGains { kp_shoulder_knee: 5.0 * 14.0 / 3.3, kp_ankle: 10.0 * 14.0 / 3.3, kd: 0.0 }
-    }
-}
-
-/// The x position of an ankle relative to the hip \[m\] (§3.3).
-fn ankle_x(phi: f32, hip: f32, knee: f32) -> f32 {
-    UPPER_LEG * libm::sinf(phi + hip) + LOWER_LEG * libm::sinf(phi + hip + knee)
-}
-
-/// LEO's observer and its held joints.
+/// LEO's adapter.
 #[derive(Debug, Clone)]
 pub struct Leo {
     period_s: f32,
-    gains: HoldGains,
-    rate_filters: [Butterworth1; MAX_SERVOS],
-    torso_filter: Butterworth1,
-    q: [f32; MAX_SERVOS],
-    q_prev: [Option<f32>; MAX_SERVOS],
-    qd: [f32; MAX_SERVOS],
-    qd_prev: [f32; MAX_SERVOS],
+    rate_filters: [RateFilter; NUM_JOINTS],
+    torso_filter: RateFilter,
+    q: [f32; NUM_JOINTS],
+    q_prev: [Option<f32>; NUM_JOINTS],
+    qd: [f32; NUM_JOINTS],
+    qd_prev: [f32; NUM_JOINTS],
     boom_prev: Option<f32>,
     phi: f32,
     phid: f32,
     contacts: u8,
-    stance: Option<Leg>,
-    step_len: f32,
-    step_len_prev: f32,
-    footstep: bool,
-    footsteps: i32,
+    stance: StanceTracker,
+    update: StanceUpdate,
     energy: f32,
     ready_needed: u32,
     ready_steps: u32,
 }
 
 impl Leo {
-    /// An observer for LEO's `config`.
-    pub fn new(config: &RobotConfig, gains: HoldGains) -> Self {
+    /// The stance leg (left until the feet say otherwise).
+    pub fn stance(&self) -> Leg {
+        self.stance.stance_or_left()
+    }
+
+    /// Torso angle φ \[rad\].
+    pub fn phi(&self) -> f32 {
+        self.phi
+    }
+
+    /// Joint angles \[rad\] in joint order.
+    pub fn angles(&self) -> &[f32; NUM_JOINTS] {
+        &self.q
+    }
+
+    /// Footsteps this episode (forward minus backward).
+    pub fn footsteps(&self) -> i32 {
+        self.stance.footsteps()
+    }
+}
+
+impl RobotAdapter for Leo {
+    const ROBOT: Robot = Robot::Leo;
+
+    fn new(_config: &RobotConfig) -> Self {
+        let period_us = Self::spec().period_us;
         Leo {
-            period_s: config.period_s(),
-            gains,
-            rate_filters: [Butterworth1::leo_joint(); MAX_SERVOS],
-            torso_filter: Butterworth1::leo_torso(),
-            q: [0.0; MAX_SERVOS],
-            q_prev: [None; MAX_SERVOS],
-            qd: [0.0; MAX_SERVOS],
-            qd_prev: [0.0; MAX_SERVOS],
+            period_s: period_us as f32 * 1e-6,
+            rate_filters: [joint_rate_filter(); NUM_JOINTS],
+            torso_filter: torso_rate_filter(),
+            q: [0.0; NUM_JOINTS],
+            q_prev: [None; NUM_JOINTS],
+            qd: [0.0; NUM_JOINTS],
+            qd_prev: [0.0; NUM_JOINTS],
             boom_prev: None,
             phi: 0.0,
             phid: 0.0,
             contacts: 0,
-            stance: None,
-            step_len: 0.0,
-            step_len_prev: 0.0,
-            footstep: false,
-            footsteps: 0,
+            stance: StanceTracker::new(),
+            update: StanceUpdate { length: 0.0, previous_length: 0.0, footstep: false },
             energy: 0.0,
-            ready_needed: READY_TIME_US.div_ceil(config.period_us),
+            ready_needed: READY_TIME_US.div_ceil(period_us),
             ready_steps: 0,
         }
     }
 
-    /// Episode start: filters cleared, stance unknown, L = 0 (§3.2, §3.3).
-    pub fn start_episode(&mut self) {
+    /// Filters cleared, stance unknown, L = 0 (§3.2, §3.3).
+    fn start_episode(&mut self) {
         for f in &mut self.rate_filters {
             f.reset();
         }
         self.torso_filter.reset();
-        self.stance = None;
-        self.step_len = 0.0;
-        self.step_len_prev = 0.0;
-        self.footstep = false;
-        self.footsteps = 0;
+        self.qd = [0.0; NUM_JOINTS];
+        self.stance = StanceTracker::new();
     }
 
-    /// Takes this period's readings: joint angles (`None` for a servo that
-    /// did not answer: its last angle is kept), the boom encoder's angle,
-    /// the foot switches, and the voltages applied during the last period
-    /// (for the energy term). Updates rates, stance, step length.
-    pub fn sense(
-        &mut self,
-        angles: &[Option<f32>; MAX_SERVOS],
-        boom_angle: Option<f32>,
-        contacts: u8,
-        applied: &[f32; MAX_SERVOS],
-    ) {
+    /// Joint angles (a servo that did not answer keeps its last angle), the
+    /// boom's angle, the foot switches and the voltages of the last period
+    /// (for the energy term): rates, stance, step length, energy.
+    fn sense(&mut self, s: &Sensed) {
         let dt = self.period_s;
         self.qd_prev = self.qd;
-        for i in 0..MAX_SERVOS {
-            if let Some(a) = angles[i] {
+        for i in 0..NUM_JOINTS {
+            if let Some(a) = s.angles[i] {
                 self.q[i] = a;
             }
             let raw = match self.q_prev[i] {
@@ -233,156 +143,69 @@ impl Leo {
                 None => 0.0,
             };
             self.q_prev[i] = Some(self.q[i]);
-            self.qd[i] = self.rate_filters[i].step(raw);
+            self.qd[i] = self.rate_filters[i].update(raw);
         }
-        if let Some(boom) = boom_angle {
+        if let Some(boom) = s.encoder_angle {
             let raw = match self.boom_prev {
                 Some(prev) => (boom - prev) / dt,
                 None => 0.0,
             };
             self.boom_prev = Some(boom);
             self.phi = -boom;
-            self.phid = -self.torso_filter.step(raw);
+            self.phid = -self.torso_filter.update(raw);
         }
-        self.contacts = contacts;
-
-        // Electrical energy of hips and knees during the last period (§3.7).
-        let gk = rx28::GEAR_RATIO * rx28::TORQUE_CONSTANT;
-        self.energy = [HIP_L, HIP_R, KNEE_L, KNEE_R]
-            .iter()
-            .map(|&j| {
-                let u = applied[j];
-                let w = 0.5 * (self.qd_prev[j] + self.qd[j]);
-                let current = (u - gk * w) / rx28::RESISTANCE;
-                (u * current).max(0.0) * dt
-            })
-            .sum();
-
-        // Step length with the stance from before this update (§3.3).
-        let old = self.step_len;
-        self.step_len_prev = if self.footstep { -old } else { old };
-        let xl = ankle_x(self.phi, self.q[HIP_L], self.q[KNEE_L]);
-        let xr = ankle_x(self.phi, self.q[HIP_R], self.q[KNEE_R]);
-        self.step_len = match self.stance {
-            Some(Leg::Left) => xr - xl,
-            Some(Leg::Right) | None => xl - xr,
-        };
-        let left = contacts & contact::LEFT != 0;
-        let right = contacts & contact::RIGHT != 0;
-        let new = match (left, right) {
-            (true, false) => Some(Leg::Left),
-            (false, true) => Some(Leg::Right),
-            (false, false) => self.stance,
-            // Both down: the front foot stands.
-            (true, true) => Some(if xl >= xr { Leg::Left } else { Leg::Right }),
-        };
-        self.footstep = matches!((self.stance, new), (Some(a), Some(b)) if a != b);
-        if self.footstep {
-            self.footsteps += if self.step_len > 0.0 { 1 } else { -1 };
-        }
-        self.stance = new;
+        self.contacts = s.contacts;
+        self.energy = step_energy(&s.applied, &self.qd_prev, &self.qd);
+        let ankle = |leg: Leg| ankle_x(self.phi, self.q[leg.hip() as usize], self.q[leg.knee() as usize]);
+        self.update = self.stance.update(
+            s.contacts & contact::LEFT != 0,
+            s.contacts & contact::RIGHT != 0,
+            ankle(Leg::Left),
+            ankle(Leg::Right),
+        );
     }
 
-    /// The stance leg (left until the feet say otherwise).
-    pub fn stance(&self) -> Leg {
-        self.stance.unwrap_or(Leg::Left)
-    }
-
-    /// Torso pitch φ \[rad\].
-    pub fn phi(&self) -> f32 {
-        self.phi
-    }
-
-    /// Joint angles \[rad\] in joint order.
-    pub fn angles(&self) -> &[f32; MAX_SERVOS] {
-        &self.q
-    }
-
-    /// Footsteps this episode (forward minus backward).
-    pub fn footsteps(&self) -> i32 {
-        self.footsteps
-    }
-
-    /// The mirrored observation (§3.4); returns its length (10).
-    pub fn observe(&self, obs: &mut [f32; MAX_OBS]) -> usize {
-        let st = self.stance();
-        let sw = st.other();
-        let values = [
-            self.phi,
-            self.phid,
-            self.q[st.hip()],
-            self.qd[st.hip()],
-            self.q[sw.hip()],
-            self.qd[sw.hip()],
-            self.q[st.knee()],
-            self.qd[st.knee()],
-            self.q[sw.knee()],
-            self.qd[sw.knee()],
-        ];
-        obs.copy_from_slice(&values);
+    /// The mirrored observation (§3.4).
+    fn observe(&self, obs: &mut [f32; MAX_OBS]) -> usize {
+        obs.copy_from_slice(&observe(self.phi, self.phid, &self.q, &self.qd, self.stance()).0);
         MAX_OBS
     }
 
-    /// Whether LEO is falling (absorbing, §3.8).
-    pub fn doomed(&self) -> bool {
-        let hip = self.q[self.stance().hip()];
-        self.phi.abs() > TORSO_LIMIT || (self.phi + hip).abs() > THIGH_LIMIT
+    fn reward(&self, _applied: &[f32; MAX_SERVOS]) -> f32 {
+        reward(self.energy, &self.update, self.absorbing())
     }
 
-    /// Reward of the transition into the current state (§3.7).
-    pub fn reward(&self) -> f32 {
-        let clip = |l: f32| l.clamp(-MAX_STEP, MAX_STEP);
-        let mut r = REWARD_TIME
-            + REWARD_ENERGY * self.energy
-            + REWARD_PROGRESS * (clip(self.step_len) - clip(self.step_len_prev));
-        if self.doomed() {
-            r += REWARD_FALL;
+    fn absorbing(&self) -> bool {
+        is_fall(self.phi, self.q[self.stance().hip() as usize])
+    }
+
+    /// The learner's `[U_hip,st, U_hip,sw, U_knee,sw]` on the joints of the
+    /// current stance, the held joints by §3.5.
+    fn commands(&self, output: &[f32], volts: &mut [f32; MAX_SERVOS]) {
+        let mut action = [0.0; 3];
+        for (a, o) in action.iter_mut().zip(output) {
+            *a = *o;
         }
-        r
+        *volts = joint_voltages(action, &self.q, self.stance());
     }
 
-    fn hold(&self, j: usize, set: f32, kp: f32) -> f32 {
-        let u = kp * (set - self.q[j]) - self.gains.kd * self.qd[j];
-        u.clamp(-rx28::MAX_HOLD_VOLTAGE, rx28::MAX_HOLD_VOLTAGE)
+    /// Every joint held in the start pose.
+    fn reset_commands(&self, volts: &mut [f32; MAX_SERVOS]) {
+        *volts = pose_voltages(&self.q, &START_JOINT_ANGLES);
     }
 
-    /// Per-servo voltages: the learner's `[U_hip,st, U_hip,sw, U_knee,sw]`
-    /// on the joints of the current stance, the held joints by §3.5.
-    pub fn commands(&self, output: &[f32], volts: &mut [f32; MAX_SERVOS]) {
-        let st = self.stance();
-        let sw = st.other();
-        let g = self.gains;
-        volts[SHOULDER] = self.hold(SHOULDER, SHOULDER_SET, g.kp_shoulder_knee);
-        volts[st.knee()] = self.hold(st.knee(), STANCE_KNEE_SET, g.kp_shoulder_knee);
-        volts[ANKLE_R] = self.hold(ANKLE_R, ANKLE_SET, g.kp_ankle);
-        volts[ANKLE_L] = self.hold(ANKLE_L, ANKLE_SET, g.kp_ankle);
-        volts[st.hip()] = output[0];
-        volts[sw.hip()] = output[1];
-        volts[sw.knee()] = output[2];
-    }
-
-    /// Per-servo voltages between episodes: every joint held in the start
-    /// pose.
-    pub fn reset_commands(&self, volts: &mut [f32; MAX_SERVOS]) {
-        let g = self.gains;
-        for j in 0..MAX_SERVOS {
-            let kp = if j == ANKLE_L || j == ANKLE_R { g.kp_ankle } else { g.kp_shoulder_knee };
-            volts[j] = self.hold(j, START_POSE[j], kp);
+    /// The RX-28 model's torque at each servo's filtered rate.
+    fn gear_torques(&self, applied: &[f32; MAX_SERVOS], torques: &mut [f32; MAX_SERVOS]) {
+        for j in 0..NUM_JOINTS {
+            torques[j] = estimated_gear_torque(applied[j], self.qd[j]);
         }
     }
 
-    /// Joint speeds \[rad/s\] for the torque estimate (filtered rates).
-    pub fn servo_speeds(&self, speeds: &mut [f32; MAX_SERVOS]) {
-        *speeds = self.qd;
-    }
-
-    /// Starts waiting for LEO to be set upright.
-    pub fn begin_reset(&mut self) {
+    fn begin_reset(&mut self) {
         self.ready_steps = 0;
     }
 
-    /// One period of waiting; true once the next episode may start.
-    pub fn reset_done(&mut self) -> bool {
+    fn reset_done(&mut self) -> bool {
         if (self.phi - START_PHI).abs() < READY_PHI && self.contacts != 0 {
             self.ready_steps += 1;
         } else {
@@ -390,125 +213,147 @@ impl Leo {
         }
         self.ready_steps >= self.ready_needed
     }
+
+    /// Both hips and both knees, which take turns as stance and swing
+    /// joints.
+    fn reported_joints() -> Range<usize> {
+        Joint::HipLeft as usize..Joint::KneeRight as usize + 1
+    }
+
+    fn walked_m(&self) -> Option<f32> {
+        Some(self.stance.walked())
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::Robot;
+    use crate::config::hardware;
+    use pada_core::robot::leo::{ACTION_VOLTAGE_LIMIT, HELD_VOLTAGE_LIMIT};
+
+    fn leo() -> Leo {
+        let mut l = Leo::new(&hardware(Robot::Leo));
+        l.start_episode();
+        l
+    }
+
+    fn sense(l: &mut Leo, angles: [f32; NUM_JOINTS], boom: f32, contacts: u8, applied: [f32; MAX_SERVOS]) {
+        l.sense(&Sensed { angles: angles.map(Some), encoder_angle: Some(boom), contacts, applied });
+    }
 
     /// LEO in the start pose of §1.8 (left leg stance).
-    fn start_pose(leo: &mut Leo, contacts: u8) {
-        let angles = START_POSE.map(Some);
-        leo.sense(&angles, Some(0.10), contacts, &[0.0; MAX_SERVOS]);
+    fn start_pose(l: &mut Leo, contacts: u8) {
+        sense(l, START_JOINT_ANGLES, -START_PHI, contacts, [0.0; MAX_SERVOS]);
     }
 
     #[test]
     fn start_pose_observation_and_first_reward_artefact() {
-        let mut leo = Leo::new(&Robot::Leo.config(), HoldGains::default());
-        leo.start_episode();
-        start_pose(&mut leo, contact::LEFT);
-        assert_eq!(leo.stance(), Leg::Left);
+        let mut l = leo();
+        start_pose(&mut l, contact::LEFT);
+        assert_eq!(l.stance(), Leg::Left);
         let mut obs = [0.0; MAX_OBS];
-        assert_eq!(leo.observe(&mut obs), 10);
+        assert_eq!(l.observe(&mut obs), 10);
         assert!((obs[0] + 0.10).abs() < 1e-6, "φ = −boom");
         assert!((obs[2] - 0.10).abs() < 1e-6, "stance hip = left hip");
         assert!((obs[4] - 0.82).abs() < 1e-6, "swing hip = right hip");
         assert!((obs[8] + 1.27).abs() < 1e-6, "swing knee = right knee");
-        assert!(!leo.doomed());
+        assert!(!l.absorbing());
         // The second update: L flips from x_L − x_R to x_R − x_L, the
         // +11.9 artefact of the first transition (§3.7).
-        start_pose(&mut leo, contact::LEFT);
-        let r = leo.reward();
+        start_pose(&mut l, contact::LEFT);
+        let r = l.reward(&[0.0; MAX_SERVOS]);
         assert!((r - 11.9).abs() < 0.5, "{r}");
         // Standing still afterwards: the time penalty only.
-        start_pose(&mut leo, contact::LEFT);
-        assert!((leo.reward() + 1.0).abs() < 1e-4, "{}", leo.reward());
+        start_pose(&mut l, contact::LEFT);
+        assert!((l.reward(&[0.0; MAX_SERVOS]) + 1.0).abs() < 1e-4);
     }
 
     #[test]
     fn stance_switch_mirrors_the_observation_and_counts_a_footstep() {
-        let mut leo = Leo::new(&Robot::Leo.config(), HoldGains::default());
-        leo.start_episode();
-        start_pose(&mut leo, contact::LEFT);
-        start_pose(&mut leo, contact::LEFT);
+        let mut l = leo();
+        start_pose(&mut l, contact::LEFT);
+        start_pose(&mut l, contact::LEFT);
         // Right foot (ahead) lands, left lifts.
-        start_pose(&mut leo, contact::RIGHT);
-        assert_eq!(leo.stance(), Leg::Right);
-        assert_eq!(leo.footsteps(), 1);
+        start_pose(&mut l, contact::RIGHT);
+        assert_eq!(l.stance(), Leg::Right);
+        assert_eq!(l.footsteps(), 1);
+        assert!(l.walked_m().unwrap() > 0.0);
         let mut obs = [0.0; MAX_OBS];
-        leo.observe(&mut obs);
+        l.observe(&mut obs);
         assert!((obs[2] - 0.82).abs() < 1e-6, "stance hip is now the right hip");
         // L is continuous across the switch: the next reward is the time
         // penalty only.
-        start_pose(&mut leo, contact::RIGHT);
-        assert!((leo.reward() + 1.0).abs() < 1e-4, "{}", leo.reward());
+        start_pose(&mut l, contact::RIGHT);
+        assert!((l.reward(&[0.0; MAX_SERVOS]) + 1.0).abs() < 1e-4);
         // Both feet down: the front foot stands (the right ankle is ahead).
-        start_pose(&mut leo, contact::LEFT | contact::RIGHT);
-        assert_eq!(leo.stance(), Leg::Right);
+        start_pose(&mut l, contact::LEFT | contact::RIGHT);
+        assert_eq!(l.stance(), Leg::Right);
     }
 
     #[test]
     fn falling_is_absorbing_with_the_penalty() {
-        let mut leo = Leo::new(&Robot::Leo.config(), HoldGains::default());
-        leo.start_episode();
-        let angles = START_POSE.map(Some);
-        leo.sense(&angles, Some(0.10), contact::LEFT, &[0.0; MAX_SERVOS]);
-        leo.sense(&angles, Some(0.10), contact::LEFT, &[0.0; MAX_SERVOS]);
-        assert!(!leo.doomed());
-        leo.sense(&angles, Some(1.2), contact::LEFT, &[0.0; MAX_SERVOS]);
-        assert!(leo.doomed());
-        assert!(leo.reward() < -100.0);
+        let mut l = leo();
+        start_pose(&mut l, contact::LEFT);
+        start_pose(&mut l, contact::LEFT);
+        assert!(!l.absorbing());
+        sense(&mut l, START_JOINT_ANGLES, 1.2, contact::LEFT, [0.0; MAX_SERVOS]);
+        assert!(l.absorbing());
+        assert!(l.reward(&[0.0; MAX_SERVOS]) < -100.0);
     }
 
     #[test]
     fn learned_and_held_joints_by_stance() {
-        let mut leo = Leo::new(&Robot::Leo.config(), HoldGains::default());
-        leo.start_episode();
-        start_pose(&mut leo, contact::LEFT);
+        let mut l = leo();
+        start_pose(&mut l, contact::LEFT);
         let mut v = [0.0; MAX_SERVOS];
-        leo.commands(&[1.0, 2.0, 3.0], &mut v);
-        assert_eq!((v[HIP_L], v[HIP_R], v[KNEE_R]), (1.0, 2.0, 3.0));
+        l.commands(&[1.0, 2.0, 3.0], &mut v);
+        let (hl, hr, kr, kl) =
+            (Joint::HipLeft as usize, Joint::HipRight as usize, Joint::KneeRight as usize, Joint::KneeLeft as usize);
+        assert_eq!((v[hl], v[hr], v[kr]), (1.0, 2.0, 3.0));
         // Stance knee (left) at its set point 0: no voltage; ankles at 0 →
         // 42.42 · 0.0649 V; shoulder at its set point.
-        assert!(v[KNEE_L].abs() < 1e-6);
-        assert!((v[ANKLE_L] - 42.4242 * 0.064_926_2).abs() < 1e-3);
-        assert!(v[SHOULDER].abs() < 1e-5);
-        // Clipped at 10.69 V.
-        let far = [Some(3.0); MAX_SERVOS];
-        leo.sense(&far, Some(0.10), contact::LEFT, &[0.0; MAX_SERVOS]);
-        leo.commands(&[0.0; 3], &mut v);
-        assert!((v[SHOULDER] + rx28::MAX_HOLD_VOLTAGE).abs() < 1e-5);
+        assert!(v[kl].abs() < 1e-6);
+        assert!((v[Joint::AnkleLeft as usize] - 42.4242 * 0.064_926_2).abs() < 1e-3);
+        assert!(v[Joint::Shoulder as usize].abs() < 1e-5);
+        // Learned voltages are clipped to ±10.7 V, held ones to 10.69 V.
+        l.commands(&[50.0, 0.0, 0.0], &mut v);
+        assert_eq!(v[hl], ACTION_VOLTAGE_LIMIT);
+        sense(&mut l, [3.0; NUM_JOINTS], 0.10, contact::LEFT, [0.0; MAX_SERVOS]);
+        l.commands(&[0.0; 3], &mut v);
+        assert!((v[Joint::Shoulder as usize] + HELD_VOLTAGE_LIMIT).abs() < 1e-5);
+        // Between episodes everything is held at the start pose.
+        start_pose(&mut l, contact::LEFT);
+        l.reset_commands(&mut v);
+        assert!(v.iter().all(|u| u.abs() < 1e-5), "{v:?}");
     }
 
     #[test]
     fn energy_counts_motor_work_only() {
-        let mut leo = Leo::new(&Robot::Leo.config(), HoldGains::default());
-        leo.start_episode();
-        start_pose(&mut leo, contact::LEFT);
-        start_pose(&mut leo, contact::LEFT);
+        let mut l = leo();
+        start_pose(&mut l, contact::LEFT);
+        start_pose(&mut l, contact::LEFT);
         let mut applied = [0.0; MAX_SERVOS];
-        applied[HIP_L] = 10.0;
-        let angles = START_POSE.map(Some);
-        leo.sense(&angles, Some(0.10), contact::LEFT, &applied);
-        // At stall: U²/R · dt = 100/8.6/30 J; reward −1 − 3E.
-        let e = 100.0 / 8.6 / 30.0;
-        assert!((leo.reward() - (-1.0 - 3.0 * e)).abs() < 1e-3, "{}", leo.reward());
+        applied[Joint::HipLeft as usize] = 10.0;
+        sense(&mut l, START_JOINT_ANGLES, -START_PHI, contact::LEFT, applied);
+        // At stall: U²/R · T; reward −1 − 3E.
+        let e = 100.0 / 8.6 * 0.033_333;
+        let r = l.reward(&applied);
+        assert!((r - (-1.0 - 3.0 * e)).abs() < 1e-3, "{r}");
     }
 
     #[test]
     fn reset_waits_for_an_upright_torso_on_a_foot() {
-        let mut leo = Leo::new(&Robot::Leo.config(), HoldGains::default());
-        leo.begin_reset();
+        let mut l = leo();
+        l.begin_reset();
         for _ in 0..40 {
-            start_pose(&mut leo, 0);
-            assert!(!leo.reset_done(), "no foot down");
+            start_pose(&mut l, 0);
+            assert!(!l.reset_done(), "no foot down");
         }
         let mut n = 0;
         loop {
-            start_pose(&mut leo, contact::LEFT);
+            start_pose(&mut l, contact::LEFT);
             n += 1;
-            if leo.reset_done() {
+            if l.reset_done() {
                 break;
             }
         }

@@ -8,13 +8,13 @@
 //!
 //! | module | what |
 //! |---|---|
-//! | [`config`] | the robots (physical pendulum at 33 or 20 Hz, LEO at 30 Hz): servos, state, actions, learning parameters, table size, soft limits, configuration hash |
+//! | [`config`] | the robots' hardware (servo IDs and calibration, soft limits, encoder) and the learner's fixed sizes; what they learn is `pada_core::robot`, how much they remember `pada_core::profile` |
+//! | [`robot`] | the one interface between the controller and a robot ([`robot::RobotAdapter`]) |
 //! | [`io`] | the traits a board implements: servo-bus port, byte streams, sensors, cycle counter |
 //! | [`bus`] | Dynamixel Protocol 1.0 transactions with bounded timeouts and retries (codec from `pada_core::dynamixel`) |
-//! | [`servo`] | joint calibration, commanded voltage → Moving Speed ratio, torque estimate for the fatigue counter |
+//! | [`servo`] | joint calibration, commanded voltage → Moving Speed ratio |
 //! | [`encoder`] | quadrature counts → unwrapped angle |
-//! | [`filter`] | GRL's first-order Butterworth rate filter |
-//! | [`pendulum`], [`leo`] | per robot: observation, reward, episode end, PD holds, command mapping |
+//! | [`pendulum`], [`leo`] | per robot: the adapter from counts to the robot's definition, and the wait between episodes |
 //! | [`control`] | one control period: safety, agent step, episodes, fatigue, telemetry records |
 //! | [`timing`] | loop-time and overrun accounting |
 //! | [`sil`] | software in the loop: the emulated board's lock-step clock and sensor device, shared with the host |
@@ -27,10 +27,10 @@ pub mod bus;
 pub mod config;
 pub mod control;
 pub mod encoder;
-pub mod filter;
 pub mod io;
 pub mod leo;
 pub mod pendulum;
+pub mod robot;
 pub mod servo;
 pub mod sil;
 pub mod timing;

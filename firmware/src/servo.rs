@@ -1,5 +1,6 @@
-//! One RX-28 as a joint: calibration, the commanded voltage as a wheel-mode
-//! Moving Speed, and the torque estimate the fatigue counter needs.
+//! One RX-28 as a joint: calibration, and the commanded voltage as a
+//! wheel-mode Moving Speed. (Its torque estimate for the fatigue counter is
+//! the RX-28 model of `pada_core::rx28`, through the robot's definition.)
 //!
 //! In wheel mode the RX-28's Moving Speed is not a speed but the motor's
 //! output ratio (PWM duty): bits 0–9 the magnitude out of 1023, bit 10 the
@@ -49,32 +50,6 @@ impl Joint {
     }
 }
 
-/// RX-28 constants of the simulation's motor model (grl-facts §2.1).
-pub mod rx28 {
-    /// Torque constant k \[N·m/A\].
-    pub const TORQUE_CONSTANT: f32 = 0.00992;
-    /// Terminal resistance R \[Ω\].
-    pub const RESISTANCE: f32 = 8.6;
-    /// Gear ratio G.
-    pub const GEAR_RATIO: f32 = 193.0;
-    /// Gearbox efficiency η.
-    pub const EFFICIENCY: f32 = 0.75;
-    /// LEO's voltage limit of the held joints, `LEO_MAX_DXL_VOLTAGE` (§2.2) \[V\].
-    pub const MAX_HOLD_VOLTAGE: f32 = 10.691_892;
-}
-
-/// Output torque \[N·m\] of an RX-28 at joint speed `speed` \[rad/s\] under
-/// `voltage` \[V\] (clipped to ±`supply`): the quasi-static DC-motor model
-/// of grl-facts §2.1 without the armature dynamics,
-/// `τ = η·G·k·(U − G·k·q̇)/R`. This is the torque on the last gear that
-/// the fatigue counter sees change sign.
-pub fn estimated_torque(voltage: f32, speed: f32, supply: f32) -> f32 {
-    use rx28::*;
-    let u = voltage.clamp(-supply.abs(), supply.abs());
-    let gk = GEAR_RATIO * TORQUE_CONSTANT;
-    EFFICIENCY * gk * (u - gk * speed) / RESISTANCE
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -109,18 +84,5 @@ mod tests {
         // And back.
         assert!((j.voltage_of(512, 12.0) - 6.0).abs() < 0.01);
         assert!((j.voltage_of(1024 | 512, 12.0) + 6.0).abs() < 0.01);
-    }
-
-    #[test]
-    fn torque_model_matches_the_simulation_constants() {
-        // Stall torque at 10.6919 V ≈ 2.3803 N·m before η (grl-facts §2.1).
-        let stall = estimated_torque(10.6919, 0.0, 14.0);
-        assert!((stall - 0.75 * 2.3803).abs() < 1e-3, "{stall}");
-        // No-load speed at 10.6919 V ≈ 5.5845 rad/s.
-        assert!(estimated_torque(10.6919, 5.5845, 14.0).abs() < 1e-3);
-        // Back-EMF can reverse the torque's sign (braking).
-        assert!(estimated_torque(1.0, 3.0, 14.0) < 0.0);
-        // Voltage beyond the supply is clipped.
-        assert_eq!(estimated_torque(100.0, 0.0, 12.0), estimated_torque(12.0, 0.0, 12.0));
     }
 }

@@ -24,8 +24,10 @@ use pada_core::checkpoint::LoadOutcome;
 use pada_core::safety::Transition;
 use pada_core::wire::{self, FrameDecoder, FrameEncoder, NackReason, ToChip, ToHost, MAX_FRAME_LEN};
 use pada_firmware::bus::{BusConfig, BusStats, ServoBus};
-use pada_firmware::config::{WeightTable, MAX_SERVOS};
-use pada_firmware::control::{CheckpointError, Controller, PeriodOutput, Readings, ServoRead};
+use crate::table::Ctl;
+use pada_firmware::config::MAX_SERVOS;
+use pada_core::weights::WeightStore;
+use pada_firmware::control::{CheckpointError, PeriodOutput, Readings, ServoRead};
 use pada_firmware::io::{ByteSink, ByteSource, CycleCounter, Sensors};
 use pada_firmware::servo::Joint;
 use pada_firmware::timing::LoopTiming;
@@ -200,8 +202,8 @@ pub async fn watchdog(mut wd: Watchdog, mut led: Led) -> ! {
 
 /// Everything the control loop owns.
 pub struct ControlLoop {
-    /// The controller on the table in CCM.
-    pub ctl: Controller<&'static mut WeightTable>,
+    /// The controller on the image's table.
+    pub ctl: Ctl,
     /// Encoder and foot switches.
     pub sensors: BoardSensors,
     /// The checkpoint slots.
@@ -222,7 +224,7 @@ struct WeightsJob {
 /// The control loop at the robot's rate.
 #[embassy_executor::task]
 pub async fn control(mut cl: ControlLoop) -> ! {
-    let period_us = cl.ctl.config().period_us;
+    let period_us = cl.ctl.config().period_us();
     let mut timing = LoopTiming::new(cl.cpu_hz, period_us);
     let mut readings = Readings::default();
     let mut out = PeriodOutput::default();
@@ -233,7 +235,7 @@ pub async fn control(mut cl: ControlLoop) -> ! {
     let health_every = (1_000_000 / period_us).max(1);
     let log_every = health_every * 10;
     let mut period: u32 = 0;
-    info!("control loop: {} at {=u32} us, policy {}", cl.ctl.config().name, period_us, cl.ctl.policy());
+    info!("control loop: {} at {=u32} us, policy {}", cl.ctl.config().name(), period_us, cl.ctl.policy());
 
     // Sends without waiting; a full queue drops the message (counted, and
     // visible to the host as a sequence gap).
@@ -344,7 +346,7 @@ pub async fn control(mut cl: ControlLoop) -> ! {
 }
 
 /// Sends up to four chunks of a weights read; true when done.
-fn send_weights(ctl: &Controller<&'static mut WeightTable>, job: &mut WeightsJob) -> bool {
+fn send_weights(ctl: &Ctl, job: &mut WeightsJob) -> bool {
     let weights = ctl.weights();
     for _ in 0..4 {
         if job.next >= job.end {
@@ -354,7 +356,7 @@ fn send_weights(ctl: &Controller<&'static mut WeightTable>, job: &mut WeightsJob
         let chunk = wire::WeightsChunk {
             offset: job.next,
             total: weights.len() as u32,
-            weights: weights[job.next as usize..end as usize].iter().map(|w| w.0).collect(),
+            weights: (job.next..end).map(|i| weights.get(i as usize).0).collect(),
         };
         if TO_HOST.try_send(Outgoing { msg: ToHost::Weights(chunk), skipped: 0 }).is_err() {
             // The link is busy: the rest next period.
@@ -365,7 +367,7 @@ fn send_weights(ctl: &Controller<&'static mut WeightTable>, job: &mut WeightsJob
     job.next >= job.end
 }
 
-async fn report_transition(t: &Transition, ctl: &Controller<&'static mut WeightTable>, time_ms: u32) {
+async fn report_transition(t: &Transition, ctl: &Ctl, time_ms: u32) {
     let step = ctl.agent_stats().steps as u32;
     info!("state {} -> {}", t.from, t.to);
     send_reliable(ToHost::State(wire::StateChange { step, from: t.from, to: t.to })).await;
@@ -457,7 +459,7 @@ async fn with_long_watchdog<T>(op: impl FnOnce() -> T) -> T {
 }
 
 /// What a load found, in the log.
-fn log_load(ctl: &Controller<&'static mut WeightTable>, outcome: LoadOutcome) {
+fn log_load(ctl: &Ctl, outcome: LoadOutcome) {
     match outcome {
         LoadOutcome::Loaded { generation, slot } => {
             let stats = ctl.agent_stats();
@@ -487,7 +489,7 @@ fn log_load(ctl: &Controller<&'static mut WeightTable>, outcome: LoadOutcome) {
 /// Loads the checkpoint (weights and learner state) at boot and tells the
 /// host what happened: a `Checkpoint` report when loaded, a `Warning` when
 /// one was found but ignored.
-pub async fn boot_checkpoint(ctl: &mut Controller<&'static mut WeightTable>, flash: &FlashStore) {
+pub async fn boot_checkpoint(ctl: &mut Ctl, flash: &FlashStore) {
     match ctl.load_checkpoint(flash) {
         Ok(outcome) => {
             log_load(ctl, outcome);

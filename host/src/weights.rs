@@ -63,6 +63,7 @@ impl WeightsHeader {
             tilings: TILINGS,
             table: match (&spec.table, &spec.action_tiles) {
                 (WeightTable::Exact, _) => "exact".into(),
+                (WeightTable::ExactOf { weights }, _) => format!("exact in {weights}"),
                 (WeightTable::Hashed { log2_size }, None) => format!("hashed 2^{log2_size}"),
                 (WeightTable::Hashed { log2_size }, Some(w)) => {
                     format!("hashed 2^{log2_size}, action tiles {w:?}")

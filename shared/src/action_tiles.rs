@@ -106,6 +106,17 @@ impl<const TILINGS: usize> ActionTiles<TILINGS> {
         Ok(ActionTiles { dims: space.dims(), levels, part, combos })
     }
 
+    /// Writes the tiling into a configuration hash: dimensions, levels,
+    /// combinations and every tiling's offsets.
+    pub fn write_config(&self, h: &mut crate::checkpoint::ConfigHasher) {
+        h.write_u32(self.dims as u32).write_u32(self.combos).write(&self.levels[..self.dims]);
+        for tiling in &self.part {
+            for (d, row) in tiling.iter().enumerate().take(self.dims) {
+                h.write(&row[..self.levels[d] as usize]);
+            }
+        }
+    }
+
     /// Combinations per tiling (every combination index is below this).
     pub fn combos(&self) -> u32 {
         self.combos

@@ -29,6 +29,7 @@ use crate::fixed::{Frac, Q16};
 use crate::policy::{uniform_below, Candidates, Policy, PolicyKind, PolicyState};
 use crate::tile_coding::{Layout, StateCode, StateDim, TileCoder, MAX_STATE_DIMS};
 use crate::trace::{Trace, TraceKind};
+use crate::weights::WeightStore;
 use heapless::Vec;
 use rand_core::RngCore;
 
@@ -197,9 +198,10 @@ struct Current<const TILINGS: usize> {
 /// A SARSA(λ) agent with `TILINGS` tilings and a trace of at most `TRACE`
 /// entries, on weights stored in `W`.
 ///
-/// The weights live in any `W` that lends a slice: an array owned by the
-/// agent, a `&'static mut [Q16; N]` in a chosen RAM section on the chip
-/// (compile-time size), or a boxed slice on the host. The hashed layout
+/// The weights live in any [`WeightStore`]: an array owned by the agent, a
+/// `&'static mut [Q16; N]` in a chosen RAM section on the chip
+/// (compile-time size), a boxed slice on the host, a table split over two
+/// memories, or 16-bit weights ([`crate::weights`]). The hashed layout
 /// needs a power-of-two length.
 pub struct Agent<W, const TILINGS: usize, const TRACE: usize> {
     coder: TileCoder<TILINGS>,
@@ -219,7 +221,7 @@ pub struct Agent<W, const TILINGS: usize, const TRACE: usize> {
 
 impl<W, const TILINGS: usize, const TRACE: usize> Agent<W, TILINGS, TRACE>
 where
-    W: AsRef<[Q16]> + AsMut<[Q16]>,
+    W: WeightStore,
 {
     /// Builds an agent that observes `obs` (the policy may append its own
     /// dimensions), drives `motor` through `policy`, and learns with
@@ -253,7 +255,7 @@ where
                 )
             })?;
         }
-        let coder = TileCoder::new(&dims, policy.learner_space().joint_count(), layout, weights.as_ref().len())?;
+        let coder = TileCoder::new(&dims, policy.learner_space().joint_count(), layout, weights.len())?;
         let decay = Frac::from_f32(params.gamma).times(Frac::from_f32(params.lambda));
         Ok(Agent {
             coder,
@@ -286,13 +288,17 @@ where
     /// Sets every weight from `params.init` (draws from `rng` if uniform).
     pub fn reset_weights<R: RngCore + ?Sized>(&mut self, rng: &mut R) {
         match self.params.init {
-            WeightInit::Constant(c) => self.weights.as_mut().fill(Q16::from_f32(c)),
+            WeightInit::Constant(c) => {
+                for i in 0..self.weights.len() {
+                    self.weights.set(i, Q16::from_f32(c));
+                }
+            }
             WeightInit::Uniform { min, max } => {
                 let (lo, hi) = (Q16::from_f32(min).0 as i64, Q16::from_f32(max).0 as i64);
                 let span = (hi - lo + 1) as u64;
-                for w in self.weights.as_mut() {
+                for i in 0..self.weights.len() {
                     let r = ((rng.next_u64() as u128 * span as u128) >> 64) as i64;
-                    *w = Q16((lo + r) as i32);
+                    self.weights.set(i, Q16((lo + r) as i32));
                 }
             }
         }
@@ -324,7 +330,7 @@ where
         }
         let (decision, features) = self.decide(obs, rng);
         if self.mode == Mode::Learning {
-            self.update(&current, reward, Some(decision.q));
+            self.update(&current, reward, Some(decision.q), rng);
         }
         Ok(self.commit(decision, features))
     }
@@ -354,7 +360,7 @@ where
                     Some(successor.q)
                 }
             };
-            self.update(&current, reward, q_next);
+            self.update(&current, reward, q_next, rng);
         }
         self.current = None;
         self.trace.clear();
@@ -438,6 +444,31 @@ where
         Ok(())
     }
 
+    /// Writes what gives this agent's weights their meaning into a
+    /// configuration hash ([`crate::profile::config_hash`]): the tile
+    /// coder ([`TileCoder::write_config`]), the trace's capacity and
+    /// settings, the learner's action levels (all levels, or an
+    /// integrator's −Δ/0/+Δ), α, γ and λ. Not ε, the initialisation or the
+    /// policy's own parameter when it leaves the learner unchanged (PADA,
+    /// low-pass: they share SARSA's weights).
+    pub fn write_config(&self, h: &mut crate::checkpoint::ConfigHasher) {
+        self.coder.write_config(h);
+        h.write_u32(TRACE as u32);
+        let space = self.policy.learner_space();
+        h.write_u32(space.dims() as u32);
+        for i in 0..space.dims() {
+            h.write_u32(space.dim(i).len() as u32);
+            for &v in space.dim(i).values() {
+                h.write_f32(v);
+            }
+        }
+        h.write_f32(self.params.alpha)
+            .write_f32(self.params.gamma)
+            .write_f32(self.params.lambda)
+            .write_f32(self.params.trace_threshold)
+            .write_u32(crate::profile::trace_kind_code(self.params.trace_kind));
+    }
+
     /// The action policy.
     pub fn policy(&self) -> &Policy {
         &self.policy
@@ -459,13 +490,13 @@ where
     }
 
     /// The weights.
-    pub fn weights(&self) -> &[Q16] {
-        self.weights.as_ref()
+    pub fn weights(&self) -> &W {
+        &self.weights
     }
 
     /// The weights, mutably (loading a checkpoint).
-    pub fn weights_mut(&mut self) -> &mut [Q16] {
-        self.weights.as_mut()
+    pub fn weights_mut(&mut self) -> &mut W {
+        &mut self.weights
     }
 
     /// Gives the weight storage back (to build an agent with another
@@ -474,16 +505,11 @@ where
         self.weights
     }
 
-    /// FNV-1a over the weights' little-endian bytes: equal on every machine
-    /// for equal weights.
+    /// FNV-1a over the weights' stored little-endian bytes
+    /// ([`WeightStore::checksum`]): equal on every machine for equal
+    /// weights.
     pub fn weights_checksum(&self) -> u32 {
-        let mut h: u32 = 0x811c_9dc5;
-        for w in self.weights.as_ref() {
-            for b in w.0.to_le_bytes() {
-                h = (h ^ b as u32).wrapping_mul(0x0100_0193);
-            }
-        }
-        h
+        self.weights.checksum()
     }
 
     /// `Q(s, a)` for an observation and a joint action of the learner, with
@@ -516,19 +542,19 @@ where
     /// Sum of the active weights of (state, action): `TILINGS · Q`.
     #[inline]
     fn q_sum(&self, code: &StateCode<TILINGS>, action: u32) -> i64 {
-        let w = self.weights.as_ref();
+        let w = &self.weights;
         let mut sum = 0i64;
         // The action-tile test once, not per tiling (the greedy loop's
         // inner body on the chip).
         match self.coder.action_tiles() {
             None => {
                 for j in 0..TILINGS {
-                    sum += w[self.coder.action_feature(code, j, action) as usize].0 as i64;
+                    sum += w.get(self.coder.action_feature(code, j, action) as usize).0 as i64;
                 }
             }
             Some(at) => {
                 for j in 0..TILINGS {
-                    sum += w[self.coder.combo_feature(code, j, at.combo_of_action(j, action)) as usize].0 as i64;
+                    sum += w.get(self.coder.combo_feature(code, j, at.combo_of_action(j, action)) as usize).0 as i64;
                 }
             }
         }
@@ -537,8 +563,7 @@ where
 
     /// `Q` of a feature set: the mean of its weights.
     fn q_of(&self, features: &[u32; TILINGS]) -> Q16 {
-        let w = self.weights.as_ref();
-        let sum: i64 = features.iter().map(|&f| w[f as usize].0 as i64).sum();
+        let sum: i64 = features.iter().map(|&f| self.weights.get(f as usize).0 as i64).sum();
         Q16::from_wide(sum / TILINGS as i64)
     }
 
@@ -609,11 +634,10 @@ where
         rng: &mut R,
     ) -> Levels {
         const MASK: usize = MAX_ACTION_COMBOS - 1;
-        let w = self.weights.as_ref();
         let mut table = [[0i32; MAX_ACTION_COMBOS]; TILINGS];
         for (j, row) in table.iter_mut().enumerate() {
             for (c, slot) in row.iter_mut().enumerate().take(at.combos() as usize) {
-                *slot = w[self.coder.combo_feature(code, j, c as u32) as usize].0;
+                *slot = self.weights.get(self.coder.combo_feature(code, j, c as u32) as usize).0;
             }
         }
         // Unused dimensions have lo = hi = 0 and contribute 0.
@@ -663,8 +687,9 @@ where
     }
 
     /// The SARSA(λ) update for the pair `current` that earned `reward`;
-    /// `q_next` is `Q(s', a')`, or `None` at an absorbing end.
-    fn update(&mut self, current: &Current<TILINGS>, reward: f32, q_next: Option<Q16>) {
+    /// `q_next` is `Q(s', a')`, or `None` at an absorbing end. A table that
+    /// rounds stochastically gets one dither from `rng` per weight write.
+    fn update<R: RngCore + ?Sized>(&mut self, current: &Current<TILINGS>, reward: f32, q_next: Option<Q16>, rng: &mut R) {
         let q = self.q_of(&current.features);
         let mut delta = Q16::from_f32(reward).0 as i64 - q.0 as i64;
         if let Some(qn) = q_next {
@@ -674,7 +699,7 @@ where
         self.stats.last_td_error = delta;
         let step = delta.mul_frac(self.alpha);
         self.trace.push(&current.features);
-        let weights = self.weights.as_mut();
+        let weights = &mut self.weights;
         let mut saturations = 0u32;
         self.trace.for_each_entry(|entry, eligibility| {
             let inc = step.mul_frac(eligibility);
@@ -682,13 +707,11 @@ where
                 return;
             }
             for &f in entry {
-                // Replaced slots hold u32::MAX and are skipped here.
-                if let Some(w) = weights.get_mut(f as usize) {
-                    let next = w.saturating_add(inc);
-                    if next == Q16::MAX || next == Q16::MIN {
-                        saturations += 1;
-                    }
-                    *w = next;
+                // Replaced slots hold u32::MAX: outside the table, so the
+                // store writes nothing (and no dither is drawn for them).
+                if (f as usize) < weights.len() {
+                    let dither = if W::DITHERED { rng.next_u32() } else { 0 };
+                    saturations += weights.add(f as usize, inc, dither) as u32;
                 }
             }
         });

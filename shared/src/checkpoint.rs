@@ -3,21 +3,29 @@
 //! last good checkpoint, and a board that resets continues learning where it
 //! was.
 //!
-//! # Slot layout (format 2, little endian)
+//! # Slot layout (format 3, little endian)
 //!
 //! | offset | size | field |
 //! |---|---|---|
 //! | 0 | 4 | magic `"PDCK"` |
-//! | 4 | 2 | format version ([`FORMAT_VERSION`], 2) |
+//! | 4 | 2 | format version ([`FORMAT_VERSION`], 3) |
 //! | 6 | 2 | header length (32) |
 //! | 8 | 4 | configuration hash ([`config_hash`] of the caller's description) |
 //! | 12 | 4 | weight count `n` |
 //! | 16 | 4 | generation (1 for the first save, +1 per save) |
 //! | 20 | 4 | CRC-32 of the payload: the state record and the weights |
-//! | 24 | 4 | length `s` of the learner-state record ([`STATE_LEN`], 496; format 1: reserved, 0) |
+//! | 24 | 2 | length `s` of the learner-state record ([`STATE_LEN`], 496) |
+//! | 26 | 2 | bytes `b` per stored weight (4: [`Q16`] as `i32`, 2: 16-bit, [`crate::weights::WeightFormat`]) |
 //! | 28 | 4 | CRC-32 of bytes 0–27 |
 //! | 32 | s | the learner-state record (below) |
-//! | 32 + s | 4·n | the weights, raw [`Q16`] as little-endian `i32` |
+//! | 32 + s | b·n | the weights as the table stores them ([`WeightStore::stored_le`]), little endian |
+//! | 32 + s + b·n | 0–3 | zeros up to a multiple of 4 bytes |
+//!
+//! Format 2 (4-byte weights only, a 4-byte state length at 24) and format
+//! 1 (weights without the learner's state) are refused as
+//! [`LoadOutcome::UnsupportedVersion`]. The weight format itself is part of
+//! the configuration hash, so a table saved in another format is refused as
+//! a configuration mismatch.
 //!
 //! The header's own CRC covers the payload CRC, so the two CRCs together
 //! cover header, state and weights: a flipped bit anywhere makes the slot
@@ -94,6 +102,7 @@ use crate::fatigue::JointFatigueState;
 use crate::fixed::Q16;
 use crate::policy::{kind_code, kind_from_code, kind_parameter, PolicyKind, PolicyState};
 use crate::rng::RngState;
+use crate::weights::WeightStore;
 use heapless::Vec;
 
 /// CRC-32/ISO-HDLC (polynomial 0x04C11DB7 reflected, init and xor-out
@@ -108,7 +117,7 @@ pub fn crc32(bytes: &[u8]) -> u32 {
 /// `"PDCK"` read as a little-endian `u32`.
 pub const MAGIC: u32 = u32::from_le_bytes(*b"PDCK");
 /// The format version this code writes and reads (1 held weights only).
-pub const FORMAT_VERSION: u16 = 2;
+pub const FORMAT_VERSION: u16 = 3;
 /// Bytes of the header.
 pub const HEADER_LEN: usize = 32;
 /// Version of the learner-state record this code writes and reads.
@@ -121,8 +130,6 @@ pub const MAX_JOINTS: usize = 8;
 pub const USER_COUNTERS: usize = 4;
 /// Number of slots.
 pub const SLOTS: u8 = 2;
-/// Bytes per weight in the payload.
-pub const WEIGHT_BYTES: usize = 4;
 
 /// Offsets in the state record (see the module documentation).
 mod at {
@@ -159,9 +166,10 @@ const _: () = assert!(at::OUTPUT + 4 * MAX_ACTION_DIMS == at::EPSILON);
 const _: () = assert!(STATE_LEN % 4 == 0);
 const _: () = assert!(at::USER + 4 * USER_COUNTERS == at::FATIGUE);
 
-/// Bytes a slot needs for `weights` weights (header, state record, weights).
-pub const fn slot_len(weights: usize) -> usize {
-    HEADER_LEN + STATE_LEN + weights * WEIGHT_BYTES
+/// Bytes a slot needs for `weights` weights of `weight_bytes` bytes each
+/// (header, state record, weights padded to a multiple of 4).
+pub const fn slot_len(weights: usize, weight_bytes: usize) -> usize {
+    HEADER_LEN + STATE_LEN + (weights * weight_bytes).div_ceil(4) * 4
 }
 
 /// Where checkpoints live: two slots of equal size, read and written at byte
@@ -194,8 +202,10 @@ pub struct Header {
     pub generation: u32,
     /// CRC-32 of the payload bytes (state record and weights).
     pub payload_crc: u32,
-    /// Bytes of the learner-state record ([`STATE_LEN`]; 0 in format 1).
+    /// Bytes of the learner-state record ([`STATE_LEN`]).
     pub state_len: u32,
+    /// Bytes per stored weight (4 or 2).
+    pub weight_bytes: u16,
 }
 
 /// Why a slot's header is not valid.
@@ -226,7 +236,8 @@ impl Header {
         b[12..16].copy_from_slice(&self.weight_count.to_le_bytes());
         b[16..20].copy_from_slice(&self.generation.to_le_bytes());
         b[20..24].copy_from_slice(&self.payload_crc.to_le_bytes());
-        b[24..28].copy_from_slice(&self.state_len.to_le_bytes());
+        b[24..26].copy_from_slice(&(self.state_len.min(u16::MAX as u32) as u16).to_le_bytes());
+        b[26..28].copy_from_slice(&self.weight_bytes.to_le_bytes());
         let crc = crc32(&b[..28]);
         b[28..32].copy_from_slice(&crc.to_le_bytes());
         b
@@ -252,14 +263,19 @@ impl Header {
             weight_count: u32_at(12),
             generation: u32_at(16),
             payload_crc: u32_at(20),
-            state_len: u32_at(24),
+            state_len: u16_at(24) as u32,
+            weight_bytes: u16_at(26),
         })
     }
 
     /// Bytes of the slot this header describes, if that fits a `usize`.
     fn slot_bytes(&self) -> Option<usize> {
+        if !matches!(self.weight_bytes, 2 | 4) {
+            return None;
+        }
         (self.weight_count as usize)
-            .checked_mul(WEIGHT_BYTES)?
+            .checked_mul(self.weight_bytes as usize)?
+            .checked_next_multiple_of(4)?
             .checked_add(self.state_len as usize)?
             .checked_add(HEADER_LEN)
     }
@@ -609,13 +625,14 @@ fn newest<S: CheckpointStore>(store: &S) -> Result<([SlotStatus; 2], Newest), S:
 /// Saves the learner's `state` and `weights` with `config_hash` into the
 /// slot not holding the newest valid checkpoint — state record and weights
 /// first, header last — then reads it back to verify.
-pub fn save<S: CheckpointStore>(
+pub fn save<S: CheckpointStore, W: WeightStore + ?Sized>(
     store: &mut S,
     config_hash: u32,
     state: &LearnerState,
-    weights: &[Q16],
+    weights: &W,
 ) -> Result<Saved, SaveError<S::Error>> {
-    let needed = slot_len(weights.len());
+    let bytes = weights.format().bytes();
+    let needed = slot_len(weights.len(), bytes);
     if needed > store.capacity() || weights.len() > u32::MAX as usize {
         return Err(SaveError::TooLarge { needed, capacity: store.capacity() });
     }
@@ -631,14 +648,21 @@ pub fn save<S: CheckpointStore>(
     store.write(slot, HEADER_LEN, &record).map_err(SaveError::Store)?;
     let mut buf = [0u8; CHUNK];
     let mut offset = HEADER_LEN + STATE_LEN;
-    for chunk in weights.chunks(CHUNK / WEIGHT_BYTES) {
-        let n = chunk.len() * WEIGHT_BYTES;
-        for (dst, w) in buf.chunks_exact_mut(WEIGHT_BYTES).zip(chunk) {
-            dst.copy_from_slice(&w.0.to_le_bytes());
+    let per_chunk = CHUNK / bytes;
+    let mut i = 0;
+    while i < weights.len() {
+        let count = (weights.len() - i).min(per_chunk);
+        for (k, dst) in buf.chunks_exact_mut(bytes).take(count).enumerate() {
+            weights.stored_le(i + k, dst);
         }
+        // The last chunk is padded with zeros to a multiple of 4 bytes.
+        let used = count * bytes;
+        let n = used.div_ceil(4) * 4;
+        buf[used..n].fill(0);
         digest.update(&buf[..n]);
         store.write(slot, offset, &buf[..n]).map_err(SaveError::Store)?;
         offset += n;
+        i += count;
     }
     let header = Header {
         version: FORMAT_VERSION,
@@ -647,6 +671,7 @@ pub fn save<S: CheckpointStore>(
         generation,
         payload_crc: digest.finalize(),
         state_len: STATE_LEN as u32,
+        weight_bytes: bytes as u16,
     };
     store.write(slot, 0, &header.to_bytes()).map_err(SaveError::Store)?;
     match inspect(store, slot).map_err(SaveError::Store)? {
@@ -714,21 +739,30 @@ pub fn find<S: CheckpointStore>(
 /// Copies the weights of a checkpoint [`find`] found into `weights`;
 /// [`LoadOutcome::SizeMismatch`] (and nothing written) if `weights` has
 /// another length than the checkpoint.
-pub fn read_weights<S: CheckpointStore>(store: &S, found: &Found, weights: &mut [Q16]) -> Result<LoadOutcome, S::Error> {
+pub fn read_weights<S: CheckpointStore, W: WeightStore + ?Sized>(
+    store: &S,
+    found: &Found,
+    weights: &mut W,
+) -> Result<LoadOutcome, S::Error> {
     let header = &found.header;
-    if header.weight_count as usize != weights.len() {
+    let bytes = weights.format().bytes();
+    if header.weight_count as usize != weights.len() || header.weight_bytes as usize != bytes {
         return Ok(LoadOutcome::SizeMismatch { expected: weights.len() as u32, found: header.weight_count });
     }
     // The payload was checked by `inspect`; copy it.
     let mut buf = [0u8; CHUNK];
     let mut offset = HEADER_LEN + header.state_len as usize;
-    for chunk in weights.chunks_mut(CHUNK / WEIGHT_BYTES) {
-        let n = chunk.len() * WEIGHT_BYTES;
+    let per_chunk = CHUNK / bytes;
+    let mut i = 0;
+    while i < weights.len() {
+        let count = (weights.len() - i).min(per_chunk);
+        let n = count * bytes;
         store.read(found.slot, offset, &mut buf[..n])?;
-        for (w, src) in chunk.iter_mut().zip(buf.chunks_exact(WEIGHT_BYTES)) {
-            *w = Q16(i32::from_le_bytes([src[0], src[1], src[2], src[3]]));
+        for (k, src) in buf[..n].chunks_exact(bytes).enumerate() {
+            weights.load_le(i + k, src);
         }
         offset += n;
+        i += count;
     }
     Ok(LoadOutcome::Loaded { generation: header.generation, slot: found.slot })
 }
@@ -742,11 +776,11 @@ pub fn read_weights<S: CheckpointStore>(store: &S, found: &Found, weights: &mut 
 /// ([`crate::agent::Agent::check_state`] and friends), then
 /// [`read_weights`], so that a refused state leaves the weights as they
 /// were too.
-pub fn load<S: CheckpointStore>(
+pub fn load<S: CheckpointStore, W: WeightStore + ?Sized>(
     store: &S,
     config_hash: u32,
     state: &mut LearnerState,
-    weights: &mut [Q16],
+    weights: &mut W,
 ) -> Result<LoadOutcome, S::Error> {
     let found = match find(store, config_hash, weights.len())? {
         Ok(found) => found,
@@ -913,6 +947,7 @@ mod tests {
             generation: 9,
             payload_crc: 1,
             state_len: STATE_LEN as u32,
+            weight_bytes: 4,
         };
         let b = h.to_bytes();
         assert_eq!(Header::parse(&b), Ok(h));
@@ -924,7 +959,14 @@ mod tests {
         }
         let h1 = Header { version: 1, state_len: 0, ..h };
         assert_eq!(Header::parse(&h1.to_bytes()), Err(HeaderError::UnsupportedVersion { found: 1 }));
-        let h3 = Header { version: 3, ..h };
-        assert_eq!(Header::parse(&h3.to_bytes()), Err(HeaderError::UnsupportedVersion { found: 3 }));
+        let h2 = Header { version: 2, ..h };
+        assert_eq!(Header::parse(&h2.to_bytes()), Err(HeaderError::UnsupportedVersion { found: 2 }));
+        let h4 = Header { version: 4, ..h };
+        assert_eq!(Header::parse(&h4.to_bytes()), Err(HeaderError::UnsupportedVersion { found: 4 }));
+        // A weight width other than 2 or 4 bytes describes no slot.
+        let mut store = RamStore::<{ slot_len(3, 4) }>::new();
+        let odd = Header { weight_bytes: 3, ..h };
+        let _ = store.write(0, 0, &odd.to_bytes());
+        assert_eq!(inspect(&store, 0), Ok(SlotStatus::Invalid(HeaderError::Corrupt)));
     }
 }

@@ -49,11 +49,14 @@ pub mod error;
 pub mod fatigue;
 pub mod fixed;
 pub mod policy;
+pub mod profile;
 pub mod rng;
+pub mod robot;
 pub mod rx28;
 pub mod safety;
 pub mod tile_coding;
 pub mod trace;
+pub mod weights;
 pub mod wire;
 
 /// A value the firmware references so that a link of pada-core is visible in

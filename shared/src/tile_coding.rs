@@ -84,7 +84,9 @@ impl StateDim {
         Ok(d)
     }
 
-    fn validate(&self) -> Result<(), ConfigError> {
+    /// Checks the range, tile width and (for a wrapping dimension) the whole
+    /// number of tiles per period; the error names the field.
+    pub fn validate(&self) -> Result<(), ConfigError> {
         if !self.min.is_finite() {
             return Err(ConfigError::new("state.min", self.min, "a finite number below state.max"));
         }
@@ -111,6 +113,7 @@ impl StateDim {
 /// How (tiling, tile, action) coordinates become weight indices.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Layout {
     /// Hash into a table whose size is a power of two (collisions allowed).
     Hashed,
@@ -269,6 +272,30 @@ impl<const TILINGS: usize> TileCoder<TILINGS> {
     #[inline]
     pub fn combo_feature(&self, code: &StateCode<TILINGS>, tiling: usize, combo: u32) -> u32 {
         murmur_finish(murmur_mix(code.per_tiling[tiling], combo)) & (self.table_size - 1)
+    }
+
+    /// Writes what gives this coder's features their meaning into a
+    /// configuration hash: tilings, layout, table size, joint actions, each
+    /// dimension as prepared (range, sub-tiles per unit, wrap period,
+    /// tiles) and the action tiling if any.
+    pub fn write_config(&self, h: &mut crate::checkpoint::ConfigHasher) {
+        h.write_u32(TILINGS as u32)
+            .write_u32(crate::profile::layout_code(self.layout))
+            .write_u32(self.table_size)
+            .write_u32(self.actions)
+            .write_u32(self.dims.len() as u32);
+        for d in &self.dims {
+            h.write_f32(d.min).write_f32(d.max).write_f32(d.scale).write_u32(d.period as u32).write_u32(d.tiles);
+        }
+        match &self.action_tiles {
+            Some(at) => {
+                h.write_str("action tiles");
+                at.write_config(h);
+            }
+            None => {
+                h.write_str("no action tiles");
+            }
+        }
     }
 
     /// Number of state dimensions.

@@ -9,7 +9,7 @@ use pada_core::fatigue::JointFatigueState;
 use pada_core::fixed::Q16;
 
 const N: usize = 100;
-const SLOT: usize = slot_len(N) + 16;
+const SLOT: usize = slot_len(N, 4) + 16;
 type Store = RamStore<SLOT>;
 
 fn weights(seed: i32) -> Vec<Q16> {
@@ -101,7 +101,7 @@ fn size_mismatch_is_reported() {
 #[test]
 fn too_large_is_refused_before_touching_the_store() {
     let mut store = RamStore::<600>::new();
-    assert_eq!(save_seed(&mut store, 1, 1), Err(SaveError::TooLarge { needed: slot_len(N), capacity: 600 }));
+    assert_eq!(save_seed(&mut store, 1, 1), Err(SaveError::TooLarge { needed: slot_len(N, 4), capacity: 600 }));
     assert!(store.slot(0).unwrap().iter().all(|&b| b == 0xFF));
 }
 
@@ -111,7 +111,7 @@ fn a_corrupted_payload_is_rejected() {
     // weights is caught.
     let state_at = HEADER_LEN;
     let weights_at = HEADER_LEN + STATE_LEN;
-    for byte in [state_at, state_at + 1, state_at + 33, state_at + 200, weights_at - 1, weights_at, weights_at + 200, slot_len(N) - 1] {
+    for byte in [state_at, state_at + 1, state_at + 33, state_at + 200, weights_at - 1, weights_at, weights_at + 200, slot_len(N, 4) - 1] {
         let mut store = Store::new();
         save_seed(&mut store, 42, 1).unwrap();
         store.slot_mut(0).unwrap()[byte] ^= 0x10;
@@ -149,6 +149,7 @@ fn a_future_format_is_reported() {
         generation: 1,
         payload_crc: 0,
         state_len: 0,
+        weight_bytes: 4,
     };
     store.write_bytes(0, &h.to_bytes());
     let (outcome, ..) = load_all(&store, 1);
@@ -172,7 +173,7 @@ const WRITTEN: usize = STATE_LEN + N * 4 + HEADER_LEN;
 fn a_torn_second_save_at_every_byte_keeps_the_first() {
     // Budgets 0..STATE_LEN cut the save inside the state record, then inside
     // the weights, then inside the header.
-    assert_eq!(WRITTEN, slot_len(N));
+    assert_eq!(WRITTEN, slot_len(N, 4));
     for budget in 0..WRITTEN {
         let mut base = Store::new();
         save_seed(&mut base, 42, 1).unwrap();
@@ -233,10 +234,11 @@ fn header_claiming_more_weights_than_fit_is_corrupt() {
         generation: 5,
         payload_crc: 0,
         state_len: STATE_LEN as u32,
+        weight_bytes: 4,
     };
     store.write_bytes(0, &h.to_bytes());
     assert_eq!(inspect(&store, 0), Ok(SlotStatus::Invalid(HeaderError::Corrupt)));
-    let h = Header { weight_count: 0, state_len: u32::MAX, ..h };
+    let h = Header { weight_count: 0, state_len: u16::MAX as u32, ..h };
     store.write_bytes(0, &h.to_bytes());
     assert_eq!(inspect(&store, 0), Ok(SlotStatus::Invalid(HeaderError::Corrupt)));
 }

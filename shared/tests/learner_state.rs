@@ -26,7 +26,7 @@ use proptest::prelude::*;
 use rand_core::{RngCore, SeedableRng};
 
 const WEIGHTS: usize = 1 << 10;
-const SLOT: usize = slot_len(WEIGHTS);
+const SLOT: usize = slot_len(WEIGHTS, 4);
 type Store = RamStore<SLOT>;
 type TestAgent = Agent<Box<[Q16]>, 4, 64>;
 const JOINTS: usize = 3;
@@ -410,7 +410,7 @@ proptest! {
         let mut l = new_learner(PolicyKind::Sarsa, 0);
         prop_assert_eq!(l.load(&store, HASH), outcome);
         prop_assert_eq!(l.state(), state);
-        prop_assert_eq!(l.agent.weights(), &weights[..]);
+        prop_assert_eq!(&l.agent.weights()[..], &weights[..]);
     }
 
     /// Reachable fatigue states pass the check (the invariants the check
@@ -517,6 +517,7 @@ fn write_raw(store: &mut Store, slot: u8, version: u16, generation: u32, record:
         generation,
         payload_crc: crc32(&payload),
         state_len: record.len() as u32,
+        weight_bytes: 4,
     };
     let s = store.slot_mut(slot).unwrap();
     s.fill(0xFF);
@@ -620,7 +621,7 @@ fn a_save_torn_inside_the_state_record_keeps_the_previous_checkpoint() {
     assert_ne!(second, first.0);
     // Every byte of the state record (written first), then a few of the
     // weights and of the header (written last).
-    let budgets = (0..=STATE_LEN).chain([STATE_LEN + 1, STATE_LEN + 2000, slot_len(WEIGHTS) - HEADER_LEN + 5, slot_len(WEIGHTS) - 1]);
+    let budgets = (0..=STATE_LEN).chain([STATE_LEN + 1, STATE_LEN + 2000, slot_len(WEIGHTS, 4) - HEADER_LEN + 5, slot_len(WEIGHTS, 4) - 1]);
     for budget in budgets {
         let mut torn = TornStore::new(base.clone(), budget);
         assert!(save(&mut torn, HASH, &second, a.agent.weights()).is_err(), "budget {budget}");

@@ -34,7 +34,7 @@ use heapless::Deque;
 use pada_core::checkpoint::{self, CheckpointStore};
 use pada_core::wire::{encode_frame, FrameDecoder};
 use pada_firmware::bus::{BusConfig, ServoBus};
-use pada_firmware::config::WEIGHTS;
+use crate::table::{PROFILE, WEIGHTS};
 use pada_firmware::io::{self, PortError};
 use pada_firmware::sil::{self, FromBoard, ToBoard, CLOCK_FRAME_LEN, SENSOR_ID};
 use stm32_metapac::usart::Usart;
@@ -459,7 +459,7 @@ impl Board {
         }
         let link = ClockLink::open();
         let mut seq = 0;
-        let boot = FromBoard::Boot { protocol: sil::CLOCK_PROTOCOL, robot: crate::ROBOT.code(), calibration: calibrate() };
+        let boot = FromBoard::Boot { protocol: sil::CLOCK_PROTOCOL, robot: <crate::table::ThisRobot as pada_firmware::robot::RobotAdapter>::ROBOT.code(), calibration: calibrate() };
         link.send(&boot, &mut seq);
         critical_section::with(|cs| CLOCK.borrow_ref_mut(cs).seq = seq);
         // SAFETY: `init` runs once, before the executor, which is the only
@@ -604,7 +604,7 @@ impl Led {
 const CHECKPOINT_FILE: &[u8] = b"pada-checkpoint.bin\0";
 const _: () = assert!(CHECKPOINT_FILE.len() == sil::CHECKPOINT_FILE.len() + 1);
 /// Bytes of each slot.
-const SLOT_LEN: usize = checkpoint::slot_len(WEIGHTS);
+const SLOT_LEN: usize = checkpoint::slot_len(WEIGHTS, PROFILE.format.bytes());
 
 /// Errors of the checkpoint file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, defmt::Format)]

@@ -1,9 +1,9 @@
 //! Building the host's SARSA(λ) agent for a task and a policy.
 //!
-//! Sixteen tilings (the paper's reference configuration, GRL, grl-facts §4
-//! and §5), a trace of at most 64 entries (the paper's γλ = 0.99·0.92
-//! prunes entries below 0.01 after 49 steps, so 64 never drops one), and a
-//! weight table laid out as the task asks ([`WeightTable`]).
+//! The tilings and trace capacity of every board ([`pada_core::profile`]:
+//! 16 tilings, the paper's reference configuration; a trace of at most 64
+//! entries, which the paper's γλ = 0.99·0.92 never fills), and a weight
+//! table laid out as the task asks ([`WeightTable`]).
 
 use crate::experiment::task::{TaskSpec, WeightTable};
 use pada_core::agent::Agent;
@@ -11,10 +11,7 @@ use pada_core::fixed::Q16;
 use pada_core::policy::{Policy, PolicyKind};
 use pada_core::tile_coding::{Layout, TileCoder};
 
-/// Tilings of the host's agents.
-pub const TILINGS: usize = 16;
-/// Trace capacity of the host's agents.
-pub const TRACE: usize = 64;
+pub use pada_core::profile::{TILINGS, TRACE};
 
 /// The agent the host runs: weights in a boxed slice.
 pub type HostAgent = Agent<Box<[Q16]>, TILINGS, TRACE>;
@@ -26,6 +23,7 @@ pub fn build_agent(spec: &TaskSpec, policy: PolicyKind) -> anyhow::Result<HostAg
     let err = |e: pada_core::error::ConfigError| anyhow::anyhow!("{e}");
     let (layout, size) = match spec.table {
         WeightTable::Hashed { log2_size } => (Layout::Hashed, 1usize << log2_size),
+        WeightTable::ExactOf { weights } => (Layout::Exact, weights),
         WeightTable::Exact => {
             // The exact size depends on the policy's state extension and
             // its learner actions: ask a coder built like the agent's.

@@ -8,7 +8,8 @@
 
 use pada_core::action_space::{ActionSpace, Output};
 use pada_core::agent::SarsaParams;
-use pada_core::tile_coding::StateDim;
+use pada_core::profile::{LearnerProfile, TableSize};
+use pada_core::tile_coding::{Layout, StateDim};
 use rand_core::RngCore;
 
 /// The result of one control period.
@@ -53,6 +54,12 @@ pub enum WeightTable {
     /// One weight per (tiling, tile, action), sized to fit exactly: no
     /// collisions, and small enough for the cache on low-dimensional tasks.
     Exact,
+    /// The exact layout in a table of a fixed size (a board's): a policy
+    /// whose exact table is larger does not build.
+    ExactOf {
+        /// Weights in the table.
+        weights: usize,
+    },
     /// A hashed table of `2^log2_size` weights (collisions allowed), for
     /// tasks with many state dimensions.
     Hashed {
@@ -95,6 +102,52 @@ pub struct TaskSpec {
     /// How [`Plant::gearbox_torques`] is obtained from the command, for
     /// reports.
     pub torque_note: &'static str,
+    /// The board learner profile the table follows, for the robots of
+    /// `pada_core::robot` (`None` for the simulated pendulum, which has no
+    /// board).
+    pub profile: Option<LearnerProfile>,
+}
+
+impl WeightTable {
+    /// The table a board's learner profile describes.
+    pub fn of_profile(profile: &LearnerProfile) -> WeightTable {
+        match (profile.layout, profile.size) {
+            (Layout::Exact, TableSize::FitExact) => WeightTable::Exact,
+            (Layout::Exact, TableSize::Weights(weights)) => WeightTable::ExactOf { weights },
+            // Hashed tables have a power-of-two size (checked by the tile
+            // coder); FitExact is an exact-layout size only.
+            (Layout::Hashed, TableSize::Weights(n)) => WeightTable::Hashed { log2_size: n.trailing_zeros() },
+            (Layout::Hashed, TableSize::FitExact) => WeightTable::Hashed { log2_size: 0 },
+        }
+    }
+}
+
+impl TaskSpec {
+    /// The task of a robot of `pada_core::robot` on a board's learner
+    /// `profile`: name, timing, state, motor, action tiles and learning
+    /// parameters from the robot's one definition, the table from the
+    /// profile. Defaults for the runner (learning time, trials) are the
+    /// caller's to set.
+    pub fn of_robot(profile: LearnerProfile, title: &'static str, torque_note: &'static str) -> TaskSpec {
+        let robot = profile.robot.spec();
+        TaskSpec {
+            name: robot.name(),
+            title,
+            control_period_s: robot.period_s(),
+            episode_steps: robot.episode_steps,
+            state: robot.state.to_vec(),
+            // The definitions are checked by pada-core's tests.
+            motor: robot.motor().expect("a robot definition's motor builds"),
+            table: WeightTable::of_profile(&profile),
+            action_tiles: robot.action_tiles.map(|w| w.to_vec()),
+            params: robot.params,
+            test_interval: robot.test_interval,
+            default_seconds: 1500.0,
+            default_trials: 8,
+            torque_note,
+            profile: Some(profile),
+        }
+    }
 }
 
 /// A learning task: its description and a factory of plants.

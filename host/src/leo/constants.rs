@@ -1,4 +1,6 @@
-//! Every number of the LEO model and of its walking task, in one place.
+//! Every number of the LEO model in one place; the walking task's numbers,
+//! shared with the firmware, come from `pada_core::robot::leo` (re-exported
+//! below).
 //!
 //! Each constant names the section of `shared/reference/grl-facts.md` it
 //! comes from (a clean-room restatement of GRL's `leoconfig.xml`,
@@ -19,14 +21,27 @@
 
 use pada_core::rx28;
 
+// The facts the walking task shares with the firmware live once, in
+// `pada_core::robot::leo` (joint limits, start pose, the task's constants);
+// they are re-exported here so the model reads them by the same names.
+pub use pada_core::robot::leo::{
+    ACTION_VOLTAGE_LIMIT, ANKLE_GAIN_SETPOINT, ANKLE_LIMITS, EPISODE_TIMEOUT_S as EPISODE_TIMEOUT, FALL_STANCE_THIGH_ANGLE,
+    FALL_TORSO_ANGLE, FOOTSTEP_MAX_LENGTH, HELD_VOLTAGE_LIMIT as AUTO_VOLTAGE_LIMIT, HIP_LIMITS, INIT_ARM_PITCH,
+    INIT_LEFT_LEG_PITCH, INIT_RIGHT_LEG_PITCH, INIT_TORSO_PITCH, JOINT_FILTER_HZ, KNEE_LIMITS, REWARD_ENERGY, REWARD_FALL,
+    REWARD_FOOTSTEP_DIST, REWARD_TIME, SHANK_LENGTH, SHOULDER_GAIN_SETPOINT, STANCE_KNEE_GAIN_SETPOINT, THIGH_LENGTH,
+    TORSO_FILTER_HZ,
+};
+
+/// Control period: 30 Hz, voltages held over it (§1.1, §3.6): the robot
+/// definition's 33 333 µs, the learner's period on the chip too.
+pub const CONTROL_PERIOD: f32 = pada_core::robot::leo::CONTROL_PERIOD_US as f32 * 1e-6;
+
 // ---------------------------------------------------------------------------
 // §1.1 World, integration, timing
 // ---------------------------------------------------------------------------
 
 /// Gravity in m/s², acting along −z (§1.1).
 pub const GRAVITY: f32 = 9.81;
-/// Control period: 30 Hz, voltages held over it (§1.1, §3.6).
-pub const CONTROL_PERIOD: f32 = 1.0 / 30.0;
 /// GRL's physics sub-steps per control period (1/5010 s, §1.1), for reference.
 pub const REFERENCE_SUBSTEPS: u32 = 167;
 
@@ -139,16 +154,10 @@ pub const TORSO_IYY: f32 = TORSO_RAW_IYY
 // §1.5 Joints: limits [rad] and soft stops (K [N m/rad], D [N m s/rad])
 // ---------------------------------------------------------------------------
 
-/// Hip limits, −45°…146° (§1.5).
-pub const HIP_LIMITS: [f32; 2] = [-0.785398, 2.548181];
 /// Hip stop spring and damper (§1.5).
 pub const HIP_STOP: [f32; 2] = [100.0, 10.0];
-/// Knee limits, −150°…+2° (§1.5).
-pub const KNEE_LIMITS: [f32; 2] = [-2.617994, 0.034907];
 /// Knee stop spring and damper (§1.5).
 pub const KNEE_STOP: [f32; 2] = [50.0, 5.0];
-/// Ankle limits, −90°…83° (§1.5).
-pub const ANKLE_LIMITS: [f32; 2] = [-1.570796, 1.448623];
 /// Ankle stop spring and damper (§1.5).
 pub const ANKLE_STOP: [f32; 2] = [100.0, 10.0];
 /// The shoulder has no limits (§1.5).
@@ -194,65 +203,12 @@ pub const FOAM_CONTACT: [f32; 2] = [1200.0, 40.0];
 // §1.8 Initial condition
 // ---------------------------------------------------------------------------
 
-/// Absolute torso pitch at the start (§1.8).
-pub const INIT_TORSO_PITCH: f32 = 0.10;
-/// Absolute arm pitch: torso + 15° (§1.8).
-pub const INIT_ARM_PITCH: f32 = 0.361799;
-/// Absolute pitches of the left thigh, shank and foot (§1.8).
-pub const INIT_LEFT_LEG_PITCH: [f32; 3] = [0.0, 0.0, 0.0];
-/// Absolute pitches of the right thigh, shank and foot (§1.8).
-pub const INIT_RIGHT_LEG_PITCH: [f32; 3] = [-0.72, 0.55, 0.55];
 /// The point of the left foot placed at the world origin: the bottom of the
 /// left heel wheel (§1.8).
 pub const INIT_LEFT_FOOT_POINT: [f32; 2] = [-0.0405, -0.013];
 /// Half-width C of the optional initial-pose randomisation (§1.8; off by
 /// default in every LEO configuration).
 pub const INIT_RANDOMIZATION: f32 = 0.0872639;
-
-// ---------------------------------------------------------------------------
-// §2.2 / §3 The walking task
-// ---------------------------------------------------------------------------
-
-/// Bound of the learned voltages, ±10.7 V (LW `maxvoltage`, §2.2, §3.4).
-pub const ACTION_VOLTAGE_LIMIT: f32 = 10.7;
-/// Clip of the auto-actuated joints, ≈ ±10.6919 V (§2.2, §3.5).
-pub const AUTO_VOLTAGE_LIMIT: f32 = rx28::LEO_MAX_VOLTAGE;
-
-/// Rate filter: servo joints, sampling 30 Hz, cut-off 10 Hz (§3.2).
-pub const JOINT_FILTER_HZ: [f32; 2] = [30.0, 10.0];
-/// Rate filter: torso, GRL passes the step time 1/30 where a sampling
-/// frequency is expected, cut-off 25 Hz (§3.2) — practically unfiltered.
-pub const TORSO_FILTER_HZ: [f32; 2] = [1.0 / 30.0, 25.0];
-
-/// Thigh length used for the ankle position (§3.3, §1.3 size constants).
-pub const THIGH_LENGTH: f32 = 0.116;
-/// Shank length used for the ankle position (§3.3).
-pub const SHANK_LENGTH: f32 = 0.1045;
-
-/// Shoulder P gain 5·14/3.3 V/rad and set-point −15° (§3.5).
-pub const SHOULDER_GAIN_SETPOINT: [f32; 2] = [5.0 * 14.0 / 3.3, -0.261799];
-/// Stance knee P gain 5·14/3.3 V/rad and set-point 0 (§3.5).
-pub const STANCE_KNEE_GAIN_SETPOINT: [f32; 2] = [5.0 * 14.0 / 3.3, 0.0];
-/// Ankle P gain 10·14/3.3 V/rad and set-point 3.72° (§3.5).
-pub const ANKLE_GAIN_SETPOINT: [f32; 2] = [10.0 * 14.0 / 3.3, 0.0649262];
-
-/// Reward per step (w_t, §3.7).
-pub const REWARD_TIME: f32 = -1.0;
-/// Reward per joule of motor work (w_E, §3.7).
-pub const REWARD_ENERGY: f32 = -3.0;
-/// Reward per metre of footstep-length change (w_c, §3.7).
-pub const REWARD_FOOTSTEP_DIST: f32 = 300.0;
-/// Footstep lengths are clipped to ±10.20 m (L_max, §3.7).
-pub const FOOTSTEP_MAX_LENGTH: f32 = 10.20;
-/// Reward of a fall (w_fall, §3.7).
-pub const REWARD_FALL: f32 = -125.0;
-
-/// Fall when the torso angle φ leaves ±1 rad (§3.8).
-pub const FALL_TORSO_ANGLE: f32 = 1.0;
-/// Fall when the stance thigh is more than 0.36π from vertical (§3.8).
-pub const FALL_STANCE_THIGH_ANGLE: f32 = 0.36 * core::f32::consts::PI;
-/// Episode timeout in simulated seconds after the first observation (§3.8).
-pub const EPISODE_TIMEOUT: f32 = 25.0;
 
 // ---------------------------------------------------------------------------
 // Blow-up guards (issue 4 "Bad input"): not from the reference.

@@ -9,8 +9,8 @@
 //!
 //! All facts come from `shared/reference/grl-facts.md` (sections cited in
 //! [`constants`]): [`model`] builds the rapier world (§1) with the servo
-//! model of [`pada_core::rx28`] (§2), [`task`] holds the walking task's
-//! rules (§3). The step size and solver settings, and the measurements
+//! model of [`pada_core::rx28`] (§2); the walking task's rules (§3) are the
+//! robot's one definition, [`pada_core::robot::leo`] (here as [`task`]). The step size and solver settings, and the measurements
 //! behind them, are in `README.md` next to this file.
 //!
 //! A simulation that blows up (NaN, a body far away, an absurd joint rate)
@@ -21,13 +21,16 @@ pub mod constants;
 pub mod gait;
 pub mod model;
 pub mod rl;
-pub mod task;
+/// The walking task's rules (§3): the robot's one definition in pada-core,
+/// shared with the firmware.
+pub use pada_core::robot::leo as task;
 
 use rand_core::RngCore;
 
 use constants::*;
 use model::{BlowUp, InitialPose, LeoModel, ModelError, ModelOptions, Snapshot, NUM_JOINTS};
-use task::{Leg, Observation, RateFilter, StanceTracker, ACTION_DIM};
+use pada_core::robot::filter::RateFilter;
+use task::{joint_rate_filter, torso_rate_filter, Leg, Observation, StanceTracker, ACTION_DIM};
 
 /// Configuration of the LEO walking environment.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -175,8 +178,8 @@ impl LeoEnv {
             config,
             model,
             settled,
-            joint_filters: [RateFilter::joint(); NUM_JOINTS],
-            torso_filter: RateFilter::torso(),
+            joint_filters: [joint_rate_filter(); NUM_JOINTS],
+            torso_filter: torso_rate_filter(),
             filtered: [0.0; NUM_JOINTS],
             stance: StanceTracker::new(),
             obs: Observation([0.0; task::OBS_DIM]),
@@ -264,8 +267,8 @@ impl LeoEnv {
     /// Clears the task's state for a new episode.
     fn begin_episode(&mut self) {
         self.episodes += 1;
-        self.joint_filters = [RateFilter::joint(); NUM_JOINTS];
-        self.torso_filter = RateFilter::torso();
+        self.joint_filters = [joint_rate_filter(); NUM_JOINTS];
+        self.torso_filter = torso_rate_filter();
         self.filtered = [0.0; NUM_JOINTS];
         self.stance = StanceTracker::new();
         self.time = 0.0;

@@ -68,39 +68,10 @@ pub enum Body {
 /// Number of bodies.
 pub const NUM_BODIES: usize = 8;
 
-/// The seven servo joints (§1.5). The index order is this crate's own; the
-/// task maps it to stance/swing (§3.3–3.4).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Joint {
-    /// Torso → arm.
-    Shoulder = 0,
-    /// Torso → left thigh.
-    HipLeft,
-    /// Torso → right thigh.
-    HipRight,
-    /// Left thigh → left shank.
-    KneeLeft,
-    /// Right thigh → right shank.
-    KneeRight,
-    /// Left shank → left foot.
-    AnkleLeft,
-    /// Right shank → right foot.
-    AnkleRight,
-}
-
-/// Number of servo joints.
-pub const NUM_JOINTS: usize = 7;
-
-/// All joints in index order.
-pub const JOINTS: [Joint; NUM_JOINTS] = [
-    Joint::Shoulder,
-    Joint::HipLeft,
-    Joint::HipRight,
-    Joint::KneeLeft,
-    Joint::KneeRight,
-    Joint::AnkleLeft,
-    Joint::AnkleRight,
-];
+/// The seven servo joints (§1.5), in the order of the robot's one
+/// definition (`pada_core::robot::leo`), which the firmware's servo table
+/// uses too.
+pub use pada_core::robot::leo::{Joint, JOINTS, NUM_JOINTS};
 
 /// Contact material (§1.7).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -193,6 +193,7 @@ impl SimulatedPendulumTask {
                 .expect("valid action space"),
             table: WeightTable::Exact,
             action_tiles: None,
+            profile: None,
             params: SarsaParams { init: WeightInit::Uniform { min: 0.0, max: 1.0 }, ..SarsaParams::default() },
             test_interval: 10,
             default_seconds: 3000.0,

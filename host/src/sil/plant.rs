@@ -156,27 +156,30 @@ impl Rig for PendulumRig {
 }
 
 /// A stand-in for LEO until its simulation drives the emulated bus: seven
-/// RX-28s (IDs 1–7) that hold the start pose of the firmware's LEO
-/// (`pada_firmware::leo`), the boom's encoder at the start pitch, the left
-/// foot on the ground. Nothing moves: it exercises the LEO image's control
-/// loop and agent (for the agent step's instruction count), not learning.
+/// RX-28s (IDs 1–7) that hold the start pose of LEO's definition
+/// (`pada_core::robot::leo::START_JOINT_ANGLES`), the boom's encoder at
+/// the start angle, the left foot on the ground. Nothing moves: it
+/// exercises the LEO image's control loop and agent (for the agent step's
+/// instruction count), not learning.
 #[derive(Debug, Clone)]
 pub struct LeoStandIn {
+    /// Present Position by servo ID − 1.
     positions: [u16; 7],
 }
 
 impl LeoStandIn {
-    /// Joint angles of the start pose (shoulder, hips R/L, knees R/L,
-    /// ankles R/L) \[rad\].
-    pub const START_POSE: [f64; 7] = [-0.261_799, 0.82, 0.10, -1.27, 0.0, 0.0, 0.0];
-    /// The boom angle of the start pitch (torso pitch −0.10 rad) \[rad\].
-    pub const BOOM_ANGLE: f64 = 0.10;
+    /// The boom angle of the start pose (torso angle φ = −0.10 rad) \[rad\].
+    pub const BOOM_ANGLE: f64 = -pada_core::robot::leo::START_PHI as f64;
 
     /// The robot in its start pose.
     pub fn new() -> Self {
-        LeoStandIn {
-            positions: Self::START_POSE.map(position_raw),
+        let mut positions = [0; 7];
+        let hw = pada_firmware::config::hardware(pada_core::robot::Robot::Leo);
+        for (joint, servo) in hw.joints.iter().enumerate() {
+            let angle = pada_core::robot::leo::START_JOINT_ANGLES[joint] as f64;
+            positions[servo.id as usize - 1] = position_raw(angle);
         }
+        LeoStandIn { positions }
     }
 }
 

@@ -1,7 +1,7 @@
 //! The bit-for-bit check: the observations and rewards the firmware
 //! reported, replayed through the host build of the same agent (the
-//! firmware's own configuration from `pada_firmware::config`, the same
-//! policy and seed), must give the same action at every step and the same
+//! robot's definition and the board's learner profile from pada-core, the
+//! same policy and seed), must give the same action at every step and the same
 //! weight checksum at every episode's end.
 //!
 //! The firmware's agent draws from its generator only in the agent calls
@@ -15,7 +15,7 @@ use pada_core::agent::{EpisodeEnd, Mode};
 use pada_core::fixed::Q16;
 use pada_core::policy::PolicyKind;
 use pada_core::wire::{Episode, RunMode, Step, StepKind};
-use pada_firmware::config::{Robot, WEIGHTS};
+use pada_core::profile::{LearnerProfile, TILINGS, TRACE};
 use rand_core::SeedableRng;
 use rand_pcg::Pcg32;
 use serde::Serialize;
@@ -54,12 +54,16 @@ pub struct ReplayReport {
     pub identical: bool,
 }
 
-/// Replays `records` through a fresh host agent for `robot` with `policy`
-/// and `seed`.
-pub fn replay(robot: Robot, policy: PolicyKind, seed: u64, records: &[Record]) -> ReplayReport {
+/// Replays `records` through a fresh host agent of the board's learner
+/// `profile` with `policy` and `seed`.
+pub fn replay(profile: &LearnerProfile, policy: PolicyKind, seed: u64, records: &[Record]) -> ReplayReport {
     let mut report = ReplayReport::default();
-    let table = vec![Q16::ZERO; WEIGHTS].into_boxed_slice();
-    let agent = robot.agent(policy, table);
+    let Some(weights) = profile.weights() else {
+        report.error = Some(format!("board profile {} has no fixed table size", profile.board.name()));
+        return report;
+    };
+    let table = vec![Q16::ZERO; weights].into_boxed_slice();
+    let agent = profile.robot.spec().agent::<_, TILINGS, TRACE>(policy, profile.layout, table);
     let mut agent = match agent {
         Ok(a) => a,
         Err(e) => {

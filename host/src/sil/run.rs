@@ -35,6 +35,7 @@ use pada_core::policy::PolicyKind;
 use pada_core::wire::{
     self, Decoded, FrameEncoder, LinkStats, RunMode, StepKind, ToChip, ToHost, MAX_FRAME_LEN,
 };
+use pada_core::profile::{Board, LearnerProfile};
 use pada_firmware::config::{Robot, DEFAULT_SEED};
 use pada_firmware::sil::{
     FromBoard, ToBoard, CALIBRATION_INSTRUCTIONS, CLOCK_FRAME_LEN, CLOCK_PROTOCOL, NEVER,
@@ -54,8 +55,8 @@ pub const LEARNING_CHECK_S: f64 = 300.0;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
 pub enum SilTask {
-    /// The physical pendulum at 33 Hz (firmware robot `pendulum-33hz`)
-    /// against the host's model of it.
+    /// The physical pendulum at 33 Hz (robot `physical-pendulum`) against
+    /// the host's model of it.
     Pendulum,
     /// LEO (firmware robot `leo`) against a stand-in that holds its start
     /// pose (instruction counts, not learning).
@@ -69,6 +70,12 @@ impl SilTask {
             SilTask::Pendulum => Robot::Pendulum33,
             SilTask::Leo => Robot::Leo,
         }
+    }
+
+    /// The learner profile of the emulated board: QEMU's netduinoplus2 is
+    /// an STM32F405.
+    pub fn profile(self) -> LearnerProfile {
+        Board::F405.profile(self.robot())
     }
 
     fn rig(self) -> Box<dyn Rig> {
@@ -371,7 +378,7 @@ pub fn run(cfg: &SilConfig) -> anyhow::Result<SilSummary> {
         tele_out: 0,
         replies: Vec::new(),
         commands: Vec::new(),
-        period_us: cfg.task.robot().config().period_us as u64,
+        period_us: cfg.task.robot().spec().period_us as u64,
         phase: Phase::FirstTest,
         learning_steps: 0,
         learning_episodes: 0,
@@ -736,7 +743,7 @@ impl Session<'_> {
         let cfg = self.cfg;
         let returns: Vec<f64> = self.curve.iter().map(|p| p.test_return).collect();
         let times: Vec<f64> = self.curve.iter().map(|p| p.learning_time_s).collect();
-        let replay = replay(cfg.task.robot(), cfg.policy, DEFAULT_SEED, &self.records);
+        let replay = replay(&cfg.task.profile(), cfg.policy, DEFAULT_SEED, &self.records);
         let period_ms = self.period_us as f64 * 1e-3;
         let mut faults = Vec::new();
         let mut explained = vec![false; self.fault_reports.len()];

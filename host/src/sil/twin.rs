@@ -20,8 +20,10 @@ use pada_core::dynamixel::table;
 use pada_core::fixed::Q16;
 use pada_core::policy::PolicyKind;
 use pada_core::wire::{RunMode, ToChip};
-use pada_firmware::config::{Robot, WEIGHTS};
+use pada_core::profile::Board;
+use pada_firmware::config::Robot;
 use pada_firmware::control::{Controller, PeriodOutput, Readings};
+use pada_firmware::pendulum::Pendulum33;
 use pada_firmware::io::CycleCounter;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -64,7 +66,7 @@ pub struct TwinReport {
     pub end_performance_max: Option<f64>,
 }
 
-fn start(ctl: &mut Controller<Box<[Q16]>>, mode: RunMode) -> anyhow::Result<()> {
+fn start(ctl: &mut Controller<Box<[Q16]>, Pendulum33>, mode: RunMode) -> anyhow::Result<()> {
     ctl.command(&ToChip::Start(mode))
         .0
         .map_err(|e| anyhow::anyhow!("Start refused: {e:?}"))
@@ -81,12 +83,13 @@ impl CycleCounter for NoCycles {
 /// The firmware's pendulum controller with `policy` and `seed` on the host,
 /// to `seconds` of learning.
 pub fn twin_run(policy: PolicyKind, seed: u64, seconds: f64) -> anyhow::Result<TwinRun> {
-    let robot = Robot::Pendulum33;
-    let period = robot.config().period_us as u64;
-    let mut ctl = Controller::new(
-        robot,
+    let profile = Board::F405.profile(Robot::Pendulum33);
+    let period = Robot::Pendulum33.spec().period_us as u64;
+    let weights = profile.weights().unwrap_or(0);
+    let mut ctl = Controller::<_, Pendulum33>::new(
+        profile,
         PolicyKind::Sarsa,
-        vec![Q16::ZERO; WEIGHTS].into_boxed_slice(),
+        vec![Q16::ZERO; weights].into_boxed_slice(),
         seed,
     )
     .map_err(|e| anyhow::anyhow!("{e}"))?;

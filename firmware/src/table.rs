@@ -1,0 +1,124 @@
+//! The image's learner: the robot chosen at build time, the board's learner
+//! profile for it (`pada_core::profile`), and the weight table where that
+//! profile puts it.
+//!
+//! | board (cargo feature) | pendulum | LEO |
+//! |---|---|---|
+//! | F405/F407, and QEMU's netduinoplus2 (`stm32f405`, `stm32f407`, `qemu`) | exact table: all 64 KiB of CCM, then 33.5 KiB of SRAM (`Split`) | 2^14 weights in CCM |
+//!
+//! The statics are NOLOAD (CCM) or `.uninit` (SRAM): the startup code
+//! leaves them alone; [`take`] zeroes them once and the controller then
+//! initialises every weight from its seed.
+
+use core::mem::MaybeUninit;
+use pada_core::fixed::Q16;
+use pada_core::profile::{Board, LearnerProfile, Memory};
+use pada_firmware::robot::RobotAdapter;
+
+/// The robot this image drives (cargo features `robot-leo`,
+/// `robot-pendulum-20hz`; the 33 Hz pendulum otherwise).
+#[cfg(feature = "robot-leo")]
+pub type ThisRobot = pada_firmware::leo::Leo;
+/// The robot this image drives.
+#[cfg(all(feature = "robot-pendulum-20hz", not(feature = "robot-leo")))]
+pub type ThisRobot = pada_firmware::pendulum::Pendulum20;
+/// The robot this image drives.
+#[cfg(not(any(feature = "robot-leo", feature = "robot-pendulum-20hz")))]
+pub type ThisRobot = pada_firmware::pendulum::Pendulum33;
+
+/// The board's learner profile: F405-class chips (and their emulation).
+pub const BOARD: Board = Board::F405;
+
+/// The learner of this image.
+pub const PROFILE: LearnerProfile = BOARD.profile(ThisRobot::ROBOT);
+
+/// Weights in the table.
+pub const WEIGHTS: usize = match PROFILE.weights() {
+    Some(n) => n,
+    None => panic!("a chip's profile has a fixed table size"),
+};
+
+/// A zeroed `&'static mut` array from a static `MaybeUninit` (all-zero bits
+/// are valid `Q16`s). The caller takes each static once.
+///
+/// # Safety
+/// `cell` must not be referenced anywhere else.
+unsafe fn zeroed<const N: usize>(cell: *mut MaybeUninit<[Q16; N]>) -> &'static mut [Q16; N] {
+    // SAFETY: the caller's guarantee makes the reference unique; the
+    // memory is zeroed before it is made.
+    unsafe {
+        (*cell).as_mut_ptr().cast::<Q16>().write_bytes(0, N);
+        (*cell).assume_init_mut()
+    }
+}
+
+/// Guards [`take`]: a second call panics, so every `&'static mut` is unique.
+static TAKEN: static_cell::StaticCell<()> = static_cell::StaticCell::new();
+
+// ---------------------------------------------------------------------------
+// The pendulum on an F405: all of CCM, then the rest in SRAM.
+// ---------------------------------------------------------------------------
+
+#[cfg(not(feature = "robot-leo"))]
+mod layout {
+    use super::*;
+    use pada_core::weights::Split;
+
+    const CCM: usize = match PROFILE.memory {
+        Memory::CcmThenSram { ccm_weights } => ccm_weights,
+        _ => panic!("the F405's pendulum table is split over CCM and SRAM"),
+    };
+    const REST: usize = WEIGHTS - CCM;
+
+    #[link_section = ".ccmram"]
+    static mut IN_CCM: MaybeUninit<[Q16; CCM]> = MaybeUninit::uninit();
+    #[link_section = ".uninit.pada_table"]
+    static mut IN_SRAM: MaybeUninit<[Q16; REST]> = MaybeUninit::uninit();
+
+    /// The table.
+    pub type Table = Split<&'static mut [Q16; CCM], &'static mut [Q16; REST]>;
+
+    pub fn take() -> Table {
+        TAKEN.init(());
+        // SAFETY: reached once (TAKEN), and nothing else names the statics.
+        unsafe {
+            Split {
+                first: zeroed(core::ptr::addr_of_mut!(IN_CCM)),
+                second: zeroed(core::ptr::addr_of_mut!(IN_SRAM)),
+            }
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// LEO on an F405: the 64 KiB of CCM.
+// ---------------------------------------------------------------------------
+
+#[cfg(feature = "robot-leo")]
+mod layout {
+    use super::*;
+
+    const _: () = assert!(matches!(PROFILE.memory, Memory::Ccm), "the F405's LEO table is in CCM");
+
+    #[link_section = ".ccmram"]
+    static mut IN_CCM: MaybeUninit<[Q16; WEIGHTS]> = MaybeUninit::uninit();
+
+    /// The table.
+    pub type Table = &'static mut [Q16; WEIGHTS];
+
+    pub fn take() -> Table {
+        TAKEN.init(());
+        // SAFETY: reached once (TAKEN), and nothing else names the static.
+        unsafe { zeroed(core::ptr::addr_of_mut!(IN_CCM)) }
+    }
+}
+
+pub use layout::Table;
+
+/// The weight table, zeroed; once (a second call panics).
+pub fn take() -> Table {
+    layout::take()
+}
+
+/// The controller of this image.
+pub type Ctl = pada_firmware::control::Controller<Table, ThisRobot>;

@@ -1,0 +1,265 @@
+//! Board learner profiles: a board's memory decides its learner.
+//!
+//! The learning task is the robot's ([`crate::robot`]); how much it can
+//! remember is the board's. A [`LearnerProfile`] fixes, for one board and
+//! one robot, the weight table's layout and size, the weight format and the
+//! memory the table lives in. The firmware sizes its tables from it at
+//! compile time, and the host runs the same profile (`pada run --board`),
+//! so a user sees what a board will learn before flashing it.
+//!
+//! | board | memory for the table | pendulum | LEO |
+//! |---|---|---|---|
+//! | `f405` | 64 KB CCM + 128 KB SRAM (STM32F405) | exact, 24 960 Q16 weights (CCM, then SRAM) | hashed, see [`Board::profile`] |
+//! | `f429-sdram` | 8 MB SDRAM on the FMC (STM32F429I-DISC1) | exact, in SRAM | hashed, 2^21 Q16 weights (8 MiB) |
+//! | `host` | the heap | exact, as large as the policy needs | hashed, 2^22 Q16 weights (16 MiB) |
+//!
+//! [`config_hash`] covers the profile: a checkpoint saved under one
+//! profile is refused by another.
+
+use crate::agent::Agent;
+use crate::checkpoint::ConfigHasher;
+use crate::robot::Robot;
+use crate::tile_coding::Layout;
+use crate::trace::TraceKind;
+use crate::weights::{WeightFormat, WeightStore};
+
+/// Tilings of every board's tile coder: the paper's reference
+/// configuration (GRL, grl-facts §4 and §5).
+pub const TILINGS: usize = 16;
+/// Capacity of every board's eligibility trace, in (state, action) entries:
+/// LEO's γλ = 0.9962 · 0.8582 keeps 30 entries above 0.01, the paper's
+/// pendulum γλ = 0.99 · 0.92 keeps 49.
+pub const TRACE: usize = 64;
+
+/// A board the learner runs on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Board {
+    /// An STM32F405 (or F407): 128 KB SRAM and 64 KB CCM on the chip.
+    F405,
+    /// An STM32F429I-DISC1-class board: the F429's 192 KB SRAM and 64 KB
+    /// CCM plus 8 MB of SDRAM on the FMC, for LEO's table.
+    F429Sdram,
+    /// The host: the table on the heap, as large as the task wants.
+    Host,
+}
+
+impl Board {
+    /// Every board.
+    pub const ALL: [Board; 3] = [Board::F405, Board::F429Sdram, Board::Host];
+
+    /// The name the command line and the configuration hash use.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Board::F405 => "f405",
+            Board::F429Sdram => "f429-sdram",
+            Board::Host => "host",
+        }
+    }
+
+    /// The board with this [`name`](Self::name).
+    pub fn from_name(name: &str) -> Option<Board> {
+        Board::ALL.into_iter().find(|b| b.name() == name)
+    }
+
+    /// What the board is, for reports.
+    pub const fn description(self) -> &'static str {
+        match self {
+            Board::F405 => "STM32F405: 128 KB SRAM + 64 KB CCM on the chip",
+            Board::F429Sdram => "STM32F429I-DISC1: 192 KB SRAM + 64 KB CCM, 8 MB SDRAM on the FMC",
+            Board::Host => "the host: tables on the heap",
+        }
+    }
+
+    /// This board's learner for `robot`.
+    pub const fn profile(self, robot: Robot) -> LearnerProfile {
+        let pendulum = matches!(robot, Robot::Pendulum33 | Robot::Pendulum20);
+        let (layout, size, format, memory) = match (self, pendulum) {
+            // The pendulum's exact table (20 × 26 tiles × 16 tilings × 3
+            // actions) is 97.5 KB: all 64 KB of CCM and 33.5 KB of SRAM.
+            (Board::F405, true) => (
+                Layout::Exact,
+                TableSize::Weights(PENDULUM_EXACT_WEIGHTS),
+                WeightFormat::Q16,
+                Memory::CcmThenSram { ccm_weights: CCM_BYTES / 4 },
+            ),
+            // LEO in the 64 KB of CCM, hashed: 2^14 Q16 weights.
+            (Board::F405, false) => (Layout::Hashed, TableSize::Weights(1 << 14), WeightFormat::Q16, Memory::Ccm),
+            (Board::F429Sdram, true) => {
+                (Layout::Exact, TableSize::Weights(PENDULUM_EXACT_WEIGHTS), WeightFormat::Q16, Memory::Sram)
+            }
+            // All 8 MiB of the SDRAM: 2^21 Q16 weights.
+            (Board::F429Sdram, false) => {
+                (Layout::Hashed, TableSize::Weights(1 << 21), WeightFormat::Q16, Memory::Sdram)
+            }
+            (Board::Host, true) => (Layout::Exact, TableSize::FitExact, WeightFormat::Q16, Memory::Heap),
+            // GRL used 2^24; 2^22 (16 MiB per agent) keeps two parallel
+            // trials small while a 14 666 s trial (4.4·10^5 steps × 16
+            // tilings) touches far fewer tiles than the table has slots.
+            (Board::Host, false) => (Layout::Hashed, TableSize::Weights(1 << 22), WeightFormat::Q16, Memory::Heap),
+        };
+        LearnerProfile { board: self, robot, layout, size, format, memory }
+    }
+}
+
+/// Bytes of the F405's core-coupled RAM.
+pub const CCM_BYTES: usize = 64 * 1024;
+/// Weights of the physical pendulum's exact table with SARSA, the low-pass
+/// filter, the integrator or PADA: 20 angle tiles × 26 velocity tiles ×
+/// 16 tilings × 3 actions (the Markov variants add a state dimension and
+/// need 4× more).
+pub const PENDULUM_EXACT_WEIGHTS: usize = 24_960;
+
+/// How many weights a table has.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum TableSize {
+    /// A fixed number (the chip's tables are sized at compile time).
+    Weights(usize),
+    /// Exactly what the exact layout needs for the policy (host only).
+    FitExact,
+}
+
+/// The memory a board keeps its table in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Memory {
+    /// Core-coupled RAM: zero wait states, no DMA.
+    Ccm,
+    /// The main SRAM.
+    Sram,
+    /// The first `ccm_weights` in CCM, the rest in SRAM
+    /// ([`crate::weights::Split`]).
+    CcmThenSram {
+        /// Weights in CCM.
+        ccm_weights: usize,
+    },
+    /// External SDRAM on the FMC.
+    Sdram,
+    /// The host's heap.
+    Heap,
+}
+
+impl Memory {
+    /// The name for reports.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Memory::Ccm => "CCM",
+            Memory::Sram => "SRAM",
+            Memory::CcmThenSram { .. } => "CCM + SRAM",
+            Memory::Sdram => "SDRAM",
+            Memory::Heap => "heap",
+        }
+    }
+}
+
+/// One board's learner for one robot.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LearnerProfile {
+    /// The board.
+    pub board: Board,
+    /// The robot.
+    pub robot: Robot,
+    /// How features map to weights.
+    pub layout: Layout,
+    /// How many weights.
+    pub size: TableSize,
+    /// How each weight is stored.
+    pub format: WeightFormat,
+    /// Where the table lives.
+    pub memory: Memory,
+}
+
+impl LearnerProfile {
+    /// The table's length when it is fixed (every chip's), else `None`.
+    pub const fn weights(&self) -> Option<usize> {
+        match self.size {
+            TableSize::Weights(n) => Some(n),
+            TableSize::FitExact => None,
+        }
+    }
+
+    /// The table's bytes when its length is fixed.
+    pub const fn table_bytes(&self) -> Option<usize> {
+        match self.weights() {
+            Some(n) => Some(n * self.format.bytes()),
+            None => None,
+        }
+    }
+}
+
+/// Version of what [`config_hash`] covers; bump when its meaning changes.
+pub const CONFIG_HASH_VERSION: u32 = 2;
+
+/// The hash of everything that gives a learner's weights their meaning
+/// (FNV-1a, stored in checkpoints and sent in `Hello`): the robot, the
+/// board's profile (its name, layout, table size, weight format), and what
+/// the built agent knows of itself ([`Agent::write_config`]: the tile
+/// coder's dimensions as prepared, tilings, trace capacity, the learner's
+/// actions and their tiles, α, γ, λ and the trace settings).
+///
+/// Computed from the agent itself, so two programs that build their
+/// learner differently (the host's runner, the firmware) get the same hash
+/// only if the learners are the same. Policies that share the learner's
+/// layout share the hash (PADA switches to SARSA on the same weights,
+/// Section VIII); ε and the initialisation are left out.
+pub fn config_hash<W: WeightStore, const TILINGS_: usize, const TRACE_: usize>(
+    profile: &LearnerProfile,
+    agent: &Agent<W, TILINGS_, TRACE_>,
+) -> u32 {
+    let mut h = ConfigHasher::new();
+    h.write_u32(CONFIG_HASH_VERSION)
+        .write_str(profile.robot.name())
+        .write_str(profile.board.name())
+        .write_u32(layout_code(profile.layout))
+        .write_u32(agent.weights().len() as u32)
+        .write_u32(agent.weights().format().code());
+    agent.write_config(&mut h);
+    h.finish()
+}
+
+/// A stable number of a layout.
+pub const fn layout_code(layout: Layout) -> u32 {
+    match layout {
+        Layout::Hashed => 1,
+        Layout::Exact => 2,
+    }
+}
+
+/// A stable number of a trace kind.
+pub const fn trace_kind_code(kind: TraceKind) -> u32 {
+    match kind {
+        TraceKind::Replacing => 1,
+        TraceKind::Accumulating => 2,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chip_tables_fit_their_memory() {
+        for robot in Robot::ALL {
+            let p = Board::F405.profile(robot);
+            let bytes = p.table_bytes().unwrap();
+            match p.memory {
+                Memory::Ccm => assert!(bytes <= CCM_BYTES, "{robot:?}"),
+                Memory::CcmThenSram { ccm_weights } => {
+                    assert!(ccm_weights * p.format.bytes() <= CCM_BYTES);
+                    // The rest must leave most of the 128 KB SRAM to the
+                    // firmware's stack, buffers and executor.
+                    assert!(bytes - ccm_weights * p.format.bytes() <= 48 * 1024, "{robot:?}");
+                }
+                m => panic!("{robot:?}: {m:?} on an F405"),
+            }
+            let p = Board::F429Sdram.profile(robot);
+            assert!(p.table_bytes().unwrap() <= 8 * 1024 * 1024);
+        }
+        assert_eq!(Board::F429Sdram.profile(Robot::Leo).table_bytes(), Some(8 * 1024 * 1024));
+        for b in Board::ALL {
+            assert_eq!(Board::from_name(b.name()), Some(b));
+        }
+    }
+}

@@ -1,0 +1,630 @@
+//! LEO, the Delft biped on its boom, walking (Section VIII), defined once:
+//! the facts of `grl-facts.md` §1.3–1.8 the task needs and the walking task
+//! of §3. The rapier3d simulation (`host/src/leo/`) produces these
+//! quantities from physics; the firmware (`firmware/src/leo.rs`) from servo
+//! positions, the boom's encoder and the foot switches. Both then apply the
+//! same rules, so the chip's learner sees what the simulated learner sees.
+//!
+//! - Joints in [`Joint`] order (shoulder, hip L/R, knee L/R, ankle L/R);
+//!   hinge angles follow ODE, `q = θ_parent − θ_child` (§1.2).
+//! - Rates through GRL's Butterworth filter ([`joint_rate_filter`],
+//!   [`torso_rate_filter`], §3.2).
+//! - Stance leg from the feet, footsteps and the step length L
+//!   ([`StanceTracker`], §3.3); the mirrored observation ([`observe`],
+//!   §3.4).
+//! - The learned voltages drive stance hip, swing hip and swing knee
+//!   ([`learned_joints`]); the others are held by P laws ([`held_voltages`],
+//!   §3.5).
+//! - Reward `−1 − 3·E + 300·(L − L_prev) − 125·[fall]` ([`reward`],
+//!   [`step_energy`], §3.7); a fall is absorbing ([`is_fall`], §3.8).
+
+use super::filter::RateFilter;
+use super::{MotorLevels, Robot, RobotSpec};
+use crate::agent::{SarsaParams, WeightInit};
+use crate::rx28::{Rx28, LEO_MAX_VOLTAGE};
+use crate::tile_coding::StateDim;
+use crate::trace::TraceKind;
+use core::f32::consts::{FRAC_PI_2, PI};
+
+// ---------------------------------------------------------------------------
+// The robot (grl-facts §1)
+// ---------------------------------------------------------------------------
+
+/// The seven servo joints (§1.5), in this order everywhere: the
+/// simulation's joint arrays and the firmware's servo table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Joint {
+    /// Torso → arm.
+    Shoulder = 0,
+    /// Torso → left thigh.
+    HipLeft,
+    /// Torso → right thigh.
+    HipRight,
+    /// Left thigh → left shank.
+    KneeLeft,
+    /// Right thigh → right shank.
+    KneeRight,
+    /// Left shank → left foot.
+    AnkleLeft,
+    /// Right shank → right foot.
+    AnkleRight,
+}
+
+/// Number of servo joints.
+pub const NUM_JOINTS: usize = 7;
+
+/// All joints in index order.
+pub const JOINTS: [Joint; NUM_JOINTS] = [
+    Joint::Shoulder,
+    Joint::HipLeft,
+    Joint::HipRight,
+    Joint::KneeLeft,
+    Joint::KneeRight,
+    Joint::AnkleLeft,
+    Joint::AnkleRight,
+];
+
+/// The leg that carries the robot (§3.3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Leg {
+    /// Left leg.
+    Left,
+    /// Right leg.
+    Right,
+}
+
+impl Leg {
+    /// The other leg.
+    pub fn other(self) -> Leg {
+        match self {
+            Leg::Left => Leg::Right,
+            Leg::Right => Leg::Left,
+        }
+    }
+    /// This leg's hip.
+    pub fn hip(self) -> Joint {
+        match self {
+            Leg::Left => Joint::HipLeft,
+            Leg::Right => Joint::HipRight,
+        }
+    }
+    /// This leg's knee.
+    pub fn knee(self) -> Joint {
+        match self {
+            Leg::Left => Joint::KneeLeft,
+            Leg::Right => Joint::KneeRight,
+        }
+    }
+}
+
+/// Hip limits, −45°…146° (§1.5) \[rad\].
+pub const HIP_LIMITS: [f32; 2] = [-0.785398, 2.548181];
+/// Knee limits, −150°…+2° (§1.5) \[rad\].
+pub const KNEE_LIMITS: [f32; 2] = [-2.617994, 0.034907];
+/// Ankle limits, −90°…83° (§1.5) \[rad\].
+pub const ANKLE_LIMITS: [f32; 2] = [-1.570796, 1.448623];
+
+/// The joint's stops (§1.5); the shoulder has none.
+pub fn joint_limits(joint: Joint) -> Option<[f32; 2]> {
+    match joint {
+        Joint::Shoulder => None,
+        Joint::HipLeft | Joint::HipRight => Some(HIP_LIMITS),
+        Joint::KneeLeft | Joint::KneeRight => Some(KNEE_LIMITS),
+        Joint::AnkleLeft | Joint::AnkleRight => Some(ANKLE_LIMITS),
+    }
+}
+
+/// Absolute torso pitch at the start (§1.8) \[rad\].
+pub const INIT_TORSO_PITCH: f32 = 0.10;
+/// Absolute arm pitch at the start: torso + 15° (§1.8) \[rad\].
+pub const INIT_ARM_PITCH: f32 = 0.361799;
+/// Absolute pitches of the left thigh, shank and foot at the start (§1.8).
+pub const INIT_LEFT_LEG_PITCH: [f32; 3] = [0.0, 0.0, 0.0];
+/// Absolute pitches of the right thigh, shank and foot at the start (§1.8).
+pub const INIT_RIGHT_LEG_PITCH: [f32; 3] = [-0.72, 0.55, 0.55];
+
+/// The joint angles of the start pose (§1.8), `q = θ_parent − θ_child`:
+/// shoulder −0.2618, hips 0.10 (L) and 0.82 (R), knees 0 (L) and −1.27
+/// (R), ankles 0.
+pub const START_JOINT_ANGLES: [f32; NUM_JOINTS] = [
+    INIT_TORSO_PITCH - INIT_ARM_PITCH,
+    INIT_TORSO_PITCH - INIT_LEFT_LEG_PITCH[0],
+    INIT_TORSO_PITCH - INIT_RIGHT_LEG_PITCH[0],
+    INIT_LEFT_LEG_PITCH[0] - INIT_LEFT_LEG_PITCH[1],
+    INIT_RIGHT_LEG_PITCH[0] - INIT_RIGHT_LEG_PITCH[1],
+    INIT_LEFT_LEG_PITCH[1] - INIT_LEFT_LEG_PITCH[2],
+    INIT_RIGHT_LEG_PITCH[1] - INIT_RIGHT_LEG_PITCH[2],
+];
+
+/// The torso angle φ of the start pose: φ is minus the torso's pitch
+/// (§3.1), so −0.10 rad.
+pub const START_PHI: f32 = -INIT_TORSO_PITCH;
+
+/// Thigh length used for the ankle position (§3.3) \[m\].
+pub const THIGH_LENGTH: f32 = 0.116;
+/// Shank length used for the ankle position (§3.3) \[m\].
+pub const SHANK_LENGTH: f32 = 0.1045;
+
+// ---------------------------------------------------------------------------
+// The walking task (grl-facts §2.2, §3)
+// ---------------------------------------------------------------------------
+
+/// Control period: 30 Hz (§1.1, §3.6) \[µs\].
+pub const CONTROL_PERIOD_US: u32 = 33_333;
+/// Control steps of an episode: 25 s at 30 Hz (§3.8).
+pub const EPISODE_STEPS: u32 = 750;
+/// Episode timeout after the first observation (§3.8) \[s\].
+pub const EPISODE_TIMEOUT_S: f32 = 25.0;
+/// Number of observation dimensions (§3.4).
+pub const OBS_DIM: usize = 10;
+/// Number of learned action dimensions (§3.4).
+pub const ACTION_DIM: usize = 3;
+/// Voltage levels per learned joint (§3.9).
+pub const ACTION_LEVELS: u8 = 7;
+/// Bound of the learned voltages, ±10.7 V (LW `maxvoltage`, §2.2, §3.4).
+pub const ACTION_VOLTAGE_LIMIT: f32 = 10.7;
+/// Tile width of each learned voltage \[V\]: GRL generalises over actions
+/// (`generalizeActions`, voltage scale 0.15 ↔ 6.67 V, §3.9), so
+/// neighbouring levels (3.57 V apart) share about half their tiles.
+pub const ACTION_TILE_WIDTH: f32 = 6.67;
+/// Clip of the held joints, ≈ ±10.6919 V (§2.2, §3.5).
+pub const HELD_VOLTAGE_LIMIT: f32 = LEO_MAX_VOLTAGE;
+/// Rate filter of the servo joints: sampling 30 Hz, cut-off 10 Hz (§3.2).
+pub const JOINT_FILTER_HZ: [f32; 2] = [30.0, 10.0];
+/// Rate filter of the torso: GRL passes the step time 1/30 where a sampling
+/// frequency belongs, cut-off 25 Hz (§3.2), which makes it practically a
+/// pass-through; kept so every learner sees what GRL's saw.
+pub const TORSO_FILTER_HZ: [f32; 2] = [1.0 / 30.0, 25.0];
+/// Shoulder P gain 5·14/3.3 V/rad and set point −15° (§3.5).
+pub const SHOULDER_GAIN_SETPOINT: [f32; 2] = [5.0 * 14.0 / 3.3, -0.261799];
+/// Stance knee P gain 5·14/3.3 V/rad and set point 0 (§3.5).
+pub const STANCE_KNEE_GAIN_SETPOINT: [f32; 2] = [5.0 * 14.0 / 3.3, 0.0];
+/// Ankle P gain 10·14/3.3 V/rad and set point 3.72° (§3.5).
+pub const ANKLE_GAIN_SETPOINT: [f32; 2] = [10.0 * 14.0 / 3.3, 0.0649262];
+/// Reward per step (w_t, §3.7).
+pub const REWARD_TIME: f32 = -1.0;
+/// Reward per joule of motor work (w_E, §3.7).
+pub const REWARD_ENERGY: f32 = -3.0;
+/// Reward per metre of footstep-length change (w_c, §3.7).
+pub const REWARD_FOOTSTEP_DIST: f32 = 300.0;
+/// Footstep lengths are clipped to ±10.20 m (L_max, §3.7).
+pub const FOOTSTEP_MAX_LENGTH: f32 = 10.20;
+/// Reward of a fall (w_fall, §3.7).
+pub const REWARD_FALL: f32 = -125.0;
+/// Fall when the torso angle φ leaves ±1 rad (§3.8).
+pub const FALL_TORSO_ANGLE: f32 = 1.0;
+/// Fall when the stance thigh is more than 0.36π from vertical (§3.8).
+pub const FALL_STANCE_THIGH_ANGLE: f32 = 0.36 * PI;
+
+/// The 10 observation dimensions (§3.4 order) with GRL's tile widths
+/// (`cfg/leosim/sarsa.yaml`, §3.9): torso 0.14 rad and 5 rad/s, joints
+/// 0.28 rad and 10 rad/s. The ranges only clamp: the torso ±π/2 (a fall
+/// at |φ| > 1 ends the episode first), its rate ±20 rad/s, joint angles ±π
+/// (the stops are inside), joint rates ±40 rad/s (about 7× the RX-28's
+/// no-load speed; a swing leg hit by the floor moves faster).
+pub const STATE: [StateDim; OBS_DIM] = {
+    const ANGLE: StateDim = StateDim { min: -PI, max: PI, tile_width: 0.28, wrap: false };
+    const RATE: StateDim = StateDim { min: -40.0, max: 40.0, tile_width: 10.0, wrap: false };
+    [
+        StateDim { min: -FRAC_PI_2, max: FRAC_PI_2, tile_width: 0.14, wrap: false },
+        StateDim { min: -20.0, max: 20.0, tile_width: 5.0, wrap: false },
+        ANGLE,
+        RATE,
+        ANGLE,
+        RATE,
+        ANGLE,
+        RATE,
+        ANGLE,
+        RATE,
+    ]
+};
+
+/// GRL's LEO learning parameters (§3.9, the per-step values of
+/// `leo_sim_sarsa_walk.yaml` and the Schuitema constants): α 0.2,
+/// γ 0.9962 (≈ 4 s horizon), λ 0.8582 (≈ 0.1 s), ε 0.05, replacing traces
+/// pruned at 0.01, weights U[0, 0.01].
+pub const PARAMS: SarsaParams = SarsaParams {
+    alpha: 0.2,
+    gamma: 0.9962,
+    lambda: 0.8582,
+    epsilon: 0.05,
+    trace_threshold: 0.01,
+    trace_kind: TraceKind::Replacing,
+    init: WeightInit::Uniform { min: 0.0, max: 0.01 },
+};
+
+/// LEO's learning task: 3 learned joints × 7 levels over ±10.7 V, the
+/// 10-D mirrored state, 25 s episodes at 30 Hz, a test run every 10
+/// learning episodes (Section VI).
+pub const SPEC: RobotSpec = RobotSpec {
+    robot: Robot::Leo,
+    period_us: CONTROL_PERIOD_US,
+    episode_steps: EPISODE_STEPS,
+    test_interval: 10,
+    state: &STATE,
+    motor_dims: ACTION_DIM as u8,
+    levels: MotorLevels::Uniform { min: -ACTION_VOLTAGE_LIMIT, max: ACTION_VOLTAGE_LIMIT, count: ACTION_LEVELS },
+    action_tiles: Some(&[ACTION_TILE_WIDTH; ACTION_DIM]),
+    params: PARAMS,
+};
+
+/// The 10-D mirrored observation (§3.4): φ, φ̇, q_hip,st, q̇_hip,st,
+/// q_hip,sw, q̇_hip,sw, q_knee,st, q̇_knee,st, q_knee,sw, q̇_knee,sw.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Observation(pub [f32; OBS_DIM]);
+
+/// The servo joints' rate filter: 30 Hz sampling, 10 Hz cut-off (§3.2).
+pub fn joint_rate_filter() -> RateFilter {
+    RateFilter::new(JOINT_FILTER_HZ[0], JOINT_FILTER_HZ[1])
+}
+
+/// The torso's rate filter as GRL configures it (§3.2).
+pub fn torso_rate_filter() -> RateFilter {
+    RateFilter::new(TORSO_FILTER_HZ[0], TORSO_FILTER_HZ[1])
+}
+
+/// Horizontal ankle position relative to the hip (§3.3):
+/// x_a = 0.116·sin(φ + q_hip) + 0.1045·sin(φ + q_hip + q_knee).
+pub fn ankle_x(phi: f32, q_hip: f32, q_knee: f32) -> f32 {
+    THIGH_LENGTH * libm::sinf(phi + q_hip) + SHANK_LENGTH * libm::sinf(phi + q_hip + q_knee)
+}
+
+/// What one stance update found (§3.3).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StanceUpdate {
+    /// Footstep length L after the update.
+    pub length: f32,
+    /// L_prev for the reward (sign kept continuous across stance switches).
+    pub previous_length: f32,
+    /// Whether the stance leg changed (a footstep).
+    pub footstep: bool,
+}
+
+/// The stance/swing state machine of §3.3 (BW `updateDerivedStateVars`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StanceTracker {
+    stance: Option<Leg>,
+    length: f32,
+    last_was_footstep: bool,
+    footsteps: i32,
+    walked: f32,
+}
+
+impl Default for StanceTracker {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl StanceTracker {
+    /// Unknown stance, no footsteps (episode start).
+    pub const fn new() -> Self {
+        StanceTracker { stance: None, length: 0.0, last_was_footstep: false, footsteps: 0, walked: 0.0 }
+    }
+
+    /// The current stance leg, `None` before the first update.
+    pub fn stance(&self) -> Option<Leg> {
+        self.stance
+    }
+
+    /// The stance leg; the start pose stands on the left leg (§1.8), so
+    /// that is the answer before any foot ever touched.
+    pub fn stance_or_left(&self) -> Leg {
+        self.stance.unwrap_or(Leg::Left)
+    }
+
+    /// Footstep count: +1 per forward step, −1 per backward step.
+    pub fn footsteps(&self) -> i32 {
+        self.footsteps
+    }
+
+    /// Walked distance: the sum of footstep lengths \[m\].
+    pub fn walked(&self) -> f32 {
+        self.walked
+    }
+
+    /// One update after a control step. `contact_left/right`: toe or heel
+    /// of that foot touches; `ankle_left/right`: [`ankle_x`] of each leg.
+    ///
+    /// - stance: only left touches → left; only right → right; neither →
+    ///   unchanged; both → the front foot (larger ankle x);
+    /// - L = x_a(swing) − x_a(stance) with the stance from *before* this
+    ///   update (unknown before the first update: L = x_L − x_R);
+    /// - a footstep is a stance change with a known previous stance:
+    ///   count ±1 by the sign of L, walked distance += L;
+    /// - L_prev = old L, negated if the previous update was a footstep.
+    pub fn update(
+        &mut self,
+        contact_left: bool,
+        contact_right: bool,
+        ankle_left: f32,
+        ankle_right: f32,
+    ) -> StanceUpdate {
+        let previous_length = if self.last_was_footstep { -self.length } else { self.length };
+        let before = self.stance;
+        let after = match (contact_left, contact_right) {
+            (true, false) => Some(Leg::Left),
+            (false, true) => Some(Leg::Right),
+            (false, false) => before,
+            (true, true) => Some(if ankle_left >= ankle_right { Leg::Left } else { Leg::Right }),
+        };
+        let x = |leg: Leg| match leg {
+            Leg::Left => ankle_left,
+            Leg::Right => ankle_right,
+        };
+        self.length = match before {
+            Some(st) => x(st.other()) - x(st),
+            None => ankle_left - ankle_right,
+        };
+        let footstep = before.is_some() && after != before;
+        if footstep {
+            self.footsteps += if self.length > 0.0 { 1 } else { -1 };
+            self.walked += self.length;
+        }
+        self.last_was_footstep = footstep;
+        self.stance = after;
+        StanceUpdate { length: self.length, previous_length, footstep }
+    }
+}
+
+/// Voltages of the held joints (§3.5), from the current joint angles and
+/// the stance leg, clipped to ±10.6919 V: shoulder, stance knee and both
+/// ankles, proportional only (GRL has no D term). Returns (joint, voltage)
+/// pairs.
+pub fn held_voltages(angles: &[f32; NUM_JOINTS], stance: Leg) -> [(Joint, f32); 4] {
+    let knee = stance.knee();
+    [
+        (Joint::Shoulder, hold(SHOULDER_GAIN_SETPOINT, angles[Joint::Shoulder as usize])),
+        (knee, hold(STANCE_KNEE_GAIN_SETPOINT, angles[knee as usize])),
+        (Joint::AnkleLeft, hold(ANKLE_GAIN_SETPOINT, angles[Joint::AnkleLeft as usize])),
+        (Joint::AnkleRight, hold(ANKLE_GAIN_SETPOINT, angles[Joint::AnkleRight as usize])),
+    ]
+}
+
+/// A P law `gain·(set point − q)` clipped to the held joints' limit.
+fn hold([gain, setpoint]: [f32; 2], q: f32) -> f32 {
+    (gain * (setpoint - q)).clamp(-HELD_VOLTAGE_LIMIT, HELD_VOLTAGE_LIMIT)
+}
+
+/// The P gain of `joint` when it is held [V/rad]: the ankles' (§3.5) for
+/// the ankles, the shoulder's and knees' for every other joint. The
+/// firmware holds every joint at the start pose with these between
+/// episodes, while a person sets LEO upright.
+pub fn hold_gain(joint: Joint) -> f32 {
+    match joint {
+        Joint::AnkleLeft | Joint::AnkleRight => ANKLE_GAIN_SETPOINT[0],
+        _ => SHOULDER_GAIN_SETPOINT[0],
+    }
+}
+
+/// Voltages that hold every joint at `targets` with [`hold_gain`], clipped
+/// to the held joints' limit.
+pub fn pose_voltages(angles: &[f32; NUM_JOINTS], targets: &[f32; NUM_JOINTS]) -> [f32; NUM_JOINTS] {
+    let mut u = [0.0; NUM_JOINTS];
+    for j in JOINTS {
+        let k = j as usize;
+        u[k] = hold([hold_gain(j), targets[k]], angles[k]);
+    }
+    u
+}
+
+/// The joints the three learned actions drive with this stance leg (§3.4):
+/// stance hip, swing hip, swing knee.
+pub fn learned_joints(stance: Leg) -> [Joint; ACTION_DIM] {
+    [stance.hip(), stance.other().hip(), stance.other().knee()]
+}
+
+/// All seven voltages for one control step (§3.6 step 1): the learned
+/// voltages (clipped to ±10.7 V; non-finite → 0 V) on the stance hip, swing
+/// hip and swing knee, the held joints' P laws on the rest.
+pub fn joint_voltages(action: [f32; ACTION_DIM], angles: &[f32; NUM_JOINTS], stance: Leg) -> [f32; NUM_JOINTS] {
+    let mut u = [0.0f32; NUM_JOINTS];
+    for (joint, v) in held_voltages(angles, stance) {
+        u[joint as usize] = v;
+    }
+    for (joint, v) in learned_joints(stance).into_iter().zip(action) {
+        u[joint as usize] = sanitize_action(v);
+    }
+    u
+}
+
+/// A learned voltage clipped to ±10.7 V; non-finite → 0 V.
+pub fn sanitize_action(v: f32) -> f32 {
+    if v.is_finite() {
+        v.clamp(-ACTION_VOLTAGE_LIMIT, ACTION_VOLTAGE_LIMIT)
+    } else {
+        0.0
+    }
+}
+
+/// Motor work of one control step (§3.7): Σ over both hips and both knees
+/// of max(0, U·I)·T with I = (U − k·G·ω̄)/R, ω̄ the mean of the previous
+/// and current filtered rate and T the control period.
+pub fn step_energy(
+    voltages: &[f32; NUM_JOINTS],
+    filtered_prev: &[f32; NUM_JOINTS],
+    filtered_now: &[f32; NUM_JOINTS],
+) -> f32 {
+    let servo = Rx28::LEO;
+    let period = CONTROL_PERIOD_US as f32 * 1e-6;
+    [Joint::HipLeft, Joint::HipRight, Joint::KneeLeft, Joint::KneeRight]
+        .iter()
+        .map(|&j| {
+            let k = j as usize;
+            let w = 0.5 * (filtered_prev[k] + filtered_now[k]);
+            let u = voltages[k];
+            (u * servo.current(u, w)).max(0.0) * period
+        })
+        .sum()
+}
+
+/// Reward of one step (§3.7): r = −1 − 3·E + 300·(clip(L) − clip(L_prev))
+/// − 125·\[fall\], lengths clipped to ±10.2 m.
+pub fn reward(energy: f32, update: &StanceUpdate, fall: bool) -> f32 {
+    let clip = |l: f32| l.clamp(-FOOTSTEP_MAX_LENGTH, FOOTSTEP_MAX_LENGTH);
+    REWARD_TIME
+        + REWARD_ENERGY * energy
+        + REWARD_FOOTSTEP_DIST * (clip(update.length) - clip(update.previous_length))
+        + if fall { REWARD_FALL } else { 0.0 }
+}
+
+/// "Doomed to fall" (§3.8): φ outside ±1 rad, or the stance thigh more than
+/// 0.36π from vertical (|φ + q_hip,st|); a NaN is a fall.
+pub fn is_fall(phi: f32, q_hip_stance: f32) -> bool {
+    !(phi.abs() <= FALL_TORSO_ANGLE && (phi + q_hip_stance).abs() <= FALL_STANCE_THIGH_ANGLE)
+}
+
+/// The mirrored observation (§3.4) from the torso angle φ and its filtered
+/// rate, the joint angles and filtered rates, and the stance leg.
+pub fn observe(
+    phi: f32,
+    phi_rate: f32,
+    angles: &[f32; NUM_JOINTS],
+    rates: &[f32; NUM_JOINTS],
+    stance: Leg,
+) -> Observation {
+    let sw = stance.other();
+    let (hs, hw, ks, kw) = (stance.hip() as usize, sw.hip() as usize, stance.knee() as usize, sw.knee() as usize);
+    Observation([
+        phi, phi_rate, angles[hs], rates[hs], angles[hw], rates[hw], angles[ks], rates[ks], angles[kw], rates[kw],
+    ])
+}
+
+/// The gearbox torque the fatigue counter sees on a servo that applies
+/// `voltage` at joint rate `rate`, as the robot can estimate it: the RX-28
+/// model in steady motion, η·G·k·(U − G·k·q̇)/R (§2.1,
+/// [`Rx28::estimate_joint_torque`]).
+pub fn estimated_gear_torque(voltage: f32, rate: f32) -> f32 {
+    Rx28::LEO.estimate_joint_torque(voltage, rate)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn filter_coefficients_match_section_3_2() {
+        let (b, a1) = joint_rate_filter().coefficients();
+        assert!((b - 0.511527).abs() < 1e-5 && (a1 - 0.023055).abs() < 1e-5, "{b} {a1}");
+        let (b, a1) = torso_rate_filter().coefficients();
+        assert!((b - 0.999576).abs() < 1e-5 && (a1 - 0.999152).abs() < 1e-5, "{b} {a1}");
+        // DC gain 1: a constant input is passed through.
+        let mut f = joint_rate_filter();
+        let mut y = 0.0;
+        for _ in 0..50 {
+            y = f.update(2.0);
+        }
+        assert!((y - 2.0).abs() < 1e-4);
+        f.reset();
+        assert_eq!(f.value(), 0.0);
+    }
+
+    #[test]
+    fn start_pose_in_joint_angles() {
+        let want = [-0.261799, 0.10, 0.82, 0.0, -1.27, 0.0, 0.0];
+        for (a, b) in START_JOINT_ANGLES.iter().zip(want) {
+            assert!((a - b).abs() < 1e-6, "{START_JOINT_ANGLES:?}");
+        }
+        assert!(!is_fall(START_PHI, START_JOINT_ANGLES[Joint::HipLeft as usize]));
+    }
+
+    #[test]
+    fn stance_logic_follows_section_3_3() {
+        let mut s = StanceTracker::new();
+        // First update, left on the floor, right foot ahead by 0.02 m:
+        // previous stance unknown → L = x_L − x_R.
+        let u = s.update(true, false, 0.01, 0.03);
+        assert_eq!(s.stance(), Some(Leg::Left));
+        assert!((u.length - (-0.02)).abs() < 1e-6 && !u.footstep);
+        // Still left stance: L = x_R − x_L.
+        let u = s.update(true, false, 0.0, 0.05);
+        assert!((u.length - 0.05).abs() < 1e-6 && (u.previous_length + 0.02).abs() < 1e-6);
+        // Right touches down ahead: both feet down, right is in front → footstep.
+        let u = s.update(true, true, -0.04, 0.06);
+        assert!(u.footstep && s.stance() == Some(Leg::Right));
+        assert!((u.length - 0.10).abs() < 1e-6);
+        assert_eq!(s.footsteps(), 1);
+        assert!((s.walked() - 0.10).abs() < 1e-6);
+        // Next update: L is measured for the right stance, L_prev is −L.
+        let u = s.update(false, true, -0.05, 0.05);
+        assert!((u.previous_length + 0.10).abs() < 1e-6);
+        assert!((u.length + 0.10).abs() < 1e-6);
+        // Neither foot: keep stance.
+        s.update(false, false, 0.0, 0.0);
+        assert_eq!(s.stance(), Some(Leg::Right));
+        // Backward step: left lands behind → footstep −1.
+        let u = s.update(true, false, -0.1, 0.0);
+        assert!(u.footstep && u.length < 0.0);
+        assert_eq!(s.footsteps(), 0);
+    }
+
+    #[test]
+    fn held_joints_and_clipping() {
+        let mut q = [0.0f32; NUM_JOINTS];
+        q[Joint::Shoulder as usize] = -0.261799;
+        q[Joint::KneeRight as usize] = -0.1;
+        q[Joint::AnkleLeft as usize] = 0.0649262;
+        q[Joint::AnkleRight as usize] = 2.0;
+        let u = joint_voltages([20.0, f32::NAN, -3.0], &q, Leg::Right);
+        assert!(u[Joint::Shoulder as usize].abs() < 1e-4);
+        assert!((u[Joint::KneeRight as usize] - 21.2121 * 0.1).abs() < 1e-3);
+        assert!(u[Joint::AnkleLeft as usize].abs() < 1e-4);
+        assert!((u[Joint::AnkleRight as usize] + HELD_VOLTAGE_LIMIT).abs() < 1e-5);
+        // Learned: stance hip (right), swing hip (left), swing knee (left).
+        assert_eq!(u[Joint::HipRight as usize], ACTION_VOLTAGE_LIMIT);
+        assert_eq!(u[Joint::HipLeft as usize], 0.0);
+        assert_eq!(u[Joint::KneeLeft as usize], -3.0);
+        // Holding a pose: zero at the pose, clipped far from it.
+        let at = pose_voltages(&START_JOINT_ANGLES, &START_JOINT_ANGLES);
+        assert!(at.iter().all(|v| v.abs() < 1e-6), "{at:?}");
+        let far = pose_voltages(&[3.0; NUM_JOINTS], &START_JOINT_ANGLES);
+        assert!(far.iter().all(|v| (v + HELD_VOLTAGE_LIMIT).abs() < 1e-5), "{far:?}");
+    }
+
+    #[test]
+    fn reward_and_fall() {
+        let up = StanceUpdate { length: 0.05, previous_length: 0.03, footstep: false };
+        assert!((reward(0.1, &up, false) - (-1.0 - 0.3 + 6.0)).abs() < 1e-4);
+        assert!((reward(0.0, &up, true) - (-1.0 + 6.0 - 125.0)).abs() < 1e-4);
+        assert!(!is_fall(-0.1, 0.1));
+        assert!(is_fall(1.01, 0.0));
+        assert!(is_fall(-1.01, 0.0));
+        assert!(is_fall(0.5, 0.7));
+        assert!(is_fall(f32::NAN, 0.0));
+    }
+
+    #[test]
+    fn energy_counts_only_positive_work_of_hips_and_knees() {
+        let mut u = [0.0f32; NUM_JOINTS];
+        u[Joint::HipLeft as usize] = 10.0;
+        u[Joint::AnkleLeft as usize] = 10.0; // ankles excluded
+        let zero = [0.0; NUM_JOINTS];
+        let e = step_energy(&u, &zero, &zero);
+        assert!((e - 10.0 * 10.0 / 8.6 * 0.033333).abs() < 1e-4, "{e}");
+        // Regenerative braking is not counted as negative work.
+        let mut w = [0.0; NUM_JOINTS];
+        w[Joint::HipLeft as usize] = 10.0; // back-EMF 19 V > 10 V: current < 0
+        assert_eq!(step_energy(&u, &w, &w), 0.0);
+    }
+
+    #[test]
+    fn observation_is_mirrored() {
+        let q = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+        let r = q.map(|x| x * 10.0);
+        let l = observe(0.5, 0.6, &q, &r, Leg::Left).0;
+        assert_eq!(l, [0.5, 0.6, 1.0, 10.0, 2.0, 20.0, 3.0, 30.0, 4.0, 40.0]);
+        let rr = observe(0.5, 0.6, &q, &r, Leg::Right).0;
+        assert_eq!(rr, [0.5, 0.6, 2.0, 20.0, 1.0, 10.0, 4.0, 40.0, 3.0, 30.0]);
+    }
+
+    #[test]
+    fn the_gear_torque_estimate_is_the_rx28_model() {
+        // Stall torque at 10.6919 V ≈ 2.3803 N·m before η (grl-facts §2.1).
+        let stall = estimated_gear_torque(10.6919, 0.0);
+        assert!((stall - 0.75 * 2.3803).abs() < 1e-3, "{stall}");
+        // Back-EMF can reverse the torque's sign (braking).
+        assert!(estimated_gear_torque(1.0, 3.0) < 0.0);
+    }
+}
