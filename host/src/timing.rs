@@ -222,7 +222,10 @@ mod tests {
         let ts = [t(0.0, 2.0), t(0.0, 1.0), t(1.0, 2.0), t(2.0, 1.0)];
         assert_eq!(peak_concurrency(ts.iter()), 2);
         assert_eq!(span_s(ts.iter()), 3.0);
-        assert_eq!(peak_concurrency([t(0.0, 5.0), t(1.0, 1.0), t(1.5, 1.0)].iter()), 3);
+        assert_eq!(
+            peak_concurrency([t(0.0, 5.0), t(1.0, 1.0), t(1.5, 1.0)].iter()),
+            3
+        );
         assert_eq!(peak_concurrency([].iter()), 0);
         assert_eq!(span_s([].iter()), 0.0);
     }
@@ -230,7 +233,13 @@ mod tests {
     #[test]
     fn times_per_configuration() {
         let ts = vec![(0, t(0.0, 1.0)), (0, t(0.0, 3.0)), (1, t(1.0, 4.0))];
-        let r = RunTiming::of_trials("merge", None, 100, &ts, &["a".into(), "b".into(), "c".into()]);
+        let r = RunTiming::of_trials(
+            "merge",
+            None,
+            100,
+            &ts,
+            &["a".into(), "b".into(), "c".into()],
+        );
         assert_eq!(r.wall_s, 5.0);
         assert_eq!(r.env_steps_per_s, 20.0);
         let times = r.trials.unwrap();

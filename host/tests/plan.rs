@@ -81,7 +81,10 @@ fn assert_same_outputs(local: &Path, merged: &Path) {
         "the same files"
     );
     for (name, bytes) in &a {
-        assert!(bytes == &b[name], "{name} differs between the local and the merged run");
+        assert!(
+            bytes == &b[name],
+            "{name} differs between the local and the merged run"
+        );
     }
 }
 
@@ -93,7 +96,16 @@ fn a_merged_paper_pendulum_equals_the_local_run_byte_for_byte() {
         root.path().join("plan"),
         root.path().join("merged"),
     );
-    let opts = ["--trials", "2", "--seconds", "30", "--physical-seconds", "30", "--seed", "3"];
+    let opts = [
+        "--trials",
+        "2",
+        "--seconds",
+        "30",
+        "--physical-seconds",
+        "30",
+        "--seed",
+        "3",
+    ];
     let with = |extra: &[&str]| {
         let mut v = vec!["paper", "pendulum"];
         v.extend(opts);
@@ -113,7 +125,10 @@ fn a_merged_paper_pendulum_equals_the_local_run_byte_for_byte() {
     ])));
     assert_same_outputs(&local, &merged);
     let report = std::fs::read_to_string(merged.join("report.md")).unwrap();
-    assert!(report.contains("timing.json"), "the report says where the wall time went");
+    assert!(
+        report.contains("timing.json"),
+        "the report says where the wall time went"
+    );
     let timing: serde_json::Value =
         serde_json::from_slice(&std::fs::read(merged.join("timing.json")).unwrap()).unwrap();
     assert_eq!(timing["how"], "merge");
@@ -138,7 +153,12 @@ fn a_merged_paper_leo_equals_the_local_run_with_its_best_learner() {
     ok(&run(&["--out", local.to_str().unwrap()]));
     ok(&run(&["--plan", plan.to_str().unwrap()]));
     run_all_trials(&plan, 9);
-    let out = run(&["--merge", plan.to_str().unwrap(), "--out", merged.to_str().unwrap()]);
+    let out = run(&[
+        "--merge",
+        plan.to_str().unwrap(),
+        "--out",
+        merged.to_str().unwrap(),
+    ]);
     ok(&out);
     assert!(
         String::from_utf8_lossy(&out.stderr).contains("running the best trial again"),
@@ -152,8 +172,18 @@ fn a_merged_paper_leo_equals_the_local_run_with_its_best_learner() {
 /// `pada run` of low-pass on the pendulum, 60 s trials, seed 11, JSON.
 fn run_args(trials: &str, extra: &[&str]) -> Vec<String> {
     let mut v = vec![
-        "run", "--task", "pendulum", "--algo", "lowpass", "--trials", trials, "--seconds", "60",
-        "--seed", "11", "--json",
+        "run",
+        "--task",
+        "pendulum",
+        "--algo",
+        "lowpass",
+        "--trials",
+        trials,
+        "--seconds",
+        "60",
+        "--seed",
+        "11",
+        "--json",
     ];
     v.extend(extra);
     v.iter().map(|s| s.to_string()).collect()
@@ -209,8 +239,11 @@ fn missing_corrupt_and_foreign_results_are_listed_and_nothing_is_reported() {
     ok(&pada_s(&other));
     ok(&pada(&["trial", "--plan", &p("other"), "--index", "3"]));
     let results = root.path().join("plan/results");
-    std::fs::copy(root.path().join("other/results/000003.json"), results.join("000003.json"))
-        .unwrap();
+    std::fs::copy(
+        root.path().join("other/results/000003.json"),
+        results.join("000003.json"),
+    )
+    .unwrap();
     // Trial 1: one digit of its end performance changed.
     let path = results.join("000001.json");
     let text = std::fs::read_to_string(&path).unwrap();
@@ -246,13 +279,24 @@ fn missing_corrupt_and_foreign_results_are_listed_and_nothing_is_reported() {
     assert!(!err.contains("trial 0 ("), "trial 0 verifies: {err}");
     assert!(!root.path().join("merged").exists(), "no report written");
     // The last line is the one-line error.
-    assert!(err.trim_end().lines().last().unwrap().starts_with("error: "), "{err}");
+    assert!(
+        err.trim_end()
+            .lines()
+            .last()
+            .unwrap()
+            .starts_with("error: "),
+        "{err}"
+    );
 
     // Removing trial 3 makes it "missing"; `pada trial` replaces a corrupt
     // result and skips a verified one.
     std::fs::remove_file(results.join("000003.json")).unwrap();
     let out = pada_s(&merge);
-    fails(&out, 1, &["trial 3 (pendulum lowpass α=0.834, trial 3): missing"]);
+    fails(
+        &out,
+        1,
+        &["trial 3 (pendulum lowpass α=0.834, trial 3): missing"],
+    );
     let out = pada(&["trial", "--plan", &p("plan"), "--index", "1"]);
     ok(&out);
     assert!(String::from_utf8_lossy(&out.stderr).contains("replaced a result that did not verify"));
@@ -279,12 +323,23 @@ fn a_changed_or_another_plan_is_refused() {
         2,
         &["holds the plan of `pada run --task pendulum --algo lowpass --alpha 0.834 --trials 2 --seconds 60 --seed 11`"],
     );
-    assert!(err.contains("give the options the plan was written with"), "{err}");
-    fails(&pada_s(&run_args("3", &["--merge", &p("plan")])), 2, &["holds the plan of"]);
+    assert!(
+        err.contains("give the options the plan was written with"),
+        "{err}"
+    );
+    fails(
+        &pada_s(&run_args("3", &["--merge", &p("plan")])),
+        2,
+        &["holds the plan of"],
+    );
     // An edited trial file: `pada trial` refuses the plan.
     let path = root.path().join("plan/trials/000001.json");
     let text = std::fs::read_to_string(&path).unwrap();
-    std::fs::write(&path, text.replace("\"seconds\": 60.0", "\"seconds\": 600.0")).unwrap();
+    std::fs::write(
+        &path,
+        text.replace("\"seconds\": 60.0", "\"seconds\": 600.0"),
+    )
+    .unwrap();
     fails(
         &pada(&["trial", "--plan", &p("plan"), "--index", "0"]),
         2,
@@ -302,8 +357,14 @@ fn the_trial_index_comes_from_slurm_or_kubernetes() {
     let root = tempfile::tempdir().unwrap();
     let p = |n: &str| root.path().join(n).to_str().unwrap().to_string();
     ok(&pada_s(&run_args("3", &["--plan", &p("plan")])));
-    ok(&pada_env(&["trial", "--plan", &p("plan")], &[("SLURM_ARRAY_TASK_ID", "1")]));
-    ok(&pada_env(&["trial", "--plan", &p("plan")], &[("JOB_COMPLETION_INDEX", "0")]));
+    ok(&pada_env(
+        &["trial", "--plan", &p("plan")],
+        &[("SLURM_ARRAY_TASK_ID", "1")],
+    ));
+    ok(&pada_env(
+        &["trial", "--plan", &p("plan")],
+        &[("JOB_COMPLETION_INDEX", "0")],
+    ));
     // A plan submitted as several arrays: the script adds its offset.
     ok(&pada_env(
         &["trial", "--plan", &p("plan"), "--index-offset", "2"],
@@ -316,19 +377,33 @@ fn the_trial_index_comes_from_slurm_or_kubernetes() {
     names.sort();
     assert_eq!(names, ["000000.json", "000001.json", "000002.json"]);
     fails(
-        &pada_env(&["trial", "--plan", &p("plan")], &[("SLURM_ARRAY_TASK_ID", "-2")]),
+        &pada_env(
+            &["trial", "--plan", &p("plan")],
+            &[("SLURM_ARRAY_TASK_ID", "-2")],
+        ),
         2,
         &["SLURM_ARRAY_TASK_ID is \"-2\", not a trial index"],
     );
     fails(
         &pada(&["trial", "--plan", &p("plan")]),
         2,
-        &["no trial index", "SLURM_ARRAY_TASK_ID", "JOB_COMPLETION_INDEX", "valid is 0..=2"],
+        &[
+            "no trial index",
+            "SLURM_ARRAY_TASK_ID",
+            "JOB_COMPLETION_INDEX",
+            "valid is 0..=2",
+        ],
     );
     fails(
-        &pada_env(&["trial", "--plan", &p("plan")], &[("SLURM_ARRAY_TASK_ID", "7")]),
+        &pada_env(
+            &["trial", "--plan", &p("plan")],
+            &[("SLURM_ARRAY_TASK_ID", "7")],
+        ),
         2,
-        &["trial index 7 (from SLURM_ARRAY_TASK_ID", "out of range: valid is 0..=2"],
+        &[
+            "trial index 7 (from SLURM_ARRAY_TASK_ID",
+            "out of range: valid is 0..=2",
+        ],
     );
 }
 
@@ -339,8 +414,17 @@ fn a_trial_killed_midway_leaves_no_result() {
     let d = dir.to_str().unwrap();
     // 3000 s of learning: seconds of wall time even in an optimised build.
     ok(&pada(&[
-        "run", "--task", "pendulum", "--algo", "sarsa", "--trials", "1", "--seconds", "3000",
-        "--plan", d,
+        "run",
+        "--task",
+        "pendulum",
+        "--algo",
+        "sarsa",
+        "--trials",
+        "1",
+        "--seconds",
+        "3000",
+        "--plan",
+        d,
     ]));
     for signal in ["KILL", "TERM"] {
         let mut child = Command::new(env!("CARGO_BIN_EXE_pada"))
@@ -356,12 +440,18 @@ fn a_trial_killed_midway_leaves_no_result() {
             .unwrap();
         assert!(killed.success());
         let status = child.wait().unwrap();
-        assert!(status.code().is_none(), "the trial was still running when killed ({signal})");
+        assert!(
+            status.code().is_none(),
+            "the trial was still running when killed ({signal})"
+        );
         let left: Vec<String> = std::fs::read_dir(dir.join("results"))
             .unwrap()
             .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
             .collect();
-        assert!(left.is_empty(), "nothing left behind by SIG{signal}: {left:?}");
+        assert!(
+            left.is_empty(),
+            "nothing left behind by SIG{signal}: {left:?}"
+        );
     }
 }
 
@@ -377,15 +467,31 @@ fn cluster_options_are_checked_before_anything_runs() {
         pada(&v)
     };
     fails(&with(&["--partition", "debug"]), 2, &["--slurm"]);
-    fails(&with(&["--merge", d, "--plan", d]), 2, &["cannot be used with"]);
-    fails(&with(&["--slurm", "--time", "1h"]), 2, &["--time \"1h\"", "valid forms are"]);
-    fails(&with(&["--slurm", "--partition", "a b"]), 2, &["not a partition name"]);
+    fails(
+        &with(&["--merge", d, "--plan", d]),
+        2,
+        &["cannot be used with"],
+    );
+    fails(
+        &with(&["--slurm", "--time", "1h"]),
+        2,
+        &["--time \"1h\"", "valid forms are"],
+    );
+    fails(
+        &with(&["--slurm", "--partition", "a b"]),
+        2,
+        &["not a partition name"],
+    );
     fails(
         &with(&["--slurm", "--sbatch-arg=--array=0-3"]),
         2,
         &["pada sets --array itself"],
     );
     fails(&with(&["--slurm", "--retries", "99"]), 2, &["99"]);
-    fails(&with(&["--plan", d, "--telemetry", "t.bin"]), 2, &["do not combine with --plan"]);
+    fails(
+        &with(&["--plan", d, "--telemetry", "t.bin"]),
+        2,
+        &["do not combine with --plan"],
+    );
     assert!(!root.path().join("x").exists());
 }

@@ -38,12 +38,14 @@ impl Cluster {
 }
 
 fn find_cluster() -> Result<Cluster, String> {
-    let conf = std::env::var_os("SLURM_CONF").map(PathBuf::from).or_else(|| {
-        let dir = std::env::var_os("PADA_SLURM_DIR")
-            .map(PathBuf::from)
-            .unwrap_or_else(|| PathBuf::from("/tmp/pada-slurm"));
-        Some(dir.join("slurm.conf")).filter(|p| p.exists())
-    });
+    let conf = std::env::var_os("SLURM_CONF")
+        .map(PathBuf::from)
+        .or_else(|| {
+            let dir = std::env::var_os("PADA_SLURM_DIR")
+                .map(PathBuf::from)
+                .unwrap_or_else(|| PathBuf::from("/tmp/pada-slurm"));
+            Some(dir.join("slurm.conf")).filter(|p| p.exists())
+        });
     // Slurm's clients retry a missing configuration for a minute: look first.
     let file = conf
         .clone()
@@ -121,8 +123,19 @@ fn ok(out: &Output) -> String {
 /// `pada run` of PADA on the pendulum with `trials` trials of `seconds`.
 fn run_args(trials: &str, seconds: &str, seed: &str, out: &Path) -> Vec<String> {
     [
-        "run", "--task", "pendulum", "--algo", "pada", "--trials", trials, "--seconds", seconds,
-        "--seed", seed, "--json", "--out",
+        "run",
+        "--task",
+        "pendulum",
+        "--algo",
+        "pada",
+        "--trials",
+        trials,
+        "--seconds",
+        seconds,
+        "--seed",
+        seed,
+        "--json",
+        "--out",
     ]
     .iter()
     .map(|s| s.to_string())
@@ -138,7 +151,10 @@ fn json(text: &str) -> serde_json::Value {
 fn without_timing(v: &serde_json::Value) -> serde_json::Value {
     let mut v = v.clone();
     for k in ["wall_s", "env_steps_per_s", "threads"] {
-        assert!(v.as_object_mut().unwrap().remove(k).is_some(), "{k} present");
+        assert!(
+            v.as_object_mut().unwrap().remove(k).is_some(),
+            "{k} present"
+        );
     }
     v
 }
@@ -180,11 +196,17 @@ fn a_sweep_on_slurm_reports_what_the_local_run_reports_and_resumes() {
     assert_eq!(slurm["per_trial"], local["per_trial"]);
     assert_same_trial_files(&local_dir, &slurm_dir, 6);
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("slurm: submitted job") && err.contains("6 trials (indices 0-5)"), "{err}");
+    assert!(
+        err.contains("slurm: submitted job") && err.contains("6 trials (indices 0-5)"),
+        "{err}"
+    );
     let timing = json(&std::fs::read_to_string(slurm_dir.join("timing.json")).unwrap());
     assert_eq!(timing["how"], "slurm");
     assert_eq!(timing["trials"]["count"], 6);
-    assert!(timing["threads"].as_u64().unwrap() <= 2, "--max-parallel 2 held: {timing}");
+    assert!(
+        timing["threads"].as_u64().unwrap() <= 2,
+        "--max-parallel 2 held: {timing}"
+    );
     // Every array task ran in Slurm (its result names its task).
     let result = std::fs::read_to_string(slurm_dir.join("plan/results/000004.json")).unwrap();
     assert!(result.contains("\"slurm_task\": \""), "{result}");
@@ -193,13 +215,19 @@ fn a_sweep_on_slurm_reports_what_the_local_run_reports_and_resumes() {
     let results = slurm_dir.join("plan/results");
     let path = results.join("000002.json");
     let text = std::fs::read_to_string(&path).unwrap();
-    std::fs::write(&path, text.replacen("\"learning_steps\": 1200", "\"learning_steps\": 1201", 1))
-        .unwrap();
+    std::fs::write(
+        &path,
+        text.replacen("\"learning_steps\": 1200", "\"learning_steps\": 1201", 1),
+    )
+    .unwrap();
     std::fs::remove_file(results.join("000004.json")).unwrap();
     let out = slurm_run(&[]);
     let again = json(&ok(&out));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("4 of 6 trials already have verified results"), "{err}");
+    assert!(
+        err.contains("4 of 6 trials already have verified results"),
+        "{err}"
+    );
     assert!(err.contains("2 trials (indices 2,4)"), "{err}");
     assert_eq!(without_timing(&again), without_timing(&local));
     // All verified: nothing is submitted.
@@ -245,7 +273,11 @@ fn an_array_task_cancelled_while_it_runs_is_submitted_again() {
     let lines = collect_lines(child.stderr.take().unwrap());
     let deadline = Instant::now() + Duration::from_secs(600);
     let job = loop {
-        assert!(Instant::now() < deadline, "no submission: {:?}", lines.lock().unwrap());
+        assert!(
+            Instant::now() < deadline,
+            "no submission: {:?}",
+            lines.lock().unwrap()
+        );
         let found = lines.lock().unwrap().iter().find_map(|l| {
             l.strip_prefix("slurm: submitted job ")
                 .and_then(|r| r.split(':').next())
@@ -280,7 +312,10 @@ fn an_array_task_cancelled_while_it_runs_is_submitted_again() {
         }
         if Instant::now() > deadline {
             let _ = child.kill();
-            panic!("pada run --slurm did not finish: {:?}", lines.lock().unwrap());
+            panic!(
+                "pada run --slurm did not finish: {:?}",
+                lines.lock().unwrap()
+            );
         }
         std::thread::sleep(Duration::from_millis(100));
     };
@@ -288,12 +323,17 @@ fn an_array_task_cancelled_while_it_runs_is_submitted_again() {
     let err = lines.lock().unwrap().join("\n");
     assert!(status.success(), "{err}");
     assert!(
-        err.contains(&format!("trial {index} (pendulum pada Δ=0.5, trial {index}) left no verified result"))
-            && err.contains("submitting it again (attempt 2 of 3)"),
+        err.contains(&format!(
+            "trial {index} (pendulum pada Δ=0.5, trial {index}) left no verified result"
+        )) && err.contains("submitting it again (attempt 2 of 3)"),
         "task {task} was cancelled: {err}"
     );
     let timing = json(&std::fs::read_to_string(slurm_dir.join("timing.json")).unwrap());
-    assert_eq!(timing["slurm"]["resubmitted"], serde_json::json!([index]), "{timing}");
+    assert_eq!(
+        timing["slurm"]["resubmitted"],
+        serde_json::json!([index]),
+        "{timing}"
+    );
 
     let local = json(&ok(&c
         .pada()

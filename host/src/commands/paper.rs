@@ -9,9 +9,9 @@ use crate::paper::figure_data::{curves, point};
 use crate::paper::numbers::{PHYS_TRIALS, SIM_TRIALS};
 use crate::paper::pendulum::{self, ConfigResult, PendulumOptions, PendulumResults};
 use crate::paper::report;
+use crate::plan::mode::{obtain, Trials};
 use crate::plot::figures::{LearningCurves, Measure, MtbfSweep, PerformanceVsMtbf, SweepPoint};
 use crate::plot::save;
-use crate::plan::mode::{obtain, Trials};
 use crate::progress::steps_bar;
 use crate::timing::RunTiming;
 

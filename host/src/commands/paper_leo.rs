@@ -10,9 +10,9 @@ use crate::output::OutDir;
 use crate::paper::figure_data::{curves, point};
 use crate::paper::leo::{self, LeoOptions, LeoResults};
 use crate::paper::objective::Objective;
+use crate::plan::mode::{obtain, Trials};
 use crate::plot::figures::{LearningCurves, Measure, PerformanceVsMtbf, SweepPoint};
 use crate::plot::save;
-use crate::plan::mode::{obtain, Trials};
 use crate::progress::steps_bar;
 use std::fmt::Write as _;
 

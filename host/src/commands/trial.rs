@@ -36,26 +36,33 @@ pub fn resolve_index(
     env: impl Fn(&str) -> Option<String>,
     trials: usize,
 ) -> Result<u32, CliError> {
-    let valid = format!("valid is 0..={} (the plan has {trials} trials)", trials.saturating_sub(1));
+    let valid = format!(
+        "valid is 0..={} (the plan has {trials} trials)",
+        trials.saturating_sub(1)
+    );
     let (i, from) = match index {
         Some(i) => (i as u64, "--index".to_string()),
         None => {
-            let Some((var, text)) = INDEX_VARIABLES
-                .iter()
-                .find_map(|v| env(v).map(|t| (*v, t)))
+            let Some((var, text)) = INDEX_VARIABLES.iter().find_map(|v| env(v).map(|t| (*v, t)))
             else {
                 return Err(usage(format!(
                     "no trial index: give --index N, or run as a Slurm array task (SLURM_ARRAY_TASK_ID) or a Kubernetes indexed job (JOB_COMPLETION_INDEX); {valid}"
                 )));
             };
-            let i: u64 = text.trim().parse().map_err(|_| {
-                usage(format!("{var} is {text:?}, not a trial index: {valid}"))
-            })?;
-            (i + offset as u64, format!("{var} + --index-offset {offset}"))
+            let i: u64 = text
+                .trim()
+                .parse()
+                .map_err(|_| usage(format!("{var} is {text:?}, not a trial index: {valid}")))?;
+            (
+                i + offset as u64,
+                format!("{var} + --index-offset {offset}"),
+            )
         }
     };
     if i >= trials as u64 {
-        return Err(usage(format!("trial index {i} (from {from}) is out of range: {valid}")));
+        return Err(usage(format!(
+            "trial index {i} (from {from}) is out of range: {valid}"
+        )));
     }
     Ok(i as u32)
 }
@@ -85,7 +92,10 @@ pub fn run(args: TrialArgs) -> Result<(), CliError> {
             replaced,
         } => {
             if let Some(why) = replaced {
-                eprintln!("trial {}: replaced a result that did not verify ({why})", spec.describe());
+                eprintln!(
+                    "trial {}: replaced a result that did not verify ({why})",
+                    spec.describe()
+                );
             }
             println!(
                 "trial {}: end performance {:.1}, rise time {:.0} s, MTBF {:.0} s; {:.2} s wall on {}; wrote {}",
@@ -107,14 +117,27 @@ mod tests {
     use super::*;
 
     fn env<'a>(vars: &'a [(&'a str, &'a str)]) -> impl Fn(&str) -> Option<String> + 'a {
-        move |name| vars.iter().find(|(k, _)| *k == name).map(|(_, v)| v.to_string())
+        move |name| {
+            vars.iter()
+                .find(|(k, _)| *k == name)
+                .map(|(_, v)| v.to_string())
+        }
     }
 
     #[test]
     fn the_index_comes_from_the_flag_or_the_environment() {
-        assert_eq!(resolve_index(Some(3), 0, env(&[("SLURM_ARRAY_TASK_ID", "1")]), 5).unwrap(), 3);
-        assert_eq!(resolve_index(None, 0, env(&[("SLURM_ARRAY_TASK_ID", "1")]), 5).unwrap(), 1);
-        assert_eq!(resolve_index(None, 0, env(&[("JOB_COMPLETION_INDEX", "4")]), 5).unwrap(), 4);
+        assert_eq!(
+            resolve_index(Some(3), 0, env(&[("SLURM_ARRAY_TASK_ID", "1")]), 5).unwrap(),
+            3
+        );
+        assert_eq!(
+            resolve_index(None, 0, env(&[("SLURM_ARRAY_TASK_ID", "1")]), 5).unwrap(),
+            1
+        );
+        assert_eq!(
+            resolve_index(None, 0, env(&[("JOB_COMPLETION_INDEX", "4")]), 5).unwrap(),
+            4
+        );
         assert_eq!(
             resolve_index(
                 None,
@@ -130,7 +153,10 @@ mod tests {
     #[test]
     fn a_bad_index_names_its_source_and_the_range() {
         let e = resolve_index(None, 0, env(&[]), 5).unwrap_err().to_string();
-        assert!(e.contains("SLURM_ARRAY_TASK_ID") && e.contains("valid is 0..=4"), "{e}");
+        assert!(
+            e.contains("SLURM_ARRAY_TASK_ID") && e.contains("valid is 0..=4"),
+            "{e}"
+        );
         let e = resolve_index(None, 0, env(&[("SLURM_ARRAY_TASK_ID", "x")]), 5)
             .unwrap_err()
             .to_string();
@@ -139,7 +165,12 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("not a trial index"), "{e}");
-        let e = resolve_index(Some(5), 0, env(&[]), 5).unwrap_err().to_string();
-        assert!(e.contains("trial index 5 (from --index) is out of range: valid is 0..=4"), "{e}");
+        let e = resolve_index(Some(5), 0, env(&[]), 5)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("trial index 5 (from --index) is out of range: valid is 0..=4"),
+            "{e}"
+        );
     }
 }

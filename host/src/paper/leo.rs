@@ -8,15 +8,15 @@
 //! each without and with the switch at half the learning time (the paper's
 //! 7,333 s of 14,666 s).
 
+use crate::experiment::task::Task;
 use crate::experiment::tasks::TaskName;
 use crate::experiment::{
     run_configs_keeping, run_trial_keep, FinishedTrial, HostAgent, RunConfig, TrialResult,
 };
-use crate::plan::{Experiment, ExperimentKind};
 use crate::leo::rl::LeoTask;
 use crate::paper::pendulum::{mean_curve, ConfigResult};
+use crate::plan::{Experiment, ExperimentKind};
 use crate::summary::RunSummary;
-use crate::experiment::task::Task;
 use pada_core::policy::PolicyKind;
 use serde::Serialize;
 
@@ -146,8 +146,7 @@ pub fn experiment(o: &LeoOptions, command: String) -> Experiment {
 /// configuration and trial, so the choice does not depend on which trial
 /// finished first.
 fn beats(e: f64, at: (usize, u32), best: Option<(f64, (usize, u32))>) -> bool {
-    e.is_finite()
-        && best.is_none_or(|(b, b_at)| e > b || (e == b && at < b_at))
+    e.is_finite() && best.is_none_or(|(b, b_at)| e > b || (e == b && at < b_at))
 }
 
 /// The best trial of the results: `(configuration, trial)`.
@@ -192,7 +191,10 @@ pub fn run_local(
             });
         }
     })?;
-    Ok((results, best.into_inner().unwrap_or_else(|p| p.into_inner())))
+    Ok((
+        results,
+        best.into_inner().unwrap_or_else(|p| p.into_inner()),
+    ))
 }
 
 /// Runs the best trial again to get its learner, for a run whose trials ran

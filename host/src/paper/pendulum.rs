@@ -15,9 +15,9 @@ use crate::experiment::algo::{algo_of, Algo};
 use crate::experiment::task::Task;
 use crate::experiment::tasks::TaskName;
 use crate::experiment::{RunConfig, TrialResult};
-use crate::plan::{Experiment, ExperimentKind};
 use crate::paper::objective::{Objective, Verdict};
 use crate::pendulum::{PhysicalPendulumTask, SimulatedPendulumTask};
+use crate::plan::{Experiment, ExperimentKind};
 use crate::stats::Estimate;
 use crate::summary::RunSummary;
 use pada_core::policy::PolicyKind;
@@ -176,11 +176,12 @@ pub fn experiment(o: &PendulumOptions, command: String) -> Experiment {
         .into_iter()
         .map(|p| (TaskName::Pendulum, cfg(p, o.sim_trials, o.sim_seconds)))
         .collect();
-    configs.extend(
-        physical_policies()
-            .into_iter()
-            .map(|p| (TaskName::PhysicalPendulum, cfg(p, o.phys_trials, o.phys_seconds))),
-    );
+    configs.extend(physical_policies().into_iter().map(|p| {
+        (
+            TaskName::PhysicalPendulum,
+            cfg(p, o.phys_trials, o.phys_seconds),
+        )
+    }));
     Experiment::new(ExperimentKind::PaperPendulum, command, &configs)
 }
 

@@ -91,7 +91,12 @@ impl fmt::Display for Incomplete {
             self.problems.len(),
             self.total
         )?;
-        let shown: Vec<String> = self.problems.iter().take(5).map(|p| p.to_string()).collect();
+        let shown: Vec<String> = self
+            .problems
+            .iter()
+            .take(5)
+            .map(|p| p.to_string())
+            .collect();
         f.write_str(&shown.join("; "))?;
         if self.problems.len() > 5 {
             write!(f, "; and {} more", self.problems.len() - 5)?;
@@ -111,7 +116,10 @@ pub fn collect(dir: &Path, plan: &Plan) -> Result<Collected, Incomplete> {
             problems: scan.problems,
         });
     }
-    Ok(from_results(plan, scan.results.into_iter().flatten().collect()))
+    Ok(from_results(
+        plan,
+        scan.results.into_iter().flatten().collect(),
+    ))
 }
 
 /// Groups verified results (one per trial, in plan order) by configuration.

@@ -30,7 +30,9 @@ pub mod f64 {
     }
 
     /// Reads what [`serialize`] wrote.
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<::core::primitive::f64, D::Error> {
+    pub fn deserialize<'de, D: Deserializer<'de>>(
+        d: D,
+    ) -> Result<::core::primitive::f64, D::Error> {
         d.deserialize_any(ExactVisitor)
     }
 }

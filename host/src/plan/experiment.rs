@@ -74,7 +74,9 @@ impl Configuration {
             index,
             label: format!("{task} {}{switch}", label(&cfg.policy)),
             task: task.to_string(),
-            algo: crate::experiment::algo::algo_of(&cfg.policy).name().to_string(),
+            algo: crate::experiment::algo::algo_of(&cfg.policy)
+                .name()
+                .to_string(),
             parameter: parameter_of(&cfg.policy),
             switch_at_s: cfg.switch_at_s,
             seconds: cfg.seconds,
@@ -225,12 +227,27 @@ mod tests {
         let e = Experiment::new(
             ExperimentKind::Run,
             "x".into(),
-            &[(TaskName::Pendulum, cfg(2)), (TaskName::PhysicalPendulum, cfg(3))],
+            &[
+                (TaskName::Pendulum, cfg(2)),
+                (TaskName::PhysicalPendulum, cfg(3)),
+            ],
         );
         let t = e.trials();
         assert_eq!(t.len(), 5);
-        assert_eq!(t[1], TrialRef { config: 0, trial: 1 });
-        assert_eq!(t[2], TrialRef { config: 1, trial: 0 });
+        assert_eq!(
+            t[1],
+            TrialRef {
+                config: 0,
+                trial: 1
+            }
+        );
+        assert_eq!(
+            t[2],
+            TrialRef {
+                config: 1,
+                trial: 0
+            }
+        );
         assert_eq!(e.trial_seed(t[4]), trial_seed(1, 2));
     }
 
@@ -245,12 +262,20 @@ mod tests {
         };
         let mut c = Configuration::new(0, TaskName::Pendulum, &cfg);
         c.parameter = Some(0.5);
-        assert!(c.run_config().unwrap_err().to_string().contains("takes no parameter"));
+        assert!(c
+            .run_config()
+            .unwrap_err()
+            .to_string()
+            .contains("takes no parameter"));
         c.parameter = None;
         c.board = Some("f405".into());
         assert!(c.run_config().unwrap_err().to_string().contains("board"));
         c.board = None;
         c.task = "cartpole".into();
-        assert!(c.task_name().unwrap_err().to_string().contains("valid: pendulum"));
+        assert!(c
+            .task_name()
+            .unwrap_err()
+            .to_string()
+            .contains("valid: pendulum"));
     }
 }

@@ -39,7 +39,12 @@ pub struct ClusterOptions {
     #[arg(long, value_name = "T", requires = "slurm")]
     pub time: Option<String>,
     /// A further sbatch option, e.g. --sbatch-arg=--mem=2G (repeatable).
-    #[arg(long = "sbatch-arg", value_name = "ARG", requires = "slurm", allow_hyphen_values = true)]
+    #[arg(
+        long = "sbatch-arg",
+        value_name = "ARG",
+        requires = "slurm",
+        allow_hyphen_values = true
+    )]
     pub sbatch_args: Vec<String>,
     /// How many times a trial left without a result (cancelled, failed,
     /// timed out) is submitted again.
@@ -136,9 +141,7 @@ pub fn from_plan(mode: &Mode, plan: &Plan, json: bool) -> Result<FromPlan, CliEr
                 for p in &incomplete.problems {
                     eprintln!("merge: {p}");
                 }
-                CliError::Runtime(
-                    anyhow::Error::new(incomplete).context("no report written"),
-                )
+                CliError::Runtime(anyhow::Error::new(incomplete).context("no report written"))
             })?;
             let timing = RunTiming::of_trials(
                 "merge",

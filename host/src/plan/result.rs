@@ -228,8 +228,11 @@ pub fn write(
         timing: timing.clone(),
     };
     let json = serde_json::to_string_pretty(&body)? + "\n";
-    let mut bytes = format!("{MAGIC} {RESULT_FORMAT} sha256 {}\n", sha256_hex(json.as_bytes()))
-        .into_bytes();
+    let mut bytes = format!(
+        "{MAGIC} {RESULT_FORMAT} sha256 {}\n",
+        sha256_hex(json.as_bytes())
+    )
+    .into_bytes();
     bytes.extend_from_slice(json.as_bytes());
 
     let path = result_path(dir, plan, spec.index);
@@ -280,7 +283,9 @@ fn verify(bytes: &[u8], plan: &Plan, index: u32) -> Result<StoredResult, String>
         return Err(format!("the header {header:?} is not a result's"));
     }
     if format != RESULT_FORMAT.to_string() {
-        return Err(format!("format {format} is not supported (valid: {RESULT_FORMAT})"));
+        return Err(format!(
+            "format {format} is not supported (valid: {RESULT_FORMAT})"
+        ));
     }
     let actual = sha256_hex(json);
     if actual != sum {
@@ -300,7 +305,11 @@ fn verify(bytes: &[u8], plan: &Plan, index: u32) -> Result<StoredResult, String>
     }
     let spec = &plan.trials[index as usize];
     if body.index != index || body.spec != *spec {
-        return Err(format!("it answers trial {}, not {}", body.spec.describe(), spec.describe()));
+        return Err(format!(
+            "it answers trial {}, not {}",
+            body.spec.describe(),
+            spec.describe()
+        ));
     }
     let result = TrialResult::from(body.result);
     if result.trial != spec.trial || result.seed != spec.trial_seed {
@@ -313,4 +322,161 @@ fn verify(bytes: &[u8], plan: &Plan, index: u32) -> Result<StoredResult, String>
         result,
         timing: body.timing,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiment::tasks::TaskName;
+    use crate::experiment::RunConfig;
+    use crate::plan::{Experiment, ExperimentKind};
+    use pada_core::policy::PolicyKind;
+
+    fn plan() -> Plan {
+        Plan::new(Experiment::new(
+            ExperimentKind::Run,
+            "pada run".into(),
+            &[(
+                TaskName::Leo,
+                RunConfig {
+                    policy: PolicyKind::Pada { delta: 1.0 / 6.0 },
+                    switch_at_s: None,
+                    seconds: 60.0,
+                    trials: 2,
+                    seed: 9,
+                },
+            )],
+        ))
+        .unwrap()
+    }
+
+    /// A result with every awkward value: NaN, ∞, None, a long curve.
+    fn result(p: &Plan) -> TrialResult {
+        TrialResult {
+            trial: 1,
+            seed: p.trials[1].trial_seed,
+            end_performance: -785.231_712_341_234_5,
+            rise_time_s: f64::NAN,
+            mtbf_s: f64::INFINITY,
+            window_reengagements: 349,
+            learning_steps: 1800,
+            test_steps: 77,
+            learning_falls: 3,
+            learning_episodes: 40,
+            test_falls: 1,
+            end_walked_m: Some(0.1 + 0.2),
+            end_speed_m_s: None,
+            saturations: 0,
+            trace_drops: 0,
+            curve: (0..50)
+                .map(|i| TestPoint {
+                    learning_time_s: i as f64 / 30.0,
+                    learning_episodes: i,
+                    test_return: -1.0 / (i as f64 + 0.7),
+                    walked_m: (i % 2 == 0).then_some(i as f64 * 1e-3),
+                    fell: i % 3 == 0,
+                    duration_s: 25.0 - i as f64 / 7.0,
+                })
+                .collect(),
+        }
+    }
+
+    fn timing() -> TrialTiming {
+        TrialTiming {
+            started_unix_s: 1.8e9 + 0.123,
+            wall_s: 12.5,
+            host: "node-7".into(),
+            slurm_task: Some("42_1".into()),
+        }
+    }
+
+    #[test]
+    fn a_result_reads_back_bit_for_bit() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = plan();
+        let r = result(&p);
+        let path = write(dir.path(), &p, &p.trials[1], &r, &timing()).unwrap();
+        assert_eq!(path, dir.path().join("results/000001.json"));
+        let ResultState::Verified(back) = read(dir.path(), &p, 1) else {
+            panic!("{:?}", read(dir.path(), &p, 1));
+        };
+        assert!(back.result.rise_time_s.is_nan());
+        let bits = |r: &TrialResult| {
+            let mut v = vec![r.end_performance.to_bits(), r.mtbf_s.to_bits()];
+            v.extend(r.curve.iter().flat_map(|c| {
+                [
+                    c.learning_time_s.to_bits(),
+                    c.test_return.to_bits(),
+                    c.duration_s.to_bits(),
+                ]
+            }));
+            v
+        };
+        assert_eq!(bits(&back.result), bits(&r));
+        let mut expected = r.clone();
+        expected.rise_time_s = 0.0;
+        let mut got = back.result.clone();
+        got.rise_time_s = 0.0;
+        assert_eq!(got, expected, "NaN aside, every field is equal");
+        assert_eq!(back.timing, timing());
+        assert_eq!(read(dir.path(), &p, 0), ResultState::Missing);
+        // Only the result: no temporary file left.
+        assert_eq!(
+            std::fs::read_dir(dir.path().join("results"))
+                .unwrap()
+                .count(),
+            1
+        );
+    }
+
+    #[test]
+    fn any_changed_byte_is_detected() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = plan();
+        let path = write(dir.path(), &p, &p.trials[1], &result(&p), &timing()).unwrap();
+        let good = std::fs::read(&path).unwrap();
+        // Every 97th byte of the content, flipped in its low bit.
+        let header = good.iter().position(|&b| b == b'\n').unwrap() + 1;
+        for at in (header..good.len()).step_by(97) {
+            let mut bad = good.clone();
+            bad[at] ^= 1;
+            std::fs::write(&path, &bad).unwrap();
+            match read(dir.path(), &p, 1) {
+                ResultState::Corrupt(why) => assert!(why.contains("checksum"), "{why}"),
+                other => panic!("byte {at} changed, read as {other:?}"),
+            }
+        }
+        std::fs::write(&path, &good[..good.len() - 10]).unwrap();
+        assert!(matches!(read(dir.path(), &p, 1), ResultState::Corrupt(_)));
+        std::fs::write(&path, b"not a result").unwrap();
+        let ResultState::Corrupt(why) = read(dir.path(), &p, 1) else {
+            panic!()
+        };
+        assert!(why.contains("no header line"), "{why}");
+        // The right file under the wrong name.
+        std::fs::write(&path, &good).unwrap();
+        std::fs::copy(&path, dir.path().join("results/000000.json")).unwrap();
+        let ResultState::Corrupt(why) = read(dir.path(), &p, 0) else {
+            panic!()
+        };
+        assert!(why.contains("it answers trial 1"), "{why}");
+    }
+
+    #[test]
+    fn stale_partial_files_are_removed_for_their_index_only() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = plan();
+        let results = dir.path().join("results");
+        std::fs::create_dir_all(&results).unwrap();
+        for name in [".000001-abc.partial", ".000000-def.partial", "000000.json"] {
+            std::fs::write(results.join(name), b"x").unwrap();
+        }
+        remove_partials(dir.path(), &p, 1);
+        let mut left: Vec<String> = std::fs::read_dir(&results)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        assert_eq!(left, [".000000-def.partial", "000000.json"]);
+    }
 }

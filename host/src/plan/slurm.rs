@@ -167,7 +167,12 @@ pub fn ended_states(jobs: &[String]) -> Option<TaskStates> {
         return Some(TaskStates::new());
     }
     let out = Command::new("sacct")
-        .args(["--noheader", "--parsable2", "--allocations", "--format=JobID,State"])
+        .args([
+            "--noheader",
+            "--parsable2",
+            "--allocations",
+            "--format=JobID,State",
+        ])
         .arg(format!("--jobs={}", jobs.join(",")))
         .output()
         .ok()?;
@@ -242,7 +247,9 @@ pub fn check_sbatch_arg(a: &str) -> Result<(), CliError> {
         }
     }
     if a.is_empty() {
-        return Err(usage("--sbatch-arg is empty: give an sbatch option such as --mem=2G"));
+        return Err(usage(
+            "--sbatch-arg is empty: give an sbatch option such as --mem=2G",
+        ));
     }
     Ok(())
 }
@@ -260,7 +267,15 @@ mod tests {
 
     #[test]
     fn time_limits() {
-        for ok in ["30", "30:00", "2:00:00", "1-12", "1-12:30", "1-12:30:05", "0"] {
+        for ok in [
+            "30",
+            "30:00",
+            "2:00:00",
+            "1-12",
+            "1-12:30",
+            "1-12:30:05",
+            "0",
+        ] {
             assert!(check_time(ok).is_ok(), "{ok}");
         }
         for bad in ["", "1h", "1:2:3:4", "-5", "1-", "a-1", "1-2-3", "1:", "1 2"] {

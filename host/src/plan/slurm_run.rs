@@ -62,8 +62,12 @@ pub fn run(dir: &Path, plan: &Plan, opts: &SlurmOptions) -> Result<SlurmOutcome,
     store::write(dir, plan)?;
     // The script names this pada executable: written again on every run, so
     // a plan written by another build runs with this one.
-    store::write_array_script(dir, plan)
-        .map_err(|e| usage(format!("cannot write the job script in {}: {e:#}", dir.display())))?;
+    store::write_array_script(dir, plan).map_err(|e| {
+        usage(format!(
+            "cannot write the job script in {}: {e:#}",
+            dir.display()
+        ))
+    })?;
     let jobs_file = store::slurm_dir(dir).join("jobs.txt");
     let mut report = SlurmReport::default();
     let mut first_submission: Option<Instant> = None;
@@ -148,7 +152,10 @@ fn why_no_result(
     what: &str,
 ) -> String {
     if let Some(states) = states {
-        if let Some((_, state)) = states.iter().find(|((j, t), _)| jobs.contains(j) && *t == index) {
+        if let Some((_, state)) = states
+            .iter()
+            .find(|((j, t), _)| jobs.contains(j) && *t == index)
+        {
             return format!("no verified result ({state}; {what})");
         }
     }
@@ -236,9 +243,11 @@ impl Progress {
         let bar = std::io::stderr().is_terminal().then(|| {
             let b = ProgressBar::with_draw_target(Some(total as u64), ProgressDrawTarget::stderr());
             b.set_style(
-                ProgressStyle::with_template("slurm [{bar:30}] {pos}/{len} trials, {msg}, {elapsed}")
-                    .unwrap_or_else(|_| ProgressStyle::default_bar())
-                    .progress_chars("=> "),
+                ProgressStyle::with_template(
+                    "slurm [{bar:30}] {pos}/{len} trials, {msg}, {elapsed}",
+                )
+                .unwrap_or_else(|_| ProgressStyle::default_bar())
+                .progress_chars("=> "),
             );
             b
         });

@@ -192,8 +192,8 @@ pub fn load(dir: &Path) -> Result<Plan, CliError> {
             path.display()
         ))
     })?;
-    let file: PlanFile = serde_json::from_slice(&text)
-        .map_err(|e| bad(format!("plan.json is not a plan ({e})")))?;
+    let file: PlanFile =
+        serde_json::from_slice(&text).map_err(|e| bad(format!("plan.json is not a plan ({e})")))?;
     if file.format != PLAN_FORMAT {
         return Err(bad(format!(
             "format {} is not supported: valid is {PLAN_FORMAT}",
@@ -307,7 +307,10 @@ mod tests {
         std::fs::write(root.path().join("notes.txt"), "x").unwrap();
         let e = write(root.path(), &plan(1)).unwrap_err().to_string();
         assert!(e.contains("holds no plan.json"), "{e}");
-        assert!(load(root.path()).unwrap_err().to_string().contains("cannot read"));
+        assert!(load(root.path())
+            .unwrap_err()
+            .to_string()
+            .contains("cannot read"));
     }
 
     #[test]
