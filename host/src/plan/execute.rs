@@ -21,7 +21,7 @@ pub enum Outcome {
         /// The result file.
         path: PathBuf,
         /// The result.
-        result: TrialResult,
+        result: Box<TrialResult>,
         /// Its timing.
         timing: TrialTiming,
         /// Why an existing file was replaced (it did not verify), if one was.
@@ -57,7 +57,7 @@ pub fn run_index(dir: &Path, plan: &Plan, index: u32) -> anyhow::Result<Outcome>
     let path = result::write(dir, plan, spec, &result, &timing)?;
     Ok(Outcome::Ran {
         path,
-        result,
+        result: Box::new(result),
         timing,
         replaced,
     })

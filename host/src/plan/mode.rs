@@ -113,7 +113,7 @@ pub enum FromPlan {
         /// The results.
         collected: Collected,
         /// The run's timing.
-        timing: RunTiming,
+        timing: Box<RunTiming>,
     },
 }
 
@@ -150,7 +150,10 @@ pub fn from_plan(mode: &Mode, plan: &Plan, json: bool) -> Result<FromPlan, CliEr
                 &collected.timings,
                 &labels,
             );
-            Ok(FromPlan::Results { collected, timing })
+            Ok(FromPlan::Results {
+                collected,
+                timing: Box::new(timing),
+            })
         }
         Mode::Slurm(dir, opts) => {
             let outcome = slurm_run::run(dir, plan, opts)?;
@@ -164,7 +167,7 @@ pub fn from_plan(mode: &Mode, plan: &Plan, json: bool) -> Result<FromPlan, CliEr
             timing.slurm = Some(outcome.report);
             Ok(FromPlan::Results {
                 collected: outcome.collected,
-                timing,
+                timing: Box::new(timing),
             })
         }
     }
@@ -248,6 +251,6 @@ pub fn obtain(
     let plan = Plan::new(experiment.clone()).map_err(CliError::Runtime)?;
     Ok(match from_plan(mode, &plan, json)? {
         FromPlan::Written => Trials::PlanWritten,
-        FromPlan::Results { collected, timing } => Trials::Results(collected.per_config, timing),
+        FromPlan::Results { collected, timing } => Trials::Results(collected.per_config, *timing),
     })
 }
