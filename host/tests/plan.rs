@@ -153,20 +153,36 @@ fn a_merged_paper_leo_equals_the_local_run_with_its_best_learner() {
     ok(&run(&["--out", local.to_str().unwrap()]));
     ok(&run(&["--plan", plan.to_str().unwrap()]));
     run_all_trials(&plan, 9);
-    let out = run(&[
-        "--merge",
-        plan.to_str().unwrap(),
-        "--out",
-        merged.to_str().unwrap(),
-    ]);
+    // Of the nine trials' weights, only the best trial's are left.
+    let kept: Vec<_> = std::fs::read_dir(plan.join("best")).unwrap().collect();
+    assert_eq!(kept.len(), 1, "{kept:?}");
+    let merge = |to: &Path| {
+        run(&[
+            "--merge",
+            plan.to_str().unwrap(),
+            "--out",
+            to.to_str().unwrap(),
+        ])
+    };
+    let out = merge(&merged);
     ok(&out);
-    assert!(
-        String::from_utf8_lossy(&out.stderr).contains("running the best trial again"),
-        "the merge draws the best learner by running its trial again"
-    );
+    let rerun = |out: &Output| {
+        String::from_utf8_lossy(&out.stderr).contains("running the best trial again")
+    };
+    assert!(!rerun(&out), "the merge takes the kept weights");
     // best.weights, the gait strip and animation are the local run's too.
     assert!(files(&merged).contains_key("best.weights"));
     assert_same_outputs(&local, &merged);
+
+    // Without the kept weights, the merge runs the best trial again.
+    for e in std::fs::read_dir(plan.join("best")).unwrap() {
+        std::fs::remove_file(e.unwrap().path()).unwrap();
+    }
+    let again = root.path().join("again");
+    let out = merge(&again);
+    ok(&out);
+    assert!(rerun(&out), "the best trial is run again");
+    assert_same_outputs(&local, &again);
 }
 
 /// `pada run` of low-pass on the pendulum, 60 s trials, seed 11, JSON.

@@ -50,12 +50,10 @@ pub fn run(args: PaperArgs) -> Result<(), CliError> {
         Trials::PlanWritten => return Ok(()),
         Trials::Results(r, t) => (r, t),
     };
-    let best = match kept {
-        Some(best) => best,
-        None => {
-            eprintln!("running the best trial again for its weights and gait (one trial's time)");
-            leo::rerun_best(&experiment, &per_config)?
-        }
+    let best = match (kept, mode.plan_dir()) {
+        (Some(best), _) => best,
+        (None, Some(dir)) => leo::best_of_plan(dir, &experiment, &per_config)?,
+        (None, None) => leo::rerun_best(&experiment, &per_config)?,
     };
     let r = leo::assemble(&o, &experiment, per_config)?;
     let report = render(&r, &command);

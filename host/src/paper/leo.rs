@@ -223,6 +223,46 @@ pub fn rerun_best(
     }))
 }
 
+/// The best trial's learner for a run of the plan in `dir`: the weights
+/// its trial kept there ([`crate::plan::best`]), or, if they are missing,
+/// the trial run again ([`rerun_best`]).
+pub fn best_of_plan(
+    dir: &std::path::Path,
+    experiment: &Experiment,
+    per_config: &[Vec<TrialResult>],
+) -> anyhow::Result<Option<BestTrial>> {
+    let Some((config, trial)) = best_of(per_config) else {
+        return Ok(None);
+    };
+    let index = experiment
+        .trials()
+        .iter()
+        .position(|t| t.config == config && t.trial == trial)
+        .ok_or_else(|| anyhow::anyhow!("the best trial is not in the plan"))? as u32;
+    let path = crate::plan::best::weights_path(dir, index);
+    if !path.exists() {
+        eprintln!(
+            "{} is missing: running the best trial again for its weights and gait",
+            path.display()
+        );
+        return rerun_best(experiment, per_config);
+    }
+    let (header, agent) = crate::weights::load(&path, LeoTask::default().spec())?;
+    let cfg = experiment.configurations[config].run_config()?;
+    anyhow::ensure!(
+        header.policy == cfg.policy,
+        "{} holds the weights of another configuration",
+        path.display()
+    );
+    Ok(Some(BestTrial {
+        config,
+        trial,
+        end_performance: per_config[config][trial as usize].end_performance,
+        switched: header.switched,
+        agent,
+    }))
+}
+
 /// The results of Section VIII from every configuration's trials.
 pub fn assemble(
     o: &LeoOptions,

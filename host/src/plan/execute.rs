@@ -1,13 +1,15 @@
 //! Running one trial of a plan (`pada trial`): the trial the index names,
-//! with the experiment runner's own [`run_trial`], its result written
-//! atomically under `DIR/results/`. A trial whose result already verifies
+//! with the experiment runner's own [`run_trial_keep`], its result written
+//! atomically under `DIR/results/` (and, for a report that draws the best
+//! learner, its weights offered to [`best`]). A trial whose result already verifies
 //! is not run again, so a resubmitted or repeated array task costs nothing.
 
+use super::best;
 use super::result::{self, ResultState, TrialTiming};
 use super::spec::{Plan, TrialSpec};
-use crate::experiment::task::Task;
+use crate::experiment::task::{Task, TaskSpec};
 use crate::experiment::tasks::{visit_task, TaskVisitor};
-use crate::experiment::{run_trial, RunConfig, TrialResult};
+use crate::experiment::{run_trial_keep, HostAgent, RunConfig, TrialResult};
 use std::path::{Path, PathBuf};
 use std::time::{Instant, SystemTime, UNIX_EPOCH};
 
@@ -34,11 +36,15 @@ struct RunOne<'a> {
     trial: u32,
 }
 
+/// A trial's result, and its learner with what saving it needs.
+type Learned = (TrialResult, HostAgent, bool, TaskSpec);
+
 impl TaskVisitor for RunOne<'_> {
-    type Output = anyhow::Result<TrialResult>;
+    type Output = anyhow::Result<Learned>;
 
     fn visit<T: Task>(self, task: &T) -> Self::Output {
-        run_trial(task, self.cfg, self.trial, &|_| {})
+        let (result, agent, switched) = run_trial_keep(task, self.cfg, self.trial, &|_| {})?;
+        Ok((result, agent, switched, task.spec().clone()))
     }
 }
 
@@ -53,8 +59,14 @@ pub fn run_index(dir: &Path, plan: &Plan, index: u32) -> anyhow::Result<Outcome>
         ResultState::Corrupt(why) => Some(why),
     };
     result::remove_partials(dir, plan, index);
-    let (result, timing) = run_spec(spec)?;
+    let ((result, agent, switched, task_spec), timing) = run_spec(spec)?;
     let path = result::write(dir, plan, spec, &result, &timing)?;
+    if plan.experiment.kind.keeps_best_learner() {
+        let policy = spec.configuration.run_config()?.policy;
+        best::offer(dir, plan, index, result.end_performance, |p| {
+            crate::weights::save(p, &task_spec, policy, switched, &agent)
+        })?;
+    }
     Ok(Outcome::Ran {
         path,
         result: Box::new(result),
@@ -64,7 +76,7 @@ pub fn run_index(dir: &Path, plan: &Plan, index: u32) -> anyhow::Result<Outcome>
 }
 
 /// Runs the trial `spec` describes and times it.
-pub fn run_spec(spec: &TrialSpec) -> anyhow::Result<(TrialResult, TrialTiming)> {
+fn run_spec(spec: &TrialSpec) -> anyhow::Result<(Learned, TrialTiming)> {
     let task = spec.configuration.task_name()?;
     let cfg = spec.configuration.run_config()?;
     let started = SystemTime::now()
@@ -72,7 +84,7 @@ pub fn run_spec(spec: &TrialSpec) -> anyhow::Result<(TrialResult, TrialTiming)> 
         .map(|d| d.as_secs_f64())
         .unwrap_or(0.0);
     let clock = Instant::now();
-    let result = visit_task(
+    let learned = visit_task(
         task,
         RunOne {
             cfg: &cfg,
@@ -81,14 +93,14 @@ pub fn run_spec(spec: &TrialSpec) -> anyhow::Result<(TrialResult, TrialTiming)> 
     )?;
     let wall_s = clock.elapsed().as_secs_f64();
     anyhow::ensure!(
-        result.seed == spec.trial_seed,
+        learned.0.seed == spec.trial_seed,
         "trial {} ran with seed {} but the plan says {}",
         spec.describe(),
-        result.seed,
+        learned.0.seed,
         spec.trial_seed
     );
     Ok((
-        result,
+        learned,
         TrialTiming {
             started_unix_s: started,
             wall_s,

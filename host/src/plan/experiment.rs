@@ -24,6 +24,12 @@ pub enum ExperimentKind {
 }
 
 impl ExperimentKind {
+    /// Whether its report draws the best trial's learner (so each trial of
+    /// its plan offers its weights, [`super::best`]).
+    pub fn keeps_best_learner(self) -> bool {
+        self == ExperimentKind::PaperLeo
+    }
+
     /// The command that writes, merges and reports it.
     pub fn command(self) -> &'static str {
         match self {

@@ -14,9 +14,11 @@
 //! | [`local`] | an experiment's configurations run in this process |
 //! | [`slurm`] | Slurm's client commands (sbatch, squeue, sacct, scontrol) |
 //! | [`slurm_run`] | `--slurm`: submit, wait, resubmit, collect |
+//! | [`best`] | the best learner of a plan, kept across array tasks without locks |
 //! | [`exact`] | floats stored bit for bit in JSON |
 //! | [`mode`] | where a command's trials come from: local, plan, merge or Slurm |
 
+pub mod best;
 pub mod collect;
 pub mod exact;
 pub mod execute;

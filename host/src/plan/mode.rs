@@ -65,6 +65,16 @@ pub enum Mode {
     Slurm(PathBuf, SlurmOptions),
 }
 
+impl Mode {
+    /// The plan's directory, for the modes that use one.
+    pub fn plan_dir(&self) -> Option<&Path> {
+        match self {
+            Mode::Local => None,
+            Mode::WritePlan(d) | Mode::Merge(d) | Mode::Slurm(d, _) => Some(d),
+        }
+    }
+}
+
 impl ClusterOptions {
     /// The mode the options ask for, checked; `out` is the output directory
     /// (a `--slurm` plan goes to `out/plan` unless `--plan` names one).
