@@ -348,7 +348,8 @@ fn a_changed_or_another_plan_is_refused() {
         2,
         &["holds the plan of"],
     );
-    // An edited trial file: `pada trial` refuses the plan.
+    // An edited trial file: that trial refuses to run, and so does the
+    // merge (which reads them all).
     let path = root.path().join("plan/trials/000001.json");
     let text = std::fs::read_to_string(&path).unwrap();
     std::fs::write(
@@ -356,10 +357,27 @@ fn a_changed_or_another_plan_is_refused() {
         text.replace("\"seconds\": 60.0", "\"seconds\": 600.0"),
     )
     .unwrap();
+    let changed = "a file of the plan was changed after it was written";
+    fails(
+        &pada(&["trial", "--plan", &p("plan"), "--index", "1"]),
+        2,
+        &["000001.json is not the plan's trial 1", changed],
+    );
+    fails(
+        &pada_s(&run_args("2", &["--merge", &p("plan")])),
+        2,
+        &[changed],
+    );
+    std::fs::write(&path, text).unwrap();
+    ok(&pada(&["trial", "--plan", &p("plan"), "--index", "1"]));
+    // An edited plan.json: every trial refuses it.
+    let path = root.path().join("plan/plan.json");
+    let text = std::fs::read_to_string(&path).unwrap();
+    std::fs::write(&path, text.replace("\"seed\": 11", "\"seed\": 12")).unwrap();
     fails(
         &pada(&["trial", "--plan", &p("plan"), "--index", "0"]),
         2,
-        &["a file of the plan was changed after it was written"],
+        &["plan.json hashes to", changed],
     );
     fails(
         &pada(&["trial", "--plan", &p("nowhere"), "--index", "0"]),

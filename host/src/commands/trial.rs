@@ -69,13 +69,14 @@ pub fn resolve_index(
 
 /// Runs `pada trial`.
 pub fn run(args: TrialArgs) -> Result<(), CliError> {
-    let plan = store::load(&args.plan)?;
+    let plan = store::load_header(&args.plan)?;
     let index = resolve_index(
         args.index,
         args.index_offset,
         |v| std::env::var(v).ok(),
         plan.len(),
     )?;
+    store::check_trial(&args.plan, &plan, index)?;
     let spec = &plan.trials[index as usize];
     match run_index(&args.plan, &plan, index)? {
         Outcome::AlreadyDone(path) => {

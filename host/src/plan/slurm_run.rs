@@ -59,6 +59,10 @@ const SQUEUE_FAILURES: u32 = 120;
 /// Runs `plan` in `dir` on Slurm.
 pub fn run(dir: &Path, plan: &Plan, opts: &SlurmOptions) -> Result<SlurmOutcome, CliError> {
     slurm::check_available()?;
+    // Absolute, so that the array tasks' logs land in the plan whatever
+    // directory Slurm starts them in.
+    let dir = &std::path::absolute(dir)
+        .map_err(|e| usage(format!("cannot resolve {}: {e}", dir.display())))?;
     store::write(dir, plan)?;
     // The script names this pada executable: written again on every run, so
     // a plan written by another build runs with this one.
@@ -204,8 +208,8 @@ fn submit_all(
         })
         .map_err(CliError::Runtime)?;
         eprintln!(
-            "slurm: submitted job {id}: {} trials (indices {}{})",
-            indices.len(),
+            "slurm: submitted job {id}: {} (indices {}{})",
+            trials(indices.len()),
             slurm::array_spec(&indices.iter().map(|i| i + offset).collect::<Vec<_>>()),
             if offset > 0 {
                 format!(", array offset {offset}")
@@ -216,6 +220,15 @@ fn submit_all(
         jobs.push(id);
     }
     Ok(jobs)
+}
+
+/// `1 trial`, `6 trials`.
+fn trials(n: usize) -> String {
+    if n == 1 {
+        "1 trial".into()
+    } else {
+        format!("{n} trials")
+    }
 }
 
 fn read_jobs(path: &Path) -> Vec<String> {

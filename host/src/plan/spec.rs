@@ -110,17 +110,6 @@ impl Plan {
         })
     }
 
-    /// Rebuilds a plan from its parts as read from files; the caller checks
-    /// the hash against the stored one.
-    pub fn from_parts(experiment: Experiment, trials: Vec<TrialSpec>) -> anyhow::Result<Plan> {
-        let hash = hash_of(&experiment, &trials)?;
-        Ok(Plan {
-            experiment,
-            trials,
-            hash,
-        })
-    }
-
     /// Number of trials.
     pub fn len(&self) -> usize {
         self.trials.len()
@@ -180,15 +169,12 @@ mod tests {
         assert_eq!(a.hash.len(), 64);
         assert_eq!(a.hash, Plan::new(experiment(1)).unwrap().hash);
         assert_ne!(a.hash, Plan::new(experiment(2)).unwrap().hash);
-        let mut trials = a.trials.clone();
-        trials[2].configuration.seconds = 61.0;
-        assert_ne!(
-            Plan::from_parts(a.experiment.clone(), trials).unwrap().hash,
-            a.hash
-        );
+        let mut e = a.experiment.clone();
+        e.configurations[0].seconds = 61.0;
+        assert_ne!(Plan::new(e).unwrap().hash, a.hash);
         let mut e = a.experiment.clone();
         e.command += " --seed 1";
-        assert_ne!(Plan::from_parts(e, a.trials.clone()).unwrap().hash, a.hash);
+        assert_ne!(Plan::new(e).unwrap().hash, a.hash);
         assert_eq!(a.trials[2].result, "results/000002.json");
         assert_eq!(a.trials[1].describe(), "1 (pendulum pada Δ=0.5, trial 1)");
     }

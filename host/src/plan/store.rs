@@ -184,6 +184,19 @@ fn another_plan(dir: &Path, existing: &Plan, wanted: &Plan) -> CliError {
 
 /// Loads the plan in `dir`, checking every file against the hash.
 pub fn load(dir: &Path) -> Result<Plan, CliError> {
+    let plan = load_header(dir)?;
+    for i in 0..plan.len() as u32 {
+        check_trial(dir, &plan, i)?;
+    }
+    Ok(plan)
+}
+
+/// Loads `plan.json` and checks it against its hash. The trials follow
+/// from its configurations, so they are enumerated again rather than read;
+/// [`check_trial`] then compares a trial's file with its enumeration. (A
+/// trial checks only its own file: reading all of them in each of N array
+/// tasks would cost N² reads.)
+pub fn load_header(dir: &Path) -> Result<Plan, CliError> {
     let bad = |why: String| usage(format!("plan {}: {why}", dir.display()));
     let path = plan_json(dir);
     let text = std::fs::read(&path).map_err(|e| {
@@ -206,37 +219,42 @@ pub fn load(dir: &Path) -> Result<Plan, CliError> {
             file.pada_version
         )));
     }
-    let mut trials = Vec::with_capacity(file.trials as usize);
-    for i in 0..file.trials {
-        let path = trial_json(dir, i);
-        let text = std::fs::read(&path)
-            .map_err(|e| bad(format!("cannot read {} ({e})", path.display())))?;
-        let t: TrialFile = serde_json::from_slice(&text)
-            .map_err(|e| bad(format!("{} is not a trial of a plan ({e})", path.display())))?;
-        if t.plan != file.hash || t.trial.index != i {
-            return Err(bad(format!(
-                "{} belongs to another plan or index (plan {}, index {}): the plan's files were mixed",
-                path.display(),
-                t.plan.get(..12).unwrap_or(&t.plan),
-                t.trial.index
-            )));
-        }
-        trials.push(t.trial);
-    }
+    let changed = |what: String| {
+        bad(format!(
+            "{what}: a file of the plan was changed after it was written"
+        ))
+    };
     let experiment = Experiment {
         kind: file.kind,
         command: file.command,
         configurations: file.configurations,
     };
-    let plan = Plan::from_parts(experiment, trials).map_err(CliError::Runtime)?;
-    if plan.hash != file.hash {
-        return Err(bad(format!(
-            "its files hash to {} but plan.json says {}: a file of the plan was changed after it was written",
+    let plan = Plan::new(experiment).map_err(|e| changed(format!("{e:#}")))?;
+    if plan.hash != file.hash || plan.len() != file.trials as usize {
+        return Err(changed(format!(
+            "plan.json hashes to {} but says {}",
             plan.short_hash(),
             file.hash.get(..12).unwrap_or(&file.hash)
         )));
     }
     Ok(plan)
+}
+
+/// Checks that trial `index`'s file is the plan's trial.
+pub fn check_trial(dir: &Path, plan: &Plan, index: u32) -> Result<(), CliError> {
+    let bad = |why: String| usage(format!("plan {}: {why}", dir.display()));
+    let path = trial_json(dir, index);
+    let text =
+        std::fs::read(&path).map_err(|e| bad(format!("cannot read {} ({e})", path.display())))?;
+    let t: TrialFile = serde_json::from_slice(&text)
+        .map_err(|e| bad(format!("{} is not a trial of a plan ({e})", path.display())))?;
+    if t.plan != plan.hash || t.trial != plan.trials[index as usize] {
+        return Err(bad(format!(
+            "{} is not the plan's trial {index}: a file of the plan was changed after it was written",
+            path.display()
+        )));
+    }
+    Ok(())
 }
 
 /// Loads the plan in `dir` and checks that it is `wanted` (the plan of the
