@@ -100,16 +100,17 @@ pub fn run(dir: &Path, plan: &Plan, opts: &SlurmOptions) -> Result<SlurmOutcome,
     }
     let max_array = slurm::max_array_size();
     let mut attempt = 0;
-    let mut last_jobs: Vec<String> = Vec::new();
+    let mut last_jobs: Vec<Submitted> = Vec::new();
     while !scan.problems.is_empty() && attempt <= opts.retries {
         let todo: Vec<u32> = scan.problems.iter().map(|p| p.index).collect();
         if attempt > 0 {
-            let states = slurm::ended_states(&last_jobs);
+            let ids: Vec<String> = last_jobs.iter().map(|j| j.id.clone()).collect();
+            let states = slurm::ended_states(&ids);
             for p in &scan.problems {
                 eprintln!(
                     "slurm: trial {} left {}; submitting it again (attempt {} of {})",
                     p.trial,
-                    why_no_result(&states, &last_jobs, dir, p.index, &p.what),
+                    why_no_result(&states, &last_jobs, max_array, dir, p.index, &p.what),
                     attempt + 1,
                     opts.retries + 1
                 );
@@ -118,9 +119,10 @@ pub fn run(dir: &Path, plan: &Plan, opts: &SlurmOptions) -> Result<SlurmOutcome,
         }
         first_submission.get_or_insert_with(Instant::now);
         last_jobs = submit_all(dir, plan, &todo, opts, max_array)?;
-        append_jobs(&jobs_file, &last_jobs)?;
-        report.jobs.extend(last_jobs.iter().cloned());
-        wait(dir, plan, &last_jobs)?;
+        let ids: Vec<String> = last_jobs.iter().map(|j| j.id.clone()).collect();
+        append_jobs(&jobs_file, &ids)?;
+        report.jobs.extend(ids.iter().cloned());
+        wait(dir, plan, &ids)?;
         attempt += 1;
         scan = collect::scan(dir, plan);
     }
@@ -146,27 +148,37 @@ pub fn run(dir: &Path, plan: &Plan, opts: &SlurmOptions) -> Result<SlurmOutcome,
     })
 }
 
+/// A submitted job array: its id and the plan index of its array index 0.
+struct Submitted {
+    id: String,
+    offset: u32,
+}
+
 /// The cause of a missing result: sacct's state where accounting is kept,
 /// else the file's problem and the task's log.
 fn why_no_result(
     states: &Option<TaskStates>,
-    jobs: &[String],
+    jobs: &[Submitted],
+    max_array: u32,
     dir: &Path,
     index: u32,
     what: &str,
 ) -> String {
-    if let Some(states) = states {
-        if let Some((_, state)) = states
-            .iter()
-            .find(|((j, t), _)| jobs.contains(j) && *t == index)
-        {
-            return format!("no verified result ({state}; {what})");
-        }
-    }
-    let log = jobs
+    // The array task that ran plan index `index`: (job id, array index).
+    let Some((job, task)) = jobs
         .iter()
-        .map(|j| store::slurm_dir(dir).join(format!("{j}_{index}.out")))
-        .find(|p| p.exists());
+        .find(|j| (j.offset..j.offset.saturating_add(max_array)).contains(&index))
+        .map(|j| (j.id.as_str(), index - j.offset))
+    else {
+        return format!("no verified result ({what})");
+    };
+    if let Some(state) = states
+        .as_ref()
+        .and_then(|s| s.get(&(job.to_string(), task)))
+    {
+        return format!("no verified result ({state}; {what})");
+    }
+    let log = Some(store::slurm_dir(dir).join(format!("{job}_{task}.out"))).filter(|p| p.exists());
     match log {
         Some(p) => format!("no verified result ({what}; log {})", p.display()),
         None => format!("no verified result ({what})"),
@@ -182,18 +194,18 @@ fn submit_all(
     todo: &[u32],
     opts: &SlurmOptions,
     max_array: u32,
-) -> Result<Vec<String>, CliError> {
+) -> Result<Vec<Submitted>, CliError> {
     let script = store::array_script(dir);
     let output = store::slurm_dir(dir).join("%A_%a.out");
     let name = format!("pada-{}", plan.short_hash());
-    let mut jobs: Vec<String> = Vec::new();
+    let mut jobs: Vec<Submitted> = Vec::new();
     let mut rest = todo;
     while let Some(&first) = rest.first() {
         let offset = first / max_array * max_array;
         let n = rest.iter().take_while(|&&i| i < offset + max_array).count();
         let indices: Vec<u32> = rest[..n].iter().map(|i| i - offset).collect();
         rest = &rest[n..];
-        let after = opts.max_parallel.and(jobs.last().map(String::as_str));
+        let after = opts.max_parallel.and(jobs.last().map(|j| j.id.as_str()));
         let id = slurm::submit(&Submission {
             script: &script,
             offset,
@@ -217,7 +229,7 @@ fn submit_all(
                 String::new()
             }
         );
-        jobs.push(id);
+        jobs.push(Submitted { id, offset });
     }
     Ok(jobs)
 }
