@@ -13,7 +13,7 @@
 //! delay).
 
 use crate::io::{BusPort, PortError};
-use pada_core::dynamixel::{self, table, DecodeError, ErrorFlags, StatusDecoder, StatusPacket, BROADCAST_ID};
+use pada_core::dynamixel::{self, table, DecodeError, ErrorFlags, Reply, StatusDecoder, StatusPacket, BROADCAST_ID};
 
 /// Longest status packet the firmware reads (header to checksum).
 pub const STATUS_LEN: usize = 32;
@@ -141,7 +141,7 @@ impl<P: BusPort> ServoBus<P> {
             return exchange;
         };
         for _ in 0..self.config.attempts.max(1) {
-            match self.request(id, n, &mut exchange.checksum_errors).await {
+            match self.request(Reply { id, params: len }, n, &mut exchange.checksum_errors).await {
                 Some(status) if status.params.len() == len as usize => {
                     exchange.status = Some(status);
                     return exchange;
@@ -161,7 +161,7 @@ impl<P: BusPort> ServoBus<P> {
             return exchange;
         };
         for _ in 0..self.config.attempts.max(1) {
-            if let Some(status) = self.request(id, n, &mut exchange.checksum_errors).await {
+            if let Some(status) = self.request(Reply { id, params: 0 }, n, &mut exchange.checksum_errors).await {
                 exchange.status = Some(status);
                 return exchange;
             }
@@ -252,7 +252,7 @@ impl<P: BusPort> ServoBus<P> {
                 return;
             };
             let mut checksum_errors = 0;
-            let _ = self.request(id, n, &mut checksum_errors).await;
+            let _ = self.request(Reply { id, params: 0 }, n, &mut checksum_errors).await;
         } else {
             self.write_no_reply(id, addr, data).await.ok();
         }
@@ -269,11 +269,14 @@ impl<P: BusPort> ServoBus<P> {
     }
 
     /// One attempt: send the first `n` bytes of the transmit buffer, listen
-    /// for `id`'s status packet until the reply deadline.
-    async fn request(&mut self, id: u8, n: usize, checksum_errors: &mut u8) -> Option<Status> {
+    /// for the `reply` (the servo asked, with the parameter count the
+    /// request implies) until the reply deadline. Anything else on the bus
+    /// is discarded and counted as stray; the decoder resynchronises on the
+    /// next header.
+    async fn request(&mut self, reply: Reply, n: usize, checksum_errors: &mut u8) -> Option<Status> {
         self.port.discard_input();
         self.decoder.reset();
-        self.decoder.expect(Some(id));
+        self.decoder.expect(Some(reply));
         self.send(n).await.ok()?;
         let deadline = self.port.now_us() + self.config.reply_timeout_us as u64;
         loop {
@@ -298,7 +301,7 @@ impl<P: BusPort> ServoBus<P> {
                         *checksum_errors = checksum_errors.saturating_add(1);
                         corrupted = true;
                     }
-                    Err(DecodeError::UnexpectedId { .. } | DecodeError::BadLength { .. }) => {
+                    Err(DecodeError::UnexpectedId { .. } | DecodeError::BadLength { .. } | DecodeError::BroadcastStatus) => {
                         self.stats.stray_packets = self.stats.stray_packets.wrapping_add(1);
                     }
                 }
@@ -335,6 +338,9 @@ pub(crate) mod tests {
         /// Answers to drop (counted down), to corrupt, and a stray prefix.
         pub drop_next: u32,
         pub corrupt_next: u32,
+        /// Bytes put on the bus before the next answer (noise, other
+        /// servos' packets).
+        pub stray: Vec<u8>,
         pub decoder: InstructionDecoder<64>,
     }
 
@@ -364,6 +370,7 @@ pub(crate) mod tests {
                 now: 0,
                 drop_next: 0,
                 corrupt_next: 0,
+                stray: Vec::new(),
                 decoder: InstructionDecoder::new(),
             }
         }
@@ -385,6 +392,7 @@ pub(crate) mod tests {
                 let last = bytes.len() - 1;
                 bytes[last] ^= 0x55;
             }
+            self.inbox.extend(self.stray.drain(..));
             self.inbox.extend(bytes);
         }
     }
@@ -499,6 +507,24 @@ pub(crate) mod tests {
         let (state, ex) = block_on(bus.read_present(1));
         assert!(state.is_none());
         assert_eq!((ex.timeouts, ex.checksum_errors), (2, 2));
+    }
+
+    #[test]
+    fn stray_packets_before_the_reply_are_discarded_and_counted() {
+        // Issue 16, defect 6: a valid packet from another servo, one from
+        // the asked servo with the wrong length, and a spurious header with
+        // a large LENGTH come before the real reply.
+        let mut bus = ServoBus::new(FakeBus::with_servos(&[1]), BusConfig::default());
+        let mut buf = [0u8; 64];
+        let mut stray = Status::new(2, ErrorFlags::NONE, &[0; 8]).unwrap().encode(&mut buf).unwrap().to_vec();
+        stray.extend_from_slice(Status::new(1, ErrorFlags::NONE, &[0; 3]).unwrap().encode(&mut buf).unwrap());
+        stray.extend_from_slice(&[0xFF, 0xFF, 1, 28]);
+        bus.port_mut().stray = stray;
+        let (state, ex) = block_on(bus.read_present(1));
+        assert_eq!(state.map(|s| s.position), Some(512));
+        assert_eq!((ex.timeouts, ex.checksum_errors), (0, 0));
+        assert_eq!(bus.stats().stray_packets, 3);
+        assert_eq!(bus.stats().replies, 1);
     }
 
     #[test]

@@ -45,7 +45,7 @@ use crate::io::CycleCounter;
 use crate::robot::{RobotAdapter, Sensed};
 use heapless::Vec;
 use pada_core::agent::{Decision, EpisodeEnd, Mode};
-use pada_core::checkpoint::{self, CheckpointStore, LearnerState, LoadOutcome, SaveError, Saved};
+use pada_core::checkpoint::{self, CheckpointStore, FlashWear, LearnerState, LoadOutcome, SaveError, Saved, WearBudget};
 use pada_core::dynamixel::{table::PresentState, ErrorFlags};
 use pada_core::error::ConfigError;
 use pada_core::fatigue::{FatigueCounter, FatigueError, GearboxParams, PAPER_WINDOW_STEPS};
@@ -102,6 +102,9 @@ pub struct PeriodOutput {
     pub transitions: Vec<Transition, 8>,
     /// Cycles of the agent call, if there was one.
     pub agent_cycles: Option<u32>,
+    /// The gearbox torque of each servo the fatigue counter saw this
+    /// period \[N·m\] (the robot's estimate; 0 with torque off).
+    pub torques: [f32; MAX_SERVOS],
 }
 
 /// A host command's result, for the `Ack`/`Nack`.
@@ -183,6 +186,15 @@ pub struct Controller<W, R> {
     checkpoints_refused: u32,
     /// Why the last learner state was refused.
     last_refusal: Option<ConfigError>,
+    /// Control periods since boot (the operating time of this boot).
+    periods: u64,
+    /// The checkpoint sectors' erases as far as known (the store's newest
+    /// record at load, then every save of this boot).
+    flash_wear: FlashWear,
+    /// Operating seconds before this boot, as the checkpoints carried it.
+    operating_before_s: u64,
+    /// Saves refused since boot to keep the flash within its budget.
+    saves_refused: u32,
 }
 
 /// The record has room for every servo's fatigue counter.
@@ -259,6 +271,10 @@ where
             steps: 0,
             checkpoints_refused: 0,
             last_refusal: None,
+            periods: 0,
+            flash_wear: FlashWear::default(),
+            operating_before_s: 0,
+            saves_refused: 0,
         };
         controller.build(policy, weights)?;
         Ok(controller)
@@ -353,7 +369,34 @@ where
             // Fits: MAX_SERVOS <= MAX_JOINTS (checked at compile time).
             joints: Vec::from_slice(&self.fatigue.state()).unwrap_or_default(),
             user,
+            wear: FlashWear { erases: self.flash_wear.erases, operating_s: self.operating_s() },
         }
+    }
+
+    /// Seconds this board has operated: before this boot (as the
+    /// checkpoints carried it) and the control periods since.
+    pub fn operating_s(&self) -> u64 {
+        let period_us = (self.config.period_s() as f64 * 1e6) as u64;
+        self.operating_before_s.saturating_add(self.periods.saturating_mul(period_us) / 1_000_000)
+    }
+
+    /// The checkpoint sectors' erase counts as far as known.
+    pub fn flash_wear(&self) -> FlashWear {
+        self.flash_wear
+    }
+
+    /// Saves refused since boot to keep the flash within its erase budget.
+    pub fn saves_refused(&self) -> u32 {
+        self.saves_refused
+    }
+
+    /// Takes in the wear the store's newest checkpoint recorded (whatever
+    /// its configuration): erase counts and the operating time before this
+    /// boot.
+    fn note_stored_wear(&mut self, stored: FlashWear) {
+        self.flash_wear = self.flash_wear.max(&stored);
+        let since_boot = self.operating_s() - self.operating_before_s;
+        self.operating_before_s = self.operating_before_s.max(stored.operating_s.saturating_sub(since_boot));
     }
 
     /// Checks that `state` can be restored into this controller; the error
@@ -406,13 +449,25 @@ where
 
     /// Saves the weights and the learner's state ([`learner_state`](Self::learner_state))
     /// into `store` (the slot not holding the newest checkpoint); only while
-    /// torque is off.
-    pub fn save_checkpoint<S: CheckpointStore>(&self, store: &mut S) -> Result<Saved, CheckpointError<S::Error>> {
+    /// torque is off, and only within the flash's erase budget
+    /// ([`WearBudget::STM32F4`]: a refused save is
+    /// `CheckpointError::Save(SaveError::Wear(..))`, counted in
+    /// [`saves_refused`](Self::saves_refused), and erases nothing).
+    pub fn save_checkpoint<S: CheckpointStore>(&mut self, store: &mut S) -> Result<Saved, CheckpointError<S::Error>> {
         if self.torque_enabled() {
             return Err(CheckpointError::Busy);
         }
         let state = self.learner_state();
-        checkpoint::save(store, self.config_hash, &state, self.weights()).map_err(CheckpointError::Save)
+        let result = checkpoint::save_within(store, self.config_hash, &state, self.weights(), &WearBudget::STM32F4);
+        match result {
+            Ok(saved) => {
+                let slot = saved.slot as usize & 1;
+                self.flash_wear.erases[slot] = self.flash_wear.erases[slot].max(saved.erases);
+            }
+            Err(SaveError::Wear(_)) => self.saves_refused = self.saves_refused.saturating_add(1),
+            Err(_) => {}
+        }
+        result.map_err(CheckpointError::Save)
     }
 
     /// Loads the newest checkpoint of `store` — weights and learner state —
@@ -432,6 +487,8 @@ where
             return Err(CheckpointError::Busy);
         }
         self.last_refusal = None;
+        let stored = checkpoint::stored_wear(store).map_err(CheckpointError::Store)?;
+        self.note_stored_wear(stored);
         let weight_count = self.weights().len();
         let found = match checkpoint::find(store, self.config_hash, weight_count).map_err(CheckpointError::Store)? {
             Ok(found) => found,
@@ -448,6 +505,7 @@ where
             return Ok(LoadOutcome::InvalidState);
         }
         let read = checkpoint::read_weights(store, &found, self.agent_mut().weights_mut());
+        self.agent_mut().rehash();
         let outcome = match read {
             Ok(outcome) => outcome,
             Err(e) => {
@@ -526,6 +584,17 @@ where
         }
     }
 
+    /// The `Policy` report of the learner now: the built policy with its
+    /// α/Δ and whether it switched back to SARSA(λ).
+    pub fn policy_report(&self) -> wire::PolicyReport {
+        let policy = self.agent().policy();
+        wire::PolicyReport {
+            step: self.agent_stats().steps as u32,
+            built: policy.built_kind().into(),
+            switched_to_sarsa: policy.switched(),
+        }
+    }
+
     /// At boot, after a reset by the independent watchdog: a fault.
     pub fn watchdog_reset(&mut self) -> Transition {
         self.safety.on(Event::WatchdogReset)
@@ -552,7 +621,7 @@ where
             return (result, Some(t));
         }
         let result = match *cmd {
-            wire::ToChip::SetPolicy(spec) => self.set_policy(spec.into()),
+            wire::ToChip::SetPolicy(spec) => self.set_policy(spec),
             wire::ToChip::SetEpsilon(e) => self.agent_mut().set_epsilon(e).map_err(|_| NackReason::InvalidParameter),
             wire::ToChip::SwitchToSarsa => {
                 self.agent_mut().switch_to_sarsa().map_err(|_| NackReason::InvalidParameter)
@@ -588,7 +657,9 @@ where
         out.transitions.clear();
         out.speeds.clear();
         out.agent_cycles = None;
+        out.torques = [0.0; MAX_SERVOS];
         self.steps = self.steps.wrapping_add(1);
+        self.periods = self.periods.saturating_add(1);
         let now = readings.time_ms;
         let joints = self.config.joints;
         let n = joints.len();
@@ -683,6 +754,7 @@ where
             self.robot.gear_torques(&self.applied, &mut torques);
             torques[n..].fill(0.0);
             let _ = self.fatigue.update(&torques);
+            out.torques = torques;
         }
         out.torque = torque;
     }
@@ -729,6 +801,11 @@ where
         let dims = self.robot.observe(&mut obs);
         let (reward, absorbing) = (self.robot.reward(&self.applied), self.robot.absorbing());
         let timeout = steps >= self.spec.episode_steps;
+        // A footstep: the policy's memory moves with the joints before the
+        // next decision.
+        if let (true, Some(map)) = (self.robot.footstep(), self.spec.footstep_remap) {
+            self.agent_mut().remap_memory(&map);
+        }
         let t0 = cycles.cycles();
         let (kind, result) = {
             let Some(agent) = self.agent.as_mut() else { return };
@@ -830,6 +907,8 @@ where
         let stats = self.agent().stats();
         health.trace_drops = stats.trace_drops;
         health.weight_saturations = stats.saturations;
+        health.checkpoint_erases = self.flash_wear.most_erases();
+        health.saves_refused = self.saves_refused;
     }
 }
 
@@ -1036,16 +1115,16 @@ mod tests {
         let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 5).unwrap();
         let fresh = c.agent().weights_checksum();
         c.agent_mut().weights_mut()[0] = Q16(12345);
-        assert_eq!(c.command(&wire::ToChip::SetPolicy(wire::PolicySpec::Pada(0.5))).0, Ok(()));
+        assert_eq!(c.command(&wire::ToChip::SetPolicy(PolicyKind::Pada { delta: 0.5 })).0, Ok(()));
         assert_eq!(c.policy(), PolicyKind::Pada { delta: 0.5 });
         assert_eq!(c.agent().weights_checksum(), fresh, "fresh learner, same seed, same weights");
         assert_eq!(
-            c.command(&wire::ToChip::SetPolicy(wire::PolicySpec::Pada(-1.0))).0,
+            c.command(&wire::ToChip::SetPolicy(PolicyKind::Pada { delta: -1.0 })).0,
             Err(NackReason::InvalidParameter)
         );
         assert_eq!(c.policy(), PolicyKind::Pada { delta: 0.5 });
         start(&mut c, RunMode::Learning);
-        assert_eq!(c.command(&wire::ToChip::SetPolicy(wire::PolicySpec::Sarsa)).0, Err(NackReason::Busy));
+        assert_eq!(c.command(&wire::ToChip::SetPolicy(PolicyKind::Sarsa)).0, Err(NackReason::Busy));
         assert!(c.weights_mut().is_none());
         assert_eq!(c.command(&wire::ToChip::SetEpsilon(2.0)).0, Err(NackReason::InvalidParameter));
         assert_eq!(c.command(&wire::ToChip::SetEpsilon(0.0)).0, Ok(()));
@@ -1158,7 +1237,7 @@ mod tests {
         assert!(before.len() > 300);
         stop(&mut a);
         assert!(a.fatigue().joint(0).unwrap().reengagements() > 0);
-        assert_eq!(a.save_checkpoint(&mut store), Ok(Saved { generation: 1, slot: 0 }));
+        assert_eq!(a.save_checkpoint(&mut store), Ok(Saved { generation: 1, slot: 0, erases: 1 }));
         let saved = a.learner_state();
         assert_eq!(saved.user[user::EPISODES], a.episodes);
         assert!(a.episodes >= 3);
@@ -1203,10 +1282,34 @@ mod tests {
 
         // The next save goes to the other slot and carries on the counters.
         stop(&mut b);
-        assert_eq!(b.save_checkpoint(&mut store), Ok(Saved { generation: 2, slot: 1 }));
+        assert_eq!(b.save_checkpoint(&mut store), Ok(Saved { generation: 2, slot: 1, erases: 1 }));
         let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 5).unwrap();
         assert_eq!(c.load_checkpoint(&store), Ok(LoadOutcome::Loaded { generation: 2, slot: 1 }));
         assert_eq!(c.learner_state(), b.learner_state());
+    }
+
+    #[test]
+    fn saves_beyond_the_flash_budget_are_refused_counted_and_reported() {
+        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 3).unwrap();
+        let mut store = Store::new();
+        assert_eq!(c.save_checkpoint(&mut store).map(|s| s.erases), Ok(1));
+        // A store whose sectors were erased 5000 times in under a minute of
+        // operation: far ahead of the ten-year budget.
+        let mut worn = c.learner_state();
+        worn.wear = FlashWear { erases: [5000, 5000], operating_s: 40 };
+        checkpoint::save(&mut store, c.config_hash(), &worn, c.weights()).unwrap();
+        let mut d = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 3).unwrap();
+        assert!(matches!(d.load_checkpoint(&store), Ok(LoadOutcome::Loaded { .. })));
+        assert_eq!(d.flash_wear().erases, [5000, 5001]);
+        assert_eq!(d.operating_s(), 40, "the operating time carried by the checkpoint");
+        let before = store.clone();
+        let r = d.save_checkpoint(&mut store);
+        assert!(matches!(r, Err(CheckpointError::Save(SaveError::Wear(_)))), "{r:?}");
+        assert_eq!(store.slot(0), before.slot(0), "nothing erased");
+        assert_eq!(d.saves_refused(), 1);
+        let mut health = wire::Health::default();
+        d.health(&mut health);
+        assert_eq!((health.checkpoint_erases, health.saves_refused), (5001, 1));
     }
 
     #[test]
@@ -1217,8 +1320,9 @@ mod tests {
         run_pendulum(&mut c, &mut angle, 0, 600);
         stop(&mut c);
         let (state, checksum) = (c.learner_state(), c.agent().weights_checksum());
+        // The learner is unchanged; the flash wear is the store's to report.
         let unchanged = |c: &Controller<Box<[Q16]>, Pendulum33>| {
-            assert_eq!(c.learner_state(), state);
+            assert_eq!(LearnerState { wear: state.wear, ..c.learner_state() }, state);
             assert_eq!(c.agent().weights_checksum(), checksum);
         };
 
@@ -1228,7 +1332,7 @@ mod tests {
         assert_eq!(c.checkpoints_refused(), 0);
 
         // Another robot's checkpoint.
-        let leo = Controller::<_, Leo>::new(profile(Robot::Leo), PolicyKind::Sarsa, leo_table(), 1).unwrap();
+        let mut leo = Controller::<_, Leo>::new(profile(Robot::Leo), PolicyKind::Sarsa, leo_table(), 1).unwrap();
         leo.save_checkpoint(&mut store).unwrap();
         let expected = LoadOutcome::ConfigMismatch { expected: c.config_hash(), found: leo.config_hash() };
         assert_eq!(c.load_checkpoint(&store), Ok(expected));

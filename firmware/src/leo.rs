@@ -220,6 +220,10 @@ impl RobotAdapter for Leo {
         Joint::HipLeft as usize..Joint::KneeRight as usize + 1
     }
 
+    fn footstep(&self) -> bool {
+        self.update.footstep
+    }
+
     fn walked_m(&self) -> Option<f32> {
         Some(self.stance.walked())
     }

@@ -58,6 +58,8 @@ async fn main(spawner: Spawner) {
 
     tasks::send_reliable(ToHost::Hello(ctl.hello())).await;
     tasks::boot_checkpoint(&mut ctl, &board.flash).await;
+    // After the checkpoint, which may restore another policy or the switch.
+    tasks::send_reliable(ToHost::Policy(ctl.policy_report())).await;
     if board.watchdog_reset {
         let t = ctl.watchdog_reset();
         defmt::warn!("reset by the independent watchdog: Fault until the host clears it");

@@ -78,6 +78,13 @@ pub trait RobotAdapter {
     /// joints.
     fn reported_joints() -> Range<usize>;
 
+    /// Whether the last [`sense`](Self::sense) saw a footstep (the stance
+    /// leg changed), when the policy's memory moves with the joints
+    /// (`RobotSpec::footstep_remap`).
+    fn footstep(&self) -> bool {
+        false
+    }
+
     /// Distance walked in the current episode \[m\], for a walking robot.
     fn walked_m(&self) -> Option<f32> {
         None

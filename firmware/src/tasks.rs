@@ -20,7 +20,7 @@ use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 use embassy_time::{Duration, Instant, Ticker};
 use heapless::Vec;
-use pada_core::checkpoint::LoadOutcome;
+use pada_core::checkpoint::{LoadOutcome, SaveError};
 use pada_core::safety::Transition;
 use pada_core::wire::{self, FrameDecoder, FrameEncoder, NackReason, ToChip, ToHost, MAX_FRAME_LEN};
 use pada_firmware::bus::{BusConfig, BusStats, ServoBus};
@@ -325,6 +325,8 @@ pub async fn control(mut cl: ControlLoop) -> ! {
                 overruns: timing.overruns,
                 max_loop_us: timing.max_us,
                 telemetry_drops: drops,
+                checkpoint_erases: 0,
+                saves_refused: 0,
             };
             cl.ctl.health(&mut health);
             send(ToHost::Health(health), &mut skipped, &mut drops);
@@ -387,6 +389,7 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
     let result = match *cmd {
         ToChip::Ping => {
             send_reliable(ToHost::Hello(cl.ctl.hello())).await;
+            send_reliable(ToHost::Policy(cl.ctl.policy_report())).await;
             Ok(())
         }
         ToChip::SaveCheckpoint => {
@@ -402,6 +405,11 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
                         Ok(())
                     }
                     Err(CheckpointError::Busy) => Err(NackReason::Busy),
+                    Err(CheckpointError::Save(SaveError::Wear(refusal))) => {
+                        warn!("checkpoint save refused to spare the flash: {}", refusal);
+                        send_reliable(ToHost::Checkpoint(wire::CheckpointReport::SaveFailed)).await;
+                        Err(NackReason::FlashWear)
+                    }
                     Err(e) => {
                         warn!("checkpoint save failed: {}", defmt::Debug2Format(&e));
                         send_reliable(ToHost::Checkpoint(wire::CheckpointReport::SaveFailed)).await;
@@ -414,6 +422,9 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
             Ok(outcome) => {
                 log_load(&cl.ctl, outcome);
                 send_reliable(ToHost::Checkpoint(wire::CheckpointReport::Load(outcome))).await;
+                if let LoadOutcome::Loaded { .. } = outcome {
+                    send_reliable(ToHost::Policy(cl.ctl.policy_report())).await;
+                }
                 match outcome {
                     LoadOutcome::Loaded { .. } => Ok(()),
                     _ => Err(NackReason::CheckpointFailed),
@@ -440,6 +451,10 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
             let (result, transition) = cl.ctl.command(cmd);
             if let Some(t) = transition.filter(|t| t.changed()) {
                 report_transition(&t, &cl.ctl, Instant::now().as_millis() as u32).await;
+            }
+            let changes_policy = matches!(cmd, ToChip::SetPolicy(_) | ToChip::SwitchToSarsa);
+            if changes_policy && result.is_ok() {
+                send_reliable(ToHost::Policy(cl.ctl.policy_report())).await;
             }
             result
         }

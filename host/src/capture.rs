@@ -125,12 +125,19 @@ impl Recorder {
             match result {
                 Ok(frame) => {
                     if let Some(gap) = frame.gap {
-                        let detail = format!(
-                            "expected seq {} got {} ({} missed)",
-                            gap.expected,
-                            gap.got,
-                            gap.missed()
-                        );
+                        let detail = if gap.is_resync() {
+                            format!(
+                                "expected seq {} got {} (resynchronised: too far to count frames)",
+                                gap.expected, gap.got
+                            )
+                        } else {
+                            format!(
+                                "expected seq {} got {} ({} missed)",
+                                gap.expected,
+                                gap.got,
+                                gap.missed()
+                            )
+                        };
                         self.row_other(time_s, Some(frame.seq), "gap", &detail)?;
                     }
                     self.note(&frame.msg);
@@ -141,6 +148,20 @@ impl Recorder {
             }
         }
         Ok(())
+    }
+
+    /// The input has ended (end of file, the port closed): a frame still in
+    /// progress can never complete, so it is counted as lost
+    /// ([`FrameError::Truncated`]) and recorded as a `lost` row at
+    /// `time_s`. Returns whether there was one.
+    pub fn finish(&mut self, time_s: f64) -> std::io::Result<bool> {
+        match self.decoder.finish() {
+            Some(e) => {
+                self.row_other(time_s, None, "lost", &loss_name(&e))?;
+                Ok(true)
+            }
+            None => Ok(false),
+        }
     }
 
     /// Link counters: frames, bytes, every kind of loss.
@@ -201,7 +222,7 @@ impl Recorder {
             s.frames_missed,
             s.crc_errors,
             s.cobs_errors,
-            s.oversize + s.too_short + s.decode_errors
+            s.oversize + s.too_short + s.decode_errors + s.noncanonical + s.truncated
         );
         line
     }
@@ -337,6 +358,8 @@ pub fn loss_name(e: &FrameError) -> String {
             format!("crc (computed {computed:08x}, received {received:08x})")
         }
         FrameError::Decode => "undecodable".into(),
+        FrameError::NonCanonical => "non-canonical".into(),
+        FrameError::Truncated => "truncated (the input ended inside a frame)".into(),
     }
 }
 
@@ -374,6 +397,10 @@ pub fn describe(msg: &ToHost) -> (&'static str, String) {
         ToHost::Weights(w) => ("weights", format!("offset {} of {} ({} weights)", w.offset, w.total, w.weights.len())),
         ToHost::Ack(a) => ("ack", format!("seq {}", a.seq)),
         ToHost::Nack(n) => ("nack", format!("seq {} {:?}", n.seq, n.reason)),
+        ToHost::Policy(p) => (
+            "policy",
+            format!("{:?} switched {} at step {}", p.built, p.switched_to_sarsa, p.step),
+        ),
         ToHost::Step(_) => ("step", String::new()),
         ToHost::Episode(_) => ("episode", String::new()),
     }
@@ -413,6 +440,25 @@ mod tests {
             length: 100,
             weights_checksum: 7,
         })
+    }
+
+    #[test]
+    fn the_end_of_the_input_counts_a_cut_off_frame() {
+        // Issue 16, defect 1.
+        let bytes = frames(&[hello(), episode(0, RunMode::Learning, -1.0)]);
+        let mut rec = Recorder::new(None).unwrap();
+        let mut out = Vec::new();
+        rec.feed(&bytes[..bytes.len() - 4], 0.0, &mut out).unwrap();
+        assert!(rec.stats().is_clean());
+        assert!(rec.finish(1.0).unwrap());
+        assert_eq!((rec.stats().frames, rec.stats().truncated), (1, 1));
+        assert!(!rec.stats().is_clean());
+        assert!(
+            rec.status_line().contains("other 1"),
+            "{}",
+            rec.status_line()
+        );
+        assert!(!rec.finish(1.0).unwrap(), "counted once");
     }
 
     #[test]

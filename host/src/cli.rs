@@ -42,6 +42,10 @@ pub enum Command {
     Sil(commands::sil::SilArgs),
     /// Decode telemetry from a board's serial port or a recorded stream.
     Capture(commands::capture::CaptureArgs),
+    /// A live page in the browser of a board's, a recording's or a live
+    /// run's telemetry (decoded and recorded as capture does).
+    #[command(allow_negative_numbers = true)]
+    Watch(commands::watch::WatchArgs),
     /// Draw a learned LEO gait (saved weights) as a strip of stick figures.
     Render(RenderArgs),
     /// Run one trial of a plan (written with --plan DIR), as a Slurm array
@@ -67,7 +71,7 @@ pub struct RunArgs {
     #[arg(long, value_enum, default_value_t = TaskName::Pendulum)]
     pub task: TaskName,
     /// The algorithm (Section V).
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = crate::experiment::algo::algo_parser())]
     pub algo: Algo,
     /// Low-pass α of Eq. 8, 0 < α ≤ 1 (lowpass, markov-lowpass; default 0.834).
     #[arg(long)]
@@ -101,6 +105,24 @@ pub struct RunArgs {
     /// a checksum; read by `pada render`).
     #[arg(long, value_name = "FILE")]
     pub save_weights: Option<PathBuf>,
+    /// Run a board's own learner instead of the host's: the firmware's
+    /// controller built for the host, with the board's learner profile
+    /// (table layout, size, weight format), its sensors (servo counts,
+    /// differenced rates, the encoder) and its episode logic, against the
+    /// task's plant (physical-pendulum or leo). What it learns is what the
+    /// board will learn.
+    #[arg(long, value_enum, value_name = "NAME")]
+    pub board: Option<crate::board::BoardName>,
+    /// With --board: a hashed table of 2^N weights instead of the board's
+    /// (placed in CCM, then SRAM on an F405), to see what a board would
+    /// learn with more or less memory. The firmware builds only the boards'
+    /// own profiles.
+    #[arg(long, value_name = "N", requires = "board", value_parser = clap::value_parser!(u32).range(8..=26))]
+    pub table_log2: Option<u32>,
+    /// With --board: store weights in 16 or 32 bits (16: stochastic
+    /// rounding, the robot's range; see pada_core::weights).
+    #[arg(long, value_name = "BITS", requires = "board", value_parser = ["16", "32"])]
+    pub weight_bits: Option<String>,
     /// Seed and threads.
     #[command(flatten)]
     pub trial: TrialOptions,
@@ -263,7 +285,7 @@ where
                     Ok(())
                 }
                 ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => Err(usage(
-                    "no command given: valid commands are run, demo, paper, trial, mtbf, render, sil, capture (see pada --help)",
+                    "no command given: valid commands are run, demo, paper, trial, mtbf, render, sil, capture, watch (see pada --help)",
                 )),
                 _ => Err(usage(clap_one_line(&e))),
             };
@@ -276,6 +298,7 @@ where
         Command::Mtbf(a) => commands::mtbf::run(a),
         Command::Sil(a) => commands::sil::run(a),
         Command::Capture(a) => commands::capture::run(a),
+        Command::Watch(a) => commands::watch::run(a),
         Command::Render(a) => commands::render::run(a),
         Command::Trial(a) => commands::trial::run(a),
     }

@@ -5,6 +5,7 @@
 
 #![warn(missing_docs)]
 
+pub mod board;
 pub mod capture;
 pub mod cli;
 pub mod commands;
@@ -19,11 +20,14 @@ pub mod pendulum;
 pub mod plan;
 pub mod plot;
 pub mod progress;
+pub mod rig;
 pub mod seed;
 pub mod sil;
 pub mod stats;
+pub mod console;
 pub mod summary;
 pub mod telemetry;
 pub mod timing;
 pub mod torque_log;
+pub mod watch;
 pub mod weights;

@@ -62,10 +62,16 @@ pub struct RunSummary {
     pub end_performance: Estimate,
     /// Rise time over trials \[s\] (Section VI).
     pub rise_time_s: Estimate,
-    /// Predicted MTBF from the first 1200 actions \[s\] (Eqs. 3–7).
+    /// Predicted MTBF from the first 1200 actions \[s\] (Eqs. 3–7), the
+    /// paper's definition: gearbox torques from the commanded action.
     pub mtbf_s: Estimate,
-    /// Backlash re-engagements within those actions.
+    /// Backlash re-engagements within those actions (the paper's).
     pub window_reengagements: Estimate,
+    /// Predicted MTBF from the first 1200 actions \[s\] from the simulated
+    /// gear torques.
+    pub physical_mtbf_s: Estimate,
+    /// Re-engagements of the simulated gear torques within those actions.
+    pub physical_window_reengagements: Estimate,
     /// Distance walked in the last 10% of the test runs \[m\] (walking
     /// tasks only).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -142,6 +148,8 @@ impl RunSummary {
             rise_time_s: Estimate::of(&col(|r| r.rise_time_s)),
             mtbf_s: Estimate::of(&col(|r| r.mtbf_s)),
             window_reengagements: Estimate::of(&col(|r| r.window_reengagements as f64)),
+            physical_mtbf_s: Estimate::of(&col(|r| r.physical_mtbf_s)),
+            physical_window_reengagements: Estimate::of(&col(|r| r.physical_window_reengagements as f64)),
             end_walked_m: walking.then(|| Estimate::of(&col(|r| r.end_walked_m.unwrap_or(f64::NAN)))),
             end_speed_m_s: walking.then(|| Estimate::of(&col(|r| r.end_speed_m_s.unwrap_or(f64::NAN)))),
             learning_falls: Estimate::of(&col(|r| r.learning_falls as f64)),
@@ -243,5 +251,80 @@ pub fn run_files(summary: &RunSummary) -> anyhow::Result<Vec<(String, Vec<u8>)>>
     for r in &summary.per_trial {
         files.push((format!("trial-{:03}.csv", r.trial), curve_csv(r)?));
     }
+    Ok(files)
+}
+
+/// The summary of `pada run --board`: everything of [`RunSummary`] (the
+/// same keys, flattened), plus the board's learner and what the board
+/// itself would report per trial.
+#[derive(Debug, Clone, Serialize)]
+pub struct BoardSummary {
+    /// What `pada run` reports.
+    #[serde(flatten)]
+    pub run: RunSummary,
+    /// The board's learner profile and its memory.
+    pub profile: crate::board::ProfileReport,
+    /// The predicted MTBF from the board's own torque estimate over the
+    /// first learning actions \[s\] (`mtbf_s` is from the simulation's gear
+    /// torques, as `pada run` counts them).
+    pub board_estimated_mtbf_s: Estimate,
+    /// Per trial: the configuration hash, the final weights' checksum, the
+    /// board's estimated MTBF and the control periods run.
+    pub board_per_trial: Vec<BoardTrialSummary>,
+}
+
+/// What one board trial adds to its [`TrialResult`].
+#[derive(Debug, Clone, Serialize)]
+pub struct BoardTrialSummary {
+    /// Trial index.
+    pub trial: u32,
+    /// The learner's configuration hash.
+    pub config_hash: u32,
+    /// FNV-1a of the final table's stored bytes.
+    pub weights_checksum: u32,
+    /// MTBF from the board's torque estimate \[s\].
+    pub board_estimated_mtbf_s: f64,
+    /// Control periods, with the waits between episodes.
+    pub periods: u64,
+}
+
+impl BoardSummary {
+    /// Summarises board `trials` of `cfg` with `profile` on a task with `spec`.
+    pub fn new(
+        spec: &TaskSpec,
+        cfg: &RunConfig,
+        profile: &pada_core::profile::LearnerProfile,
+        trials: &[crate::board::BoardTrial],
+        wall_s: f64,
+    ) -> BoardSummary {
+        let results = crate::board::results(trials);
+        let weights = trials.first().map_or(profile.weights().unwrap_or(0), |t| t.weights);
+        BoardSummary {
+            run: RunSummary::new(spec, cfg, &results, wall_s),
+            profile: crate::board::ProfileReport::new(profile, weights),
+            board_estimated_mtbf_s: Estimate::of(&trials.iter().map(|t| t.board_estimated_mtbf_s).collect::<Vec<_>>()),
+            board_per_trial: trials
+                .iter()
+                .map(|t| BoardTrialSummary {
+                    trial: t.result.trial,
+                    config_hash: t.config_hash,
+                    weights_checksum: t.weights_checksum,
+                    board_estimated_mtbf_s: t.board_estimated_mtbf_s,
+                    periods: t.periods,
+                })
+                .collect(),
+        }
+    }
+
+    /// The summary as pretty JSON (non-finite numbers become `null`).
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
+    }
+}
+
+/// The files of a board run: `run_files`' with the board's summary.
+pub fn board_files(summary: &BoardSummary) -> anyhow::Result<Vec<(String, Vec<u8>)>> {
+    let mut files = run_files(&summary.run)?;
+    files[0].1 = (summary.to_json() + "\n").into_bytes();
     Ok(files)
 }

@@ -49,9 +49,15 @@ pub fn parse_target(spec: &str) -> Result<TelemetryTarget, CliError> {
     }
 }
 
+/// Buffered frames are pushed out at least this often, so that a live
+/// viewer (`pada watch --listen`) sees a slow run as it goes rather than in
+/// 8 KiB bursts seconds apart.
+pub const FLUSH_EVERY: Duration = Duration::from_millis(100);
+
 /// An open telemetry stream. Write errors end the stream (the run goes on)
 /// and are reported by [`TelemetrySink::finish`].
 pub struct TelemetrySink {
+    last_flush: std::time::Instant,
     out: Box<dyn Write + Send>,
     encoder: FrameEncoder,
     frames: u64,
@@ -81,6 +87,7 @@ impl TelemetrySink {
             }
         };
         Ok(TelemetrySink {
+            last_flush: std::time::Instant::now(),
             out,
             encoder: FrameEncoder::new(),
             frames: 0,
@@ -104,6 +111,7 @@ impl TelemetrySink {
                 } else {
                     self.frames += 1;
                     self.bytes += n;
+                    self.flush_now_and_then();
                 }
             }
             Err(e) => self.error = Some(format!("cannot encode a frame: {e:?}")),
@@ -116,8 +124,21 @@ impl TelemetrySink {
             return;
         }
         match self.out.write_all(bytes) {
-            Ok(()) => self.bytes += bytes.len() as u64,
+            Ok(()) => {
+                self.bytes += bytes.len() as u64;
+                self.flush_now_and_then();
+            }
             Err(e) => self.error = Some(e.to_string()),
+        }
+    }
+
+    /// Flushes when [`FLUSH_EVERY`] has passed since the last flush.
+    fn flush_now_and_then(&mut self) {
+        if self.last_flush.elapsed() >= FLUSH_EVERY {
+            self.last_flush = std::time::Instant::now();
+            if let Err(e) = self.out.flush() {
+                self.error = Some(e.to_string());
+            }
         }
     }
 

@@ -191,6 +191,7 @@ pub fn load(path: &Path, spec: &TaskSpec) -> anyhow::Result<(WeightsHeader, Host
         );
     }
     agent.weights_mut().copy_from_slice(&weights);
+    agent.rehash();
     if header.switched {
         agent
             .switch_to_sarsa()

@@ -107,7 +107,7 @@ fn pada_and_lowpass_reengage_less_harshly_than_sarsa() {
     };
     let sarsa = mean(PolicyKind::Sarsa);
     let pada = mean(policy_kind(Algo::Pada, None, Some(0.5)).unwrap());
-    let lowpass = mean(policy_kind(Algo::Lowpass, Some(0.5), None).unwrap());
+    let lowpass = mean(policy_kind(Algo::LowPass, Some(0.5), None).unwrap());
     assert!(pada > 1.5 * sarsa, "PADA {pada} vs SARSA {sarsa}");
     assert!(lowpass > 5.0 * sarsa, "low-pass {lowpass} vs SARSA {sarsa}");
 }

@@ -29,7 +29,7 @@ use crate::fixed::{Frac, Q16};
 use crate::policy::{uniform_below, Candidates, Policy, PolicyKind, PolicyState};
 use crate::tile_coding::{Layout, StateCode, StateDim, TileCoder, MAX_STATE_DIMS};
 use crate::trace::{Trace, TraceKind};
-use crate::weights::WeightStore;
+use crate::weights::{entry_hash, WeightStore};
 use heapless::Vec;
 use rand_core::RngCore;
 
@@ -217,6 +217,10 @@ pub struct Agent<W, const TILINGS: usize, const TRACE: usize> {
     obs_dims: usize,
     current: Option<Current<TILINGS>>,
     stats: AgentStats,
+    /// The table's checksum, kept up to date write by write
+    /// ([`WeightStore::checksum`]); `None` after the weights were handed
+    /// out mutably, until [`rehash`](Agent::rehash).
+    checksum: Option<u32>,
 }
 
 impl<W, const TILINGS: usize, const TRACE: usize> Agent<W, TILINGS, TRACE>
@@ -270,6 +274,7 @@ where
             obs_dims: obs.len(),
             current: None,
             stats: AgentStats::default(),
+            checksum: None,
         })
     }
 
@@ -302,6 +307,7 @@ where
                 }
             }
         }
+        self.rehash();
     }
 
     /// Starts an episode in observation `obs`: clears the trace, puts the
@@ -389,6 +395,14 @@ where
     /// (Section VIII).
     pub fn switch_to_sarsa(&mut self) -> Result<(), StepError> {
         self.policy.switch_to_sarsa()
+    }
+
+    /// Moves the policy's memory between action dimensions when the joints
+    /// they drive swap roles ([`Policy::remap`]; LEO's footstep,
+    /// [`crate::robot::RobotSpec::footstep_remap`]). Call it after the
+    /// observation that shows the swap and before the next decision.
+    pub fn remap_memory(&mut self, map: &[Option<u8>; MAX_ACTION_DIMS]) {
+        self.policy.remap(map);
     }
 
     /// The agent's state besides its weights, as plain data
@@ -494,9 +508,18 @@ where
         &self.weights
     }
 
-    /// The weights, mutably (loading a checkpoint).
+    /// The weights, mutably (loading a checkpoint). The running checksum is
+    /// dropped; [`rehash`](Self::rehash) computes it again.
     pub fn weights_mut(&mut self) -> &mut W {
+        self.checksum = None;
         &mut self.weights
+    }
+
+    /// Computes the table's checksum from every weight (after the weights
+    /// were changed from outside, e.g. loaded), to be kept up to date from
+    /// then on.
+    pub fn rehash(&mut self) {
+        self.checksum = Some(self.weights.checksum());
     }
 
     /// Gives the weight storage back (to build an agent with another
@@ -505,11 +528,12 @@ where
         self.weights
     }
 
-    /// FNV-1a over the weights' stored little-endian bytes
-    /// ([`WeightStore::checksum`]): equal on every machine for equal
-    /// weights.
+    /// The table's checksum ([`WeightStore::checksum`]): equal on every
+    /// machine for equal weights. Kept up to date by every update, so it
+    /// costs nothing per call; only after [`weights_mut`](Self::weights_mut)
+    /// without a [`rehash`](Self::rehash) is it computed from every weight.
     pub fn weights_checksum(&self) -> u32 {
-        self.weights.checksum()
+        self.checksum.unwrap_or_else(|| self.weights.checksum())
     }
 
     /// `Q(s, a)` for an observation and a joint action of the learner, with
@@ -700,6 +724,7 @@ where
         let step = delta.mul_frac(self.alpha);
         self.trace.push(&current.features);
         let weights = &mut self.weights;
+        let checksum = &mut self.checksum;
         let mut saturations = 0u32;
         self.trace.for_each_entry(|entry, eligibility| {
             let inc = step.mul_frac(eligibility);
@@ -709,9 +734,15 @@ where
             for &f in entry {
                 // Replaced slots hold u32::MAX: outside the table, so the
                 // store writes nothing (and no dither is drawn for them).
-                if (f as usize) < weights.len() {
+                let i = f as usize;
+                if i < weights.len() {
                     let dither = if W::DITHERED { rng.next_u32() } else { 0 };
-                    saturations += weights.add(f as usize, inc, dither) as u32;
+                    let old = weights.raw(i);
+                    saturations += weights.add(i, inc, dither) as u32;
+                    if let Some(c) = checksum.as_mut() {
+                        let new = weights.raw(i);
+                        *c = c.wrapping_add(entry_hash(i, new)).wrapping_sub(entry_hash(i, old));
+                    }
                 }
             }
         });

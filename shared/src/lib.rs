@@ -24,8 +24,9 @@
 //! - [`checkpoint`]: learned weights and the learner's state (counters, ε,
 //!   policy, fatigue counters, generator) in two alternating flash slots
 //!   that survive a torn write;
-//! - [`rng`]: PCG32, output-identical to `rand_pcg::Pcg32`, with a state
-//!   that can be saved and restored;
+//! - [`crc`]: the CRC-32 of frames and checkpoints and the configuration
+//!   hash;
+//! - [`rng`]: `rand_pcg::Pcg32` and its state as a checkpoint saves it;
 //! - [`safety`]: the Idle → Learning/Testing → Fault state machine that owns
 //!   torque enable;
 //! - [`rx28`]: the RX-28 servo's voltage-driven motor model (shared by the
@@ -44,6 +45,7 @@ pub mod action_space;
 pub mod action_tiles;
 pub mod agent;
 pub mod checkpoint;
+pub mod crc;
 pub mod dynamixel;
 pub mod error;
 pub mod fatigue;

@@ -38,9 +38,144 @@ use crate::error::{check_range, ConfigError, StepError};
 use crate::tile_coding::StateDim;
 use rand_core::RngCore;
 
-/// Which of the six policies of Section V, with its parameter.
+/// The six policies of Section V by name, without their parameter: the one
+/// list that the policy kind ([`PolicyKind`]), the checkpoint's policy code
+/// ([`PolicyName::code`]), the wire's `SetPolicy` (which carries a
+/// [`PolicyKind`]) and the host's `--algo` names all derive from.
+///
+/// The discriminant is the checkpoint code and the variant index on the
+/// wire, so the order is a stored format: append, never reorder.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[repr(u8)]
+pub enum PolicyName {
+    /// SARSA(λ): the chosen level is applied.
+    #[serde(rename = "sarsa")]
+    Sarsa = 0,
+    /// Low-pass filtered actions (Eq. 8).
+    #[serde(rename = "lowpass")]
+    LowPass = 1,
+    /// Low-pass filter with the previous output in the state.
+    #[serde(rename = "markov-lowpass")]
+    MarkovLowPass = 2,
+    /// Integrating controller: the learner chooses −Δ, 0 or +Δ.
+    #[serde(rename = "integrator")]
+    Integrator = 3,
+    /// Integrating controller with the integrated command in the state.
+    #[serde(rename = "markov-integrator")]
+    MarkovIntegrator = 4,
+    /// Previous-action-dependent actions (Eq. 9).
+    #[serde(rename = "pada")]
+    Pada = 5,
+}
+
+impl PolicyName {
+    /// Every policy, in the paper's order (which is the code order).
+    pub const ALL: [PolicyName; 6] = [
+        PolicyName::Sarsa,
+        PolicyName::LowPass,
+        PolicyName::MarkovLowPass,
+        PolicyName::Integrator,
+        PolicyName::MarkovIntegrator,
+        PolicyName::Pada,
+    ];
+
+    /// The name of `kind`.
+    pub const fn of(kind: &PolicyKind) -> PolicyName {
+        match kind {
+            PolicyKind::Sarsa => PolicyName::Sarsa,
+            PolicyKind::LowPass { .. } => PolicyName::LowPass,
+            PolicyKind::MarkovLowPass { .. } => PolicyName::MarkovLowPass,
+            PolicyKind::Integrator { .. } => PolicyName::Integrator,
+            PolicyKind::MarkovIntegrator { .. } => PolicyName::MarkovIntegrator,
+            PolicyKind::Pada { .. } => PolicyName::Pada,
+        }
+    }
+
+    /// The kind of this name with `parameter` as its α or Δ (ignored for
+    /// SARSA); the parameter is not checked here ([`PolicyKind::validate`]).
+    pub const fn with_parameter(self, parameter: f32) -> PolicyKind {
+        match self {
+            PolicyName::Sarsa => PolicyKind::Sarsa,
+            PolicyName::LowPass => PolicyKind::LowPass { alpha: parameter },
+            PolicyName::MarkovLowPass => PolicyKind::MarkovLowPass { alpha: parameter },
+            PolicyName::Integrator => PolicyKind::Integrator { delta: parameter },
+            PolicyName::MarkovIntegrator => PolicyKind::MarkovIntegrator { delta: parameter },
+            PolicyName::Pada => PolicyKind::Pada { delta: parameter },
+        }
+    }
+
+    /// The number that stands for the policy in a checkpoint (0 sarsa, 1
+    /// lowpass, 2 markov-lowpass, 3 integrator, 4 markov-integrator, 5 pada).
+    pub const fn code(self) -> u8 {
+        self as u8
+    }
+
+    /// The policy of a [`code`](Self::code); `None` for an unknown code.
+    pub fn from_code(code: u8) -> Option<PolicyName> {
+        PolicyName::ALL.get(code as usize).copied()
+    }
+
+    /// The name as the command line spells it.
+    pub const fn name(self) -> &'static str {
+        match self {
+            PolicyName::Sarsa => "sarsa",
+            PolicyName::LowPass => "lowpass",
+            PolicyName::MarkovLowPass => "markov-lowpass",
+            PolicyName::Integrator => "integrator",
+            PolicyName::MarkovIntegrator => "markov-integrator",
+            PolicyName::Pada => "pada",
+        }
+    }
+
+    /// The policy of a command-line name.
+    pub fn from_name(name: &str) -> Option<PolicyName> {
+        PolicyName::ALL.into_iter().find(|n| n.name() == name)
+    }
+
+    /// The name used in the paper's figures.
+    pub const fn title(self) -> &'static str {
+        match self {
+            PolicyName::Sarsa => "SARSA(λ)",
+            PolicyName::LowPass => "low-pass filter",
+            PolicyName::MarkovLowPass => "Markov low-pass filter",
+            PolicyName::Integrator => "integrating controller",
+            PolicyName::MarkovIntegrator => "Markov integrating controller",
+            PolicyName::Pada => "PADA",
+        }
+    }
+
+    /// Whether the policy takes α (the low-pass filters, Eq. 8).
+    pub const fn takes_alpha(self) -> bool {
+        matches!(self, PolicyName::LowPass | PolicyName::MarkovLowPass)
+    }
+
+    /// Whether the policy takes Δ (the integrators and PADA).
+    pub const fn takes_delta(self) -> bool {
+        matches!(self, PolicyName::Integrator | PolicyName::MarkovIntegrator | PolicyName::Pada)
+    }
+
+    /// Whether a learner of this policy can run as (or switch back to)
+    /// plain SARSA(λ) without changing its actions or state (Section VIII):
+    /// SARSA itself, PADA and the low-pass filter.
+    pub const fn can_switch(self) -> bool {
+        matches!(self, PolicyName::Sarsa | PolicyName::LowPass | PolicyName::Pada)
+    }
+}
+
+impl core::fmt::Display for PolicyName {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Which of the six policies of Section V, with its parameter. Its variants
+/// are [`PolicyName`]'s in the same order, so its postcard encoding (the
+/// variant index, then the `f32` parameter if any) is what the wire's
+/// `SetPolicy` carries.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[derive(serde::Serialize, serde::Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum PolicyKind {
     /// Plain SARSA(λ): the chosen level is applied.
@@ -73,16 +208,39 @@ pub enum PolicyKind {
     },
 }
 
+// The variant order of the two enums is one format (checkpoint code, wire
+// variant index): keep them in step.
+const _: () = {
+    let kinds = [
+        PolicyKind::Sarsa,
+        PolicyKind::LowPass { alpha: 0.0 },
+        PolicyKind::MarkovLowPass { alpha: 0.0 },
+        PolicyKind::Integrator { delta: 0.0 },
+        PolicyKind::MarkovIntegrator { delta: 0.0 },
+        PolicyKind::Pada { delta: 0.0 },
+    ];
+    let mut i = 0;
+    while i < kinds.len() {
+        assert!(PolicyName::of(&kinds[i]) as usize == i);
+        i += 1;
+    }
+};
+
 impl PolicyKind {
     /// The policy's name as the command line spells it.
     pub fn name(&self) -> &'static str {
-        match self {
-            PolicyKind::Sarsa => "sarsa",
-            PolicyKind::LowPass { .. } => "lowpass",
-            PolicyKind::MarkovLowPass { .. } => "markov-lowpass",
-            PolicyKind::Integrator { .. } => "integrator",
-            PolicyKind::MarkovIntegrator { .. } => "markov-integrator",
-            PolicyKind::Pada { .. } => "pada",
+        PolicyName::of(self).name()
+    }
+
+    /// Its parameter (α of the low-pass filters, Δ of the others); `None`
+    /// for SARSA.
+    pub fn parameter(&self) -> Option<f32> {
+        match *self {
+            PolicyKind::Sarsa => None,
+            PolicyKind::LowPass { alpha } | PolicyKind::MarkovLowPass { alpha } => Some(alpha),
+            PolicyKind::Integrator { delta } | PolicyKind::MarkovIntegrator { delta } | PolicyKind::Pada { delta } => {
+                Some(delta)
+            }
         }
     }
 
@@ -201,18 +359,10 @@ pub struct PolicyState {
     pub output: Output,
 }
 
-/// The number that stands for a policy kind in a checkpoint:
-/// 0 sarsa, 1 lowpass, 2 markov-lowpass, 3 integrator, 4 markov-integrator,
-/// 5 pada.
+/// The number that stands for a policy kind in a checkpoint
+/// ([`PolicyName::code`]).
 pub fn kind_code(kind: &PolicyKind) -> u8 {
-    match kind {
-        PolicyKind::Sarsa => 0,
-        PolicyKind::LowPass { .. } => 1,
-        PolicyKind::MarkovLowPass { .. } => 2,
-        PolicyKind::Integrator { .. } => 3,
-        PolicyKind::MarkovIntegrator { .. } => 4,
-        PolicyKind::Pada { .. } => 5,
-    }
+    PolicyName::of(kind).code()
 }
 
 /// Kinds whose learners mean the same by an action and a state: SARSA, PADA
@@ -227,27 +377,15 @@ fn family(kind: &PolicyKind) -> u8 {
     }
 }
 
-/// The parameter of a kind (α or Δ; 0 for SARSA).
+/// The parameter of a kind (α or Δ; 0 for SARSA), as a checkpoint stores it.
 pub fn kind_parameter(kind: &PolicyKind) -> f32 {
-    match *kind {
-        PolicyKind::Sarsa => 0.0,
-        PolicyKind::LowPass { alpha } | PolicyKind::MarkovLowPass { alpha } => alpha,
-        PolicyKind::Integrator { delta } | PolicyKind::MarkovIntegrator { delta } | PolicyKind::Pada { delta } => delta,
-    }
+    kind.parameter().unwrap_or(0.0)
 }
 
 /// The kind of a [`kind_code`] with its parameter; `None` for an unknown
 /// code. The parameter is not checked here ([`PolicyKind::validate`]).
 pub fn kind_from_code(code: u8, parameter: f32) -> Option<PolicyKind> {
-    Some(match code {
-        0 => PolicyKind::Sarsa,
-        1 => PolicyKind::LowPass { alpha: parameter },
-        2 => PolicyKind::MarkovLowPass { alpha: parameter },
-        3 => PolicyKind::Integrator { delta: parameter },
-        4 => PolicyKind::MarkovIntegrator { delta: parameter },
-        5 => PolicyKind::Pada { delta: parameter },
-        _ => return None,
-    })
+    PolicyName::from_code(code).map(|n| n.with_parameter(parameter))
 }
 
 /// An action policy with its memory (previous action, filter state or
@@ -484,6 +622,30 @@ impl Policy {
         self.output
     }
 
+    /// Moves the memory between action dimensions when the joints they
+    /// drive swap roles (LEO's footstep: stance and swing trade legs):
+    /// dimension `i` takes dimension `map[i]`'s previous action and filter
+    /// or integrator output, or, for `None`, starts at rest (the level and
+    /// output of 0, as at an episode's start). Unused dimensions are left
+    /// alone; an index out of range counts as `None`.
+    pub fn remap(&mut self, map: &[Option<u8>; MAX_ACTION_DIMS]) {
+        let (prev, output) = (self.prev, self.output);
+        let mut rest = self.clone();
+        rest.reset();
+        for i in 0..self.learner.dims() {
+            match map[i].map(|j| j as usize).filter(|&j| j < self.learner.dims()) {
+                Some(j) => {
+                    self.prev[i] = prev[j];
+                    self.output[i] = output[j];
+                }
+                None => {
+                    self.prev[i] = rest.prev[i];
+                    self.output[i] = rest.output[i];
+                }
+            }
+        }
+    }
+
     /// Number of state dimensions the policy appends (0, or one per motor
     /// for the Markov variants).
     pub fn extension_len(&self) -> usize {
@@ -655,6 +817,29 @@ mod tests {
                 for i in 0..3 {
                     prop_assert!((out[i] - prev[i]).abs() <= limit);
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn remap_moves_memory_between_dimensions_and_rests_the_rest() {
+        let level = ActionDim::uniform(-10.7, 10.7, 7).unwrap();
+        let motor = ActionSpace::repeated(level, 3).unwrap();
+        for kind in [PolicyKind::Pada { delta: 1.0 / 6.0 }, PolicyKind::LowPass { alpha: 0.5 }] {
+            let mut p = Policy::new(kind, motor.clone()).unwrap();
+            p.reset();
+            let out = p.apply(&[6, 0, 5, 0]);
+            p.remap(&[Some(1), Some(0), None, None]);
+            assert_eq!(&p.previous()[..3], &[0, 6, 3], "{kind:?}: hips swap, the knee rests at 0 V");
+            assert_eq!(p.output()[0], out[1]);
+            assert_eq!(p.output()[1], out[0]);
+            assert_eq!(p.output()[2], 0.0);
+            // PADA's next candidates follow the moved memory.
+            if let PolicyKind::Pada { .. } = kind {
+                let c = p.candidates();
+                assert_eq!((c.lo[0], c.hi[0]), (0, 1));
+                assert_eq!((c.lo[1], c.hi[1]), (5, 6));
+                assert_eq!((c.lo[2], c.hi[2]), (2, 4));
             }
         }
     }

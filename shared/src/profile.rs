@@ -189,6 +189,26 @@ impl LearnerProfile {
     }
 }
 
+impl LearnerProfile {
+    /// The same board with another hashed table of `2^log2_weights`
+    /// weights in `format`, placed as a chip would place it: in CCM if it
+    /// fits, else CCM first and the rest in SRAM (the F405), the SDRAM
+    /// (the F429) or the heap (the host). For exploring what a board could
+    /// learn with more or less memory; the firmware builds only the
+    /// profiles of [`Board::profile`].
+    pub const fn with_hashed_table(self, log2_weights: u32, format: WeightFormat) -> LearnerProfile {
+        let weights = 1usize << log2_weights;
+        let bytes = weights * format.bytes();
+        let memory = match self.board {
+            Board::Host => Memory::Heap,
+            Board::F429Sdram => Memory::Sdram,
+            Board::F405 if bytes <= CCM_BYTES => Memory::Ccm,
+            Board::F405 => Memory::CcmThenSram { ccm_weights: CCM_BYTES / format.bytes() },
+        };
+        LearnerProfile { layout: Layout::Hashed, size: TableSize::Weights(weights), format, memory, ..self }
+    }
+}
+
 /// Version of what [`config_hash`] covers; bump when its meaning changes.
 pub const CONFIG_HASH_VERSION: u32 = 2;
 

@@ -9,9 +9,14 @@
 //! `rand_pcg::Pcg32`; `shared/tests/learner_state.rs` checks the two against
 //! each other draw for draw.
 //!
-//! What rand_pcg does not offer is reading the state back. [`Pcg32::state`]
-//! gives the two words ([`RngState`]) and [`Pcg32::from_state`] continues
-//! exactly where they were taken, so a checkpoint can carry the generator
+//! What rand_pcg does not offer on the chip is reading the state back. Its
+//! fields are private; its `serde` feature would expose them, but it
+//! depends on serde with serde's default features (rand_pcg 0.9's manifest
+//! does not set `default-features = false`), which turns on serde's `std`
+//! and so cannot build for `thumbv7em-none-eabihf`. Hence this copy of its
+//! twenty lines of arithmetic. [`Pcg32::state`] gives the two words
+//! ([`RngState`]) and [`Pcg32::from_state`] continues exactly where they
+//! were taken, so a checkpoint can carry the generator
 //! (`crate::checkpoint`).
 
 use crate::error::ConfigError;

@@ -100,26 +100,43 @@ pub trait WeightStore {
     /// Sets weight `i` from bytes written by [`stored_le`](Self::stored_le).
     fn load_le(&mut self, i: usize, bytes: &[u8]);
 
-    /// FNV-1a over every weight's stored little-endian bytes: equal on every
-    /// machine for equal tables (for full-width tables, the same value as
-    /// over the `i32`s).
+    /// The stored bits of weight `i` (the `i32` of a full-width weight, the
+    /// `i16` of a 16-bit one, sign-extended), 0 outside the table.
+    fn raw(&self, i: usize) -> u32;
+
+    /// The table's checksum ([`entry_hash`] summed over every weight): equal
+    /// on every machine for equal tables, and cheap to keep up to date one
+    /// write at a time ([`crate::agent::Agent`] does), so that a board with
+    /// millions of weights need not read them all at every episode's end.
     fn checksum(&self) -> u32 {
-        let mut h: u32 = 0x811c_9dc5;
-        let mut buf = [0u8; 4];
-        let n = self.format().bytes();
-        for i in 0..self.len() {
-            self.stored_le(i, &mut buf);
-            for &b in &buf[..n] {
-                h = (h ^ b as u32).wrapping_mul(0x0100_0193);
-            }
-        }
-        h
+        (0..self.len()).fold(0u32, |sum, i| sum.wrapping_add(entry_hash(i, self.raw(i))))
     }
+}
+
+/// One weight's share of the table checksum: MurmurHash3's 32-bit
+/// finaliser of its index and stored bits. The checksum is the wrapping sum
+/// of these, so a write changes it by `entry_hash(i, new) −
+/// entry_hash(i, old)`; a sum of well-mixed terms still detects any single
+/// change and, with overwhelming probability, any divergence of two
+/// learners.
+#[inline]
+pub fn entry_hash(i: usize, raw: u32) -> u32 {
+    let mut h = (i as u32).wrapping_mul(0x9E37_79B1) ^ raw.wrapping_mul(0x85EB_CA77);
+    h ^= h >> 16;
+    h = h.wrapping_mul(0x85EB_CA6B);
+    h ^= h >> 13;
+    h = h.wrapping_mul(0xC2B2_AE35);
+    h ^ (h >> 16)
 }
 
 impl<T: AsRef<[Q16]> + AsMut<[Q16]> + ?Sized> WeightStore for T {
     fn len(&self) -> usize {
         self.as_ref().len()
+    }
+
+    #[inline]
+    fn raw(&self, i: usize) -> u32 {
+        self.get(i).0 as u32
     }
 
     #[inline]
@@ -178,6 +195,16 @@ impl<A: WeightStore, B: WeightStore> WeightStore for Split<A, B> {
 
     fn len(&self) -> usize {
         self.first.len() + self.second.len()
+    }
+
+    #[inline]
+    fn raw(&self, i: usize) -> u32 {
+        let n = self.first.len();
+        if i < n {
+            self.first.raw(i)
+        } else {
+            self.second.raw(i - n)
+        }
     }
 
     #[inline]
@@ -273,6 +300,11 @@ impl<T: AsRef<[i16]> + AsMut<[i16]>, const SHIFT: u32> WeightStore for Half<T, S
 
     fn len(&self) -> usize {
         self.data.as_ref().len()
+    }
+
+    #[inline]
+    fn raw(&self, i: usize) -> u32 {
+        self.data.as_ref().get(i).copied().unwrap_or(0) as i32 as u32
     }
 
     #[inline]

@@ -276,3 +276,42 @@ fn switching_pada_to_sarsa_keeps_weights_and_widens_candidates() {
     assert_eq!(agent.policy().candidates().count(), 9);
 }
 
+
+/// The checksum the agent keeps up to date write by write is the checksum
+/// of the whole table, for every kind of store, through learning, a
+/// handed-out table and a rehash.
+#[test]
+fn the_running_checksum_is_the_whole_tables() {
+    use pada_core::weights::{Half, Split, WeightStore};
+    fn learn<W: WeightStore>(weights: W) {
+        let dims = [StateDim::new(-1.0, 1.0, 0.25).unwrap(), StateDim::new(-2.0, 2.0, 0.5).unwrap()];
+        let motor = ActionSpace::new(&[ActionDim::from_levels(&[-1.0, 0.0, 1.0]).unwrap()]).unwrap();
+        let params = SarsaParams { init: WeightInit::Uniform { min: 0.0, max: 1.0 }, ..SarsaParams::default() };
+        let mut agent: Agent<W, 8, 32> =
+            Agent::new(&dims, motor, PolicyKind::Sarsa, params, Layout::Hashed, weights).unwrap();
+        let mut rng = rand_pcg::Pcg32::seed_from_u64(3);
+        agent.reset_weights(&mut rng);
+        assert_eq!(agent.weights_checksum(), agent.weights().checksum());
+        let mut x = 0.3f32;
+        agent.start_episode(&[x, -x], &mut rng).unwrap();
+        for k in 0..500 {
+            x = (x * 3.7 + 0.1).sin();
+            let r = if k % 7 == 0 { -5.0 } else { 0.5 };
+            agent.step(r, &[x, -x], &mut rng).unwrap();
+        }
+        agent.end_episode(-1.0, EpisodeEnd::Absorbing, &mut rng).unwrap();
+        let whole = agent.weights().checksum();
+        assert_eq!(agent.weights_checksum(), whole);
+        // A change from outside is seen (computed from the table) and kept
+        // after a rehash.
+        let w0 = agent.weights().get(0);
+        agent.weights_mut().set(0, pada_core::fixed::Q16(w0.0.wrapping_add(1 << 16)));
+        assert_ne!(agent.weights_checksum(), whole);
+        assert_eq!(agent.weights_checksum(), agent.weights().checksum());
+        agent.rehash();
+        assert_eq!(agent.weights_checksum(), agent.weights().checksum());
+    }
+    learn(vec![Q16::ZERO; 1 << 12].into_boxed_slice());
+    learn(Split { first: vec![Q16::ZERO; 1 << 11], second: vec![Q16::ZERO; 1 << 11] });
+    learn(Half::<_, 10>::new(vec![0i16; 1 << 12]));
+}

@@ -37,18 +37,21 @@ fn save_seed<S: CheckpointStore>(store: &mut S, hash: u32, seed: u32) -> Result<
     save(store, hash, &state(seed), &weights(seed as i32))
 }
 
-/// Loads into fresh buffers: (outcome, state, weights).
+/// Loads into fresh buffers: (outcome, state, weights). The state's flash
+/// wear, which `save` fills in, is cleared so that it compares with the
+/// `state(seed)` saved (the wear has tests of its own).
 fn load_all(store: &impl CheckpointStore, hash: u32) -> (LoadOutcome, LearnerState, Vec<Q16>) {
     let mut st = LearnerState::default();
     let mut out = vec![Q16(5); N];
     let outcome = load(store, hash, &mut st, &mut out).unwrap_or_else(|_| panic!("store error"));
+    st.wear = FlashWear::default();
     (outcome, st, out)
 }
 
 #[test]
 fn save_then_load_round_trips() {
     let mut store = Store::new();
-    assert_eq!(save_seed(&mut store, 42, 1), Ok(Saved { generation: 1, slot: 0 }));
+    assert_eq!(save_seed(&mut store, 42, 1), Ok(Saved { generation: 1, slot: 0, erases: 1 }));
     let (outcome, st, out) = load_all(&store, 42);
     assert_eq!(outcome, LoadOutcome::Loaded { generation: 1, slot: 0 });
     assert_eq!(out, weights(1));
@@ -60,7 +63,7 @@ fn saves_alternate_slots_and_load_takes_the_newest() {
     let mut store = Store::new();
     for g in 1..=6u32 {
         let saved = save_seed(&mut store, 42, g).unwrap();
-        assert_eq!(saved, Saved { generation: g, slot: ((g - 1) % 2) as u8 });
+        assert_eq!(saved, Saved { generation: g, slot: ((g - 1) % 2) as u8, erases: g.div_ceil(2) });
         let (outcome, st, out) = load_all(&store, 42);
         assert_eq!(outcome, LoadOutcome::Loaded { generation: g, slot: saved.slot });
         assert_eq!(out, weights(g as i32));
@@ -135,7 +138,7 @@ fn a_corrupted_newest_checkpoint_falls_back_to_the_older() {
         assert_eq!(out, weights(1));
         assert_eq!(st, state(1));
         // The next save overwrites the corrupted slot, not the good one.
-        assert_eq!(save_seed(&mut store, 42, 2), Ok(Saved { generation: 2, slot: 1 }));
+        assert_eq!(save_seed(&mut store, 42, 2), Ok(Saved { generation: 2, slot: 1, erases: 1 }));
     }
 }
 
@@ -187,14 +190,14 @@ fn a_torn_second_save_at_every_byte_keeps_the_first() {
         assert_eq!(st, state(1), "budget {budget}");
         // And the next save goes to the torn slot again and succeeds.
         let mut store = torn.inner;
-        assert_eq!(save_seed(&mut store, 42, 2), Ok(Saved { generation: 2, slot: 1 }), "budget {budget}");
+        assert_eq!(save_seed(&mut store, 42, 2), Ok(Saved { generation: 2, slot: 1, erases: 1 }), "budget {budget}");
         assert_eq!(load_all(&store, 42).1, state(2), "budget {budget}");
     }
     // With the whole budget the save completes.
     let mut base = Store::new();
     save_seed(&mut base, 42, 1).unwrap();
     let mut full = TornStore::new(base, WRITTEN);
-    assert_eq!(save_seed(&mut full, 42, 2), Ok(Saved { generation: 2, slot: 1 }));
+    assert_eq!(save_seed(&mut full, 42, 2), Ok(Saved { generation: 2, slot: 1, erases: 1 }));
 }
 
 #[test]
@@ -241,4 +244,88 @@ fn header_claiming_more_weights_than_fit_is_corrupt() {
     let h = Header { weight_count: 0, state_len: u16::MAX as u32, ..h };
     store.write_bytes(0, &h.to_bytes());
     assert_eq!(inspect(&store, 0), Ok(SlotStatus::Invalid(HeaderError::Corrupt)));
+}
+
+#[test]
+fn saving_goes_on_past_the_largest_generation() {
+    // Regression (issue 16, defect 4): the generation saturated at u32::MAX
+    // and, with a strict `>`, every later save was lost and loading
+    // returned the older slot. Start just below the wrap by writing a
+    // checkpoint of generation u32::MAX - 2 by hand.
+    let mut store = Store::new();
+    save_seed(&mut store, 42, 1).unwrap();
+    let mut h = Header::parse(store.slot(0).unwrap()[..HEADER_LEN].try_into().unwrap()).unwrap();
+    h.generation = u32::MAX - 2;
+    store.slot_mut(0).unwrap()[..HEADER_LEN].copy_from_slice(&h.to_bytes());
+    let mut expected = u32::MAX - 2;
+    for seed in 2..=8u32 {
+        expected = expected.wrapping_add(1);
+        let saved = save_seed(&mut store, 42, seed).unwrap();
+        assert_eq!(saved.generation, expected, "seed {seed}");
+        let (outcome, st, out) = load_all(&store, 42);
+        assert_eq!(outcome, LoadOutcome::Loaded { generation: expected, slot: saved.slot }, "seed {seed}");
+        assert_eq!((st, out), (state(seed), weights(seed as i32)), "seed {seed}: the newest loads");
+    }
+    assert_eq!(expected, 4, "wrapped through u32::MAX and 0");
+    assert!(is_newer(0, u32::MAX) && is_newer(1, u32::MAX - 1) && !is_newer(u32::MAX, 0) && !is_newer(5, 5));
+}
+
+#[test]
+fn a_never_written_store_smaller_than_a_header_is_empty() {
+    // Regression (issue 16, defect 9): it loaded as Corrupt.
+    let tiny = RamStore::<{ HEADER_LEN - 1 }>::new();
+    let mut st = LearnerState::default();
+    let mut out = vec![Q16(5); N];
+    assert_eq!(load(&tiny, 42, &mut st, &mut out), Ok(LoadOutcome::NoCheckpoint));
+    let mut tiny = RamStore::<4>::new();
+    tiny.slot_mut(1).unwrap()[2] = 0;
+    assert_eq!(load(&tiny, 42, &mut st, &mut out), Ok(LoadOutcome::Corrupt), "a written byte is not erased flash");
+    let mut tiny = RamStore::<4>::new();
+    assert!(matches!(save_seed(&mut tiny, 42, 1), Err(SaveError::TooLarge { .. })));
+}
+
+#[test]
+fn erases_are_counted_in_the_record_across_configurations() {
+    let mut store = Store::new();
+    for g in 1..=5u32 {
+        save_seed(&mut store, 42, g).unwrap();
+    }
+    let wear = stored_wear(&store).unwrap();
+    assert_eq!(wear.erases, [3, 2]);
+    // Another configuration's save carries the counts on; so does a state
+    // that brings its own (higher) counts and operating time.
+    let mut s = state(9);
+    s.wear = FlashWear { erases: [1, 7], operating_s: 3600 };
+    let saved = save(&mut store, 7, &s, &weights(9)).unwrap();
+    assert_eq!(saved, Saved { generation: 6, slot: 1, erases: 8 });
+    assert_eq!(stored_wear(&store).unwrap(), FlashWear { erases: [3, 8], operating_s: 3600 });
+    // The loaded state reports them.
+    let mut st = LearnerState::default();
+    let mut out = vec![Q16::ZERO; N];
+    load(&store, 7, &mut st, &mut out).unwrap();
+    assert_eq!(st.wear.erases, [3, 8]);
+}
+
+#[test]
+fn a_save_beyond_the_wear_budget_is_refused_before_anything_is_erased() {
+    let budget = WearBudget { endurance: 6, reserve: 2, lifetime_s: 4000 };
+    let mut store = Store::new();
+    let mut s = state(1);
+    // The reserve: two erases per slot at operating time 0.
+    for _ in 0..4 {
+        save_within(&mut store, 42, &s, &weights(1), &budget).unwrap();
+    }
+    let before = store.clone();
+    let r = save_within(&mut store, 42, &s, &weights(1), &budget);
+    assert_eq!(r, Err(SaveError::Wear(WearRefusal::TooSoon { erases: 2, allowed: 2, retry_in_s: 1000 })));
+    assert_eq!(store.slot(0), before.slot(0));
+    assert_eq!(store.slot(1), before.slot(1));
+    // After 1000 s of operation one more erase per slot is allowed.
+    s.wear.operating_s = 1000;
+    assert_eq!(save_within(&mut store, 42, &s, &weights(1), &budget).unwrap().erases, 3);
+    // At the end of the lifetime the endurance is reached, and then refused.
+    s.wear.operating_s = 10_000;
+    while save_within(&mut store, 42, &s, &weights(1), &budget).is_ok() {}
+    assert_eq!(stored_wear(&store).unwrap().erases, [6, 6]);
+    assert_eq!(save_within(&mut store, 42, &s, &weights(1), &budget), Err(SaveError::Wear(WearRefusal::WornOut { erases: 6 })));
 }

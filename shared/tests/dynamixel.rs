@@ -222,13 +222,94 @@ fn corrupted_streams_lose_only_the_corrupted_packets() {
     assert!(s.bad_checksums + s.bad_lengths > 0);
 }
 
+#[test]
+fn a_status_packet_from_the_broadcast_id_is_refused() {
+    // Found by `cargo xtask fuzz`: the decoder accepted a status packet from
+    // ID 0xFE, which no servo sends and the encoder refuses.
+    let mut raw = vec![0xFF, 0xFF, BROADCAST_ID, 2, 0];
+    raw.push(checksum(&raw[2..]));
+    let good = encode_status(&Status::new(1, ErrorFlags::NONE, &[]).unwrap());
+    raw.extend(&good);
+    let mut dec = StatusDecoder::<64>::new();
+    let got = decode_all_status(&mut dec, &raw);
+    assert_eq!(got[0], Err(DecodeError::BroadcastStatus));
+    assert!(matches!(got.last(), Some(Ok(p)) if p.id == 1));
+    assert_eq!(dec.stats().unexpected_ids, 1);
+    assert_eq!(dec.stats().skipped_bytes as usize, raw.len() - good.len());
+    // Instructions to the broadcast ID are packets like any other.
+    let mut ins = InstructionDecoder::<64>::new();
+    let mut buf = [0u8; 16];
+    let sent = action(BROADCAST_ID, &mut buf).unwrap();
+    assert!(matches!(ins.feed(sent).next(), Some(Ok(p)) if p.id == BROADCAST_ID));
+}
+
+#[test]
+fn writes_without_data_are_refused_by_encoder_and_parser_alike() {
+    // Regression (issue 16, defect 7): WRITE and REG_WRITE with no data
+    // encoded, and the emulator's parser then refused them as BadParams.
+    let mut buf = [0u8; 16];
+    for code in [0x03u8, 0x04] {
+        let ins = if code == 3 { Instruction::Write { addr: 24, data: &[] } } else { Instruction::RegWrite { addr: 24, data: &[] } };
+        assert_eq!(ins.encode(1, &mut buf), Err(EncodeError::NoData { code }));
+        assert_eq!(Instruction::parse(code, &[24]), Err(InstructionError::BadParams { code, len: 1 }));
+    }
+    assert_eq!(write_data(1, 24, &[], &mut buf), Err(EncodeError::NoData { code: 3 }));
+    // Every instruction that encodes parses back to itself (one byte of
+    // data is the least a write carries).
+    let one = [7u8];
+    for ins in [Instruction::Write { addr: 3, data: &one }, Instruction::RegWrite { addr: 3, data: &one }] {
+        let p = ins.encode(2, &mut buf).unwrap();
+        assert_eq!(Instruction::parse(p[4], &p[5..p.len() - 1]), Ok(ins));
+    }
+}
+
+#[test]
+fn only_the_expected_reply_is_accepted_and_a_spurious_header_holds_nothing_back() {
+    // Regression (issue 16, defect 6): garbage that formed a header with a
+    // valid checksum was accepted, and a spurious header with a large
+    // LENGTH held back the real reply behind it.
+    let reply = Status::new(3, ErrorFlags::NONE, &[1, 2, 3, 4, 5, 6, 7, 8]).unwrap();
+    let real = encode_status(&reply);
+    // A well-formed status packet from another servo, one of the right ID
+    // with the wrong length (valid checksums both), and a spurious header
+    // announcing 200 bytes: all before the real reply.
+    let other_id = encode_status(&Status::new(4, ErrorFlags::NONE, &[9; 8]).unwrap());
+    let other_len = encode_status(&Status::new(3, ErrorFlags::NONE, &[9; 2]).unwrap());
+    let mut stream = other_id.clone();
+    stream.extend(&other_len);
+    stream.extend([0xFF, 0xFF, 3, 50]);
+    stream.extend(&real);
+    let mut dec = StatusDecoder::<64>::new();
+    dec.expect(Some(Reply { id: 3, params: 8 }));
+    let got = decode_all_status(&mut dec, &stream);
+    assert_eq!(got.last(), Some(&Ok(reply.clone())), "{got:?}");
+    assert_eq!(got.iter().filter(|r| r.is_ok()).count(), 1, "only the expected reply: {got:?}");
+    assert!(got.contains(&Err(DecodeError::UnexpectedId { expected: 3, got: 4 })));
+    assert!(got.contains(&Err(DecodeError::BadLength { id: 3, length: 4 })));
+    assert!(got.contains(&Err(DecodeError::BadLength { id: 3, length: 50 })));
+    // Everything before the reply was discarded and counted, byte for byte.
+    let s = dec.stats();
+    assert_eq!(s.skipped_bytes as usize, stream.len() - real.len());
+    assert_eq!((s.packets, s.unexpected_ids, s.bad_lengths), (1, 1, 2));
+    assert_eq!(dec.buffered(), 0);
+    // Without the expectation the spurious header waits for its 54 bytes
+    // and holds the reply back; with it, the reply is found at once.
+    let mut early = vec![0xFF, 0xFF, 3, 50];
+    early.extend(&real);
+    let mut any = StatusDecoder::<64>::new();
+    assert!(decode_all_status(&mut any, &early).is_empty());
+    let mut dec = StatusDecoder::<64>::new();
+    dec.expect(Some(Reply { id: 3, params: 8 }));
+    assert_eq!(decode_all_status(&mut dec, &early).last(), Some(&Ok(reply)));
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(2000))]
 
     #[test]
     fn arbitrary_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..600), chunk in 1usize..40) {
         let mut s = StatusDecoder::<16>::new();
-        s.expect(Some(1));
+        s.expect(Some(Reply { id: 1, params: 8 }));
         let mut i = InstructionDecoder::<64>::new();
         for c in bytes.chunks(chunk) {
             for r in s.feed(c) { let _ = r; }
@@ -248,10 +329,13 @@ proptest! {
             junk in proptest::collection::vec(any::<u8>(), 0..20)) {
         let st = Status::new(id, ErrorFlags(err), &params).unwrap();
         let mut stream = junk.clone();
-        // End the junk so it cannot start a header that swallows the packet.
-        stream.extend([0u8; 4]);
         stream.extend(encode_status(&st));
+        // As the firmware listens: for the asked servo's reply of the length
+        // its request implies. Junk before it that looks like a header (even
+        // one announcing more bytes than follow, which a decoder expecting
+        // anything would wait for) cannot hold it back.
         let mut dec = StatusDecoder::<64>::new();
+        dec.expect(Some(Reply { id, params: params.len() as u8 }));
         let got: Vec<_> = dec.feed(&stream).filter_map(|r| r.ok()).collect();
         prop_assert_eq!(got.last(), Some(&st));
     }

@@ -170,6 +170,7 @@ impl Learner {
             rng: self.rng.state(),
             joints: heapless::Vec::from_slice(&self.fatigue.state()).unwrap(),
             user: self.user,
+            wear: FlashWear::default(),
         }
     }
 
@@ -244,7 +245,7 @@ fn a_restored_learner_continues_exactly_where_the_saved_one_was() {
         a.finish_episode();
         a.agent.set_epsilon(0.1).unwrap();
         let mut store = Store::new();
-        assert_eq!(a.save(&mut store), Saved { generation: 1, slot: 0 });
+        assert_eq!(a.save(&mut store), Saved { generation: 1, slot: 0, erases: 1 });
         // A board after a reset: another seed, fresh weights, SARSA at boot.
         let mut b = new_learner(PolicyKind::Sarsa, 99);
         assert_ne!(b.fingerprint(), a.fingerprint());
@@ -367,15 +368,22 @@ fn agent_state() -> impl Strategy<Value = AgentState> {
 }
 
 fn learner_state() -> impl Strategy<Value = LearnerState> {
-    (agent_state(), any::<u64>(), any::<u64>(), any::<[u32; 4]>(), 0u64..5000)
-        .prop_flat_map(|(agent, state, inc, user, steps)| {
-            (Just(agent), Just(RngState { state, increment: inc | 1 }), Just(user), [joint_state(steps), joint_state(steps), joint_state(steps)])
+    (agent_state(), any::<u64>(), any::<u64>(), any::<[u32; 4]>(), 0u64..5000, [0u32..1_000_000, 0u32..1_000_000], any::<u64>())
+        .prop_flat_map(|(agent, state, inc, user, steps, erases, operating_s)| {
+            (
+                Just(agent),
+                Just(RngState { state, increment: inc | 1 }),
+                Just(user),
+                [joint_state(steps), joint_state(steps), joint_state(steps)],
+                Just(FlashWear { erases, operating_s }),
+            )
         })
-        .prop_map(|(agent, rng, user, joints)| LearnerState {
+        .prop_map(|(agent, rng, user, joints, wear)| LearnerState {
             agent,
             rng,
             joints: heapless::Vec::from_slice(&joints).unwrap(),
             user,
+            wear,
         })
 }
 
@@ -402,14 +410,18 @@ proptest! {
         let outcome = load(&store, HASH, &mut st, &mut out).unwrap();
         let loaded = matches!(outcome, LoadOutcome::Loaded { generation, .. } if generation == 1 + earlier as u32);
         prop_assert!(loaded, "outcome {:?}", outcome);
-        prop_assert_eq!(&st, &state);
+        // Every save counted its erase on top of the counts it found.
+        let e = state.wear.erases;
+        let erases = if earlier { [e[0] + 1, e[1] + 1] } else { [e[0] + 1, e[1]] };
+        prop_assert_eq!(st.wear, FlashWear { erases, ..state.wear });
+        prop_assert_eq!(&LearnerState { wear: state.wear, ..st.clone() }, &state);
         prop_assert_eq!(&out, &weights);
         // The record alone.
         prop_assert_eq!(LearnerState::from_bytes(&state.to_bytes()).unwrap(), state.clone());
 
         let mut l = new_learner(PolicyKind::Sarsa, 0);
         prop_assert_eq!(l.load(&store, HASH), outcome);
-        prop_assert_eq!(l.state(), state);
+        prop_assert_eq!(l.state(), LearnerState { wear: FlashWear::default(), ..state });
         prop_assert_eq!(&l.agent.weights()[..], &weights[..]);
     }
 
@@ -529,7 +541,7 @@ fn write_raw(store: &mut Store, slot: u8, version: u16, generation: u32, record:
 fn records_that_cannot_be_decoded_are_refused_by_name() {
     let good = trained(PolicyKind::Pada { delta: 0.5 }, 3, 300).state().to_bytes();
     let cases: [(usize, u8, &str); 9] = [
-        (0, 2, "state.version"),   // record version 2
+        (0, 1, "state.version"),   // record version 1 (before the flash wear)
         (2, 2, "mode"),            // mode 2
         (3, 6, "policy.kind"),     // kind 6
         (8, 2, "policy.switched"), // switched 2
@@ -600,7 +612,7 @@ fn a_version_1_checkpoint_is_refused_not_loaded_without_its_state() {
     // in slot 0.
     let mut store = Store::new();
     write_raw(&mut store, 1, 1, 7, &[], &v1_weights);
-    assert_eq!(saver.save(&mut store), Saved { generation: 1, slot: 0 });
+    assert_eq!(saver.save(&mut store), Saved { generation: 1, slot: 0, erases: 1 });
     assert_eq!(l.load(&store, HASH), LoadOutcome::Loaded { generation: 1, slot: 0 });
 }
 
@@ -631,7 +643,7 @@ fn a_save_torn_inside_the_state_record_keeps_the_previous_checkpoint() {
     }
     // Uninterrupted, the second save loads.
     let mut store = base;
-    assert_eq!(a.save(&mut store), Saved { generation: 2, slot: 1 });
+    assert_eq!(a.save(&mut store), Saved { generation: 2, slot: 1, erases: 1 });
     let mut b = new_learner(PolicyKind::Sarsa, 42);
     assert_eq!(b.load(&store, HASH), LoadOutcome::Loaded { generation: 2, slot: 1 });
     assert_eq!(b.state(), second);

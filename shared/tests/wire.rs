@@ -5,7 +5,7 @@
 use heapless::{String, Vec as HVec};
 use pada_core::checkpoint::{LoadOutcome, Saved};
 use pada_core::dynamixel::ErrorFlags;
-use pada_core::policy::PolicyKind;
+use pada_core::policy::{PolicyKind, PolicyName};
 use pada_core::safety::{FaultCause, Rejection, State};
 use pada_core::wire::*;
 use proptest::prelude::*;
@@ -52,6 +52,8 @@ fn full_health() -> Health {
         overruns: u32::MAX,
         max_loop_us: u32::MAX,
         telemetry_drops: u32::MAX,
+        checkpoint_erases: u32::MAX,
+        saves_refused: u32::MAX,
     }
 }
 
@@ -105,8 +107,10 @@ fn all_to_host() -> Vec<ToHost> {
             weights: (0..WEIGHTS_PER_CHUNK as i32).map(|i| i32::MIN + i).collect(),
         }),
         ToHost::Ack(Ack { seq: 41 }),
-        ToHost::Checkpoint(CheckpointReport::Saved(Saved { generation: 3, slot: 0 })),
+        ToHost::Checkpoint(CheckpointReport::Saved(Saved { generation: 3, slot: 0, erases: u32::MAX })),
         ToHost::Checkpoint(CheckpointReport::SaveFailed),
+        ToHost::Policy(PolicyReport { step: 7, built: PolicyKind::Pada { delta: 0.5 }, switched_to_sarsa: true }),
+        ToHost::Policy(PolicyReport { step: u32::MAX, built: PolicyKind::LowPass { alpha: 0.834 }, switched_to_sarsa: false }),
     ];
     for o in [
         LoadOutcome::Loaded { generation: 9, slot: 1 },
@@ -156,12 +160,12 @@ fn all_to_chip() -> Vec<ToChip> {
         ToChip::Start(RunMode::Testing),
         ToChip::Stop,
         ToChip::Pause,
-        ToChip::SetPolicy(PolicySpec::Sarsa),
-        ToChip::SetPolicy(PolicySpec::LowPass(0.3)),
-        ToChip::SetPolicy(PolicySpec::MarkovLowPass(0.3)),
-        ToChip::SetPolicy(PolicySpec::Integrator(0.1)),
-        ToChip::SetPolicy(PolicySpec::MarkovIntegrator(0.1)),
-        ToChip::SetPolicy(PolicySpec::Pada(0.25)),
+        ToChip::SetPolicy(PolicyKind::Sarsa),
+        ToChip::SetPolicy(PolicyKind::LowPass { alpha: 0.3 }),
+        ToChip::SetPolicy(PolicyKind::MarkovLowPass { alpha: 0.3 }),
+        ToChip::SetPolicy(PolicyKind::Integrator { delta: 0.1 }),
+        ToChip::SetPolicy(PolicyKind::MarkovIntegrator { delta: 0.1 }),
+        ToChip::SetPolicy(PolicyKind::Pada { delta: 0.25 }),
         ToChip::SwitchToSarsa,
         ToChip::SetEpsilon(0.05),
         ToChip::SaveCheckpoint,
@@ -197,6 +201,29 @@ fn round_trip<M: serde::Serialize + serde::de::DeserializeOwned + PartialEq + st
         assert_eq!(dec.stats().bytes, stream.len() as u64);
     }
 }
+
+/// CRC-32 of the postcard bytes of one of every message, both directions.
+fn layout_fingerprint() -> u32 {
+    let mut bytes = Vec::new();
+    for m in all_to_host() {
+        bytes.extend(body(&m));
+    }
+    for m in all_to_chip() {
+        bytes.extend(body(&m));
+    }
+    pada_core::crc::crc32(&bytes)
+}
+
+#[test]
+fn the_protocol_version_changes_with_the_layout() {
+    // A change of any message's layout changes this fingerprint: then bump
+    // PROTOCOL_VERSION and put the new pair here (with the docs that name
+    // the version: docs/sil.md, firmware/README.md, README.md).
+    assert_eq!((PROTOCOL_VERSION, layout_fingerprint()), (4, EXPECTED_FINGERPRINT), "{:#010x}", layout_fingerprint());
+}
+
+/// [`layout_fingerprint`] of protocol 4.
+const EXPECTED_FINGERPRINT: u32 = 0xa605_d408;
 
 #[test]
 fn every_chip_message_round_trips() {
@@ -410,18 +437,124 @@ fn floats_round_trip_bit_for_bit() {
 }
 
 #[test]
-fn policy_spec_converts_both_ways() {
-    let kinds = [
-        PolicyKind::Sarsa,
-        PolicyKind::LowPass { alpha: 0.3 },
-        PolicyKind::MarkovLowPass { alpha: 0.4 },
-        PolicyKind::Integrator { delta: 0.1 },
-        PolicyKind::MarkovIntegrator { delta: 0.2 },
-        PolicyKind::Pada { delta: 0.25 },
-    ];
-    for k in kinds {
-        assert_eq!(PolicyKind::from(PolicySpec::from(k)), k);
+fn set_policy_carries_the_policy_kind_as_its_code_and_parameter() {
+    // The wire's PolicySpec is PolicyKind itself; its bytes are the
+    // policy's code (the checkpoint's too) and then α or Δ.
+    for name in PolicyName::ALL {
+        let kind = name.with_parameter(0.25);
+        let bytes = body(&ToChip::SetPolicy(kind));
+        let mut expected = vec![4, name.code()];
+        if name != PolicyName::Sarsa {
+            expected.extend_from_slice(&0.25f32.to_le_bytes());
+        }
+        assert_eq!(bytes, expected, "{name}");
+        assert_eq!(pada_core::policy::kind_code(&kind), name.code());
     }
+}
+
+/// The bytes of one frame (delimiter included) for `msg` with `seq`.
+fn frame_of<M: serde::Serialize>(msg: &M, seq: u32) -> Vec<u8> {
+    let mut buf = [0u8; MAX_FRAME_LEN];
+    encode_frame(msg, seq, &mut buf).unwrap().to_vec()
+}
+
+/// COBS of `raw` (no zero bytes in it, at most 253) and a delimiter.
+fn cobs_small(raw: &[u8]) -> Vec<u8> {
+    assert!(!raw.contains(&0) && raw.len() < 254);
+    let mut f = vec![raw.len() as u8 + 1];
+    f.extend_from_slice(raw);
+    f.push(0);
+    f
+}
+
+#[test]
+fn the_end_of_the_input_counts_a_cut_off_frame() {
+    // Regression (issue 16, defect 1): a frame cut off by the end of the
+    // stream, or bytes without a delimiter, were never counted as lost.
+    let whole = frame_of(&ToHost::Ack(Ack { seq: 5 }), 0);
+    let mut dec = HostDecoder::new();
+    assert_eq!(dec.feed(&whole).count(), 1);
+    assert_eq!(dec.finish(), None, "ended on a delimiter: nothing lost");
+    dec.feed(&whole[..whole.len() - 3]).for_each(drop);
+    assert_eq!(dec.pending(), whole.len() - 3);
+    assert_eq!(dec.finish(), Some(FrameError::Truncated));
+    assert_eq!((dec.stats().truncated, dec.stats().bad_frames()), (1, 1));
+    assert!(!dec.stats().is_clean());
+    assert_eq!(dec.finish(), None, "counted once");
+    // 10 kB without a zero byte: one oversize frame in progress, lost.
+    let mut dec = HostDecoder::new();
+    assert_eq!(dec.feed(&[0x55; 10_000]).count(), 0);
+    assert!(dec.stats().is_clean(), "nothing is known to be lost until the end");
+    assert_eq!(dec.finish(), Some(FrameError::Truncated));
+    assert!(!dec.stats().is_clean());
+    // The decoder goes on with the next stream.
+    assert_eq!(dec.feed(&whole).filter(|r| r.is_ok()).count(), 1);
+}
+
+#[test]
+fn a_non_canonical_body_is_refused() {
+    // Regression (issue 16, defect 5): an overlong varint with a valid CRC
+    // decoded as if canonical. Ack { seq: 5 } with seq 300 written
+    // canonically (AC 02), then with the 5 padded to two bytes (85 00),
+    // then with the sequence number padded to three (AC 82 00).
+    let good = [0xAC, 0x02, 10, 5];
+    for body in [vec![0xAC, 0x02, 10, 0x85, 0x00], vec![0xAC, 0x82, 0x00, 10, 5], vec![0xAC, 0x02, 0x8A, 0x00, 5]] {
+        let mut raw = body.clone();
+        raw.extend_from_slice(&pada_core::crc::crc32(&body).to_le_bytes());
+        // The zero padding byte is data: COBS encodes it as a block end.
+        let mut f = vec![0u8; 32];
+        let n = cobs::encode(&raw, &mut f);
+        f.truncate(n);
+        f.push(0);
+        let mut dec = HostDecoder::new();
+        assert_eq!(dec.feed(&f).next(), Some(Err(FrameError::NonCanonical)), "{body:02x?}");
+        assert_eq!((dec.stats().noncanonical, dec.stats().frames), (1, 0));
+    }
+    let mut raw = good.to_vec();
+    raw.extend_from_slice(&pada_core::crc::crc32(&good).to_le_bytes());
+    let mut dec = HostDecoder::new();
+    assert!(matches!(dec.feed(&cobs_small(&raw)).next(), Some(Ok(_))));
+    // A non-canonical COBS encoding of canonical bytes: 254 non-zero bytes
+    // fill a block (code FF) and end the frame; an empty block (01) after
+    // it decodes to the same bytes, but is not what the encoder writes.
+    type Blob = HVec<u8, 300>;
+    let mut blob: Blob = HVec::from_slice(&[0x33; 247]).unwrap();
+    let mut canonical = Vec::new();
+    for fill in 1u8..=255 {
+        blob[0] = fill;
+        let f = frame_of(&blob, 1);
+        if f.len() == 254 + 2 && f[0] == 0xFF {
+            canonical = f;
+            break;
+        }
+    }
+    assert!(!canonical.is_empty(), "some fill gives a CRC without zero bytes");
+    let mut padded = canonical.clone();
+    padded.insert(255, 0x01);
+    let mut dec = FrameDecoder::<Blob, 600>::new();
+    assert_eq!(dec.feed(&padded).next(), Some(Err(FrameError::NonCanonical)));
+    assert!(dec.feed(&canonical).next().unwrap().is_ok());
+}
+
+#[test]
+fn a_large_sequence_jump_is_a_resync_not_billions_missed() {
+    // Regression (issue 16, defect 8): a forward jump counted up to 2^31 - 1
+    // missing frames.
+    let mut dec = HostDecoder::new();
+    let ack = ToHost::Ack(Ack { seq: 0 });
+    for seq in [0u32, 1, 5, 7 + MAX_SEQ_GAP, 8 + MAX_SEQ_GAP, 3] {
+        dec.feed(&frame_of(&ack, seq)).for_each(drop);
+    }
+    let s = dec.stats();
+    assert_eq!(s.frames, 6);
+    assert_eq!(s.seq_gaps, 3, "5 after 1, the jump, and the way back to 3");
+    assert_eq!(s.seq_resyncs, 2);
+    assert_eq!(s.frames_missed, 3, "only the three between 1 and 5");
+    // The largest jump still counted as missed frames.
+    let mut dec = HostDecoder::new();
+    dec.feed(&frame_of(&ack, 10)).for_each(drop);
+    dec.feed(&frame_of(&ack, 11 + MAX_SEQ_GAP)).for_each(drop);
+    assert_eq!((dec.stats().frames_missed, dec.stats().seq_resyncs), (MAX_SEQ_GAP as u64, 0));
 }
 
 fn xorshift(s: &mut u64) -> u64 {

@@ -9,7 +9,7 @@ use pada::sil::replay::{replay, Record};
 use pada::sil::{run, SilConfig, SilSummary, SilTask};
 use pada_core::policy::PolicyKind;
 use pada_core::wire::{HostDecoder, RunMode, StepKind, ToHost};
-use pada_firmware::config::{Robot, DEFAULT_SEED};
+use pada_firmware::config::{Board, Robot, DEFAULT_SEED};
 use std::path::Path;
 use std::time::Duration;
 
@@ -84,8 +84,24 @@ fn the_firmware_in_qemu_replays_bit_for_bit_on_the_host_and_its_link_is_clean() 
     // the agent's Q16.16 resolution, or in a greedy test episode, which
     // does not learn, would change no weight).
     let stream = std::fs::read(dir.path().join("telemetry.bin")).unwrap();
+    // The firmware reports the policy it was set to (the wire's Policy
+    // frame, which pada watch shows).
+    let mut decoder = pada_core::wire::HostDecoder::new();
+    let policies: Vec<pada_core::wire::PolicyReport> = decoder
+        .feed(&stream)
+        .filter_map(|r| match r.ok()?.msg {
+            pada_core::wire::ToHost::Policy(p) => Some(p),
+            _ => None,
+        })
+        .collect();
+    // At boot (SARSA), then after the run's SetPolicy.
+    assert_eq!(policies.len(), 2, "{policies:?}");
+    assert_eq!(PolicyKind::from(policies[0].built), PolicyKind::Sarsa);
+    let last = policies.last().expect("the firmware sent a Policy frame");
+    assert_eq!(PolicyKind::from(last.built), policy, "{policies:?}");
+    assert!(!last.switched_to_sarsa);
     let mut recs = records(&stream);
-    assert!(replay(Robot::Pendulum33, policy, DEFAULT_SEED, &recs).identical);
+    assert!(replay(&Board::F405.profile(Robot::Pendulum33), policy, DEFAULT_SEED, &recs).identical);
     let k = recs
         .iter()
         .position(|r| matches!(r, Record::Step(s) if s.mode == RunMode::Learning && s.kind == StepKind::Step))
@@ -93,15 +109,15 @@ fn the_firmware_in_qemu_replays_bit_for_bit_on_the_host_and_its_link_is_clean() 
     if let Record::Step(s) = &mut recs[k] {
         s.reward += 1.0;
     }
-    let tampered = replay(Robot::Pendulum33, policy, DEFAULT_SEED, &recs);
+    let tampered = replay(&Board::F405.profile(Robot::Pendulum33), policy, DEFAULT_SEED, &recs);
     assert!(
         !tampered.identical && tampered.first_checksum_mismatch.is_some(),
         "{tampered:?}"
     );
     // And a wrong seed or policy is not the same agent.
     let recs = records(&stream);
-    assert!(!replay(Robot::Pendulum33, policy, DEFAULT_SEED + 1, &recs).identical);
-    assert!(!replay(Robot::Pendulum33, PolicyKind::Sarsa, DEFAULT_SEED, &recs).identical);
+    assert!(!replay(&Board::F405.profile(Robot::Pendulum33), policy, DEFAULT_SEED + 1, &recs).identical);
+    assert!(!replay(&Board::F405.profile(Robot::Pendulum33), PolicyKind::Sarsa, DEFAULT_SEED, &recs).identical);
 }
 
 #[test]

@@ -6,6 +6,8 @@
 //!   (see [`toolchain`]), then print its flash and RAM use (see [`elf`]).
 //! - `qemu`, `sil`: the same firmware for the emulated board (QEMU's
 //!   `netduinoplus2`), and a software-in-the-loop run of it (`pada sil`).
+//! - `fuzz [--seconds S]`: the decoders that face untrusted bytes, fuzzed
+//!   on stable Rust (`fuzz/`, package `pada-fuzz`).
 //!
 //! The xtask has no dependencies. Its command line is two flags and a
 //! subcommand, so a hand-written parser is shorter than the argument-parser
@@ -47,6 +49,11 @@ tasks:
         build as `qemu`, then run it in qemu-system-arm against the
         simulated plant: `pada sil --elf <ELF> <options>` (release build
         of the host); the robot's task is passed on (--task)
+  fuzz [--seconds S] [--seed K]
+        fuzz every decoder that faces untrusted bytes (wire frames of host
+        and chip, Dynamixel status and instruction packets, checkpoint load
+        and torn saves) for about S seconds in all (default 60) and print
+        the inputs per second of each; fails if any invariant broke
   help  print this message";
 
 /// A microcontroller the firmware can be built for (one cargo feature each).
@@ -142,6 +149,8 @@ enum Task {
     Qemu(Build),
     /// Build for the emulated board and run `pada sil` with these options.
     Sil(Build, Vec<String>),
+    /// Run `pada-fuzz` with these options (`--seconds S`, `--seed K`).
+    Fuzz(Vec<String>),
 }
 
 /// `qemu` and `sil`: release unless `--debug`, a robot, and for `sil`
@@ -210,6 +219,31 @@ fn parse_args(args: &[String]) -> Result<Task, String> {
             Ok(if task == "flash" { Task::Flash(build) } else { Task::Firmware(build) })
         }
         "qemu" | "sil" => parse_emulated(task, rest),
+        "fuzz" => {
+            let mut it = rest.iter();
+            while let Some(arg) = it.next() {
+                match arg.as_str() {
+                    "-h" | "--help" => return Ok(Task::Help),
+                    "--seconds" | "--seed" => {
+                        let v = it.next().ok_or_else(|| format!("{arg} needs a value"))?;
+                        let ok = if arg == "--seconds" {
+                            v.parse::<f64>().is_ok_and(|s| s.is_finite() && s > 0.0 && s <= 86_400.0)
+                        } else {
+                            v.parse::<u64>().is_ok()
+                        };
+                        if !ok {
+                            return Err(if arg == "--seconds" {
+                                format!("--seconds {v} is out of range: valid is 0 < S <= 86400")
+                            } else {
+                                format!("--seed {v}: valid is an integer 0..=18446744073709551615")
+                            });
+                        }
+                    }
+                    other => return Err(format!("unknown argument `{other}` for `fuzz`")),
+                }
+            }
+            Ok(Task::Fuzz(rest.to_vec()))
+        }
         "firmware-test" => match rest.first() {
             None => Ok(Task::FirmwareTest),
             Some(other) => Err(format!("unknown argument `{other}` for `firmware-test`")),
@@ -248,6 +282,7 @@ fn main() -> ExitCode {
         Task::Firmware(build) => firmware(&workspace_root(), build).map(|_| ()),
         Task::Flash(build) => firmware(&workspace_root(), build).and_then(|elf| flash(&elf, build.chip)),
         Task::FirmwareTest => firmware_test(&workspace_root()),
+        Task::Fuzz(args) => fuzz(&workspace_root(), &args),
         Task::Qemu(build) => qemu_image(&workspace_root(), build).map(|_| ()),
         Task::Sil(build, args) => {
             qemu_image(&workspace_root(), build).and_then(|elf| sil(&workspace_root(), &elf, build.robot, &args))
@@ -464,12 +499,41 @@ fn firmware_test(root: &Path) -> Result<(), String> {
     }
 }
 
+/// Builds `pada-fuzz` in the `fuzz` profile (optimised, overflow checks
+/// on) and runs it with `args`.
+fn fuzz(root: &Path, args: &[String]) -> Result<(), String> {
+    let cargo = env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let mut cmd = std::process::Command::new(&cargo);
+    toolchain::clean_env(&mut cmd, false);
+    cmd.current_dir(root)
+        .args(["run", "--quiet", "--profile", "fuzz", "--package", "pada-fuzz", "--manifest-path"])
+        .arg(root.join("Cargo.toml"))
+        .arg("--")
+        .args(args);
+    println!("xtask: fuzzing the decoders (pada-fuzz {})", args.join(" "));
+    let status = cmd.status().map_err(|e| format!("cannot start cargo: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("fuzzing found inputs that break an invariant ({status})"))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn args(s: &str) -> Vec<String> {
         s.split_whitespace().map(String::from).collect()
+    }
+
+    #[test]
+    fn fuzz_takes_seconds_and_seed_and_refuses_the_rest() {
+        assert_eq!(parse_args(&args("fuzz")), Ok(Task::Fuzz(vec![])));
+        assert_eq!(parse_args(&args("fuzz --seconds 90 --seed 7")), Ok(Task::Fuzz(args("--seconds 90 --seed 7"))));
+        for bad in ["fuzz --seconds 0", "fuzz --seconds nan", "fuzz --seconds", "fuzz --seed -1", "fuzz --release"] {
+            assert!(parse_args(&args(bad)).is_err(), "{bad}");
+        }
     }
 
     #[test]

@@ -3,8 +3,12 @@
 //!
 //! Nothing stops a capture but the end of its input (end of file, the port
 //! going away), Ctrl-C, or `--seconds`: a bad frame is counted and the
-//! decoder picks up at the next frame.
+//! decoder picks up at the next frame. At the end of the input a frame cut
+//! off is counted as lost too (a capture stopped by Ctrl-C or `--seconds`
+//! cut it itself, so it is not). A read error ends the capture with its
+//! summary and exit code 1.
 
+use crate::console::{errln, outln};
 use crate::capture::Recorder;
 use crate::error::{usage, CliError};
 use anyhow::Context;
@@ -93,6 +97,12 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
             "standard input".to_string(),
         ),
         (None, Some(file)) => {
+            if file.is_dir() {
+                return Err(usage(format!(
+                    "--file {}: is a directory; valid is a recorded stream file or - for standard input",
+                    file.display()
+                )));
+            }
             let f = std::fs::File::open(file)
                 .map_err(|e| usage(format!("--file {}: cannot open: {e}", file.display())))?;
             (Source::Reader(Box::new(f)), file.display().to_string())
@@ -122,19 +132,21 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
     let mut last_status = Instant::now();
     let mut buf = vec![0u8; 4096];
     let mut frames = Vec::new();
-    let ended = loop {
+    // Why the capture ended, and whether that was the end of the input
+    // (which cuts off a frame in progress) or a read error.
+    let (ended, input_ended, read_error) = loop {
         if stop.load(Ordering::SeqCst) {
-            break "interrupted".to_string();
+            break ("interrupted".to_string(), false, false);
         }
         if args
             .seconds
             .is_some_and(|s| started.elapsed().as_secs_f64() >= s)
         {
-            break "time limit".to_string();
+            break ("time limit".to_string(), false, false);
         }
         let n = match &mut source {
             Source::Port(p) => match p.read(&mut buf) {
-                Ok(0) => break "the port closed".to_string(),
+                Ok(0) => break ("the port closed".to_string(), true, false),
                 Ok(n) => n,
                 Err(e)
                     if e.kind() == std::io::ErrorKind::TimedOut
@@ -142,13 +154,13 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
                 {
                     0
                 }
-                Err(e) => break format!("the port went away ({e})"),
+                Err(e) => break (format!("the port went away ({e})"), true, false),
             },
             Source::Reader(r) => match r.read(&mut buf) {
-                Ok(0) => break "end of file".to_string(),
+                Ok(0) => break ("end of file".to_string(), true, false),
                 Ok(n) => n,
                 Err(e) if e.kind() == std::io::ErrorKind::Interrupted => 0,
-                Err(e) => break format!("read error ({e})"),
+                Err(e) => break (format!("read error ({e})"), true, true),
             },
         };
         frames.clear();
@@ -165,6 +177,11 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
             status(&rec, tty, false);
         }
     };
+    if input_ended {
+        rec.finish(started.elapsed().as_secs_f64())
+            .context("cannot write the CSV")
+            .map_err(CliError::Runtime)?;
+    }
     rec.flush()
         .context("cannot write the CSV")
         .map_err(CliError::Runtime)?;
@@ -180,12 +197,12 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
         latest: rec.latest().clone(),
     };
     if args.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&summary).map_err(|e| CliError::Runtime(e.into()))?
-        );
+        )?;
     } else {
-        eprintln!(
+        errln!(
             "capture of {} ended ({}): {} frames, {} lost, {} sequence gaps ({} frames missing)",
             summary.source,
             summary.ended,
@@ -194,6 +211,13 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
             link.seq_gaps,
             link.frames_missed
         );
+    }
+    if read_error {
+        return Err(CliError::Runtime(anyhow::anyhow!(
+            "capture of {} ended by a {}",
+            summary.source,
+            summary.ended
+        )));
     }
     Ok(())
 }

@@ -1,6 +1,7 @@
 //! `pada demo`: the README's main job — SARSA(λ) against PADA Δ = 0.5 on
 //! the simulated pendulum of Section VII, next to the paper's numbers.
 
+use crate::console::outln;
 use crate::cli::{check_seconds, set_threads, DemoArgs};
 use crate::display::{fmt_estimate, fmt_mtbf};
 use crate::error::CliError;
@@ -70,22 +71,22 @@ pub fn run(args: DemoArgs) -> Result<(), CliError> {
     if args.json {
         let json =
             serde_json::json!({ "sarsa": summaries[0], "pada": summaries[1], "wall_s": wall });
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&json).map_err(anyhow::Error::from)?
-        );
+        )?;
         return Ok(());
     }
     let (s, p) = (&summaries[0], &summaries[1]);
-    println!(
+    outln!(
         "Simulated pendulum of Section VII, {} trials × {} s of learning each (seed {}):\n",
         args.trials, seconds, args.trial.seed
-    );
-    println!(
+    )?;
+    outln!(
         "{:<22} {:>18} {:>18} {:>18}",
         "", "SARSA(λ)", "PADA Δ=0.5", "paper SARSA(λ)"
-    );
-    println!(
+    )?;
+    outln!(
         "{:<22} {:>18} {:>18} {:>18}",
         "end performance",
         fmt_estimate(s.end_performance.mean, s.end_performance.ci95, 0, ""),
@@ -95,8 +96,8 @@ pub fn run(args: DemoArgs) -> Result<(), CliError> {
             SIM_SARSA_END.mean,
             SIM_SARSA_END.ci95.unwrap_or(f64::NAN)
         )
-    );
-    println!(
+    )?;
+    outln!(
         "{:<22} {:>18} {:>18} {:>18}",
         "rise time",
         fmt_estimate(s.rise_time_s.mean, s.rise_time_s.ci95, 0, " s"),
@@ -106,8 +107,8 @@ pub fn run(args: DemoArgs) -> Result<(), CliError> {
             SIM_SARSA_RISE_S.mean,
             SIM_SARSA_RISE_S.ci95.unwrap_or(f64::NAN)
         )
-    );
-    println!(
+    )?;
+    outln!(
         "{:<22} {:>18} {:>18} {:>18}",
         "MTBF (1200 actions)",
         fmt_mtbf(s.mtbf_s.mean, s.mtbf_s.ci95),
@@ -117,20 +118,20 @@ pub fn run(args: DemoArgs) -> Result<(), CliError> {
             SIM_SARSA_MTBF_S.mean,
             SIM_SARSA_MTBF_S.ci95.unwrap_or(f64::NAN)
         )
-    );
-    println!(
+    )?;
+    outln!(
         "{:<22} {:>18.0} {:>18.0} {:>18}",
         "re-engagements", s.window_reengagements.mean, p.window_reengagements.mean, "–"
-    );
-    println!(
+    )?;
+    outln!(
         "\nPADA's MTBF is {:.2}× SARSA(λ)'s (paper: about 2×). {:.1} s wall, {:.0} env steps/s on {} threads.",
         p.mtbf_s.mean / s.mtbf_s.mean,
         wall,
         env_steps as f64 / wall,
         s.threads
-    );
+    )?;
     if let Some(out) = &out {
-        println!("wrote {}", out.path().display());
+        outln!("wrote {}", out.path().display())?;
     }
     Ok(())
 }

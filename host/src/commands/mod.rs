@@ -9,3 +9,4 @@ pub mod render;
 pub mod run;
 pub mod sil;
 pub mod trial;
+pub mod watch;

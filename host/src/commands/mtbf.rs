@@ -2,6 +2,7 @@
 //! torque log, per joint: backlash re-engagements, damage J and predicted
 //! MTBF, over the first N steps (the paper's window) and the whole log.
 
+use crate::console::outln;
 use crate::cli::MtbfArgs;
 use crate::error::{usage, CliError};
 use crate::torque_log;
@@ -69,28 +70,28 @@ pub fn run(args: MtbfArgs) -> Result<(), CliError> {
             robot_window_mtbf_s: robot_window,
             robot_mtbf_s: robot,
         };
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&out).map_err(anyhow::Error::from)?
-        );
+        )?;
         return Ok(());
     }
-    println!(
+    outln!(
         "{}: {} steps at {} Hz ({:.1} s), window of the first {} steps",
         args.torques.display(),
         log.rows.len(),
         args.rate,
         log.rows.len() as f64 * period,
         args.window
-    );
-    println!(
+    )?;
+    outln!(
         "{:<12} {:>10} {:>12} {:>14} {:>10} {:>12} {:>14}",
         "joint", "re-eng.", "J", "MTBF [s]", "re-eng.*", "J*", "MTBF* [s]"
-    );
+    )?;
     for j in &joints {
         let r = &j.report;
         let w = r.window.as_ref();
-        println!(
+        outln!(
             "{:<12} {:>10} {:>12.4e} {:>14} {:>10} {:>12.4e} {:>14}",
             j.joint,
             r.reengagements,
@@ -99,14 +100,14 @@ pub fn run(args: MtbfArgs) -> Result<(), CliError> {
             w.map_or(0, |w| w.reengagements),
             w.map_or(0.0, |w| w.damage),
             fmt_s(w.map_or(f64::INFINITY, |w| w.mtbf_s))
-        );
+        )?;
     }
-    println!("(* = first {} steps, the paper's MTBF window)", args.window);
-    println!(
+    outln!("(* = first {} steps, the paper's MTBF window)", args.window)?;
+    outln!(
         "robot MTBF (weakest joint): {} over the window, {} over the whole log",
         fmt_s(robot_window),
         fmt_s(robot)
-    );
+    )?;
     Ok(())
 }
 

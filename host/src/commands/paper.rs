@@ -1,6 +1,7 @@
 //! `pada paper pendulum`: the whole of Section VII — data, report.md and
 //! the figures — in one directory.
 
+use crate::console::outln;
 use crate::cli::{check_seconds, set_threads, PaperArgs, PaperExperiment};
 use crate::error::CliError;
 use crate::experiment::algo::{algo_of, parameter_of};
@@ -87,8 +88,8 @@ fn pendulum_cmd(args: PaperArgs) -> Result<(), CliError> {
     ];
     out.write_all(&files)?;
     draw_figures(&results, &out)?;
-    println!("{}", headline(&results, &timing));
-    println!("wrote {}/report.md and the figures", out.path().display());
+    outln!("{}", headline(&results, &timing))?;
+    outln!("wrote {}/report.md and the figures", out.path().display())?;
     Ok(())
 }
 
@@ -164,8 +165,7 @@ fn draw_figures(r: &PendulumResults, out: &OutDir) -> anyhow::Result<()> {
             curves: curves(&r.simulated, |c| {
                 let p = parameter_of(&c.policy);
                 matches!(algo_of(&c.policy), crate::experiment::algo::Algo::Sarsa)
-                    || (algo_of(&c.policy) == crate::experiment::algo::Algo::Lowpass
-                        && p == Some(0.834))
+                    || (algo_of(&c.policy) == crate::experiment::algo::Algo::LowPass && p == Some(0.834))
                     || (algo_of(&c.policy) == crate::experiment::algo::Algo::Pada && p == Some(0.5))
             }),
             sarsa_end: sarsa.end_performance.mean,

@@ -2,6 +2,7 @@
 //! paper's numbers, Fig. 7-style learning curves and Fig. 8-style end
 //! performance against MTBF.
 
+use crate::console::outln;
 use crate::cli::{check_seconds, set_threads, PaperArgs};
 use crate::display::{fmt_estimate, fmt_mtbf};
 use crate::error::CliError;
@@ -86,19 +87,19 @@ pub fn run(args: PaperArgs) -> Result<(), CliError> {
         );
         let title = crate::leo::gait::gait_title(&source, &frames, fell);
         out.write_all(&crate::leo::gait::gait_files(&frames, 12, &title)?)?;
-        println!("{title}");
+        outln!("{title}")?;
     }
-    println!("{report}");
-    println!(
+    outln!("{report}")?;
+    outln!(
         "{:.0} s wall, {}, {:.0} environment steps/s",
         timing.wall_s,
         timing.workers(),
         timing.env_steps_per_s
-    );
-    println!(
+    )?;
+    outln!(
         "wrote {}/report.md, the figures, best.weights and the gait (gait.svg/png, gait-animation.svg)",
         out.path().display()
-    );
+    )?;
     Ok(())
 }
 
@@ -142,8 +143,8 @@ pub fn render(r: &LeoResults, command: &str) -> String {
         "Objective from this run's SARSA(λ) (Section VI rule): end performance above {:.1}.\n",
         obj.end_threshold
     );
-    let _ = writeln!(s, "| configuration | end performance | MTBF (1200 actions) | MTBF / SARSA | walked, last 10% of tests | speed | learning falls / trial |");
-    let _ = writeln!(s, "|---|---|---|---|---|---|---|");
+    let _ = writeln!(s, "| configuration | end performance | MTBF, the paper's (1200 actions) | × SARSA | physical MTBF | × SARSA | walked, last 10% of tests | walking trials (≥ 1 m) | speed | learning falls / trial |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
     for (i, c) in r.configs.iter().enumerate() {
         let m = &c.summary;
         let w = m
@@ -152,21 +153,26 @@ pub fn render(r: &LeoResults, command: &str) -> String {
         let v = m
             .end_speed_m_s
             .unwrap_or_else(|| crate::stats::Estimate::of(&[]));
+        let walking = m.per_trial.iter().filter(|t| t.end_walked_m.is_some_and(|w| w >= 1.0)).count();
         let _ = writeln!(
             s,
-            "| {} | {} | {} | ×{:.2} | {} | {} | {:.0} |",
+            "| {} | {} | {} | ×{:.2} | {} | ×{:.2} | {} | {} of {} | {} | {:.0} |",
             name(r, i),
             fmt_estimate(m.end_performance.mean, m.end_performance.ci95, 1, ""),
             fmt_mtbf(m.mtbf_s.mean, m.mtbf_s.ci95),
             m.mtbf_s.mean / sarsa.mtbf_s.mean,
+            fmt_mtbf(m.physical_mtbf_s.mean, m.physical_mtbf_s.ci95),
+            m.physical_mtbf_s.mean / sarsa.physical_mtbf_s.mean,
             fmt_estimate(w.mean, w.ci95, 2, " m"),
+            walking,
+            m.per_trial.len(),
             fmt_estimate(v.mean, v.ci95, 3, " m/s"),
             m.learning_falls.mean
         );
     }
     let _ = writeln!(
         s,
-        "\nThe MTBF is predicted from the first 1200 learning actions (40 s), before any switch; the switch only changes the end performance. Figures: `fig7-learning-curves.svg/png`, `fig8-end-vs-mtbf.svg/png` (without switch), `fig8-end-vs-mtbf-switch.svg/png` (with)."
+        "\nBoth MTBFs are predicted from the first 1200 learning actions (40 s), before any switch (the switch only changes the end performance), per physical gearbox (both hips, both knees; the robot's is the weakest gearbox's). **The paper's** (Section IV) takes T_m from the commanded action, linear in the voltage: the RX-28's stall torque of the commanded voltage (0.167 N·m/V). **The physical** one takes the rapier3d model's mean gear torque over each control step, back-EMF included. The figures use the paper's. Figures: `fig7-learning-curves.svg/png`, `fig8-end-vs-mtbf.svg/png` (without switch), `fig8-end-vs-mtbf-switch.svg/png` (with)."
     );
     s
 }

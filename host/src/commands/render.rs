@@ -2,6 +2,7 @@
 //! PNG) and the trajectory as CSV, from weights saved by
 //! `pada run --task leo --save-weights FILE`.
 
+use crate::console::outln;
 use crate::cli::RenderArgs;
 use crate::error::{usage, CliError};
 use crate::experiment::task::Task;
@@ -41,10 +42,10 @@ pub fn run(args: RenderArgs) -> Result<(), CliError> {
         .unwrap_or_default();
     let title = gait_title(&source, &frames, fell);
     out.write_all(&gait_files(&frames, args.frames as usize, &title)?)?;
-    println!("{title}");
-    println!(
+    outln!("{title}")?;
+    outln!(
         "wrote {}/gait.svg, gait.png, gait-animation.svg, gait.csv",
         out.path().display()
-    );
+    )?;
     Ok(())
 }

@@ -1,12 +1,22 @@
 //! `pada run`: trials of one algorithm on one task, with a progress bar,
 //! `summary.json`, `trials.csv` and per-trial learning curves.
 
+use crate::console::outln;
 use crate::cli::{check_seconds, set_threads, RunArgs};
 use crate::display::{fmt_estimate, fmt_mtbf};
 use crate::error::{usage, CliError};
 use crate::experiment::algo::{label, parameter_of, policy_kind, Algo};
-use crate::experiment::task::Task;
+use crate::board::trial::table_len;
+use crate::board::{robot_of_task, run_board};
+use crate::experiment::task::{Task, TaskSpec};
 use crate::experiment::tasks::{visit_task, TaskVisitor};
+use crate::leo::rl::{leo_params, LeoTask};
+use crate::pendulum::{PhysicalPendulumParams, PhysicalPendulumTask};
+use crate::summary::{board_files, BoardSummary};
+use pada_core::profile::{Board, TILINGS};
+use pada_core::robot::Robot;
+use pada_core::tile_coding::Layout;
+use pada_core::weights::WeightFormat;
 use crate::experiment::{build_agent, run_trials, run_trials_observed, RunConfig, TrialResult};
 use crate::output::OutDir;
 use crate::plan::mode::{obtain, Mode, Trials};
@@ -16,10 +26,128 @@ use crate::summary::{run_files, RunSummary};
 use crate::telemetry::{parse_target, TelemetrySink};
 use pada_core::wire::{self, ToHost};
 use std::path::PathBuf;
+use std::time::Instant;
 
 /// Runs `pada run`.
 pub fn run(args: RunArgs) -> Result<(), CliError> {
+    if let Some(board) = args.board {
+        return run_on_board(args, board.board());
+    }
     visit_task(args.task, RunVisitor(args))
+}
+
+/// `pada run --board`: the board's own learner ([`crate::board`]).
+fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
+    let robot = robot_of_task(args.task).map_err(usage)?;
+    for (flag, given) in [("--telemetry", args.telemetry.is_some()), ("--save-weights", args.save_weights.is_some())] {
+        if given {
+            return Err(usage(format!(
+                "{flag} is not available with --board (the board streams its own telemetry: `pada sil --telemetry`)"
+            )));
+        }
+    }
+    if args.cluster.plan.is_some() || args.cluster.merge.is_some() || args.cluster.slurm {
+        // A plan's configurations leave room for a board (plan::Configuration::board),
+        // but its trials run on the host's learner only, so far.
+        return Err(usage(
+            "--plan, --merge and --slurm run the host's learner: they do not combine with --board yet",
+        ));
+    }
+    let mut profile = board.profile(robot);
+    let format = match args.weight_bits.as_deref() {
+        Some("16") => WeightFormat::Half { shift: robot.spec().half_shift },
+        Some(_) => WeightFormat::Q16,
+        None => profile.format,
+    };
+    if args.table_log2.is_some() || format != profile.format {
+        let log2 = match (args.table_log2, profile.layout, profile.weights()) {
+            (Some(n), _, _) => n,
+            (None, Layout::Hashed, Some(n)) => n.trailing_zeros(),
+            _ => return Err(usage(format!(
+                "--weight-bits without --table-log2 needs a hashed board table; {} has an exact one for {}",
+                board.name(),
+                robot.name()
+            ))),
+        };
+        profile = profile.with_hashed_table(log2, format);
+    }
+    let policy = policy_kind(args.algo, args.alpha, args.delta).map_err(|e| usage(e.0))?;
+    // The task as the runner describes it, with the board's table: the
+    // summary's keys and parameters are `pada run`'s.
+    let task_spec = match robot {
+        Robot::Leo => LeoTask::with_profile(profile, leo_params()).spec().clone(),
+        _ => PhysicalPendulumTask::with_profile(PhysicalPendulumParams::default(), profile).spec().clone(),
+    };
+    let weights = table_len(&profile, policy).map_err(|e| usage(format!("{e}")))?;
+    if let Err(e) = robot.spec().check::<TILINGS>(policy, profile.layout, weights) {
+        return Err(usage(format!(
+            "--algo {} does not fit board {}'s learner for {} ({} {} weights): {e}",
+            args.algo,
+            board.name(),
+            robot.name(),
+            weights,
+            match profile.layout {
+                Layout::Exact => "exact",
+                Layout::Hashed => "hashed",
+            }
+        )));
+    }
+    let cfg = run_config(&args, &task_spec, policy)?;
+    let out_path = args.out.clone().unwrap_or_else(|| {
+        PathBuf::from(format!("pada-out/run-{}-{}-{}", task_spec.name, args.algo, board.name()))
+    });
+    let out = OutDir::check(&out_path)?;
+    set_threads(args.trial.threads)?;
+    let total = cfg.trials as u64
+        * cfg.expected_steps(task_spec.control_period_s, task_spec.episode_steps, task_spec.test_interval);
+    let bar = steps_bar(total, &format!("{} {} on {}", task_spec.name, label(&policy), board.name()));
+    let start = Instant::now();
+    let trials = run_board(profile, &cfg, &|n| bar.inc(n))?;
+    let wall = start.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+    let summary = BoardSummary::new(&task_spec, &cfg, &profile, &trials, wall);
+    out.write_all(&board_files(&summary)?)?;
+    if args.json {
+        outln!("{}", summary.to_json())?;
+    } else {
+        print_summary(&summary.run, &label(&policy))?;
+        outln!(
+            "  board                {}: {} {} weights ({} KiB, {}-bit) in {}",
+            board.name(),
+            summary.profile.layout,
+            summary.profile.weights,
+            summary.profile.table_bytes / 1024,
+            summary.profile.weight_bits,
+            summary.profile.memory
+        )?;
+        outln!("wrote {}", out.path().display())?;
+    }
+    Ok(())
+}
+
+/// The run's configuration from the flags, checked.
+fn run_config(args: &RunArgs, spec: &TaskSpec, policy: pada_core::policy::PolicyKind) -> Result<RunConfig, CliError> {
+    let seconds = check_seconds("--seconds", args.seconds.unwrap_or(spec.default_seconds))?;
+    if let Some(s) = args.switch_at {
+        if !matches!(args.algo, Algo::LowPass | Algo::Pada) {
+            return Err(usage(format!(
+                "--switch-at applies only to lowpass and pada (Section VIII), not to {}",
+                args.algo
+            )));
+        }
+        if !(s.is_finite() && s >= 0.0 && s <= seconds) {
+            return Err(usage(format!(
+                "--switch-at {s} is out of range: valid is 0 <= switch-at <= seconds ({seconds})"
+            )));
+        }
+    }
+    Ok(RunConfig {
+        policy,
+        switch_at_s: args.switch_at,
+        seconds,
+        trials: args.trials.unwrap_or(spec.default_trials),
+        seed: args.trial.seed,
+    })
 }
 
 struct RunVisitor(RunArgs);
@@ -31,27 +159,7 @@ impl TaskVisitor for RunVisitor {
         let args = self.0;
         let spec = task.spec();
         let policy = policy_kind(args.algo, args.alpha, args.delta).map_err(|e| usage(e.0))?;
-        let seconds = check_seconds("--seconds", args.seconds.unwrap_or(spec.default_seconds))?;
-        if let Some(s) = args.switch_at {
-            if !matches!(args.algo, Algo::Lowpass | Algo::Pada) {
-                return Err(usage(format!(
-                    "--switch-at applies only to lowpass and pada (Section VIII), not to {}",
-                    args.algo
-                )));
-            }
-            if !(s.is_finite() && s >= 0.0 && s <= seconds) {
-                return Err(usage(format!(
-                    "--switch-at {s} is out of range: valid is 0 <= switch-at <= seconds ({seconds})"
-                )));
-            }
-        }
-        let cfg = RunConfig {
-            policy,
-            switch_at_s: args.switch_at,
-            seconds,
-            trials: args.trials.unwrap_or(spec.default_trials),
-            seed: args.trial.seed,
-        };
+        let cfg = run_config(&args, spec, policy)?;
         let out_path = args
             .out
             .clone()
@@ -132,17 +240,17 @@ impl TaskVisitor for RunVisitor {
         if let Some(sink) = telemetry {
             let totals = sink.finish()?;
             if !args.json {
-                println!(
+                outln!(
                     "telemetry: trial 0, {} frames ({} bytes) to {}",
                     totals.frames, totals.bytes, totals.target
-                );
+                )?;
             }
         }
         if args.json {
-            println!("{}", summary.to_json());
+            outln!("{}", summary.to_json())?;
         } else {
-            print_summary(&summary, &label(&policy));
-            println!("wrote {}", out.path().display());
+            print_summary(&summary, &label(&policy))?;
+            outln!("wrote {}", out.path().display())?;
         }
         Ok(())
     }
@@ -167,39 +275,44 @@ fn command_line(args: &RunArgs, cfg: &RunConfig) -> String {
 }
 
 /// A short human-readable summary.
-pub fn print_summary(s: &RunSummary, label: &str) {
-    println!(
+pub fn print_summary(s: &RunSummary, label: &str) -> Result<(), CliError> {
+    outln!(
         "{}, {}: {} trials of {} s learning (seed {})",
         s.task, label, s.trials, s.parameters.seconds, s.parameters.seed
-    );
-    println!(
+    )?;
+    outln!(
         "  end performance      {}",
         fmt_estimate(s.end_performance.mean, s.end_performance.ci95, 1, "")
-    );
-    println!(
+    )?;
+    outln!(
         "  rise time            {}",
         fmt_estimate(s.rise_time_s.mean, s.rise_time_s.ci95, 0, " s")
-    );
-    println!(
-        "  MTBF (1200 actions)  {}",
+    )?;
+    outln!(
+        "  MTBF (1200 actions)  {} (the paper's: torque from the commanded action)",
         fmt_mtbf(s.mtbf_s.mean, s.mtbf_s.ci95)
-    );
+    )?;
+    outln!(
+        "  physical MTBF        {} (from the simulated gear torques)",
+        fmt_mtbf(s.physical_mtbf_s.mean, s.physical_mtbf_s.ci95)
+    )?;
     if let (Some(w), Some(v)) = (&s.end_walked_m, &s.end_speed_m_s) {
-        println!(
+        outln!(
             "  walked (last 10%)    {}",
             fmt_estimate(w.mean, w.ci95, 2, " m")
-        );
-        println!(
+        )?;
+        outln!(
             "  speed (last 10%)     {}",
             fmt_estimate(v.mean, v.ci95, 3, " m/s")
-        );
+        )?;
     }
-    println!(
+    outln!(
         "  falls                {:.1} learning, {:.1} test runs per trial",
         s.learning_falls.mean, s.test_falls.mean
-    );
-    println!(
+    )?;
+    outln!(
         "  wall {:.1} s, {:.0} env steps/s on {} threads",
         s.wall_s, s.env_steps_per_s, s.threads
-    );
+    )?;
+    Ok(())
 }

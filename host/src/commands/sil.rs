@@ -1,6 +1,7 @@
 //! `pada sil`: the firmware image learns inside QEMU against the simulated
 //! plant (docs/sil.md).
 
+use crate::console::{errln, outln};
 use crate::cli::check_seconds;
 use crate::error::{usage, CliError};
 use crate::experiment::algo::{label, policy_kind, Algo};
@@ -23,7 +24,7 @@ pub struct SilArgs {
     #[arg(long, value_name = "S")]
     pub seconds: Option<f64>,
     /// The algorithm the firmware learns with (Section V).
-    #[arg(long, value_enum, default_value_t = Algo::Sarsa)]
+    #[arg(long, value_parser = crate::experiment::algo::algo_parser(), default_value_t = Algo::Sarsa)]
     pub algo: Algo,
     /// Low-pass α (lowpass, markov-lowpass; default 0.834).
     #[arg(long)]
@@ -115,13 +116,13 @@ pub fn run(args: SilArgs) -> Result<(), CliError> {
     };
     let summary = sil::run(&cfg)?;
     if args.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&summary).map_err(|e| CliError::Runtime(e.into()))?
-        );
+        )?;
     } else {
-        print_summary(&summary, &label(&policy));
-        println!("wrote {}", out_path.display());
+        print_summary(&summary, &label(&policy))?;
+        outln!("wrote {}", out_path.display())?;
     }
     if summary.passed {
         Ok(())
@@ -157,7 +158,7 @@ fn build_image(task: SilTask) -> Result<PathBuf, CliError> {
         SilTask::Pendulum => "pendulum",
         SilTask::Leo => "leo",
     };
-    eprintln!(
+    errln!(
         "pada sil: building the firmware for the emulated board (cargo xtask qemu --robot {robot})"
     );
     let output =
@@ -184,30 +185,31 @@ fn build_image(task: SilTask) -> Result<PathBuf, CliError> {
         })
 }
 
-fn print_summary(s: &SilSummary, policy: &str) {
-    println!(
+fn print_summary(s: &SilSummary, policy: &str) -> Result<(), CliError> {
+    outln!(
         "sil {} ({}), {policy}: {:.0} s learning in {:.0} s emulated, {:.1} s wall ({:.0}x real time)",
         s.robot, s.plant, s.learning_s, s.emulated_s, s.wall_s, s.speedup
-    );
+    )?;
     let fmt = |x: Option<f64>| x.map(|v| format!("{v:.1}")).unwrap_or_else(|| "-".into());
-    println!(
+    outln!(
         "  test return: first {}, end performance {}, rise time {} s; {} learning episodes",
         fmt(s.first_test_return),
         fmt(s.end_performance),
         fmt(s.rise_time_s),
         s.learning_episodes
-    );
+    )?;
     let i = &s.agent_instructions;
-    println!(
+    outln!(
         "  agent step on the Cortex-M4 build: {:.0} instructions mean (min {}, max {}) learning; {:.0} greedy",
         i.learning_step.mean, i.learning_step.min, i.learning_step.max, i.test_step.mean
-    );
+    )?;
     for c in &s.checks {
-        println!(
+        outln!(
             "  [{}] {}: {}",
             if c.ok { "ok" } else { "FAILED" },
             c.name,
             c.detail
-        );
+        )?;
     }
+    Ok(())
 }

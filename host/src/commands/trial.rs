@@ -2,6 +2,7 @@
 //! array (`SLURM_ARRAY_TASK_ID`), one Kubernetes indexed job
 //! (`JOB_COMPLETION_INDEX`), or by hand (`--index`).
 
+use crate::console::{errln, outln};
 use crate::error::{usage, CliError};
 use crate::plan::execute::{run_index, Outcome};
 use crate::plan::store;
@@ -80,11 +81,11 @@ pub fn run(args: TrialArgs) -> Result<(), CliError> {
     let spec = &plan.trials[index as usize];
     match run_index(&args.plan, &plan, index)? {
         Outcome::AlreadyDone(path) => {
-            println!(
+            outln!(
                 "trial {}: already done ({} verifies); not run again",
                 spec.describe(),
                 path.display()
-            );
+            )?;
         }
         Outcome::Ran {
             path,
@@ -93,12 +94,12 @@ pub fn run(args: TrialArgs) -> Result<(), CliError> {
             replaced,
         } => {
             if let Some(why) = replaced {
-                eprintln!(
+                errln!(
                     "trial {}: replaced a result that did not verify ({why})",
                     spec.describe()
                 );
             }
-            println!(
+            outln!(
                 "trial {}: end performance {:.1}, rise time {:.0} s, MTBF {:.0} s; {:.2} s wall on {}; wrote {}",
                 spec.describe(),
                 result.end_performance,
@@ -107,7 +108,7 @@ pub fn run(args: TrialArgs) -> Result<(), CliError> {
                 timing.wall_s,
                 timing.host,
                 path.display()
-            );
+            )?;
         }
     }
     Ok(())

@@ -1,84 +1,20 @@
 //! The six algorithms of Section V by their command-line names, with their
 //! parameter (α of Eq. 8 or Δ of Eq. 9), checked before anything runs.
+//!
+//! The names are the learning core's ([`pada_core::policy::PolicyName`]):
+//! one list for the learner, the checkpoint codes, the wire and the
+//! command line. This module adds what only the command line needs: the
+//! clap parser, the defaults and the parameter checks with their messages.
 
 use pada_core::policy::PolicyKind;
-use serde::Serialize;
-use std::fmt;
+pub use pada_core::policy::PolicyName as Algo;
 
-/// An algorithm of Section V.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, clap::ValueEnum, Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Algo {
-    /// SARSA(λ): the chosen torque is applied.
-    Sarsa,
-    /// Low-pass filtered actions (Eq. 8).
-    Lowpass,
-    /// Low-pass filter with the previous output in the state.
-    MarkovLowpass,
-    /// Integrating controller: the learner chooses −Δ, 0 or +Δ.
-    Integrator,
-    /// Integrating controller with the integrated command in the state.
-    MarkovIntegrator,
-    /// Previous-action-dependent actions (Eq. 9).
-    Pada,
-}
-
-impl Algo {
-    /// Every algorithm, in the paper's order.
-    pub const ALL: [Algo; 6] = [
-        Algo::Sarsa,
-        Algo::Lowpass,
-        Algo::MarkovLowpass,
-        Algo::Integrator,
-        Algo::MarkovIntegrator,
-        Algo::Pada,
-    ];
-
-    /// The command-line name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Algo::Sarsa => "sarsa",
-            Algo::Lowpass => "lowpass",
-            Algo::MarkovLowpass => "markov-lowpass",
-            Algo::Integrator => "integrator",
-            Algo::MarkovIntegrator => "markov-integrator",
-            Algo::Pada => "pada",
-        }
-    }
-
-    /// The name used in the paper's figures.
-    pub fn title(self) -> &'static str {
-        match self {
-            Algo::Sarsa => "SARSA(λ)",
-            Algo::Lowpass => "low-pass filter",
-            Algo::MarkovLowpass => "Markov low-pass filter",
-            Algo::Integrator => "integrating controller",
-            Algo::MarkovIntegrator => "Markov integrating controller",
-            Algo::Pada => "PADA",
-        }
-    }
-
-    /// Whether the algorithm takes α (the low-pass filters).
-    pub fn takes_alpha(self) -> bool {
-        matches!(self, Algo::Lowpass | Algo::MarkovLowpass)
-    }
-
-    /// Whether the algorithm takes Δ (the integrators and PADA).
-    pub fn takes_delta(self) -> bool {
-        matches!(self, Algo::Integrator | Algo::MarkovIntegrator | Algo::Pada)
-    }
-
-    /// Whether it can switch back to SARSA(λ) after an exploration phase
-    /// (Section VIII): PADA and the low-pass filter.
-    pub fn can_switch(self) -> bool {
-        matches!(self, Algo::Sarsa | Algo::Lowpass | Algo::Pada)
-    }
-}
-
-impl fmt::Display for Algo {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
+/// The clap parser of `--algo`: exactly the core's names, listed in the
+/// help and in the error for an unknown one.
+pub fn algo_parser() -> impl clap::builder::TypedValueParser<Value = Algo> {
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(Algo::ALL.map(Algo::name))
+        .try_map(|name| Algo::from_name(&name).ok_or("unknown algorithm"))
 }
 
 /// A bad algorithm parameter: the message names it and its valid range.
@@ -122,37 +58,17 @@ pub fn policy_kind(
             "--delta {d} is out of range: valid is 0 < delta <= 1 (relative to the action range)"
         )));
     }
-    Ok(match algo {
-        Algo::Sarsa => PolicyKind::Sarsa,
-        Algo::Lowpass => PolicyKind::LowPass { alpha: a },
-        Algo::MarkovLowpass => PolicyKind::MarkovLowPass { alpha: a },
-        Algo::Integrator => PolicyKind::Integrator { delta: d },
-        Algo::MarkovIntegrator => PolicyKind::MarkovIntegrator { delta: d },
-        Algo::Pada => PolicyKind::Pada { delta: d },
-    })
+    Ok(algo.with_parameter(if algo.takes_alpha() { a } else { d }))
 }
 
 /// The algorithm of a policy.
 pub fn algo_of(kind: &PolicyKind) -> Algo {
-    match kind {
-        PolicyKind::Sarsa => Algo::Sarsa,
-        PolicyKind::LowPass { .. } => Algo::Lowpass,
-        PolicyKind::MarkovLowPass { .. } => Algo::MarkovLowpass,
-        PolicyKind::Integrator { .. } => Algo::Integrator,
-        PolicyKind::MarkovIntegrator { .. } => Algo::MarkovIntegrator,
-        PolicyKind::Pada { .. } => Algo::Pada,
-    }
+    Algo::of(kind)
 }
 
 /// The policy's parameter (α or Δ), if it has one.
 pub fn parameter_of(kind: &PolicyKind) -> Option<f32> {
-    match *kind {
-        PolicyKind::Sarsa => None,
-        PolicyKind::LowPass { alpha } | PolicyKind::MarkovLowPass { alpha } => Some(alpha),
-        PolicyKind::Integrator { delta }
-        | PolicyKind::MarkovIntegrator { delta }
-        | PolicyKind::Pada { delta } => Some(delta),
-    }
+    kind.parameter()
 }
 
 /// A short label: `sarsa`, `lowpass α=0.834`, `pada Δ=0.5`.
@@ -176,11 +92,11 @@ mod tests {
             Ok(PolicyKind::Pada { delta: 0.5 })
         );
         assert_eq!(
-            policy_kind(Algo::Lowpass, None, None),
+            policy_kind(Algo::LowPass, None, None),
             Ok(PolicyKind::LowPass { alpha: 0.834 })
         );
         assert_eq!(policy_kind(Algo::Sarsa, None, None), Ok(PolicyKind::Sarsa));
-        let e = policy_kind(Algo::Lowpass, Some(1.5), None).unwrap_err().0;
+        let e = policy_kind(Algo::LowPass, Some(1.5), None).unwrap_err().0;
         assert!(e.contains("0 < alpha <= 1"), "{e}");
         let e = policy_kind(Algo::Integrator, None, Some(0.0))
             .unwrap_err()
@@ -189,7 +105,7 @@ mod tests {
         assert!(policy_kind(Algo::Pada, None, Some(f32::NAN)).is_err());
         let e = policy_kind(Algo::Sarsa, Some(0.5), None).unwrap_err().0;
         assert!(e.contains("--alpha applies only"), "{e}");
-        assert!(policy_kind(Algo::Lowpass, None, Some(0.5)).is_err());
+        assert!(policy_kind(Algo::LowPass, None, Some(0.5)).is_err());
     }
 
     #[test]
@@ -203,5 +119,22 @@ mod tests {
         for a in Algo::ALL {
             assert_eq!(algo_of(&policy_kind(a, None, None).unwrap()), a);
         }
+    }
+
+    #[test]
+    fn the_command_line_names_are_the_cores_and_serialise_as_them() {
+        for a in Algo::ALL {
+            assert_eq!(
+                serde_json::to_string(&a).unwrap(),
+                format!("\"{}\"", a.name())
+            );
+        }
+        use clap::builder::TypedValueParser;
+        let cmd = clap::Command::new("t");
+        let parsed = algo_parser().parse_ref(&cmd, None, std::ffi::OsStr::new("markov-lowpass"));
+        assert_eq!(parsed.unwrap(), Algo::MarkovLowPass);
+        assert!(algo_parser()
+            .parse_ref(&cmd, None, std::ffi::OsStr::new("lowpas"))
+            .is_err());
     }
 }

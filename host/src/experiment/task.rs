@@ -36,15 +36,33 @@ pub trait Plant: Send {
     /// returns the reward and whether the state is absorbing.
     fn step(&mut self, command: &[f32], obs: &mut [f32]) -> Step;
 
-    /// The torque on each gearbox \[N·m\] while `command` was applied in
-    /// the step just taken (the runner asks after [`Plant::step`]), for the
-    /// fatigue counter (Eqs. 3–7). Unused joints are 0.
+    /// The torque on each physical gearbox \[N·m\] in the step just taken
+    /// under `command` (the runner asks after [`Plant::step`]), as the
+    /// simulation computes it: the **physical** MTBF's input (Eqs. 3–7).
+    /// One entry per gearbox ([`TaskSpec::gearboxes`]), the rest 0.
     fn gearbox_torques(&self, command: &[f32]) -> Output;
+
+    /// The torque on each physical gearbox as **the paper** takes it
+    /// (Section IV): from the commanded action, "a linear relationship
+    /// between voltage and torque" — the stall torque of the commanded
+    /// voltage, back-EMF left out. The same as
+    /// [`gearbox_torques`](Self::gearbox_torques) for a plant whose action
+    /// is the torque or whose torque is linear in the voltage.
+    fn commanded_torques(&self, command: &[f32]) -> Output {
+        self.gearbox_torques(command)
+    }
 
     /// Distance walked in the current episode \[m\], for walking tasks
     /// (LEO); `None` for the others.
     fn walked_distance_m(&self) -> Option<f64> {
         None
+    }
+
+    /// Whether the step just taken was a footstep (the stance leg changed),
+    /// when the policy's memory moves with the joints
+    /// ([`TaskSpec::footstep_remap`]).
+    fn footstep(&self) -> bool {
+        false
     }
 }
 
@@ -102,6 +120,14 @@ pub struct TaskSpec {
     /// How [`Plant::gearbox_torques`] is obtained from the command, for
     /// reports.
     pub torque_note: &'static str,
+    /// Physical gearboxes whose fatigue is counted (the entries of
+    /// [`Plant::gearbox_torques`]): the pendulum's one; LEO's two hips and
+    /// two knees (not the three learned roles, which move between
+    /// gearboxes at every footstep).
+    pub gearboxes: usize,
+    /// How the policy's memory moves between motor dimensions at a footstep
+    /// (the robot's definition, `pada_core::robot::RobotSpec::footstep_remap`).
+    pub footstep_remap: Option<[Option<u8>; pada_core::action_space::MAX_ACTION_DIMS]>,
     /// The board learner profile the table follows, for the robots of
     /// `pada_core::robot` (`None` for the simulated pendulum, which has no
     /// board).
@@ -145,6 +171,8 @@ impl TaskSpec {
             default_seconds: 1500.0,
             default_trials: 8,
             torque_note,
+            gearboxes: robot.gearboxes as usize,
+            footstep_remap: robot.footstep_remap,
             profile: Some(profile),
         }
     }

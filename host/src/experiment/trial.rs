@@ -7,8 +7,12 @@
 //! - End performance and rise time follow from it ([`super::metrics`]).
 //! - The predicted MTBF is the fatigue counter's windowed MTBF over the
 //!   first [`PAPER_WINDOW_STEPS`] learning actions (end of Section IV),
-//!   from the torques the plant applies to its gearboxes (Eqs. 3–7); the
-//!   robot's MTBF is its weakest joint's.
+//!   counted per physical gearbox (Eqs. 3–7); the robot's MTBF is its
+//!   weakest gearbox's. Two of them: **the paper's** (`mtbf_s`), from the
+//!   commanded action as Section IV takes it, linear in the voltage
+//!   ([`Plant::commanded_torques`]); and **the physical** one
+//!   (`physical_mtbf_s`), from the gear torques the simulation computes
+//!   ([`Plant::gearbox_torques`]).
 
 use super::agent_setup::{build_agent, HostAgent};
 use super::metrics::{end_performance, rise_time};
@@ -52,11 +56,18 @@ pub struct TrialResult {
     pub end_performance: f64,
     /// Rise time \[s of learning time\].
     pub rise_time_s: f64,
-    /// Predicted MTBF from the first 1200 learning actions \[s\]
-    /// (infinite when nothing re-engaged).
+    /// Predicted MTBF from the first 1200 learning actions \[s\], the
+    /// paper's definition: torques from the commanded action (infinite when
+    /// nothing re-engaged).
     pub mtbf_s: f64,
-    /// Backlash re-engagements within those actions (all joints).
+    /// Backlash re-engagements within those actions (all gearboxes), the
+    /// paper's definition.
     pub window_reengagements: u64,
+    /// Predicted MTBF from the first 1200 learning actions \[s\], from the
+    /// simulated gear torques.
+    pub physical_mtbf_s: f64,
+    /// Re-engagements of the simulated gear torques within those actions.
+    pub physical_window_reengagements: u64,
     /// Learning steps taken.
     pub learning_steps: u64,
     /// Test-run steps taken.
@@ -132,12 +143,14 @@ pub fn run_trial_observed<T: Task>(
         Some(PAPER_WINDOW_STEPS),
     )
     .map_err(|e| anyhow!("{e}"))?;
+    let physical = fatigue.clone();
     let mut t = Trial {
         spec,
         agent,
         plant: task.plant(),
         rng,
         fatigue,
+        physical,
         obs: [0.0; MAX_STATE_DIMS],
         switch_step: cfg
             .switch_at_s
@@ -153,6 +166,7 @@ pub fn run_trial_observed<T: Task>(
     };
 
     let budget = (cfg.seconds / spec.control_period_s).round() as u64;
+    t.report_policy();
     t.test_run()?;
     while t.learning_steps < budget {
         let mut done = t.episode(true)?.1 as u64;
@@ -179,6 +193,13 @@ pub fn run_trial_observed<T: Task>(
         end_performance: end_performance(&returns).unwrap_or(f64::NAN),
         rise_time_s: rise_time(&times, &returns).unwrap_or(f64::NAN),
         mtbf_s: t.fatigue.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
+        physical_mtbf_s: t.physical.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
+        physical_window_reengagements: t
+            .physical
+            .joints()
+            .iter()
+            .filter_map(|j| j.window_reengagements())
+            .sum(),
         window_reengagements: t
             .fatigue
             .joints()
@@ -205,7 +226,10 @@ struct Trial<'a, 'o, P: Plant> {
     agent: HostAgent,
     plant: P,
     rng: Pcg64,
+    /// Per gearbox, from the commanded action (the paper's MTBF).
     fatigue: FatigueCounter<MAX_ACTION_DIMS>,
+    /// Per gearbox, from the simulated gear torques (the physical MTBF).
+    physical: FatigueCounter<MAX_ACTION_DIMS>,
     obs: [f32; MAX_STATE_DIMS],
     /// Learning step at which the policy switches back to SARSA(λ).
     switch_step: Option<u64>,
@@ -244,7 +268,7 @@ impl<P: Plant> Trial<'_, '_, P> {
             .fatigue
             .joints()
             .iter()
-            .take(motors.min(wire::MAX_JOINTS))
+            .take(self.spec.gearboxes.min(wire::MAX_JOINTS))
             .map(|j| wire::JointFatigue {
                 damage: j.damage(),
                 reengagements: j.reengagements().min(u32::MAX as u64) as u32,
@@ -325,8 +349,23 @@ impl<P: Plant> Trial<'_, '_, P> {
         if self.switch_step.is_some_and(|s| self.learning_steps >= s) {
             self.agent.switch_to_sarsa().map_err(|e| anyhow!("{e}"))?;
             self.switch_step = None;
+            self.report_policy();
         }
         Ok(())
+    }
+
+    /// Reports the policy in force to the observer (at the start and after
+    /// the switch back to SARSA(λ)), as the firmware does.
+    fn report_policy(&mut self) {
+        let Some(observer) = self.observer.as_mut() else {
+            return;
+        };
+        let policy = self.agent.policy();
+        observer(ToHost::Policy(wire::PolicyReport {
+            step: self.calls,
+            built: policy.built_kind().into(),
+            switched_to_sarsa: policy.switched(),
+        }));
     }
 
     /// One episode to the time limit or an absorbing state; returns the
@@ -349,8 +388,16 @@ impl<P: Plant> Trial<'_, '_, P> {
         for k in 1..=spec.episode_steps {
             let command = &d.output[..motors];
             let step = self.plant.step(command, &mut self.obs[..n]);
+            // A footstep: the policy's memory moves with the joints before
+            // the next decision (the robot's definition).
+            if let (true, Some(map)) = (self.plant.footstep(), spec.footstep_remap) {
+                self.agent.remap_memory(&map);
+            }
             if learning {
                 self.fatigue
+                    .update(&self.plant.commanded_torques(command))
+                    .map_err(|e| anyhow!("{e}"))?;
+                self.physical
                     .update(&self.plant.gearbox_torques(command))
                     .map_err(|e| anyhow!("{e}"))?;
                 self.learning_steps += 1;

@@ -72,6 +72,9 @@ pub fn record_agent(agent: &mut HostAgent, seconds: f64) -> anyhow::Result<(Vec<
     let mut fell = false;
     for k in 1..=steps {
         let s = plant.step(&d.output[..3], &mut obs);
+        if let (true, Some(map)) = (plant.footstep(), spec.footstep_remap) {
+            agent.remap_memory(&map);
+        }
         frames.push(frame(&plant, k));
         if s.terminal {
             fell = true;

@@ -117,6 +117,9 @@ pub struct StepInfo {
     pub learned_torques: [f32; ACTION_DIM],
     /// Mean gear torque of every joint (N m, [`model::Joint`] order).
     pub joint_torques: [f32; NUM_JOINTS],
+    /// The voltage each servo was commanded over the step (V,
+    /// [`model::Joint`] order): learned or held.
+    pub voltages: [f32; NUM_JOINTS],
     /// The stance leg after the step.
     pub stance: Leg,
     /// Whether the stance leg changed in this step.
@@ -390,6 +393,7 @@ impl LeoEnv {
             energy,
             learned_torques: learned.map(|j| torques[j as usize]),
             joint_torques: torques,
+            voltages,
             stance: stance_after,
             footstep: update.footstep,
             time: self.time,
@@ -413,6 +417,7 @@ fn empty_info() -> StepInfo {
         energy: 0.0,
         learned_torques: [0.0; ACTION_DIM],
         joint_torques: [0.0; NUM_JOINTS],
+        voltages: [0.0; NUM_JOINTS],
         stance: Leg::Left,
         footstep: false,
         time: 0.0,

@@ -11,10 +11,12 @@
 //! ([`Board::Host`]: hashed, 2^22 weights, 16 MiB of Q16.16 per agent), or
 //! a board's with `pada run --board`.
 //!
-//! Gearbox torques for the fatigue counter: the mean gear torque of the
-//! three learned joints over the step just taken (`learned_torques`).
+//! Gearbox torques for the fatigue counter, per physical gearbox (both hips,
+//! both knees, [`pada_core::robot::leo::GEARBOXES`]): the simulation's mean
+//! gear torque over the step (the physical MTBF), and the stall torque of
+//! the commanded voltage (the paper's, [`pada_core::robot::leo::commanded_gear_torque`]).
 
-use super::task::{Observation, ACTION_DIM, OBS_DIM};
+use super::task::{commanded_gear_torque, Observation, GEARBOXES, OBS_DIM};
 use super::{LeoConfig, LeoEnv, Terminal};
 use crate::experiment::task::{Plant, Step, Task, TaskSpec};
 use pada_core::action_space::{Output, MAX_ACTION_DIMS};
@@ -22,6 +24,10 @@ use pada_core::agent::SarsaParams;
 use pada_core::profile::{Board, LearnerProfile};
 use pada_core::robot::Robot;
 use rand_core::RngCore;
+
+/// Gearboxes counted: both hips, both knees.
+const GEARBOX_COUNT: usize = GEARBOXES.len();
+const _: () = assert!(GEARBOX_COUNT <= MAX_ACTION_DIMS);
 
 /// GRL's LEO learning parameters (`pada_core::robot::leo::PARAMS`, §3.9).
 pub fn leo_params() -> SarsaParams {
@@ -53,7 +59,7 @@ impl LeoTask {
         let mut spec = TaskSpec::of_robot(
             profile,
             "LEO walking (Section VIII; rapier3d model of grl-facts §1-3, 30 Hz, 3 joints x 7 voltages)",
-            "mean gear torque of the three learned joints (stance hip, swing hip, swing knee) over the control step, from the rapier3d model",
+            "per gearbox (hips, knees): mtbf_s from the commanded voltage's RX-28 stall torque (0.167 N m/V, the paper's linear law); physical_mtbf_s from the rapier3d model's mean gear torque over the control step",
         );
         spec.params = params;
         spec.default_seconds = 14_666.0;
@@ -86,8 +92,12 @@ impl Task for LeoTask {
 /// A LEO environment as a [`Plant`].
 pub struct LeoPlant {
     env: LeoEnv,
-    torques: [f32; ACTION_DIM],
+    /// Per gearbox: the simulation's mean torque, and the commanded
+    /// voltage's stall torque, over the last step.
+    torques: [f32; GEARBOX_COUNT],
+    commanded: [f32; GEARBOX_COUNT],
     walked: f32,
+    footstep: bool,
 }
 
 impl LeoPlant {
@@ -96,8 +106,10 @@ impl LeoPlant {
     pub fn new(config: LeoConfig) -> Self {
         LeoPlant {
             env: LeoEnv::new(config).expect("the LEO configuration builds a stable model"),
-            torques: [0.0; ACTION_DIM],
+            torques: [0.0; GEARBOX_COUNT],
+            commanded: [0.0; GEARBOX_COUNT],
             walked: 0.0,
+            footstep: false,
         }
     }
 
@@ -114,15 +126,21 @@ fn write_obs(o: &Observation, obs: &mut [f32]) {
 impl Plant for LeoPlant {
     fn reset(&mut self, rng: &mut dyn RngCore, obs: &mut [f32]) {
         let o = self.env.reset(rng);
-        self.torques = [0.0; ACTION_DIM];
+        self.torques = [0.0; GEARBOX_COUNT];
+        self.commanded = [0.0; GEARBOX_COUNT];
         self.walked = 0.0;
+        self.footstep = false;
         write_obs(&o, obs);
     }
 
     fn step(&mut self, command: &[f32], obs: &mut [f32]) -> Step {
         let r = self.env.step([command[0], command[1], command[2]]);
-        self.torques = r.info.learned_torques;
+        for (g, j) in GEARBOXES.iter().enumerate() {
+            self.torques[g] = r.info.joint_torques[*j as usize];
+            self.commanded[g] = commanded_gear_torque(r.info.voltages[*j as usize]);
+        }
         self.walked = r.info.walked_distance;
+        self.footstep = r.info.footstep;
         write_obs(&r.obs, obs);
         Step {
             reward: r.reward,
@@ -132,11 +150,21 @@ impl Plant for LeoPlant {
 
     fn gearbox_torques(&self, _command: &[f32]) -> Output {
         let mut t = [0.0; MAX_ACTION_DIMS];
-        t[..ACTION_DIM].copy_from_slice(&self.torques);
+        t[..GEARBOX_COUNT].copy_from_slice(&self.torques);
+        t
+    }
+
+    fn commanded_torques(&self, _command: &[f32]) -> Output {
+        let mut t = [0.0; MAX_ACTION_DIMS];
+        t[..GEARBOX_COUNT].copy_from_slice(&self.commanded);
         t
     }
 
     fn walked_distance_m(&self) -> Option<f64> {
         Some(self.walked as f64)
+    }
+
+    fn footstep(&self) -> bool {
+        self.footstep
     }
 }

@@ -8,6 +8,7 @@
 //! each without and with the switch at half the learning time (the paper's
 //! 7,333 s of 14,666 s).
 
+use crate::console::errln;
 use crate::experiment::task::Task;
 use crate::experiment::tasks::TaskName;
 use crate::experiment::{
@@ -241,7 +242,7 @@ pub fn best_of_plan(
         .ok_or_else(|| anyhow::anyhow!("the best trial is not in the plan"))? as u32;
     let path = crate::plan::best::weights_path(dir, index);
     if !path.exists() {
-        eprintln!(
+        errln!(
             "{} is missing: running the best trial again for its weights and gait",
             path.display()
         );

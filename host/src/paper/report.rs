@@ -215,7 +215,7 @@ pub fn render(r: &PendulumResults, command: &str) -> String {
          the end performance and both Markov variants miss the rise time.\n"
     );
     for (algo, p) in [
-        (Algo::Lowpass, SIM_LOWPASS_ALPHA),
+        (Algo::LowPass, SIM_LOWPASS_ALPHA),
         (Algo::Pada, SIM_PADA_DELTA),
     ] {
         if let Some(i) = r
@@ -274,7 +274,7 @@ pub fn render(r: &PendulumResults, command: &str) -> String {
     for c in &r.physical {
         let paper = match c.algo() {
             Algo::Sarsa => PHYS_SARSA_MTBF_S,
-            Algo::Lowpass => PHYS_LOWPASS_MTBF_S,
+            Algo::LowPass => PHYS_LOWPASS_MTBF_S,
             _ => PHYS_PADA_MTBF_S,
         };
         let m = &c.summary;
@@ -317,7 +317,7 @@ pub fn render(r: &PendulumResults, command: &str) -> String {
         rel(sarsa.mtbf_s.mean, SIM_SARSA_MTBF_S.mean)
     );
     if let (Some(lp), Some(pd)) = (
-        find(&r.physical, Algo::Lowpass, Some(0.834)),
+        find(&r.physical, Algo::LowPass, Some(0.834)),
         find(&r.physical, Algo::Pada, Some(0.5)),
     ) {
         let _ = writeln!(

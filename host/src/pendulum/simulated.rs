@@ -193,6 +193,8 @@ impl SimulatedPendulumTask {
                 .expect("valid action space"),
             table: WeightTable::Exact,
             action_tiles: None,
+            gearboxes: 1,
+            footstep_remap: None,
             profile: None,
             params: SarsaParams { init: WeightInit::Uniform { min: 0.0, max: 1.0 }, ..SarsaParams::default() },
             test_interval: 10,

@@ -105,7 +105,7 @@ impl Configuration {
 
     /// The runner's configuration, parsed back and checked.
     pub fn run_config(&self) -> anyhow::Result<RunConfig> {
-        let algo = Algo::from_str(&self.algo, false).map_err(|_| {
+        let algo = Algo::from_name(&self.algo).ok_or_else(|| {
             anyhow!(
                 "configuration {}: unknown algorithm {:?}",
                 self.index,

@@ -8,6 +8,7 @@ use super::slurm::{check_partition, check_sbatch_arg, check_time};
 use super::slurm_run::{self, SlurmOptions};
 use super::spec::Plan;
 use super::store::{self, Written};
+use crate::console::{errln, outln};
 use crate::error::CliError;
 use crate::timing::RunTiming;
 use std::path::{Path, PathBuf};
@@ -142,14 +143,14 @@ pub fn from_plan(mode: &Mode, plan: &Plan, json: bool) -> Result<FromPlan, CliEr
         ))),
         Mode::WritePlan(dir) => {
             let written = store::write(dir, plan)?;
-            print_next_steps(dir, plan, written, json);
+            print_next_steps(dir, plan, written, json)?;
             Ok(FromPlan::Written)
         }
         Mode::Merge(dir) => {
             store::load_matching(dir, plan)?;
             let collected = collect::collect(dir, plan).map_err(|incomplete| {
                 for p in &incomplete.problems {
-                    eprintln!("merge: {p}");
+                    errln!("merge: {p}");
                 }
                 CliError::Runtime(anyhow::Error::new(incomplete).context("no report written"))
             })?;
@@ -191,11 +192,11 @@ fn env_steps(c: &Collected) -> u64 {
         .sum()
 }
 
-fn print_next_steps(dir: &Path, plan: &Plan, written: Written, json: bool) {
+fn print_next_steps(dir: &Path, plan: &Plan, written: Written, json: bool) -> Result<(), CliError> {
     let command = &plan.experiment.command;
     let last = plan.len().saturating_sub(1);
     if json {
-        println!(
+        outln!(
             "{}",
             serde_json::json!({
                 "plan": dir,
@@ -207,28 +208,28 @@ fn print_next_steps(dir: &Path, plan: &Plan, written: Written, json: bool) {
                 "trial": format!("pada trial --plan {} --index N", dir.display()),
                 "merge": format!("{command} --merge {}", dir.display()),
             })
-        );
-        return;
+        )?;
+        return Ok(());
     }
     let what = match written {
         Written::New => "wrote",
         Written::Existing => "found (already written, results kept)",
     };
-    println!(
+    outln!(
         "{what} the plan of `{command}`: {} trials, hash {}, in {}",
         plan.len(),
         plan.short_hash(),
         dir.display()
-    );
-    println!(
+    )?;
+    outln!(
         "run every trial:  sbatch {}   (one trial per array task, indices 0-{last})",
         store::array_script(dir).display()
-    );
-    println!(
+    )?;
+    outln!(
         "  or one by one:  pada trial --plan {} --index N   (N = 0..{last}; or SLURM_ARRAY_TASK_ID / JOB_COMPLETION_INDEX)",
         dir.display()
-    );
-    println!("then merge:       {command} --merge {}", dir.display());
+    )?;
+    outln!("then merge:       {command} --merge {}", dir.display())
 }
 
 /// An experiment's trials, however they were obtained.

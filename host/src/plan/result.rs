@@ -88,6 +88,9 @@ struct StoredTrial {
     #[serde(with = "super::exact::f64")]
     mtbf_s: f64,
     window_reengagements: u64,
+    #[serde(with = "super::exact::f64")]
+    physical_mtbf_s: f64,
+    physical_window_reengagements: u64,
     learning_steps: u64,
     test_steps: u64,
     learning_falls: u64,
@@ -126,6 +129,8 @@ impl From<&TrialResult> for StoredTrial {
             rise_time_s: r.rise_time_s,
             mtbf_s: r.mtbf_s,
             window_reengagements: r.window_reengagements,
+            physical_mtbf_s: r.physical_mtbf_s,
+            physical_window_reengagements: r.physical_window_reengagements,
             learning_steps: r.learning_steps,
             test_steps: r.test_steps,
             learning_falls: r.learning_falls,
@@ -160,6 +165,8 @@ impl From<StoredTrial> for TrialResult {
             rise_time_s: r.rise_time_s,
             mtbf_s: r.mtbf_s,
             window_reengagements: r.window_reengagements,
+            physical_mtbf_s: r.physical_mtbf_s,
+            physical_window_reengagements: r.physical_window_reengagements,
             learning_steps: r.learning_steps,
             test_steps: r.test_steps,
             learning_falls: r.learning_falls,

@@ -14,6 +14,7 @@ use super::collect::{self, Collected, Incomplete};
 use super::slurm::{self, Submission, TaskStates};
 use super::spec::Plan;
 use super::store;
+use crate::console::errln;
 use crate::error::{usage, CliError};
 use crate::timing::SlurmReport;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -79,7 +80,7 @@ pub fn run(dir: &Path, plan: &Plan, opts: &SlurmOptions) -> Result<SlurmOutcome,
     let earlier = read_jobs(&jobs_file);
     let queued = slurm::queue(&earlier).unwrap_or_default();
     if !queued.is_empty() {
-        eprintln!(
+        errln!(
             "slurm: {} tasks of an earlier run of this plan are still queued (jobs {}); waiting for them",
             queued.len(),
             earlier.join(",")
@@ -91,7 +92,7 @@ pub fn run(dir: &Path, plan: &Plan, opts: &SlurmOptions) -> Result<SlurmOutcome,
     let mut scan = collect::scan(dir, plan);
     report.already_done = scan.verified();
     if report.already_done > 0 {
-        eprintln!(
+        errln!(
             "slurm: {} of {} trials already have verified results in {}; they are not run again",
             report.already_done,
             plan.len(),
@@ -107,7 +108,7 @@ pub fn run(dir: &Path, plan: &Plan, opts: &SlurmOptions) -> Result<SlurmOutcome,
             let ids: Vec<String> = last_jobs.iter().map(|j| j.id.clone()).collect();
             let states = slurm::ended_states(&ids);
             for p in &scan.problems {
-                eprintln!(
+                errln!(
                     "slurm: trial {} left {}; submitting it again (attempt {} of {})",
                     p.trial,
                     why_no_result(&states, &last_jobs, max_array, dir, p.index, &p.what),
@@ -129,7 +130,7 @@ pub fn run(dir: &Path, plan: &Plan, opts: &SlurmOptions) -> Result<SlurmOutcome,
     let wall_s = first_submission.map_or(0.0, |t| t.elapsed().as_secs_f64());
     if !scan.problems.is_empty() {
         for p in &scan.problems {
-            eprintln!("slurm: {p}");
+            errln!("slurm: {p}");
         }
         return Err(CliError::Runtime(anyhow::Error::new(Incomplete {
             total: plan.len(),
@@ -219,7 +220,7 @@ fn submit_all(
             extra: &opts.sbatch_args,
         })
         .map_err(CliError::Runtime)?;
-        eprintln!(
+        errln!(
             "slurm: submitted job {id}: {} (indices {}{})",
             trials(indices.len()),
             slurm::array_spec(&indices.iter().map(|i| i + offset).collect::<Vec<_>>()),
@@ -294,7 +295,7 @@ impl Progress {
             .last_line
             .is_none_or(|t| t.elapsed() >= Duration::from_secs(10));
         if self.last != Some(now) && (due || force) {
-            eprintln!("slurm: {done}/{total} trials done, {running} running, {pending} pending");
+            errln!("slurm: {done}/{total} trials done, {running} running, {pending} pending");
             self.last = Some(now);
             self.last_line = Some(Instant::now());
         }

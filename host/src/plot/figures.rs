@@ -19,8 +19,8 @@ use plotters::prelude::*;
 pub fn color(algo: Algo) -> RGBColor {
     match algo {
         Algo::Sarsa => RGBColor(0, 0, 0),
-        Algo::Lowpass => RGBColor(31, 119, 180),
-        Algo::MarkovLowpass => RGBColor(23, 190, 207),
+        Algo::LowPass => RGBColor(31, 119, 180),
+        Algo::MarkovLowPass => RGBColor(23, 190, 207),
         Algo::Integrator => RGBColor(214, 39, 40),
         Algo::MarkovIntegrator => RGBColor(255, 127, 14),
         Algo::Pada => RGBColor(44, 160, 44),
@@ -44,8 +44,8 @@ pub struct SweepPoint {
 
 /// The algorithms drawn as swept lines, in the paper's order.
 const SWEPT: [Algo; 5] = [
-    Algo::Lowpass,
-    Algo::MarkovLowpass,
+    Algo::LowPass,
+    Algo::MarkovLowPass,
     Algo::Integrator,
     Algo::MarkovIntegrator,
     Algo::Pada,

@@ -9,7 +9,7 @@
 //! packet that is delivered whole when its last byte is in.
 
 use super::fault::{FaultKind, FaultSpec};
-use super::plant::Rig;
+use crate::rig::Rig;
 use pada_core::dynamixel::{
     table, ErrorFlags, Instruction, InstructionDecoder, StatusPacket, BROADCAST_ID,
 };
@@ -376,7 +376,7 @@ mod tests {
     use super::*;
     use crate::pendulum::PhysicalPendulumParams;
     use crate::sil::fault;
-    use crate::sil::plant::PendulumRig;
+    use crate::rig::PendulumRig;
     use pada_core::dynamixel::{self, StatusDecoder};
 
     fn packet(f: impl FnOnce(&mut [u8]) -> usize) -> Vec<u8> {

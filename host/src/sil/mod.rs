@@ -12,8 +12,8 @@
 //!
 //! - [`bus`]: RX-28 servos and the sensor device on the emulated Dynamixel
 //!   bus, with `--fault` injection ([`fault`]);
-//! - [`plant`]: what the servos move: the physical pendulum's model, or a
-//!   LEO stand-in;
+//! - the robot behind the bus: a [`crate::rig::Rig`] (the physical
+//!   pendulum's model, or a LEO stand-in);
 //! - [`qemu`]: starting QEMU and connecting its channels;
 //! - [`run`]: the lock-step loop, the run's commands, the summary;
 //! - [`replay`]: the bit-for-bit replay through the host build of the
@@ -26,7 +26,6 @@
 
 pub mod bus;
 pub mod fault;
-pub mod plant;
 pub mod qemu;
 pub mod replay;
 pub mod run;

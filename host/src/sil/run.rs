@@ -23,7 +23,7 @@
 
 use super::bus::{BusEmulator, BusStats, Reply};
 use super::fault::FaultSpec;
-use super::plant::{LeoStandIn, PendulumRig, Rig, SUPPLY_V};
+use crate::rig::{LeoStandIn, PendulumRig, Rig, SUPPLY_V};
 use super::qemu::{Emulator, QemuSetup};
 use super::replay::{replay, Record, ReplayReport};
 use super::twin::{twin, TwinReport};
@@ -562,7 +562,7 @@ impl Session<'_> {
                     self.booted = true;
                     // A fresh learner with the run's policy, then the first
                     // test episode.
-                    self.command_at(100_000, ToChip::SetPolicy(self.cfg.policy.into()));
+                    self.command_at(100_000, ToChip::SetPolicy(self.cfg.policy));
                     self.command_at(200_000, ToChip::Start(RunMode::Testing));
                 }
                 FromBoard::Idle {
@@ -792,7 +792,7 @@ impl Session<'_> {
                 name: "telemetry: every frame decoded, no sequence gap",
                 ok: link.is_clean() && link.frames > 0,
                 detail: format!(
-                    "{} frames, {} bytes; crc {} cobs {} oversize {} short {} undecodable {}; gaps {} ({} frames missed)",
+                    "{} frames, {} bytes; crc {} cobs {} oversize {} short {} undecodable {} non-canonical {}; gaps {} ({} frames missed, {} resyncs)",
                     link.frames,
                     link.bytes,
                     link.crc_errors,
@@ -800,8 +800,10 @@ impl Session<'_> {
                     link.oversize,
                     link.too_short,
                     link.decode_errors,
+                    link.noncanonical,
                     link.seq_gaps,
-                    link.frames_missed
+                    link.frames_missed,
+                    link.seq_resyncs
                 ),
             },
             Check {

@@ -12,7 +12,7 @@
 //! encoder counts — and shows what the emulation itself adds: nothing but
 //! bus timing. Several seeds give the spread of the configuration.
 
-use super::plant::{PendulumRig, Rig, SUPPLY_V};
+use crate::rig::{PendulumRig, Rig, SUPPLY_V};
 use super::run::TestPoint;
 use crate::experiment::{end_performance, rise_time};
 use crate::pendulum::PhysicalPendulumParams;

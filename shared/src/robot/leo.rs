@@ -18,6 +18,11 @@
 //! - Reward `−1 − 3·E + 300·(L − L_prev) − 125·[fall]` ([`reward`],
 //!   [`step_energy`], §3.7); a fall is absorbing ([`is_fall`], §3.8).
 
+// Numbers are written as the reference prints them: the joint limits are
+// the reference's degrees in radians to six places (−0.785398 is −45°, not
+// meant as π/4).
+#![allow(clippy::approx_constant)]
+
 use super::filter::RateFilter;
 use super::{MotorLevels, Robot, RobotSpec};
 use crate::agent::{SarsaParams, WeightInit};
@@ -248,7 +253,26 @@ pub const SPEC: RobotSpec = RobotSpec {
     levels: MotorLevels::Uniform { min: -ACTION_VOLTAGE_LIMIT, max: ACTION_VOLTAGE_LIMIT, count: ACTION_LEVELS },
     action_tiles: Some(&[ACTION_TILE_WIDTH; ACTION_DIM]),
     params: PARAMS,
+    gearboxes: GEARBOXES.len() as u8,
+    footstep_remap: Some(FOOTSTEP_REMAP),
+    half_shift: HALF_SHIFT,
 };
+
+/// At a footstep the learned dimensions trade joints: the new stance hip
+/// was the swing hip, the new swing hip was the stance hip, and the new
+/// swing knee was the stance knee, held by its P law rather than learned.
+/// So the policy's memory moves with the joints — stance hip ← swing hip,
+/// swing hip ← stance hip, swing knee at rest (0 V) — as GRL's LEO
+/// action sampler mirrors PADA's previous action at touchdown and sets the
+/// auto-actuated knee's entry to 0 (grl-facts §6.2). Without it a physical
+/// hip's voltage could jump by the whole range at every footstep.
+pub const FOOTSTEP_REMAP: [Option<u8>; crate::action_space::MAX_ACTION_DIMS] = [Some(1), Some(0), None, None];
+
+/// 16-bit weights hold ±2048 in steps of 1/16: LEO's Q-values stay far
+/// inside. Walking at 0.5 m/s earns about 300 · 0.5/30 − 1 = 4 per step,
+/// and with γ = 0.9962 (a horizon of 1/(1 − γ) ≈ 263 steps) Q ≈ 1000; a
+/// fall costs 125 once.
+pub const HALF_SHIFT: u8 = 12;
 
 /// The 10-D mirrored observation (§3.4): φ, φ̇, q_hip,st, q̇_hip,st,
 /// q_hip,sw, q̇_hip,sw, q_knee,st, q̇_knee,st, q_knee,sw, q̇_knee,sw.
@@ -490,6 +514,17 @@ pub fn observe(
     Observation([
         phi, phi_rate, angles[hs], rates[hs], angles[hw], rates[hw], angles[ks], rates[ks], angles[kw], rates[kw],
     ])
+}
+
+/// The gearboxes whose fatigue is counted, in this order: both hips and
+/// both knees (the shoulder and ankles are held and never learned).
+pub const GEARBOXES: [Joint; 4] = [Joint::HipLeft, Joint::HipRight, Joint::KneeLeft, Joint::KneeRight];
+
+/// The gearbox torque as the paper takes it (Section IV): linear in the
+/// commanded voltage, the RX-28's stall torque at that voltage,
+/// η·G·k·U/R ≈ 0.167 N·m/V (1.79 N·m at 10.7 V; §2.1), back-EMF left out.
+pub fn commanded_gear_torque(voltage: f32) -> f32 {
+    Rx28::LEO.estimate_joint_torque(voltage, 0.0)
 }
 
 /// The gearbox torque the fatigue counter sees on a servo that applies

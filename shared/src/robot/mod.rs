@@ -21,7 +21,7 @@ pub mod filter;
 pub mod leo;
 pub mod pendulum;
 
-use crate::action_space::{ActionDim, ActionSpace};
+use crate::action_space::{ActionDim, ActionSpace, MAX_ACTION_DIMS};
 use crate::agent::{Agent, SarsaParams};
 use crate::error::ConfigError;
 use crate::policy::{Policy, PolicyKind};
@@ -72,6 +72,17 @@ impl Robot {
     /// The robot with this [`name`](Self::name).
     pub fn from_name(name: &str) -> Option<Robot> {
         Robot::ALL.into_iter().find(|r| r.name() == name)
+    }
+
+    /// The gearbox torque \[N·m\] of a commanded voltage as the paper takes
+    /// it (Section IV: "a linear relationship between voltage and
+    /// torque"): the pendulum's K/R, LEO's RX-28 stall torque per volt. The
+    /// input of the paper's MTBF on the host and on the board alike.
+    pub fn commanded_gear_torque(self, voltage: f32) -> f32 {
+        match self {
+            Robot::Pendulum33 | Robot::Pendulum20 => pendulum::gearbox_torque(voltage as f64) as f32,
+            Robot::Leo => leo::commanded_gear_torque(voltage),
+        }
     }
 
     /// The learning task's definition.
@@ -126,6 +137,20 @@ pub struct RobotSpec {
     pub action_tiles: Option<&'static [f32]>,
     /// SARSA(λ) parameters.
     pub params: SarsaParams,
+    /// Physical gearboxes whose fatigue decides the robot's MTBF: the
+    /// pendulum's one; LEO's two hips and two knees (Section VIII), the
+    /// joints the learned actions drive as stance and swing roles trade
+    /// legs. Their servos are the firmware's reported joints.
+    pub gearboxes: u8,
+    /// How the policy's memory (PADA's previous action, the low-pass
+    /// filter's output, the integrated command) moves between the motor
+    /// dimensions at a footstep, when the joints they drive trade roles
+    /// ([`crate::agent::Agent::remap_memory`]); `None` for a robot without
+    /// stance.
+    pub footstep_remap: Option<[Option<u8>; MAX_ACTION_DIMS]>,
+    /// The shift of 16-bit weights ([`crate::weights::WeightFormat::Half`])
+    /// for this robot: its Q-values stay within ±2^(shift − 1).
+    pub half_shift: u8,
 }
 
 impl RobotSpec {
@@ -136,7 +161,9 @@ impl RobotSpec {
 
     /// The control period \[s\].
     pub fn period_s(&self) -> f64 {
-        self.period_us as f64 * 1e-6
+        // Divided, not multiplied by 1e-6: 30 000 µs is then exactly the
+        // double nearest 0.03.
+        self.period_us as f64 / 1e6
     }
 
     /// The learner's motor: [`motor_dims`](Self::motor_dims) dimensions of

@@ -52,6 +52,13 @@ pub const PARAMS: SarsaParams = SarsaParams {
     init: WeightInit::Uniform { min: 0.0, max: 1.0 },
 };
 
+/// 16-bit weights hold ±16384 in steps of 1/2. Typical Q-values are
+/// −100 … −2000; the bound of a return over the 100-step horizon of
+/// γ = 0.99, −(5π² + 0.1·(12π)² + 9)·100 ≈ −20 000, needs a pendulum
+/// spinning at its 12π limit for the whole horizon (a weight there would
+/// saturate, and be counted).
+pub const HALF_SHIFT: u8 = 15;
+
 /// The pendulum's learning task at a control period of `period_us`.
 const fn spec(robot: Robot, period_us: u32) -> RobotSpec {
     RobotSpec {
@@ -64,6 +71,9 @@ const fn spec(robot: Robot, period_us: u32) -> RobotSpec {
         levels: MotorLevels::Listed(&LEVELS),
         action_tiles: None,
         params: PARAMS,
+        gearboxes: 1,
+        footstep_remap: None,
+        half_shift: HALF_SHIFT,
     }
 }
 

@@ -1,59 +1,10 @@
-//! What stands behind the emulated bus: the robot the servos move and the
-//! sensor device reads, in continuous time.
-//!
-//! A [`Rig`] is advanced to the instant of every bus transaction, so a
-//! voltage applies from the moment its Moving Speed reaches the servo (the
-//! motor's command is a zero-order hold between writes, as on the real
-//! robot) and a reading reflects the state at the moment it is taken.
+//! The physical pendulum behind the bus.
 
+use super::{encoder_count, position_raw, Rig, SUPPLY_V, TEMPERATURE_C};
 use crate::pendulum::PhysicalPendulumParams;
 use pada_core::dynamixel::table::{self, PresentState};
+use pada_core::robot::pendulum::gearbox_torque;
 use std::f64::consts::{PI, TAU};
-
-/// Counts per revolution of the emulated encoder (a 1024-line encoder
-/// after ×4 decoding, as `pada_firmware::config::EncoderConfig`).
-pub const ENCODER_COUNTS_PER_REV: f64 = 4096.0;
-/// The servos' supply \[V\] (Present Voltage 120 = 12.0 V).
-pub const SUPPLY_V: f64 = 12.0;
-/// Present Temperature every emulated servo reports \[°C\].
-pub const TEMPERATURE_C: u8 = 40;
-
-/// The robot behind the bus.
-pub trait Rig: Send {
-    /// The Dynamixel IDs of its servos.
-    fn servo_ids(&self) -> &[u8];
-
-    /// Advances the simulation to `t_us` with the drive in force.
-    fn advance_to(&mut self, t_us: u64);
-
-    /// From `t_us` on, servo `id` has torque `torque` and applies `volts`
-    /// (its Moving Speed times its supply; ignored without torque).
-    fn drive(&mut self, t_us: u64, id: u8, torque: bool, volts: f64);
-
-    /// What servo `id` reads at `t_us` (Present Position … Temperature).
-    fn present(&mut self, t_us: u64, id: u8) -> PresentState;
-
-    /// The encoder's 16-bit count and the foot contacts at `t_us`.
-    fn sensors(&mut self, t_us: u64) -> (u16, u8);
-
-    /// A one-line description for reports.
-    fn describe(&self) -> String;
-}
-
-/// The encoder count of an angle measured from the pose at boot.
-fn encoder_count(angle_from_boot: f64) -> u16 {
-    let counts = (angle_from_boot / TAU * ENCODER_COUNTS_PER_REV).round() as i64;
-    counts.rem_euclid(1 << 16) as u16
-}
-
-/// The raw Present Position of a joint angle (512 at 0, 300° over 1023
-/// counts; the potentiometer's dead zone reads as the nearest end).
-fn position_raw(angle: f64) -> u16 {
-    let unit = table::POSITION_RANGE_RAD as f64 / table::POSITION_MAX as f64;
-    (512.0 + angle / unit)
-        .round()
-        .clamp(0.0, table::POSITION_MAX as f64) as u16
-}
 
 /// The physical pendulum of Section VII on one RX-28 in wheel mode (ID 1)
 /// with the quadrature encoder on its axis: the constants of
@@ -72,6 +23,8 @@ pub struct PendulumRig {
     t_us: u64,
     torque: bool,
     volts: f64,
+    /// Whether a hand stops the pendulum at every episode's end.
+    operator: bool,
 }
 
 impl PendulumRig {
@@ -86,7 +39,14 @@ impl PendulumRig {
             t_us: 0,
             torque: false,
             volts: 0.0,
+            operator: false,
         }
+    }
+
+    /// The same, stopped hanging at rest by hand whenever the firmware ends
+    /// an episode ([`Rig::episode_ended`]).
+    pub fn with_operator(params: PhysicalPendulumParams) -> Self {
+        PendulumRig { operator: true, ..Self::new(params) }
     }
 
     /// θ (0 upright, unwrapped) and θ̇ now.
@@ -151,88 +111,32 @@ impl Rig for PendulumRig {
     }
 
     fn describe(&self) -> String {
-        "the physical pendulum of Section VII (GRL constants, one RX-28 in wheel mode, 4096-count encoder)".into()
-    }
-}
-
-/// A stand-in for LEO until its simulation drives the emulated bus: seven
-/// RX-28s (IDs 1–7) that hold the start pose of LEO's definition
-/// (`pada_core::robot::leo::START_JOINT_ANGLES`), the boom's encoder at
-/// the start angle, the left foot on the ground. Nothing moves: it
-/// exercises the LEO image's control loop and agent (for the agent step's
-/// instruction count), not learning.
-#[derive(Debug, Clone)]
-pub struct LeoStandIn {
-    /// Present Position by servo ID − 1.
-    positions: [u16; 7],
-}
-
-impl LeoStandIn {
-    /// The boom angle of the start pose (torso angle φ = −0.10 rad) \[rad\].
-    pub const BOOM_ANGLE: f64 = -pada_core::robot::leo::START_PHI as f64;
-
-    /// The robot in its start pose.
-    pub fn new() -> Self {
-        let mut positions = [0; 7];
-        let hw = pada_firmware::config::hardware(pada_core::robot::Robot::Leo);
-        for (joint, servo) in hw.joints.iter().enumerate() {
-            let angle = pada_core::robot::leo::START_JOINT_ANGLES[joint] as f64;
-            positions[servo.id as usize - 1] = position_raw(angle);
-        }
-        LeoStandIn { positions }
-    }
-}
-
-impl Default for LeoStandIn {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl Rig for LeoStandIn {
-    fn servo_ids(&self) -> &[u8] {
-        &[1, 2, 3, 4, 5, 6, 7]
+        let hand = if self.operator { ", stopped by hand between episodes" } else { "" };
+        format!("the physical pendulum of Section VII (GRL constants, one RX-28 in wheel mode, 4096-count encoder){hand}")
     }
 
-    fn advance_to(&mut self, _t_us: u64) {}
-
-    fn drive(&mut self, _t_us: u64, _id: u8, _torque: bool, _volts: f64) {}
-
-    fn present(&mut self, _t_us: u64, id: u8) -> PresentState {
-        let i = (id as usize).clamp(1, 7) - 1;
-        PresentState {
-            position: self.positions[i],
-            speed: 0,
-            load: 0,
-            voltage: 140,
-            temperature: TEMPERATURE_C,
+    /// With an operator, the pendulum is stopped hanging at rest: the
+    /// firmware then waits its second of stillness, and every episode
+    /// starts as the simulated pendulum's do, without the up to 15 s of
+    /// swinging out that the free pendulum takes.
+    fn episode_ended(&mut self) {
+        if self.operator {
+            self.x = [PI, 0.0];
         }
     }
 
-    fn sensors(&mut self, _t_us: u64) -> (u16, u8) {
-        (
-            encoder_count(Self::BOOM_ANGLE),
-            pada_firmware::leo::contact::LEFT,
-        )
-    }
-
-    fn describe(&self) -> String {
-        "a LEO stand-in: 7 RX-28s holding the start pose, no dynamics (instruction counts only)"
-            .into()
+    fn gear_torque(&self, _id: u8) -> f32 {
+        if self.torque {
+            gearbox_torque(self.volts) as f32
+        } else {
+            0.0
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn encoder_counts_wrap_like_a_16_bit_timer() {
-        assert_eq!(encoder_count(0.0), 0);
-        assert_eq!(encoder_count(PI), 2048);
-        assert_eq!(encoder_count(-TAU / 4096.0), 65535);
-        assert_eq!(encoder_count(16.0 * TAU), 0);
-    }
 
     #[test]
     fn the_pendulum_hangs_still_without_torque_and_swings_with_it() {
@@ -279,15 +183,5 @@ mod tests {
             "{lost_braked} vs {lost_free}"
         );
         assert!(lost_free > 0.0);
-    }
-
-    #[test]
-    fn leo_stand_in_reads_its_start_pose() {
-        let mut leo = LeoStandIn::new();
-        assert_eq!(leo.present(0, 1).position, 512 - 51);
-        assert_eq!(leo.present(0, 4).position, 512 - 248);
-        let (count, contacts) = leo.sensors(0);
-        assert_eq!(count, 65);
-        assert_eq!(contacts, pada_firmware::leo::contact::LEFT);
     }
 }

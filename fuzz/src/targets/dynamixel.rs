@@ -1,0 +1,258 @@
+//! The packet decoder ([`pada_core::dynamixel::Decoder`]) in both
+//! directions: status packets as the firmware reads them (with and without
+//! an expected reply) and instruction packets as the bus emulator reads
+//! them.
+
+use super::{ensure, Outcome, Target};
+use crate::gen::{below, bytes, mutate};
+use pada_core::dynamixel::{
+    DecodeError, DecoderStats, ErrorFlags, Instruction, InstructionDecoder, Reply, StatusDecoder,
+    StatusPacket,
+};
+use rand_core::RngCore;
+
+/// The status side: the first three input bytes say what the decoder
+/// expects (byte 0 odd: a reply from ID byte 1 with byte 2 parameters).
+pub struct Status<const N: usize> {
+    name: &'static str,
+}
+
+impl<const N: usize> Status<N> {
+    pub fn new(name: &'static str) -> Self {
+        Status { name }
+    }
+}
+
+/// Valid packets, some from `id` with `params` parameter bytes, with bytes
+/// of noise between some of them.
+fn packets(
+    rng: &mut rand_pcg::Pcg64,
+    id: u8,
+    params: usize,
+    max_params: usize,
+    status: bool,
+) -> Vec<u8> {
+    let mut out = Vec::new();
+    let mut buf = [0u8; 300];
+    for _ in 0..1 + below(rng, 5) {
+        if below(rng, 3) == 0 {
+            let n = below(rng, 6);
+            out.extend(bytes(rng, n));
+        }
+        let (pid, n) = if below(rng, 2) == 0 {
+            (id, params)
+        } else {
+            (below(rng, 254) as u8, below(rng, max_params + 1))
+        };
+        let data = bytes(rng, n);
+        if status {
+            if let Ok(p) = StatusPacket::<300>::new(pid, ErrorFlags(rng.next_u32() as u8), &data) {
+                if let Ok(b) = p.encode(&mut buf) {
+                    out.extend_from_slice(b);
+                }
+            }
+        } else {
+            let ins = match below(rng, 4) {
+                0 => Instruction::Read {
+                    addr: data.first().copied().unwrap_or(0),
+                    len: n as u8,
+                },
+                1 if !data.is_empty() => Instruction::Write {
+                    addr: 30,
+                    data: &data,
+                },
+                2 => Instruction::SyncWrite {
+                    addr: 32,
+                    data_len: 2,
+                    entries: &data[..data.len() / 3 * 3],
+                },
+                _ => Instruction::Ping,
+            };
+            if let Ok(b) = ins.encode(pid, &mut buf) {
+                out.extend_from_slice(b);
+            }
+        }
+    }
+    out
+}
+
+/// Checks the counters against what the decoder returned and the bytes it
+/// was fed: every byte is in an accepted packet, skipped or buffered, and
+/// every refusal is counted once.
+fn check_counts(
+    s: &DecoderStats,
+    fed: usize,
+    accepted_bytes: usize,
+    buffered: usize,
+    oks: u32,
+    errs: [u32; 3],
+) -> Outcome {
+    ensure!(
+        s.packets == oks,
+        "packets {} counted, {oks} returned",
+        s.packets
+    );
+    let counted = [s.bad_checksums, s.bad_lengths, s.unexpected_ids];
+    ensure!(
+        counted == errs,
+        "refusals counted {counted:?}, returned {errs:?}"
+    );
+    let kept = s.skipped_bytes as usize + accepted_bytes + buffered;
+    ensure!(kept == fed, "{fed} bytes fed, {kept} accounted for (skipped {}, in packets {accepted_bytes}, buffered {buffered})", s.skipped_bytes);
+    Outcome::Ok
+}
+
+fn kind(e: &DecodeError) -> usize {
+    match e {
+        DecodeError::BadChecksum { .. } => 0,
+        DecodeError::BadLength { .. } => 1,
+        DecodeError::UnexpectedId { .. } | DecodeError::BroadcastStatus => 2,
+    }
+}
+
+/// Whether `needle` occurs in `hay`.
+fn contains(hay: &[u8], needle: &[u8]) -> bool {
+    hay.windows(needle.len()).any(|w| w == needle)
+}
+
+impl<const N: usize> Target for Status<N> {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+
+    fn generate(&mut self, rng: &mut rand_pcg::Pcg64) -> Vec<u8> {
+        let (id, params) = (below(rng, 254) as u8, below(rng, N - 5));
+        let mut input = vec![rng.next_u32() as u8, id, params as u8];
+        match below(rng, 6) {
+            0 => {
+                let n = below(rng, 300);
+                input.extend(bytes(rng, n));
+            }
+            1 => input.extend(packets(rng, id, params, N - 6, true)),
+            _ => {
+                let mut s = packets(rng, id, params, N - 6, true);
+                let other = packets(rng, id, params, N - 6, true);
+                mutate(rng, &mut s, &other);
+                input.extend(s);
+            }
+        }
+        input
+    }
+
+    fn check(&self, input: &[u8]) -> Outcome {
+        let Some((&[mode, id, params], stream)) = input.split_first_chunk::<3>() else {
+            return Outcome::Ok;
+        };
+        let reply = (mode & 1 == 1).then_some(Reply { id, params });
+        let mut dec = StatusDecoder::<N>::new();
+        dec.expect(reply);
+        let (mut oks, mut errs, mut accepted) = (0u32, [0u32; 3], 0usize);
+        let mut buf = [0u8; 300];
+        for (i, &b) in stream.iter().enumerate() {
+            let mut next = dec.push(b);
+            while let Some(r) = next {
+                match r {
+                    Ok(p) => {
+                        oks += 1;
+                        // Invariant 2: it re-encodes to bytes that were fed.
+                        let Ok(bytes) = p.encode(&mut buf) else {
+                            return Outcome::Failed(format!(
+                                "accepted packet at byte {i} does not encode"
+                            ));
+                        };
+                        ensure!(
+                            contains(&stream[..=i], bytes),
+                            "accepted packet at byte {i} was never fed"
+                        );
+                        accepted += bytes.len();
+                        if let Some(r) = reply {
+                            ensure!(
+                                p.id == r.id && p.params.len() == r.params as usize,
+                                "accepted {p:?}, expected {r:?}"
+                            );
+                        }
+                    }
+                    Err(e) => errs[kind(&e)] += 1,
+                }
+                next = dec.poll();
+            }
+        }
+        check_counts(
+            &dec.stats(),
+            stream.len(),
+            accepted,
+            dec.buffered(),
+            oks,
+            errs,
+        )
+    }
+}
+
+/// The instruction side (the bus emulator's decoder).
+pub struct Instructions<const N: usize> {
+    name: &'static str,
+}
+
+impl<const N: usize> Instructions<N> {
+    pub fn new(name: &'static str) -> Self {
+        Instructions { name }
+    }
+}
+
+impl<const N: usize> Target for Instructions<N> {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+
+    fn generate(&mut self, rng: &mut rand_pcg::Pcg64) -> Vec<u8> {
+        match below(rng, 6) {
+            0 => {
+                let n = below(rng, 300);
+                bytes(rng, n)
+            }
+            1 => packets(rng, 1, 4, N - 8, false),
+            _ => {
+                let mut s = packets(rng, 1, 4, N - 8, false);
+                let other = packets(rng, 2, 2, N - 8, false);
+                mutate(rng, &mut s, &other);
+                s
+            }
+        }
+    }
+
+    fn check(&self, stream: &[u8]) -> Outcome {
+        let mut dec = InstructionDecoder::<N>::new();
+        let (mut oks, mut errs, mut accepted) = (0u32, [0u32; 3], 0usize);
+        let (mut buf, mut again) = ([0u8; 300], [0u8; 300]);
+        for (i, p) in dec.feed(stream).enumerate() {
+            match p {
+                Ok(p) => {
+                    oks += 1;
+                    let Ok(bytes) = p.encode(&mut buf) else {
+                        return Outcome::Failed(format!("accepted packet {i} does not encode"));
+                    };
+                    ensure!(contains(stream, bytes), "accepted packet {i} was never fed");
+                    accepted += bytes.len();
+                    // The encoder and the parser agree: what parses encodes
+                    // back to the same packet.
+                    if let Ok(ins) = p.instruction() {
+                        let enc = ins.encode(p.id, &mut again);
+                        ensure!(
+                            enc.is_ok_and(|e| e == bytes),
+                            "{ins:?} parses but does not encode back"
+                        );
+                    }
+                }
+                Err(e) => errs[kind(&e)] += 1,
+            }
+        }
+        check_counts(
+            &dec.stats(),
+            stream.len(),
+            accepted,
+            dec.buffered(),
+            oks,
+            errs,
+        )
+    }
+}

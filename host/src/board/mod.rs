@@ -1,0 +1,127 @@
+//! A board's own learner on the host: `pada run --board NAME`.
+//!
+//! What runs is the firmware's controller (`pada_firmware::control`, the
+//! code the board runs, built for the host) with the board's learner
+//! profile (`pada_core::profile`: table layout, size, weight format),
+//! against the robot behind the servos ([`crate::rig`]: the physical
+//! pendulum's model, or the rapier3d LEO), with the sensors as the board
+//! sees them — positions in servo counts, rates differenced from them, the
+//! encoder in counts — and the robot's own episode logic: the held joints,
+//! the wait until the robot is back at its start. What it learns is what the
+//! board will learn; `pada sil` shows that the binary does the same, bit
+//! for bit.
+//!
+//! - [`trial`]: one trial, the controller and the rig in lock step;
+//! - [`run_board`]: the trials of a run in parallel, with the same
+//!   [`TrialResult`]s (and so the same `summary.json`) as `pada run`.
+
+pub mod trial;
+
+use crate::experiment::runner::RunConfig;
+use crate::experiment::TrialResult;
+use pada_core::profile::{Board, LearnerProfile, Memory};
+use pada_core::robot::Robot;
+use rayon::prelude::*;
+use serde::Serialize;
+
+pub use trial::{run_board_trial, BoardTrial};
+
+/// A board's learner, as `summary.json` reports it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ProfileReport {
+    /// The board's name.
+    pub board: &'static str,
+    /// What the board is.
+    pub description: &'static str,
+    /// The robot.
+    pub robot: &'static str,
+    /// `exact` or `hashed`.
+    pub layout: &'static str,
+    /// Weights in the table.
+    pub weights: usize,
+    /// Bits per stored weight.
+    pub weight_bits: usize,
+    /// The table's size \[bytes\].
+    pub table_bytes: usize,
+    /// Where the table lives.
+    pub memory: &'static str,
+    /// Bytes of it in CCM and in SRAM, when split over both.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub split_bytes: Option<[usize; 2]>,
+}
+
+impl ProfileReport {
+    /// The report of `profile` with a table of `weights` weights.
+    pub fn new(profile: &LearnerProfile, weights: usize) -> Self {
+        let bytes = profile.format.bytes();
+        ProfileReport {
+            board: profile.board.name(),
+            description: profile.board.description(),
+            robot: profile.robot.name(),
+            layout: match profile.layout {
+                pada_core::tile_coding::Layout::Exact => "exact",
+                pada_core::tile_coding::Layout::Hashed => "hashed",
+            },
+            weights,
+            weight_bits: bytes * 8,
+            table_bytes: weights * bytes,
+            memory: profile.memory.name(),
+            split_bytes: match profile.memory {
+                Memory::CcmThenSram { ccm_weights } => Some([ccm_weights * bytes, (weights - ccm_weights) * bytes]),
+                _ => None,
+            },
+        }
+    }
+}
+
+/// A board on the command line (`--board`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum BoardName {
+    /// STM32F405/F407: 128 KB SRAM + 64 KB CCM.
+    F405,
+    /// STM32F429I-DISC1: 8 MB SDRAM on the FMC.
+    #[value(name = "f429-sdram")]
+    F429Sdram,
+    /// The host's own learner (tables on the heap).
+    Host,
+}
+
+impl BoardName {
+    /// The board.
+    pub fn board(self) -> Board {
+        match self {
+            BoardName::F405 => Board::F405,
+            BoardName::F429Sdram => Board::F429Sdram,
+            BoardName::Host => Board::Host,
+        }
+    }
+}
+
+/// The robot of a `--task` that has a board, or why not.
+pub fn robot_of_task(task: crate::experiment::tasks::TaskName) -> Result<Robot, String> {
+    use crate::experiment::tasks::TaskName;
+    match task {
+        TaskName::PhysicalPendulum => Ok(Robot::Pendulum33),
+        TaskName::Leo => Ok(Robot::Leo),
+        TaskName::Pendulum => Err(
+            "--board runs a robot that has a board: --task physical-pendulum or --task leo, not pendulum \
+             (the simulated pendulum of Section VII is a simulation only)"
+                .to_string(),
+        ),
+    }
+}
+
+/// Runs the trials of `cfg` with `profile`'s learner, in parallel;
+/// `progress` is told the environment steps of every finished episode.
+pub fn run_board(
+    profile: LearnerProfile,
+    cfg: &RunConfig,
+    progress: &(dyn Fn(u64) + Sync),
+) -> anyhow::Result<Vec<BoardTrial>> {
+    (0..cfg.trials).into_par_iter().map(|i| run_board_trial(profile, cfg, i, progress)).collect()
+}
+
+/// The per-trial results of board trials.
+pub fn results(trials: &[BoardTrial]) -> Vec<TrialResult> {
+    trials.iter().map(|t| t.result.clone()).collect()
+}

@@ -1,0 +1,309 @@
+//! One trial of a board's learner on the host: the firmware's controller
+//! and a [`Rig`] in lock step, one control period at a time, with the run
+//! protocol of `pada sil` and `pada run` (a greedy test run before
+//! learning, the controller's own test run after every tenth learning
+//! episode, a final test run once the learning time is spent).
+//!
+//! Per period `k` (at `t = k·T`):
+//!
+//! 1. every servo's Present Position … Temperature and the sensors are read
+//!    from the rig at `t` (the state at the period boundary, see
+//!    [`crate::rig::leo`]);
+//! 2. the controller runs its period, as on the chip;
+//! 3. its Moving Speeds (ratios of the supply) drive the rig from `t`;
+//!    an episode's end or start tells the rig's operator;
+//! 4. the rig advances to `t + T`; if the period applied a learning action,
+//!    the gearbox torques of the learned joints over it go to the MTBF
+//!    count, as `pada run` counts them.
+//!
+//! Differences to `pada run` that are the board's: the table (the board's
+//! profile), the sensors (counts, differenced rates), the seeds (the
+//! controller's PCG32 from the trial's seed, not the runner's PCG64), the
+//! held joints and resets, and the switch back to SARSA(λ) at the first
+//! period at or after `--switch-at` rather than at the exact step.
+
+use crate::experiment::metrics::{end_performance, rise_time};
+use crate::experiment::runner::RunConfig;
+use crate::experiment::{TestPoint, TrialResult};
+use crate::leo::model::ModelOptions;
+use crate::pendulum::PhysicalPendulumParams;
+use crate::rig::{LeoRig, PendulumRig, Rig};
+use crate::seed::trial_seed;
+use anyhow::{anyhow, bail};
+use pada_core::fatigue::{FatigueCounter, GearboxParams, PAPER_WINDOW_STEPS};
+use pada_core::fixed::Q16;
+use pada_core::policy::PolicyKind;
+use pada_core::profile::{LearnerProfile, TILINGS};
+use pada_core::robot::Robot;
+use pada_core::weights::{Half, WeightFormat, WeightStore};
+use pada_core::wire::{RunMode, StepKind, ToChip};
+use pada_firmware::config::hardware;
+use pada_firmware::control::{Controller, PeriodOutput, Readings};
+use pada_firmware::io::CycleCounter;
+use pada_firmware::leo::Leo;
+use pada_firmware::pendulum::Pendulum33;
+use pada_firmware::robot::RobotAdapter;
+use serde::Serialize;
+
+/// The most joints whose fatigue a trial counts (LEO's hips and knees).
+const COUNTED: usize = 4;
+
+/// One board trial.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BoardTrial {
+    /// What `pada run` reports per trial.
+    pub result: TrialResult,
+    /// The learner's configuration hash (as the board's `Hello` says).
+    pub config_hash: u32,
+    /// Weights in the table.
+    pub weights: usize,
+    /// The final weights' checksum (FNV-1a of the stored bytes).
+    pub weights_checksum: u32,
+    /// The predicted MTBF from the board's own torque estimate (the RX-28
+    /// model at the measured rate for LEO, the linear voltage law for the
+    /// pendulum) over the same first learning actions \[s\]. (The result's
+    /// `mtbf_s` is the paper's, from the commanded voltages;
+    /// `physical_mtbf_s` is from the simulation's gear torques.)
+    pub board_estimated_mtbf_s: f64,
+    /// Control periods run, with the waits between episodes.
+    pub periods: u64,
+}
+
+/// The cycle counter of a controller off the chip: none.
+struct NoCycles;
+
+impl CycleCounter for NoCycles {
+    fn cycles(&self) -> u32 {
+        0
+    }
+}
+
+/// Weights a table of `profile` needs with `policy`: the profile's fixed
+/// size, or the exact layout's size for the policy (the host's pendulum).
+pub fn table_len(profile: &LearnerProfile, policy: PolicyKind) -> anyhow::Result<usize> {
+    if let Some(n) = profile.weights() {
+        return Ok(n);
+    }
+    let spec = profile.robot.spec();
+    let p = pada_core::policy::Policy::new(policy, spec.motor().map_err(|e| anyhow!("{e}"))?).map_err(|e| anyhow!("{e}"))?;
+    let mut dims = spec.state.to_vec();
+    for i in 0..p.extension_len() {
+        dims.push(p.extension_dim(i).map_err(|e| anyhow!("{e}"))?);
+    }
+    let coder = pada_core::tile_coding::TileCoder::<TILINGS>::new(
+        &dims,
+        p.learner_space().joint_count(),
+        profile.layout,
+        u32::MAX as usize,
+    )
+    .map_err(|e| anyhow!("{e}"))?;
+    coder.exact_size().ok_or_else(|| anyhow!("a hashed profile has a fixed size"))
+}
+
+/// Trial `trial` of `cfg` with `profile`'s learner against its robot's rig.
+pub fn run_board_trial(
+    profile: LearnerProfile,
+    cfg: &RunConfig,
+    trial: u32,
+    progress: &(dyn Fn(u64) + Sync),
+) -> anyhow::Result<BoardTrial> {
+    let n = table_len(&profile, cfg.policy)?;
+    let seed = trial_seed(cfg.seed, trial);
+    // On the host a table split over CCM and SRAM is one slice: `Split`
+    // addresses the same weights in the same order.
+    match (profile.robot, profile.format) {
+        (Robot::Pendulum33, WeightFormat::Q16) => {
+            let mut rig = PendulumRig::with_operator(PhysicalPendulumParams::default());
+            run::<Pendulum33, _>(profile, vec![Q16::ZERO; n].into_boxed_slice(), &mut rig, cfg, trial, seed, progress)
+        }
+        (Robot::Leo, WeightFormat::Q16) => {
+            let mut rig = LeoRig::new(ModelOptions::default())?;
+            run::<Leo, _>(profile, vec![Q16::ZERO; n].into_boxed_slice(), &mut rig, cfg, trial, seed, progress)
+        }
+        (Robot::Leo, WeightFormat::Half { shift: pada_core::robot::leo::HALF_SHIFT }) => {
+            let mut rig = LeoRig::new(ModelOptions::default())?;
+            let table = Half::<_, { pada_core::robot::leo::HALF_SHIFT as u32 }>::new(vec![0i16; n].into_boxed_slice());
+            run::<Leo, _>(profile, table, &mut rig, cfg, trial, seed, progress)
+        }
+        (Robot::Pendulum33, WeightFormat::Half { shift: pada_core::robot::pendulum::HALF_SHIFT }) => {
+            let mut rig = PendulumRig::with_operator(PhysicalPendulumParams::default());
+            let table = Half::<_, { pada_core::robot::pendulum::HALF_SHIFT as u32 }>::new(vec![0i16; n].into_boxed_slice());
+            run::<Pendulum33, _>(profile, table, &mut rig, cfg, trial, seed, progress)
+        }
+        (robot, format) => bail!("no board runner for {} with {format:?} weights", robot.name()),
+    }
+}
+
+/// Where the run protocol is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Phase {
+    FirstTest,
+    Learning,
+    FinalTest,
+}
+
+fn command<W: WeightStore, R: RobotAdapter>(ctl: &mut Controller<W, R>, cmd: ToChip) -> anyhow::Result<()> {
+    ctl.command(&cmd).0.map_err(|e| anyhow!("{cmd:?} refused: {e:?}"))
+}
+
+fn run<R: RobotAdapter, W: WeightStore>(
+    profile: LearnerProfile,
+    table: W,
+    rig: &mut dyn Rig,
+    cfg: &RunConfig,
+    trial: u32,
+    seed: u64,
+    progress: &(dyn Fn(u64) + Sync),
+) -> anyhow::Result<BoardTrial> {
+    let spec = R::spec();
+    let period_us = spec.period_us as u64;
+    let period_s = spec.period_s();
+    let weights = table.len();
+    // As the SIL run: the board boots with SARSA, the host sets the policy
+    // (a fresh learner from the seed) and starts the first test run.
+    let mut ctl = Controller::<W, R>::new(profile, PolicyKind::Sarsa, table, seed).map_err(|e| anyhow!("{e}"))?;
+    ctl.set_policy(cfg.policy).map_err(|e| anyhow!("--algo {:?} on board {}: {e:?}", cfg.policy, profile.board.name()))?;
+    command(&mut ctl, ToChip::Start(RunMode::Testing))?;
+
+    let hw = hardware(R::ROBOT);
+    let counted = R::reported_joints();
+    let ids: Vec<u8> = counted.clone().map(|j| hw.joints[j].id).collect();
+    anyhow::ensure!(ids.len() <= COUNTED, "at most {COUNTED} counted joints");
+    let window = Some(PAPER_WINDOW_STEPS);
+    let fatigue = |_: ()| FatigueCounter::<COUNTED>::new(GearboxParams::TABLE_I, period_s, window);
+    let mut paper = fatigue(()).map_err(|e| anyhow!("{e}"))?;
+    let mut simulated = fatigue(()).map_err(|e| anyhow!("{e}"))?;
+    let mut estimated = fatigue(()).map_err(|e| anyhow!("{e}"))?;
+    let mut volts_of = [0.0f32; 256];
+
+    let budget = (cfg.seconds / period_s).round() as u64;
+    let switch_step = cfg.switch_at_s.map(|s| (s / period_s).round() as u64);
+    let mut switched = false;
+    let mut phase = Phase::FirstTest;
+    let mut out = PeriodOutput::default();
+    let mut curve: Vec<TestPoint> = Vec::new();
+    let (mut learning_steps, mut test_steps, mut learning_falls, mut learning_episodes) = (0u64, 0u64, 0u64, 0u32);
+    let mut last_kind = StepKind::Start;
+    // Generous: every episode may be followed by a wait of up to 15 s.
+    let limit = (budget + 1) * 20 + 100_000;
+    let mut k: u64 = 0;
+    loop {
+        let t = k * period_us;
+        if k > limit {
+            bail!("trial {trial}: no end after {k} control periods (the robot never got back to its start?)");
+        }
+        // 1. Read.
+        let mut readings = Readings { time_ms: (t / 1000) as u32, ..Readings::default() };
+        for (i, joint) in hw.joints.iter().enumerate() {
+            readings.servos[i].state = Some(rig.present(t, joint.id));
+        }
+        let (count, contacts) = rig.sensors(t);
+        readings.encoder = Some(count);
+        readings.contacts = contacts;
+        // 2. The controller's period.
+        ctl.period(&readings, &NoCycles, &mut out);
+        // 3. Drive, and tell the operator.
+        let supply = hw.supply_nominal_v as f64;
+        for &(id, speed) in &out.speeds {
+            let volts = pada_core::dynamixel::table::ratio_from_moving_speed(speed) as f64 * supply;
+            rig.drive(t, id, out.torque, volts);
+            volts_of[id as usize] = if out.torque { volts as f32 } else { 0.0 };
+        }
+        let mut learning_action = false;
+        if let Some(s) = &out.step {
+            last_kind = s.kind;
+            if s.kind == StepKind::Start {
+                rig.episode_started();
+            }
+            learning_action = s.mode == RunMode::Learning && matches!(s.kind, StepKind::Start | StepKind::Step);
+        }
+        // 4. Advance; count the learning action's torques.
+        k += 1;
+        rig.advance_to(k * period_us);
+        if learning_action {
+            let mut com = [0.0f32; COUNTED];
+            let mut sim = [0.0f32; COUNTED];
+            let mut est = [0.0f32; COUNTED];
+            for (c, (j, id)) in counted.clone().zip(&ids).enumerate() {
+                com[c] = R::ROBOT.commanded_gear_torque(volts_of[*id as usize]);
+                sim[c] = rig.gear_torque(*id);
+                est[c] = out.torques[j];
+            }
+            paper.update(&com).map_err(|e| anyhow!("{e}"))?;
+            simulated.update(&sim).map_err(|e| anyhow!("{e}"))?;
+            estimated.update(&est).map_err(|e| anyhow!("{e}"))?;
+            learning_steps += 1;
+            if !switched && switch_step.is_some_and(|s| learning_steps >= s) {
+                command(&mut ctl, ToChip::SwitchToSarsa)?;
+                switched = true;
+            }
+        }
+        let Some(e) = out.episode else { continue };
+        rig.episode_ended();
+        let fell = last_kind == StepKind::Absorbing;
+        progress(e.length as u64);
+        match e.mode {
+            RunMode::Learning => {
+                learning_episodes += 1;
+                learning_falls += fell as u64;
+            }
+            RunMode::Testing => {
+                test_steps += e.length as u64;
+                curve.push(TestPoint {
+                    learning_time_s: learning_steps as f64 * period_s,
+                    learning_episodes,
+                    test_return: e.total_reward as f64,
+                    walked_m: ctl.walked_m().map(|w| w as f64),
+                    fell,
+                    duration_s: e.length as f64 * period_s,
+                });
+            }
+        }
+        match phase {
+            Phase::FirstTest if e.mode == RunMode::Testing => {
+                phase = Phase::Learning;
+                command(&mut ctl, ToChip::Start(RunMode::Learning))?;
+            }
+            Phase::Learning if e.mode == RunMode::Learning && learning_steps >= budget => {
+                phase = Phase::FinalTest;
+                command(&mut ctl, ToChip::Start(RunMode::Testing))?;
+            }
+            Phase::FinalTest if e.mode == RunMode::Testing => break,
+            _ => {}
+        }
+    }
+    let times: Vec<f64> = curve.iter().map(|p| p.learning_time_s).collect();
+    let returns: Vec<f64> = curve.iter().map(|p| p.test_return).collect();
+    let tail_n = curve.len().div_ceil(10).max(1).min(curve.len());
+    let tail = &curve[curve.len() - tail_n..];
+    let walked: Option<f64> = tail.iter().map(|p| p.walked_m).sum();
+    let stats = ctl.agent_stats();
+    let result = TrialResult {
+        trial,
+        seed,
+        end_performance: end_performance(&returns).unwrap_or(f64::NAN),
+        rise_time_s: rise_time(&times, &returns).unwrap_or(f64::NAN),
+        mtbf_s: paper.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
+        window_reengagements: paper.joints().iter().filter_map(|j| j.window_reengagements()).sum(),
+        physical_mtbf_s: simulated.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
+        physical_window_reengagements: simulated.joints().iter().filter_map(|j| j.window_reengagements()).sum(),
+        learning_steps,
+        test_steps,
+        learning_falls,
+        learning_episodes,
+        test_falls: curve.iter().filter(|p| p.fell).count() as u32,
+        end_walked_m: walked.map(|w| w / tail_n as f64),
+        end_speed_m_s: walked.map(|w| w / tail.iter().map(|p| p.duration_s).sum::<f64>()),
+        saturations: stats.saturations,
+        trace_drops: stats.trace_drops,
+        curve,
+    };
+    Ok(BoardTrial {
+        result,
+        config_hash: ctl.config_hash(),
+        weights,
+        weights_checksum: ctl.weights().checksum(),
+        board_estimated_mtbf_s: estimated.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
+        periods: k,
+    })
+}

@@ -1,0 +1,346 @@
+//! `pada watch`: decodes a telemetry stream as `pada capture` does (same
+//! decoder, same CSV, same summary) and serves a live page of it on
+//! loopback.
+//!
+//! The stream's end (end of file, the sender gone) does not end the
+//! command: the page keeps showing the final state until Ctrl-C or
+//! `--seconds`, which print the summary as `pada capture` does.
+
+use crate::capture::Recorder;
+use crate::error::{usage, CliError};
+use crate::watch::server::{self, Shared};
+use crate::watch::source::{self, Source};
+use crate::watch::state::WatchState;
+use anyhow::Context;
+use clap::Args;
+use serde::Serialize;
+use std::io::{IsTerminal, Write};
+use std::net::{SocketAddr, ToSocketAddrs};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// `pada watch`.
+#[derive(Debug, Clone, Args)]
+#[command(group(clap::ArgGroup::new("input").required(true).args(["port", "file", "listen"])))]
+pub struct WatchArgs {
+    /// A serial port with a board on it (e.g. /dev/ttyUSB0, /dev/ttyACM0).
+    #[arg(long, value_name = "DEVICE")]
+    pub port: Option<PathBuf>,
+    /// A recorded byte stream (a board's raw output, `pada run --telemetry
+    /// FILE`, `pada sil`'s telemetry.bin); `-` reads standard input.
+    #[arg(long, value_name = "FILE")]
+    pub file: Option<PathBuf>,
+    /// Wait on this loopback address for one sender (`pada run --telemetry
+    /// tcp:…`, `pada sil --telemetry tcp:…`); port 0 picks a free one.
+    #[arg(long, value_name = "tcp:HOST:PORT")]
+    pub listen: Option<String>,
+    /// The port's baud rate.
+    #[arg(long, value_name = "B", default_value_t = 921_600)]
+    pub baud: u32,
+    /// Where the page is served. Loopback unless another address is given
+    /// here (the page has no authentication); port 0 picks a free one.
+    #[arg(long, value_name = "HOST:PORT", default_value = "127.0.0.1:8080")]
+    pub serve: String,
+    /// Write every frame, lost frame and sequence gap as a CSV row (the
+    /// columns of `pada capture --out`).
+    #[arg(long, value_name = "FILE.csv")]
+    pub out: Option<PathBuf>,
+    /// Stop after this many wall-clock seconds.
+    #[arg(long, value_name = "S")]
+    pub seconds: Option<f64>,
+    /// Print the final summary as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The end of a watch: `pada capture --json`'s summary, plus the page.
+#[derive(Debug, Clone, Serialize)]
+pub struct WatchSummary {
+    /// What was read.
+    pub source: String,
+    /// Why the stream (or, before its end, the watch) ended.
+    pub ended: String,
+    /// Wall-clock duration \[s\].
+    pub wall_s: f64,
+    /// Frames, bytes and every kind of loss.
+    pub link: pada_core::wire::LinkStats,
+    /// Frames that could not be used (all kinds).
+    pub bad_frames: u32,
+    /// Frames by message.
+    pub messages: crate::capture::MessageCounts,
+    /// The latest values (episodes, returns, fatigue, fault).
+    pub latest: crate::capture::Latest,
+    /// The page's address.
+    pub url: String,
+    /// HTTP requests answered.
+    pub requests: u64,
+}
+
+/// Parses `tcp:HOST:PORT` on the loopback interface.
+pub fn parse_listen(spec: &str) -> Result<SocketAddr, CliError> {
+    let Some(addr) = spec.strip_prefix("tcp:") else {
+        return Err(usage(format!(
+            "--listen {spec}: expected tcp:HOST:PORT (e.g. tcp:127.0.0.1:9000)"
+        )));
+    };
+    let addrs: Vec<SocketAddr> = addr
+        .to_socket_addrs()
+        .map_err(|e| usage(format!("--listen {spec}: not a HOST:PORT ({e})")))?
+        .collect();
+    match addrs.first() {
+        Some(a) if addrs.iter().all(|a| a.ip().is_loopback()) => Ok(*a),
+        _ => Err(usage(format!(
+            "--listen {spec}: only the loopback interface is allowed (127.0.0.1, ::1, localhost); \
+             the stream is not authenticated"
+        ))),
+    }
+}
+
+/// Parses `--serve HOST:PORT`.
+pub fn parse_serve(spec: &str) -> Result<SocketAddr, CliError> {
+    spec.to_socket_addrs()
+        .map_err(|e| usage(format!("--serve {spec}: not a HOST:PORT ({e})")))?
+        .next()
+        .ok_or_else(|| usage(format!("--serve {spec}: names no address")))
+}
+
+/// Runs `pada watch`.
+pub fn run(args: WatchArgs) -> Result<(), CliError> {
+    if let Some(s) = args.seconds {
+        if !(s.is_finite() && s > 0.0) {
+            return Err(usage(format!(
+                "--seconds {s} is out of range: valid is > 0"
+            )));
+        }
+    }
+    if args.baud == 0 || args.baud > 12_000_000 {
+        return Err(usage(format!(
+            "--baud {} is out of range: valid is 1..=12000000",
+            args.baud
+        )));
+    }
+    let serve = parse_serve(&args.serve)?;
+    let (source, name) = open(&args)?;
+    let csv: Option<Box<dyn Write + Send>> = match &args.out {
+        Some(p) => Some(Box::new(std::io::BufWriter::new(
+            std::fs::File::create(p)
+                .map_err(|e| usage(format!("--out {}: cannot create: {e}", p.display())))?,
+        ))),
+        None => None,
+    };
+    let recorder = Arc::new(Mutex::new(
+        Recorder::new(csv)
+            .context("cannot write the CSV header")
+            .map_err(CliError::Runtime)?,
+    ));
+    let shared = Arc::new(Shared::new(WatchState::new(name.clone())));
+    let server = server::start(serve, shared.clone())
+        .map_err(|e| usage(format!("--serve {}: cannot listen: {e:#}", args.serve)))?;
+    let url = format!("http://{}/", server.addr);
+    eprintln!("watch: {url} (source: {name})");
+    if !server.addr.ip().is_loopback() {
+        eprintln!(
+            "watch: warning: the page is served on {} beyond this machine, without authentication",
+            server.addr.ip()
+        );
+    }
+
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        // As in `pada capture`: a second handler cannot be installed in one
+        // process; then Ctrl-C simply ends it.
+        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
+    }
+    let decoder_stop = Arc::new(AtomicBool::new(false));
+    let decoder = source::spawn(
+        source,
+        recorder.clone(),
+        shared.clone(),
+        decoder_stop.clone(),
+    )
+    .context("cannot start the decoder thread")
+    .map_err(CliError::Runtime)?;
+
+    let tty = std::io::stderr().is_terminal();
+    let every = if tty {
+        Duration::from_millis(100)
+    } else {
+        Duration::from_secs(1)
+    };
+    let started = Instant::now();
+    let mut last_status = Instant::now();
+    let mut told_end = false;
+    let stopped = loop {
+        std::thread::sleep(Duration::from_millis(50));
+        if stop.load(Ordering::SeqCst) {
+            break "interrupted";
+        }
+        if args
+            .seconds
+            .is_some_and(|s| started.elapsed().as_secs_f64() >= s)
+        {
+            break "time limit";
+        }
+        // A failure (a read error, the CSV not written) ends the command as
+        // it ends `pada capture`; the stream's normal end does not.
+        if shared.failed.load(Ordering::SeqCst) {
+            break "failed";
+        }
+        let ended = shared.snapshot_ended();
+        if let (Some(why), false) = (&ended, told_end) {
+            told_end = true;
+            status(&recorder, tty, true);
+            eprintln!("watch: the stream ended ({why}); the page stays at {url} until Ctrl-C");
+        }
+        if ended.is_none() && last_status.elapsed() >= every {
+            last_status = Instant::now();
+            status(&recorder, tty, false);
+        }
+    };
+    // The stream's own end, if it came first, is why it ended.
+    let ended = shared
+        .snapshot_ended()
+        .unwrap_or_else(|| stopped.to_string());
+    decoder_stop.store(true, Ordering::SeqCst);
+    // The decoder looks at the flag after every read (at most 100 ms for a
+    // port or a socket); standard input can block longer, and is left.
+    let deadline = Instant::now() + Duration::from_secs(1);
+    while !decoder.is_finished() && Instant::now() < deadline {
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let mut rec = recorder.lock().unwrap_or_else(|e| e.into_inner());
+    rec.flush()
+        .context("cannot write the CSV")
+        .map_err(CliError::Runtime)?;
+    if !told_end {
+        let line = rec.status_line();
+        let mut err = std::io::stderr().lock();
+        let _ = if tty {
+            writeln!(err, "\r\x1b[K{line}")
+        } else {
+            writeln!(err, "{line}")
+        };
+    }
+    let link = rec.stats();
+    let summary = WatchSummary {
+        source: name,
+        ended,
+        wall_s: started.elapsed().as_secs_f64(),
+        link,
+        bad_frames: link.bad_frames(),
+        messages: rec.counts(),
+        latest: rec.latest().clone(),
+        url,
+        requests: shared.requests.load(Ordering::Relaxed),
+    };
+    drop(rec);
+    if args.json {
+        let text =
+            serde_json::to_string_pretty(&summary).map_err(|e| CliError::Runtime(e.into()))?;
+        let mut out = std::io::stdout().lock();
+        writeln!(out, "{text}")
+            .and_then(|_| out.flush())
+            .context("cannot write the summary to standard output")
+            .map_err(CliError::Runtime)?;
+    } else {
+        eprintln!(
+            "watch of {} ended ({}): {} frames, {} lost, {} sequence gaps ({} frames missing); {} requests served",
+            summary.source,
+            summary.ended,
+            link.frames,
+            summary.bad_frames,
+            link.seq_gaps,
+            link.frames_missed,
+            summary.requests
+        );
+    }
+    if shared.failed.load(Ordering::SeqCst) {
+        return Err(CliError::Runtime(anyhow::anyhow!(
+            "the stream of {} failed: {}",
+            summary.source,
+            summary.ended
+        )));
+    }
+    Ok(())
+}
+
+/// Opens the source named by `--port`, `--file` or `--listen`.
+fn open(args: &WatchArgs) -> Result<(Source, String), CliError> {
+    if let Some(port) = &args.port {
+        let p = serialport::new(port.to_string_lossy(), args.baud)
+            .timeout(Duration::from_millis(100))
+            .open()
+            .map_err(|e| usage(format!("--port {}: cannot open: {e}", port.display())))?;
+        return Ok((Source::Port(p), port.display().to_string()));
+    }
+    if let Some(file) = &args.file {
+        if file.as_os_str() == "-" {
+            return Ok((
+                Source::Reader(Box::new(std::io::stdin())),
+                "standard input".to_string(),
+            ));
+        }
+        if file.is_dir() {
+            return Err(usage(format!(
+                "--file {}: is a directory, not a recorded stream",
+                file.display()
+            )));
+        }
+        let f = std::fs::File::open(file)
+            .map_err(|e| usage(format!("--file {}: cannot open: {e}", file.display())))?;
+        return Ok((Source::Reader(Box::new(f)), file.display().to_string()));
+    }
+    if let Some(spec) = &args.listen {
+        let addr = parse_listen(spec)?;
+        let l = source::listen(addr)
+            .map_err(|e| usage(format!("--listen {spec}: cannot listen: {e}")))?;
+        let bound = l
+            .local_addr()
+            .map_err(|e| usage(format!("--listen {spec}: {e}")))?;
+        eprintln!("watch: waiting for a telemetry sender on tcp:{bound}");
+        return Ok((Source::Listener(l), format!("tcp:{bound}")));
+    }
+    Err(usage(
+        "give --port DEVICE, --file FILE or --listen tcp:HOST:PORT",
+    ))
+}
+
+fn status(recorder: &Mutex<Recorder>, tty: bool, last: bool) {
+    let line = recorder
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .status_line();
+    let mut err = std::io::stderr().lock();
+    if tty {
+        let _ = write!(err, "\r\x1b[K{line}");
+        if last {
+            let _ = writeln!(err);
+        }
+    } else {
+        let _ = writeln!(err, "{line}");
+    }
+    let _ = err.flush();
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[test]
+    fn the_page_is_served_on_loopback_unless_told_otherwise() {
+        let cli = crate::cli::Cli::try_parse_from(["pada", "watch", "--file", "x.bin"]).unwrap();
+        let crate::cli::Command::Watch(args) = cli.command else {
+            panic!("not watch");
+        };
+        assert!(parse_serve(&args.serve).unwrap().ip().is_loopback());
+        assert!(parse_listen("tcp:[::1]:9000").is_ok());
+        assert!(parse_listen("tcp:localhost:9000").is_ok());
+        for bad in ["tcp:0.0.0.0:9000", "tcp:192.168.1.2:9000", "9000", "tcp:"] {
+            assert_eq!(parse_listen(bad).unwrap_err().exit_code(), 2, "{bad}");
+        }
+    }
+}

@@ -1,0 +1,232 @@
+//! The rapier3d LEO behind the bus: seven RX-28s whose voltages drive the
+//! model's joints, the boom's encoder reading the torso's pitch, the four
+//! foot switches, and an operator who sets the robot upright between
+//! episodes.
+//!
+//! - **Timing.** The model advances in whole control periods of 33 333 µs
+//!   (its own step, [`crate::leo::model::LeoModel::control_step`]), on the
+//!   boundaries `k · T`: a reading at any instant of period k is the state
+//!   at `k · T`, and the voltages in force at `(k + 1) · T` drive the step
+//!   from `k · T` to `(k + 1) · T` (a zero-order hold of the last
+//!   command, as the servo holds its Moving Speed). The firmware reads at
+//!   the start of its period and commands right after, so this is the
+//!   simulation's own control step; and the result does not depend on
+//!   where within a period a transaction lands, so the emulated bus and a
+//!   direct run on the host drive the same trajectory.
+//! - **Sensors as the board sees them.** Present Position in RX-28 counts
+//!   (300° over 1023, the firmware's default calibration: 512 at 0, counts
+//!   growing with the joint angle), Present Speed from the joint rate,
+//!   Present Load from the gear torque, Present Voltage 14.0 V; the boom's
+//!   encoder at 4096 counts per turn (the torso angle φ is minus the
+//!   torso's pitch, so the counter reads the pitch, from vertical: LEO
+//!   powered up upright); the toe and heel switches as
+//!   `pada_firmware::leo::contact` bits.
+//! - **Between episodes.** When the firmware reports an episode's end, the
+//!   operator puts LEO back into the start pose of §1.8 (the state after its
+//!   first control period, as the simulation's episodes start) and holds it
+//!   still: the physics does not run, so the firmware reads the start pose
+//!   until it has seen the torso upright with a foot down for its second
+//!   and starts the next episode, when the operator lets go. LEO is held
+//!   from boot too.
+//! - **Torque off** (a fault, Stop): modelled as 0 V, the motor shorted,
+//!   which brakes the joint a little more than the RX-28's open winding.
+
+use super::{encoder_count, position_raw, Rig, TEMPERATURE_C};
+use crate::leo::model::{InitialPose, LeoModel, ModelOptions, Snapshot, NUM_JOINTS};
+use pada_core::dynamixel::table::{self, PresentState};
+use pada_core::robot::leo::{CONTROL_PERIOD_US, JOINTS};
+use pada_core::robot::Robot;
+use pada_core::rx28::{Rx28, LEO_SUPPLY_VOLTAGE};
+use pada_firmware::leo::contact;
+
+/// LEO on its boom, behind seven emulated RX-28s.
+pub struct LeoRig {
+    model: LeoModel,
+    /// The start of every episode: the reference pose after its first
+    /// control period at 0 V.
+    start: Snapshot,
+    /// Servo ID of each joint ([`pada_core::robot::leo::Joint`] order).
+    ids: [u8; NUM_JOINTS],
+    /// Voltage and torque enable per joint.
+    volts: [f32; NUM_JOINTS],
+    torque: [bool; NUM_JOINTS],
+    /// The next period boundary \[µs\].
+    next_step_us: u64,
+    /// Whether the operator holds LEO at the start pose.
+    held: bool,
+    /// Mean gear torque of each joint over the last simulated period.
+    torques: [f32; NUM_JOINTS],
+    /// Simulated periods, and those that blew up (then the operator
+    /// resets LEO as after a fall).
+    periods: u64,
+    blow_ups: u64,
+}
+
+impl LeoRig {
+    /// LEO held at its start pose at time 0, torque off.
+    pub fn new(options: ModelOptions) -> anyhow::Result<Self> {
+        let mut model = LeoModel::new(options, &InitialPose::REFERENCE).map_err(|e| anyhow::anyhow!("{e}"))?;
+        model.set_voltages([0.0; NUM_JOINTS]);
+        model.control_step().map_err(|b| anyhow::anyhow!("the LEO model blew up settling into its start pose: {b:?}"))?;
+        let start = model.snapshot();
+        let hw = pada_firmware::config::hardware(Robot::Leo);
+        let mut ids = [0; NUM_JOINTS];
+        for (id, servo) in ids.iter_mut().zip(hw.joints) {
+            *id = servo.id;
+        }
+        Ok(LeoRig {
+            model,
+            start,
+            ids,
+            volts: [0.0; NUM_JOINTS],
+            torque: [false; NUM_JOINTS],
+            next_step_us: CONTROL_PERIOD_US as u64,
+            held: true,
+            torques: [0.0; NUM_JOINTS],
+            periods: 0,
+            blow_ups: 0,
+        })
+    }
+
+    /// The model (for inspection).
+    pub fn model(&self) -> &LeoModel {
+        &self.model
+    }
+
+    /// Control periods simulated, and how many of them blew up.
+    pub fn periods(&self) -> (u64, u64) {
+        (self.periods, self.blow_ups)
+    }
+
+    fn joint_of(&self, id: u8) -> Option<usize> {
+        self.ids.iter().position(|&i| i == id)
+    }
+
+    /// One control period with the voltages in force.
+    fn step(&mut self) {
+        let mut u = self.volts;
+        for (v, on) in u.iter_mut().zip(self.torque) {
+            if !on {
+                *v = 0.0;
+            }
+        }
+        self.model.set_voltages(u);
+        self.periods += 1;
+        match self.model.control_step() {
+            Ok(t) => self.torques = t,
+            Err(_) => {
+                // The simulation broke (NaN, a body far away): LEO is put
+                // back as after a fall; the firmware sees the jump.
+                self.blow_ups += 1;
+                self.model.restore(&self.start);
+                self.torques = [0.0; NUM_JOINTS];
+            }
+        }
+    }
+}
+
+impl Rig for LeoRig {
+    fn servo_ids(&self) -> &[u8] {
+        &self.ids
+    }
+
+    fn advance_to(&mut self, t_us: u64) {
+        while self.next_step_us <= t_us {
+            if !self.held {
+                self.step();
+            }
+            self.next_step_us += CONTROL_PERIOD_US as u64;
+        }
+    }
+
+    fn drive(&mut self, t_us: u64, id: u8, torque: bool, volts: f64) {
+        self.advance_to(t_us);
+        if let Some(k) = self.joint_of(id) {
+            self.torque[k] = torque;
+            self.volts[k] = volts as f32;
+        }
+    }
+
+    fn present(&mut self, t_us: u64, id: u8) -> PresentState {
+        self.advance_to(t_us);
+        let Some(k) = self.joint_of(id) else {
+            return PresentState { position: 0, speed: 0, load: 0, voltage: 0, temperature: TEMPERATURE_C };
+        };
+        let (q, qd) = self.model.joint_state();
+        let rpm = qd[k] as f64 * 60.0 / std::f64::consts::TAU;
+        let speed = rpm / (table::SPEED_UNIT_RPM as f64 * table::MAGNITUDE_MAX as f64);
+        let stall = Rx28::LEO.estimate_joint_torque(LEO_SUPPLY_VOLTAGE, 0.0);
+        PresentState {
+            position: position_raw(q[k] as f64),
+            speed: table::encode_signed(speed.clamp(-1.0, 1.0) as f32),
+            load: table::encode_signed((self.torques[k] / stall).clamp(-1.0, 1.0)),
+            voltage: (LEO_SUPPLY_VOLTAGE * 10.0).round() as u8,
+            temperature: TEMPERATURE_C,
+        }
+    }
+
+    fn sensors(&mut self, t_us: u64) -> (u16, u8) {
+        self.advance_to(t_us);
+        let s = self.model.state();
+        let bits = [contact::TOE_L, contact::HEEL_L, contact::TOE_R, contact::HEEL_R];
+        let contacts = s.contacts.iter().zip(bits).filter(|(on, _)| **on).fold(0, |b, (_, bit)| b | bit);
+        (encoder_count(s.torso_pitch as f64), contacts)
+    }
+
+    fn describe(&self) -> String {
+        "LEO in rapier3d (grl-facts §1-2): 7 RX-28s, the boom's 4096-count encoder, 4 foot switches, set upright by an operator between episodes".into()
+    }
+
+    fn episode_ended(&mut self) {
+        self.model.restore(&self.start);
+        self.torques = [0.0; NUM_JOINTS];
+        self.held = true;
+    }
+
+    fn episode_started(&mut self) {
+        self.held = false;
+    }
+
+    fn gear_torque(&self, id: u8) -> f32 {
+        self.joint_of(id).map_or(0.0, |k| self.torques[k])
+    }
+}
+
+const _: () = assert!(JOINTS.len() == NUM_JOINTS);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pada_core::robot::leo::{Joint, START_JOINT_ANGLES, START_PHI};
+
+    #[test]
+    fn held_at_the_start_pose_until_released() {
+        let mut rig = LeoRig::new(ModelOptions::default()).unwrap();
+        let hip_r = rig.ids[Joint::HipRight as usize];
+        let knee_r = rig.ids[Joint::KneeRight as usize];
+        let at = |rig: &mut LeoRig, t: u64| (rig.present(t, hip_r).position, rig.present(t, knee_r).position, rig.sensors(t));
+        let before = at(&mut rig, 0);
+        // Start pose: right hip 0.82 rad, right knee −1.27 rad, the torso
+        // pitched 0.10 rad (φ = −0.10), the left foot down.
+        let unit = table::POSITION_RANGE_RAD as f64 / table::POSITION_MAX as f64;
+        assert!((before.0 as f64 - (512.0 + START_JOINT_ANGLES[Joint::HipRight as usize] as f64 / unit)).abs() <= 1.5);
+        assert!((before.1 as f64 - (512.0 + START_JOINT_ANGLES[Joint::KneeRight as usize] as f64 / unit)).abs() <= 1.5);
+        // (The first control period at 0 V tips the torso by a few mrad.)
+        let pitch = before.2 .0 as i32 - encoder_count(-START_PHI as f64) as i32;
+        assert!(pitch.abs() <= 5, "{pitch} counts from the start pitch");
+        assert_ne!(before.2 .1 & contact::LEFT, 0);
+        // Held: a second passes, nothing moves, whatever is commanded.
+        rig.drive(0, hip_r, true, 10.0);
+        assert_eq!(at(&mut rig, 1_000_000), before);
+        // Released: 10 V on the right hip moves it within a few periods.
+        rig.episode_started();
+        let t0 = rig.next_step_us;
+        rig.advance_to(t0 + 5 * CONTROL_PERIOD_US as u64);
+        let after = at(&mut rig, t0 + 5 * CONTROL_PERIOD_US as u64);
+        assert!(after.0 > before.0 + 3, "{before:?} → {after:?}");
+        assert!(rig.gear_torque(hip_r) > 0.1, "{}", rig.gear_torque(hip_r));
+        // The operator resets and holds it again.
+        rig.episode_ended();
+        assert_eq!(at(&mut rig, t0 + 10 * CONTROL_PERIOD_US as u64), before);
+    }
+}

@@ -1,0 +1,283 @@
+//! The learner-state record: everything a learner saves besides its
+//! weights, as a fixed-size little-endian record (layout in the module
+//! documentation of [`crate::checkpoint`]).
+
+use super::wear::FlashWear;
+use crate::action_space::MAX_ACTION_DIMS;
+use crate::agent::{AgentState, AgentStats, Mode};
+use crate::error::ConfigError;
+use crate::fatigue::JointFatigueState;
+use crate::fixed::Q16;
+use crate::policy::{kind_code, kind_from_code, kind_parameter, PolicyKind, PolicyState};
+use crate::rng::RngState;
+use heapless::Vec;
+
+/// Version of the learner-state record this code writes and reads (2: the
+/// flash wear at offset 496).
+pub const STATE_VERSION: u16 = 2;
+/// Bytes of the learner-state record (a multiple of 4).
+pub const STATE_LEN: usize = 512;
+/// Fatigue joints the state record has room for.
+pub const MAX_JOINTS: usize = 8;
+/// Counters the state record keeps for the caller ([`LearnerState::user`]).
+pub const USER_COUNTERS: usize = 4;
+
+/// Offsets in the state record (see the module documentation).
+pub(super) mod at {
+    pub const VERSION: usize = 0;
+    pub const MODE: usize = 2;
+    pub const KIND: usize = 3;
+    pub const PARAMETER: usize = 4;
+    pub const SWITCHED: usize = 8;
+    pub const JOINTS: usize = 9;
+    pub const PREVIOUS: usize = 10;
+    pub const RESERVED_A: usize = 14;
+    pub const OUTPUT: usize = 16;
+    pub const EPSILON: usize = 32;
+    pub const TD_ERROR: usize = 36;
+    pub const STEPS: usize = 40;
+    pub const UPDATES: usize = 48;
+    pub const EXPLORATIONS: usize = 56;
+    pub const EPISODES: usize = 64;
+    pub const SATURATIONS: usize = 68;
+    pub const TRACE_DROPS: usize = 72;
+    pub const RESERVED_B: usize = 76;
+    pub const RNG_STATE: usize = 80;
+    pub const RNG_INCREMENT: usize = 88;
+    pub const USER: usize = 96;
+    pub const FATIGUE: usize = 112;
+    /// Bytes per fatigue entry.
+    pub const JOINT_LEN: usize = 48;
+    pub const ERASES: usize = 496;
+    pub const OPERATING_S: usize = 504;
+}
+
+const _: () = assert!(at::FATIGUE + MAX_JOINTS * at::JOINT_LEN == at::ERASES);
+const _: () = assert!(at::OPERATING_S + 8 == STATE_LEN);
+// The record has four action dimensions: previous levels and outputs.
+const _: () = assert!(MAX_ACTION_DIMS == 4 && at::PREVIOUS + MAX_ACTION_DIMS <= at::RESERVED_A);
+const _: () = assert!(at::OUTPUT + 4 * MAX_ACTION_DIMS == at::EPSILON);
+const _: () = assert!(STATE_LEN % 4 == 0);
+const _: () = assert!(at::USER + 4 * USER_COUNTERS == at::FATIGUE);
+
+/// Everything a learner saves besides its weights, as plain data with the
+/// capacity in the type: the agent's state, the generator, each joint's
+/// fatigue counters and a few counters of the caller's. Written and read as
+/// the fixed-size record of the module documentation
+/// ([`to_bytes`](Self::to_bytes), [`from_bytes`](Self::from_bytes)).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LearnerState {
+    /// Counters, ε, mode and policy ([`crate::agent::Agent::state`]).
+    pub agent: AgentState,
+    /// The agent's generator ([`crate::rng::Pcg32::state`]).
+    pub rng: RngState,
+    /// Fatigue counters, one per joint in joint order (at most
+    /// [`MAX_JOINTS`]; [`crate::fatigue::FatigueCounter::state`]).
+    pub joints: Vec<JointFatigueState, MAX_JOINTS>,
+    /// The caller's counters (the firmware: episodes since the first boot,
+    /// learning episodes since the last test episode).
+    pub user: [u32; USER_COUNTERS],
+    /// The checkpoint sectors' erase counts and the operating time they
+    /// were reached in. [`super::save`] writes the counts it knows (the
+    /// store's, this field's, whichever is higher, plus its own erase);
+    /// the caller supplies the operating time.
+    pub wear: FlashWear,
+}
+
+impl Default for LearnerState {
+    /// A placeholder to load into: a fresh SARSA agent's counters, no
+    /// joints, a zero generator state (whose even increment
+    /// [`RngState::check`] refuses).
+    fn default() -> Self {
+        LearnerState {
+            agent: AgentState {
+                stats: AgentStats::default(),
+                epsilon: 0.0,
+                mode: Mode::Learning,
+                policy: PolicyState {
+                    kind: PolicyKind::Sarsa,
+                    switched: false,
+                    previous: [0; MAX_ACTION_DIMS],
+                    output: [0.0; MAX_ACTION_DIMS],
+                },
+            },
+            rng: RngState::default(),
+            joints: Vec::new(),
+            user: [0; USER_COUNTERS],
+            wear: FlashWear::default(),
+        }
+    }
+}
+
+/// Little-endian field access in a state record.
+struct Record<'a>(&'a [u8; STATE_LEN]);
+
+impl Record<'_> {
+    fn u8(&self, i: usize) -> u8 {
+        self.0[i]
+    }
+    fn u16(&self, i: usize) -> u16 {
+        u16::from_le_bytes([self.0[i], self.0[i + 1]])
+    }
+    fn u32(&self, i: usize) -> u32 {
+        u32::from_le_bytes([self.0[i], self.0[i + 1], self.0[i + 2], self.0[i + 3]])
+    }
+    fn u64(&self, i: usize) -> u64 {
+        (self.u32(i) as u64) | ((self.u32(i + 4) as u64) << 32)
+    }
+    fn f32(&self, i: usize) -> f32 {
+        f32::from_bits(self.u32(i))
+    }
+    fn zero(&self, i: usize, len: usize) -> bool {
+        self.0[i..i + len].iter().all(|&b| b == 0)
+    }
+}
+
+fn put(b: &mut [u8; STATE_LEN], i: usize, bytes: &[u8]) {
+    b[i..i + bytes.len()].copy_from_slice(bytes);
+}
+
+impl LearnerState {
+    /// The state record (module documentation), reserved bytes 0.
+    pub fn to_bytes(&self) -> [u8; STATE_LEN] {
+        let mut b = [0u8; STATE_LEN];
+        let a = &self.agent;
+        let p = &a.policy;
+        put(&mut b, at::VERSION, &STATE_VERSION.to_le_bytes());
+        b[at::MODE] = match a.mode {
+            Mode::Learning => 0,
+            Mode::Testing => 1,
+        };
+        b[at::KIND] = kind_code(&p.kind);
+        put(&mut b, at::PARAMETER, &kind_parameter(&p.kind).to_le_bytes());
+        b[at::SWITCHED] = p.switched as u8;
+        b[at::JOINTS] = self.joints.len() as u8;
+        put(&mut b, at::PREVIOUS, &p.previous);
+        for (i, o) in p.output.iter().enumerate() {
+            put(&mut b, at::OUTPUT + 4 * i, &o.to_le_bytes());
+        }
+        put(&mut b, at::EPSILON, &a.epsilon.to_le_bytes());
+        put(&mut b, at::TD_ERROR, &a.stats.last_td_error.0.to_le_bytes());
+        put(&mut b, at::STEPS, &a.stats.steps.to_le_bytes());
+        put(&mut b, at::UPDATES, &a.stats.updates.to_le_bytes());
+        put(&mut b, at::EXPLORATIONS, &a.stats.explorations.to_le_bytes());
+        put(&mut b, at::EPISODES, &a.stats.episodes.to_le_bytes());
+        put(&mut b, at::SATURATIONS, &a.stats.saturations.to_le_bytes());
+        put(&mut b, at::TRACE_DROPS, &a.stats.trace_drops.to_le_bytes());
+        put(&mut b, at::RNG_STATE, &self.rng.state.to_le_bytes());
+        put(&mut b, at::RNG_INCREMENT, &self.rng.increment.to_le_bytes());
+        for (i, u) in self.user.iter().enumerate() {
+            put(&mut b, at::USER + 4 * i, &u.to_le_bytes());
+        }
+        put_wear(&mut b, &self.wear);
+        for (j, f) in self.joints.iter().enumerate() {
+            let o = at::FATIGUE + j * at::JOINT_LEN;
+            b[o] = f.last_sign as u8;
+            put(&mut b, o + 8, &f.steps.to_le_bytes());
+            put(&mut b, o + 16, &f.reengagements.to_le_bytes());
+            put(&mut b, o + 24, &f.damage_raw.to_le_bytes());
+            put(&mut b, o + 32, &f.window_reengagements.to_le_bytes());
+            put(&mut b, o + 40, &f.window_damage_raw.to_le_bytes());
+        }
+        b
+    }
+
+    /// Decodes a state record. Checks what the bytes can mean — the record
+    /// version, the mode and policy codes, the switch flag, the joint count,
+    /// reserved and unused bytes 0 — and names the field otherwise; ranges
+    /// that depend on the running learner are checked when it is restored.
+    pub fn from_bytes(bytes: &[u8; STATE_LEN]) -> Result<LearnerState, ConfigError> {
+        let r = Record(bytes);
+        let version = r.u16(at::VERSION);
+        if version != STATE_VERSION {
+            return Err(ConfigError::new("state.version", version as f32, "2"));
+        }
+        let mode = match r.u8(at::MODE) {
+            0 => Mode::Learning,
+            1 => Mode::Testing,
+            m => return Err(ConfigError::new("mode", m as f32, "0 (learning) or 1 (testing)")),
+        };
+        let code = r.u8(at::KIND);
+        let kind = kind_from_code(code, r.f32(at::PARAMETER)).ok_or(ConfigError::new(
+            "policy.kind",
+            code as f32,
+            "0 sarsa, 1 lowpass, 2 markov-lowpass, 3 integrator, 4 markov-integrator, 5 pada",
+        ))?;
+        if kind == PolicyKind::Sarsa && r.u32(at::PARAMETER) != 0 {
+            return Err(ConfigError::new("policy.parameter", r.f32(at::PARAMETER), "0 for sarsa"));
+        }
+        let switched = match r.u8(at::SWITCHED) {
+            0 => false,
+            1 => true,
+            s => return Err(ConfigError::new("policy.switched", s as f32, "0 or 1")),
+        };
+        let joints = r.u8(at::JOINTS) as usize;
+        if joints > MAX_JOINTS {
+            return Err(ConfigError::new("joints", joints as f32, "0 ..= 8 fatigue joints"));
+        }
+        if !r.zero(at::RESERVED_A, 2) || !r.zero(at::RESERVED_B, 4) {
+            return Err(ConfigError::new("state.reserved", 0.0, "reserved bytes 0"));
+        }
+        let mut previous = [0u8; MAX_ACTION_DIMS];
+        previous.copy_from_slice(&bytes[at::PREVIOUS..at::PREVIOUS + MAX_ACTION_DIMS]);
+        let output = core::array::from_fn(|i| r.f32(at::OUTPUT + 4 * i));
+        let stats = AgentStats {
+            steps: r.u64(at::STEPS),
+            updates: r.u64(at::UPDATES),
+            explorations: r.u64(at::EXPLORATIONS),
+            episodes: r.u32(at::EPISODES),
+            saturations: r.u32(at::SATURATIONS),
+            trace_drops: r.u32(at::TRACE_DROPS),
+            last_td_error: Q16(r.u32(at::TD_ERROR) as i32),
+        };
+        let mut fatigue = Vec::new();
+        for j in 0..MAX_JOINTS {
+            let o = at::FATIGUE + j * at::JOINT_LEN;
+            if j >= joints {
+                if !r.zero(o, at::JOINT_LEN) {
+                    return Err(ConfigError::new("fatigue", j as f32, "unused fatigue entries all 0").at(j));
+                }
+                continue;
+            }
+            if !r.zero(o + 1, 7) {
+                return Err(ConfigError::new("fatigue.reserved", 0.0, "reserved bytes 0").at(j));
+            }
+            let state = JointFatigueState {
+                last_sign: r.u8(o) as i8,
+                steps: r.u64(o + 8),
+                reengagements: r.u64(o + 16),
+                damage_raw: r.u64(o + 24),
+                window_reengagements: r.u64(o + 32),
+                window_damage_raw: r.u64(o + 40),
+            };
+            // Cannot fail: j < joints <= MAX_JOINTS.
+            let _ = fatigue.push(state);
+        }
+        Ok(LearnerState {
+            agent: AgentState {
+                stats,
+                epsilon: r.f32(at::EPSILON),
+                mode,
+                policy: PolicyState { kind, switched, previous, output },
+            },
+            rng: RngState { state: r.u64(at::RNG_STATE), increment: r.u64(at::RNG_INCREMENT) },
+            joints: fatigue,
+            user: core::array::from_fn(|i| r.u32(at::USER + 4 * i)),
+            wear: wear_of(bytes),
+        })
+    }
+}
+
+/// Writes `wear` into its place in a record.
+pub(super) fn put_wear(b: &mut [u8; STATE_LEN], wear: &FlashWear) {
+    for (i, e) in wear.erases.iter().enumerate() {
+        put(b, at::ERASES + 4 * i, &e.to_le_bytes());
+    }
+    put(b, at::OPERATING_S, &wear.operating_s.to_le_bytes());
+}
+
+/// The wear a record holds (every value is meaningful: counts and seconds).
+pub(super) fn wear_of(bytes: &[u8; STATE_LEN]) -> FlashWear {
+    let r = Record(bytes);
+    FlashWear { erases: [r.u32(at::ERASES), r.u32(at::ERASES + 4)], operating_s: r.u64(at::OPERATING_S) }
+}

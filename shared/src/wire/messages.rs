@@ -1,0 +1,377 @@
+//! The messages between the chip and the host: the table of the module
+//! documentation ([`crate::wire`]) as types. Framing is in
+//! [`crate::wire::frame`]; nothing here knows about bytes.
+
+use crate::checkpoint::{LoadOutcome, Saved};
+use crate::policy::PolicyKind;
+use crate::safety::{FaultCause, Rejection, State};
+use heapless::{String, Vec};
+use serde::{Deserialize, Serialize};
+
+pub use crate::safety::RunMode;
+
+/// Version of this protocol, sent in [`Hello`]; changes with any change of
+/// a message's layout (3: `Health` reports the checkpoint sectors' wear,
+/// `Saved` the erase count, `NackReason::FlashWear`; `SetPolicy` carries
+/// [`PolicyKind`] itself, in the same bytes as before; 4: the
+/// [`ToHost::Policy`] report, appended last).
+pub const PROTOCOL_VERSION: u16 = 4;
+/// State dimensions a [`Step`] carries.
+pub const MAX_STATE_DIMS: usize = 16;
+/// Action dimensions (motor outputs) a [`Step`] carries.
+pub const MAX_OUTPUTS: usize = 4;
+/// Learned joints with a fatigue counter in a [`Step`].
+pub const MAX_JOINTS: usize = 4;
+/// Servos reported in [`Health`] (LEO has seven).
+pub const MAX_SERVOS: usize = 8;
+/// Weights per [`WeightsChunk`].
+pub const WEIGHTS_PER_CHUNK: usize = 32;
+/// Bytes of text in [`Log`] and [`Warning::Text`].
+pub const MAX_TEXT: usize = 64;
+// ---------------------------------------------------------------------------
+// Chip → host
+// ---------------------------------------------------------------------------
+
+/// Everything the chip sends.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum ToHost {
+    /// Who is talking.
+    Hello(Hello),
+    /// One control step.
+    Step(Step),
+    /// One finished episode.
+    Episode(Episode),
+    /// Periodic health.
+    Health(Health),
+    /// A safety state change.
+    State(StateChange),
+    /// Entering Fault.
+    Fault(Fault),
+    /// Result of a checkpoint save or load.
+    Checkpoint(CheckpointReport),
+    /// Free text.
+    Log(Log),
+    /// Something the host should know about.
+    Warning(Warning),
+    /// Part of the weight table.
+    Weights(WeightsChunk),
+    /// A command was carried out.
+    Ack(Ack),
+    /// A command was refused.
+    Nack(Nack),
+    /// The action policy in force (protocol 4; appended last).
+    Policy(PolicyReport),
+}
+
+/// Sent at boot and in answer to [`ToChip::Ping`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Hello {
+    /// [`PROTOCOL_VERSION`] of the sender.
+    pub protocol: u16,
+    /// Hash of the running configuration (as in checkpoints).
+    pub config_hash: u32,
+    /// Number of weights in the table.
+    pub weight_count: u32,
+    /// Control period in microseconds.
+    pub period_us: u32,
+    /// State dimensions per step.
+    pub state_dims: u8,
+    /// Learned joints.
+    pub joints: u8,
+}
+
+/// What a step's observation and reward mean to the agent; with them the
+/// host can replay the run through the host build of the same agent.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum StepKind {
+    /// First observation of an episode (`start_episode`); reward is 0.
+    Start,
+    /// A step (`step`): reward for the last transition, then the new observation.
+    Step,
+    /// The episode ended in an absorbing state; no bootstrap.
+    Absorbing,
+    /// The episode hit its time limit; the observation is bootstrapped.
+    Timeout,
+}
+
+/// Fatigue of one learned joint (Section IV).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct JointFatigue {
+    /// Accumulated damage J since the counter started.
+    pub damage: f64,
+    /// Backlash re-engagements counted.
+    pub reengagements: u32,
+}
+
+/// One control step.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Step {
+    /// Control step index since boot.
+    pub step: u32,
+    /// Time since boot in ms.
+    pub time_ms: u32,
+    /// Episode index.
+    pub episode: u32,
+    /// Learning or testing.
+    pub mode: RunMode,
+    /// What the observation and reward are.
+    pub kind: StepKind,
+    /// The observation.
+    pub state: Vec<f32, MAX_STATE_DIMS>,
+    /// The learner's joint action index.
+    pub action: u32,
+    /// Output applied per action dimension, after the policy.
+    pub output: Vec<f32, MAX_OUTPUTS>,
+    /// Reward of the transition into this observation.
+    pub reward: f32,
+    /// TD error δ of the update, raw Q15.16 ([`crate::fixed::Q16`]).
+    pub td_error: i32,
+    /// Whether the action was an exploratory draw.
+    pub explored: bool,
+    /// Fatigue per learned joint.
+    pub joints: Vec<JointFatigue, MAX_JOINTS>,
+    /// Duration of this control period's work, µs.
+    pub loop_us: u32,
+    /// Cycles of the agent call of this period (DWT cycles on the chip;
+    /// instructions executed on the emulated board); 0 if none was taken.
+    pub agent_cycles: u32,
+}
+
+/// One finished episode.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Episode {
+    /// Episode index.
+    pub index: u32,
+    /// Learning or test run.
+    pub mode: RunMode,
+    /// Sum of rewards.
+    pub total_reward: f32,
+    /// Steps.
+    pub length: u32,
+    /// The agent's weight checksum at the end (for bit-for-bit replay).
+    pub weights_checksum: u32,
+}
+
+/// Periodic health. Counters are totals since boot.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Health {
+    /// Time since boot in ms.
+    pub uptime_ms: u32,
+    /// Present Temperature of each servo, °C.
+    pub servo_temps_c: Vec<u8, MAX_SERVOS>,
+    /// Lowest Present Voltage over the servos, 0.1 V.
+    pub min_voltage_dv: u8,
+    /// Servo-bus transactions that failed for any reason.
+    pub bus_errors: u32,
+    /// Status packets with a bad checksum.
+    pub checksum_errors: u32,
+    /// Servo requests that timed out.
+    pub timeouts: u32,
+    /// Eligibility-trace entries dropped for lack of capacity.
+    pub trace_drops: u32,
+    /// Weight updates that saturated.
+    pub weight_saturations: u32,
+    /// Control periods that overran.
+    pub overruns: u32,
+    /// Longest control period's work, µs.
+    pub max_loop_us: u32,
+    /// Telemetry frames dropped because the link was busy.
+    pub telemetry_drops: u32,
+    /// Erases of the more worn of the two checkpoint flash sectors, as the
+    /// newest checkpoint counted them ([`crate::checkpoint::FlashWear`]).
+    pub checkpoint_erases: u32,
+    /// Saves refused since boot because they would wear the sector out
+    /// before its stated lifetime ([`crate::checkpoint::WearBudget`]).
+    pub saves_refused: u32,
+}
+
+/// A safety state change.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct StateChange {
+    /// Step index when it happened.
+    pub step: u32,
+    /// State before.
+    pub from: State,
+    /// State after.
+    pub to: State,
+}
+
+/// The machine entered Fault; torque is off.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Fault {
+    /// Step index when it happened.
+    pub step: u32,
+    /// Time since boot in ms.
+    pub time_ms: u32,
+    /// Why (with the servo or joint concerned).
+    pub cause: FaultCause,
+}
+
+/// Result of a checkpoint operation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum CheckpointReport {
+    /// Saved.
+    Saved(Saved),
+    /// A save failed; the previous checkpoint is intact.
+    SaveFailed,
+    /// What a load found (at boot or on command).
+    Load(LoadOutcome),
+}
+
+/// Severity of a [`Log`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum LogLevel {
+    /// Information.
+    Info,
+    /// Something unusual.
+    Warn,
+    /// Something failed.
+    Error,
+}
+
+/// Free text.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Log {
+    /// Severity.
+    pub level: LogLevel,
+    /// The text (at most [`MAX_TEXT`] bytes).
+    pub text: String<MAX_TEXT>,
+}
+
+/// Something the host should know about that is not a fault.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Warning {
+    /// The checkpoint found at boot was not loaded (the outcome says why:
+    /// configuration mismatch, size mismatch, corruption, format version, a
+    /// learner state out of range).
+    CheckpointIgnored(LoadOutcome),
+    /// Frames that could not be sent since the last warning.
+    TelemetryDropped {
+        /// Frames dropped.
+        frames: u32,
+    },
+    /// Anything else.
+    Text(String<MAX_TEXT>),
+}
+
+/// Weights `offset .. offset + weights.len()` of `total`, raw Q15.16.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct WeightsChunk {
+    /// Index of the first weight.
+    pub offset: u32,
+    /// Weights in the table.
+    pub total: u32,
+    /// The weights.
+    pub weights: Vec<i32, WEIGHTS_PER_CHUNK>,
+}
+
+/// A command was carried out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Ack {
+    /// Sequence number of the command's frame.
+    pub seq: u32,
+}
+
+/// Why a command was refused.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum NackReason {
+    /// The safety state machine refused it.
+    State(Rejection),
+    /// A parameter out of range (ε, α, Δ …).
+    InvalidParameter,
+    /// A weight range outside the table.
+    OutOfRange,
+    /// Not possible right now (e.g. saving while learning).
+    Busy,
+    /// The checkpoint operation failed.
+    CheckpointFailed,
+    /// Not supported by this firmware.
+    Unsupported,
+    /// A checkpoint save refused to keep the flash sector within its erase
+    /// budget ([`crate::checkpoint::WearBudget`]); the previous checkpoint
+    /// is intact.
+    FlashWear,
+}
+
+/// A command was refused.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Nack {
+    /// Sequence number of the command's frame.
+    pub seq: u32,
+    /// Why.
+    pub reason: NackReason,
+}
+
+/// The action policy in force: sent after every [`Hello`] and whenever it
+/// changes (`SetPolicy`, `SwitchToSarsa`, a loaded checkpoint, the host
+/// runner's switch at `--switch-at`), so a viewer that joins knows what
+/// the learner restricts.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct PolicyReport {
+    /// Control step index when it took effect.
+    pub step: u32,
+    /// The policy the learner was built with, and its α (Eq. 8) or Δ
+    /// (Eq. 9).
+    pub built: PolicyKind,
+    /// Whether PADA or the low-pass filter has switched back to plain
+    /// SARSA(λ) (Section VIII); then `built` is what it explored with.
+    pub switched_to_sarsa: bool,
+}
+
+// ---------------------------------------------------------------------------
+// Host → chip
+// ---------------------------------------------------------------------------
+
+/// Everything the host sends.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ToChip {
+    /// Ask for a [`Hello`].
+    Ping,
+    /// Learn or test with torque on (also resumes from Paused).
+    Start(RunMode),
+    /// To Idle, torque off.
+    Stop,
+    /// To Paused, torque off.
+    Pause,
+    /// Choose the action policy.
+    SetPolicy(PolicySpec),
+    /// Switch PADA or low-pass back to plain SARSA (Section VIII).
+    SwitchToSarsa,
+    /// Set the exploration rate ε.
+    SetEpsilon(f32),
+    /// Save the weights and the learner's state to flash
+    /// ([`crate::checkpoint`]).
+    SaveCheckpoint,
+    /// Load the weights and the learner's state from flash, if the
+    /// configuration matches and the state is in range.
+    LoadCheckpoint,
+    /// Send weights `offset .. offset + count`.
+    ReadWeights {
+        /// First weight.
+        offset: u32,
+        /// Number of weights.
+        count: u32,
+    },
+    /// Leave Fault for Idle.
+    ClearFault,
+}
+
+/// The six policies of Section V with their parameter, as sent on the wire:
+/// the learning core's own [`PolicyKind`] (one definition, not a copy). Its
+/// postcard encoding is the policy's variant index ([`PolicyName::code`])
+/// then, except for SARSA, its α or Δ as an `f32`.
+///
+/// [`PolicyName::code`]: crate::policy::PolicyName::code
+pub type PolicySpec = PolicyKind;
