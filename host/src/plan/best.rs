@@ -127,6 +127,8 @@ mod tests {
                     rise_time_s: 0.0,
                     mtbf_s: 1.0,
                     window_reengagements: 0,
+                    physical_mtbf_s: 2.0,
+                    physical_window_reengagements: 0,
                     learning_steps: 0,
                     test_steps: 0,
                     learning_falls: 0,

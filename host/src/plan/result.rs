@@ -366,6 +366,8 @@ mod tests {
             rise_time_s: f64::NAN,
             mtbf_s: f64::INFINITY,
             window_reengagements: 349,
+            physical_mtbf_s: 1.0e-300,
+            physical_window_reengagements: 7,
             learning_steps: 1800,
             test_steps: 77,
             learning_falls: 3,
@@ -409,7 +411,11 @@ mod tests {
         };
         assert!(back.result.rise_time_s.is_nan());
         let bits = |r: &TrialResult| {
-            let mut v = vec![r.end_performance.to_bits(), r.mtbf_s.to_bits()];
+            let mut v = vec![
+                r.end_performance.to_bits(),
+                r.mtbf_s.to_bits(),
+                r.physical_mtbf_s.to_bits(),
+            ];
             v.extend(r.curve.iter().flat_map(|c| {
                 [
                     c.learning_time_s.to_bits(),
