@@ -285,7 +285,7 @@ where
                     Ok(())
                 }
                 ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => Err(usage(
-                    "no command given: valid commands are run, demo, paper, trial, mtbf, render, sil, capture, watch (see pada --help)",
+                    "no command given: valid commands are run, demo, paper, mtbf, render, sil, capture, watch, trial (see pada --help)",
                 )),
                 _ => Err(usage(clap_one_line(&e))),
             };
