@@ -254,11 +254,11 @@ fn an_array_task_cancelled_while_it_runs_is_submitted_again() {
     let Some(c) = cluster() else { return };
     let root = tempfile::tempdir().unwrap();
     let (local_dir, slurm_dir) = (root.path().join("local"), root.path().join("slurm"));
-    // 1200 s trials: seconds each in a debug build, so that one is caught
-    // running; one at a time, so the others wait in the queue meanwhile.
+    // 2400 s trials: a second or more each in a debug build, so that one is
+    // caught running; one at a time, so the others wait in the queue.
     let mut child = c
         .pada()
-        .args(run_args("4", "1200", "8", &slurm_dir))
+        .args(run_args("4", "2400", "8", &slurm_dir))
         .args(["--slurm", "--max-parallel", "1"])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -288,23 +288,41 @@ fn an_array_task_cancelled_while_it_runs_is_submitted_again() {
         }
         std::thread::sleep(Duration::from_millis(50));
     };
-    let task = loop {
-        assert!(Instant::now() < deadline, "no task of job {job} ran");
+    // Cancel a running task; if it finished before the signal landed (its
+    // result is there), cancel the next one: with one task at a time, one of
+    // the four is caught midway on any machine.
+    let results = slurm_dir.join("plan/results");
+    let running = || {
         let out = c
             .command("squeue")
             .args(["--noheader", "--array", "--states=RUNNING", "--format=%i"])
             .arg(format!("--jobs={job}"))
             .output()
             .unwrap();
-        let text = String::from_utf8_lossy(&out.stdout);
-        if let Some(t) = text.lines().next() {
-            break t.trim().to_string();
-        }
-        std::thread::sleep(Duration::from_millis(50));
+        String::from_utf8_lossy(&out.stdout)
+            .lines()
+            .next()
+            .map(|t| t.trim().to_string())
     };
-    let cancelled = c.command("scancel").arg(&task).status().unwrap();
-    assert!(cancelled.success(), "scancel {task}");
-    let index: u32 = task.split('_').nth(1).unwrap().parse().unwrap();
+    let (task, index) = loop {
+        assert!(
+            Instant::now() < deadline,
+            "no task of job {job} was caught running"
+        );
+        let Some(task) = running() else {
+            std::thread::sleep(Duration::from_millis(20));
+            continue;
+        };
+        let cancelled = c.command("scancel").arg(&task).status().unwrap();
+        assert!(cancelled.success(), "scancel {task}");
+        while running().as_deref() == Some(task.as_str()) {
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let index: u32 = task.split('_').nth(1).unwrap().parse().unwrap();
+        if !results.join(format!("{index:06}.json")).exists() {
+            break (task, index);
+        }
+    };
 
     let status = loop {
         if let Some(s) = child.try_wait().unwrap() {
@@ -337,7 +355,7 @@ fn an_array_task_cancelled_while_it_runs_is_submitted_again() {
 
     let local = json(&ok(&c
         .pada()
-        .args(run_args("4", "1200", "8", &local_dir))
+        .args(run_args("4", "2400", "8", &local_dir))
         .output()
         .unwrap()));
     let slurm = json(&stdout);
