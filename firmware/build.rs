@@ -1,10 +1,11 @@
-//! Link setup, as cortex-m-rt projects do it: put the workspace's `memory.x`
-//! where `link.x` (from cortex-m-rt) can `INCLUDE` it, and link with `link.x`.
+//! Link setup, as cortex-m-rt projects do it: put the board's memory layout
+//! where `link.x` (from cortex-m-rt) can `INCLUDE` it as `memory.x`, and
+//! link with `link.x`.
 
 use std::{env, fs, path::PathBuf};
 
 fn main() {
-    let chips: Vec<&str> = ["stm32f405", "stm32f407", "stm32f446", "qemu"]
+    let chips: Vec<&str> = ["stm32f405", "stm32f407", "stm32f429", "qemu"]
         .into_iter()
         .filter(|c| env::var_os(format!("CARGO_FEATURE_{}", c.to_uppercase())).is_some())
         .collect();
@@ -17,16 +18,17 @@ fn main() {
     }
     if chips.len() != 1 {
         panic!(
-            "pada-firmware: enable exactly one board feature (stm32f405, stm32f407, stm32f446, qemu); \
+            "pada-firmware: enable exactly one board feature (stm32f405, stm32f407, stm32f429, qemu); \
              got {chips:?}. For a non-default board use --no-default-features --features <board>."
         );
     }
     let manifest_dir = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").unwrap());
     // The workspace's memory.x describes the STM32F405RG and the F407VG
-    // (same layout; QEMU's netduinoplus2 is an F405RG); the STM32F446RE
-    // (512 KB flash, checkpoint sectors 6 and 7, no CCM RAM) has its own.
-    let memory_x = if chips.first() == Some(&"stm32f446") {
-        manifest_dir.join("memory-f446.x")
+    // (same layout; QEMU's netduinoplus2 is an F405RG); the STM32F429ZI
+    // (2 MB of flash in two banks, 192 KB SRAM, the DISC1's SDRAM) has its
+    // own. Either is copied under the name link.x includes.
+    let memory_x = if chips.first() == Some(&"stm32f429") {
+        manifest_dir.join("memory-f429.x")
     } else {
         manifest_dir.join("..").join("memory.x")
     };

@@ -184,6 +184,8 @@ pub struct Controller<W, R> {
     steps: u32,
     /// Checkpoints found but not loaded since boot.
     checkpoints_refused: u32,
+    /// Saves that failed since boot (torque on not counted).
+    saves_failed: u32,
     /// Why the last learner state was refused.
     last_refusal: Option<ConfigError>,
     /// Control periods since boot (the operating time of this boot).
@@ -270,6 +272,7 @@ where
             temps: [0; MAX_SERVOS],
             steps: 0,
             checkpoints_refused: 0,
+            saves_failed: 0,
             last_refusal: None,
             periods: 0,
             flash_wear: FlashWear::default(),
@@ -452,7 +455,12 @@ where
     /// torque is off, and only within the flash's erase budget
     /// ([`WearBudget::STM32F4`]: a refused save is
     /// `CheckpointError::Save(SaveError::Wear(..))`, counted in
-    /// [`saves_refused`](Self::saves_refused), and erases nothing).
+    /// [`saves_refused`](Self::saves_refused), and erases nothing). A
+    /// checkpoint larger than a slot
+    /// ([`checkpoint_bytes`](Self::checkpoint_bytes) > `store.capacity()`:
+    /// the F429's 8 MiB LEO table against a 128 KiB flash sector) is refused
+    /// as `SaveError::TooLarge` before the store is touched; every other
+    /// failed save counts in [`saves_failed`](Self::saves_failed).
     pub fn save_checkpoint<S: CheckpointStore>(&mut self, store: &mut S) -> Result<Saved, CheckpointError<S::Error>> {
         if self.torque_enabled() {
             return Err(CheckpointError::Busy);
@@ -465,9 +473,23 @@ where
                 self.flash_wear.erases[slot] = self.flash_wear.erases[slot].max(saved.erases);
             }
             Err(SaveError::Wear(_)) => self.saves_refused = self.saves_refused.saturating_add(1),
-            Err(_) => {}
+            Err(_) => self.saves_failed = self.saves_failed.saturating_add(1),
         }
         result.map_err(CheckpointError::Save)
+    }
+
+    /// Bytes a checkpoint of this learner takes in a slot: header, learner
+    /// state and the whole table.
+    pub fn checkpoint_bytes(&self) -> usize {
+        checkpoint::slot_len(self.weights().len(), self.weights().format().bytes())
+    }
+
+    /// Saves that failed since boot (too large for a slot, the store
+    /// failing, or a read-back that did not verify); a save refused because
+    /// torque was on, or to spare the flash ([`saves_refused`](Self::saves_refused)),
+    /// is not counted here.
+    pub fn saves_failed(&self) -> u32 {
+        self.saves_failed
     }
 
     /// Loads the newest checkpoint of `store` — weights and learner state —
@@ -1401,5 +1423,50 @@ mod tests {
         assert!(matches!(c.load_checkpoint(&store), Ok(LoadOutcome::Loaded { .. })));
         assert_eq!(c.checkpoints_refused(), 9);
         unchanged(&c);
+    }
+    /// Bytes of one checkpoint slot on every real board: one 128 KiB flash
+    /// sector (`memory.x`: sectors 10–11 of the F405/F407; `memory-f429.x`:
+    /// sectors 22–23 of the F429).
+    const FLASH_SLOT: usize = 128 * 1024;
+
+    #[test]
+    fn the_f429s_leo_table_is_refused_as_too_large_and_counted_and_its_pendulum_saves() {
+        // LEO on the F429: 2^21 Q16 weights, 8 MiB, all of the SDRAM.
+        let f429_leo = Board::F429Sdram.profile(Robot::Leo);
+        let weights = f429_leo.weights().unwrap();
+        assert_eq!(weights, 1 << 21);
+        let mut leo = Controller::<_, Leo>::new(f429_leo, PolicyKind::Sarsa, vec![Q16::ZERO; weights].into_boxed_slice(), 1).unwrap();
+        let needed = checkpoint::HEADER_LEN + checkpoint::STATE_LEN + 8 * 1024 * 1024;
+        assert_eq!(leo.checkpoint_bytes(), needed);
+        let mut store = Box::new(pada_core::checkpoint::RamStore::<FLASH_SLOT>::new());
+        let too_large = Err(CheckpointError::Save(SaveError::TooLarge { needed, capacity: FLASH_SLOT }));
+        assert_eq!(leo.save_checkpoint(&mut *store), too_large);
+        assert_eq!(leo.saves_failed(), 1);
+        assert_eq!(leo.save_checkpoint(&mut *store), too_large);
+        assert_eq!(leo.saves_failed(), 2);
+        // Refused before the store was touched: both slots still erased.
+        for slot in 0..2 {
+            assert!(store.slot_mut(slot).unwrap().iter().all(|&b| b == 0xFF), "slot {slot} written");
+        }
+        assert_eq!(leo.load_checkpoint(&*store), Ok(LoadOutcome::NoCheckpoint));
+
+        // The F429's pendulum (exact table in SRAM) fits a sector and saves.
+        let f429_pendulum = Board::F429Sdram.profile(Robot::Pendulum33);
+        let mut pendulum = Controller::<_, Pendulum33>::new(f429_pendulum, PolicyKind::Sarsa, table(), 1).unwrap();
+        assert!(pendulum.checkpoint_bytes() <= FLASH_SLOT, "{}", pendulum.checkpoint_bytes());
+        assert_eq!(pendulum.save_checkpoint(&mut *store), Ok(Saved { generation: 1, slot: 0, erases: 1 }));
+        assert_eq!(pendulum.saves_failed(), 0);
+        // A saved F429 pendulum is not the F405's: the profile is in the hash.
+        let mut f405 = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 1).unwrap();
+        assert!(matches!(f405.load_checkpoint(&*store), Ok(LoadOutcome::ConfigMismatch { .. })));
+    }
+
+    #[test]
+    fn every_f405_checkpoint_fits_a_flash_sector() {
+        for robot in Robot::ALL {
+            let p = profile(robot);
+            let bytes = checkpoint::slot_len(p.weights().unwrap(), p.format.bytes());
+            assert!(bytes <= FLASH_SLOT, "{robot:?}: {bytes}");
+        }
     }
 }

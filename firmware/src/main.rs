@@ -1,12 +1,18 @@
 //! pada firmware: the pada-core learner on an STM32F4, driving Dynamixel
 //! RX-28 servos, without breaking the robot while it learns.
 //!
-//! Boot: clocks and pins ([`board`]), the weight table where the board's
-//! learner profile puts it ([`table`]), the controller for the robot chosen
-//! at build time, the checkpoint (weights and
-//! learner state) from flash if its configuration matches, a fault if the
-//! watchdog reset the chip, then the tasks of [`tasks`]. Logs go out over
-//! RTT (defmt), telemetry over USART2 (pada_core::wire frames).
+//! Boot: clocks, pins and the table's memory ([`board`]: the F429's SDRAM is
+//! started and checked here), the weight table where the board's learner
+//! profile puts it ([`table`]), the controller for the robot chosen at
+//! build time, the checkpoint (weights and learner state) from flash if its
+//! configuration matches, a fault if the watchdog reset the chip, then the
+//! tasks of [`tasks`]. Logs go out over RTT (defmt), telemetry over the
+//! telemetry USART (pada_core::wire frames).
+//!
+//! The servo-bus task starts first and switches the servos' torque off
+//! before anything slow. If the table's memory fails its check, the board
+//! tells the host (`Warning::Text`) and does nothing else: a learner on
+//! broken memory would learn garbage.
 #![no_std]
 #![no_main]
 
@@ -14,8 +20,10 @@ mod board;
 mod table;
 mod tasks;
 
+use core::fmt::Write as _;
 use defmt::{info, unwrap};
 use embassy_executor::Spawner;
+use pada_core::checkpoint::CheckpointStore;
 use pada_core::policy::PolicyKind;
 use pada_core::weights::WeightStore;
 use pada_core::wire::{self, ToHost};
@@ -42,7 +50,36 @@ async fn main(spawner: Spawner) {
         PROFILE.board.name()
     );
 
-    let mut ctl: Ctl = match Ctl::new(PROFILE, BOOT_POLICY, table::take(), DEFAULT_SEED) {
+    // Torque off before anything slow: whatever the servos did before this
+    // boot (a watchdog reset leaves them turning at their last Moving
+    // Speed), they stop before the weight table is filled — about 0.7 s on
+    // the F429's 8 MiB table.
+    let joints = pada_firmware::config::hardware(ThisRobot::ROBOT).joints;
+    spawner.spawn(unwrap!(tasks::servo_bus(board.servo_port, joints)));
+    tasks::SERVOS_OFF.wait().await;
+
+    let table_memory = match board.table_memory {
+        Ok(memory) => memory,
+        Err(fault) => {
+            defmt::error!(
+                "the weight table's memory ({}) failed its check: wrote {=u32:#x} at {=u32:#x}, read {=u32:#x}; not starting",
+                PROFILE.memory.name(),
+                fault.wrote,
+                fault.address,
+                fault.read
+            );
+            spawner.spawn(unwrap!(tasks::telemetry_tx(board.telemetry_tx)));
+            let mut text = heapless::String::new();
+            // Fits MAX_TEXT (56 characters); cut short if it did not.
+            let _ = write!(text, "table memory fault @{:08x} wrote {:08x} read {:08x}", fault.address, fault.wrote, fault.read);
+            tasks::send_reliable(ToHost::Warning(wire::Warning::Text(text))).await;
+            loop {
+                core::future::pending::<()>().await;
+            }
+        }
+    };
+
+    let mut ctl: Ctl = match Ctl::new(PROFILE, BOOT_POLICY, table::take(table_memory), DEFAULT_SEED) {
         Ok(ctl) => ctl,
         // The profiles are constants checked by the host tests.
         Err(e) => defmt::panic!("controller configuration: {}", defmt::Debug2Format(&e)),
@@ -57,6 +94,18 @@ async fn main(spawner: Spawner) {
     );
 
     tasks::send_reliable(ToHost::Hello(ctl.hello())).await;
+    // The F429's LEO table (8 MiB) fits no flash sector: say so once, not
+    // only when a save is refused.
+    if ctl.checkpoint_bytes() > board.flash.capacity() {
+        defmt::warn!(
+            "checkpoints off: one needs {=usize} bytes, a flash slot holds {=usize}; SaveCheckpoint will be refused",
+            ctl.checkpoint_bytes(),
+            board.flash.capacity()
+        );
+        let mut text = heapless::String::new();
+        let _ = write!(text, "checkpoints off: {} B > slot {} B", ctl.checkpoint_bytes(), board.flash.capacity());
+        tasks::send_reliable(ToHost::Warning(wire::Warning::Text(text))).await;
+    }
     tasks::boot_checkpoint(&mut ctl, &board.flash).await;
     // After the checkpoint, which may restore another policy or the switch.
     tasks::send_reliable(ToHost::Policy(ctl.policy_report())).await;
@@ -69,10 +118,8 @@ async fn main(spawner: Spawner) {
         }
     }
 
-    let joints = ctl.config().joints;
     spawner.spawn(unwrap!(tasks::telemetry_tx(board.telemetry_tx)));
     spawner.spawn(unwrap!(tasks::telemetry_rx(board.telemetry_rx)));
-    spawner.spawn(unwrap!(tasks::servo_bus(board.servo_port, joints)));
     spawner.spawn(unwrap!(tasks::watchdog(board.watchdog, board.led)));
     spawner.spawn(unwrap!(tasks::control(tasks::ControlLoop {
         ctl,

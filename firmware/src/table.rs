@@ -5,11 +5,18 @@
 //! | board (cargo feature) | pendulum | LEO |
 //! |---|---|---|
 //! | F405/F407, and QEMU's netduinoplus2 (`stm32f405`, `stm32f407`, `qemu`) | exact table: all 64 KiB of CCM, then 33.5 KiB of SRAM (`Split`) | 2^14 weights in CCM |
+//! | F429I-DISC1 (`stm32f429`) | exact table, 97.5 KiB of SRAM | 2^21 weights, all 8 MiB of the SDRAM |
 //!
-//! The statics are NOLOAD (CCM) or `.uninit` (SRAM): the startup code
-//! leaves them alone; [`take`] zeroes them once and the controller then
-//! initialises every weight from its seed.
+//! The statics are NOLOAD (CCM, SDRAM) or `.uninit` (SRAM): the startup
+//! code leaves them alone; [`take`] zeroes them once — after the board
+//! layer has started their memory, which its [`TableMemory`] proves — and
+//! the controller then initialises every weight from its seed.
+//!
+//! Each static has a symbol name of its own (`PADA_TABLE_CCM`,
+//! `PADA_TABLE_SRAM`, `PADA_TABLE_SDRAM`), by which `cargo xtask firmware`
+//! finds the table's placement in the ELF.
 
+use crate::board::TableMemory;
 use core::mem::MaybeUninit;
 use pada_core::fixed::Q16;
 use pada_core::profile::{Board, LearnerProfile, Memory};
@@ -27,7 +34,11 @@ pub type ThisRobot = pada_firmware::pendulum::Pendulum20;
 pub type ThisRobot = pada_firmware::pendulum::Pendulum33;
 
 /// The board's learner profile: F405-class chips (and their emulation).
+#[cfg(not(feature = "stm32f429"))]
 pub const BOARD: Board = Board::F405;
+/// The board's learner profile: the F429I-DISC1 with its SDRAM.
+#[cfg(feature = "stm32f429")]
+pub const BOARD: Board = Board::F429Sdram;
 
 /// The learner of this image.
 pub const PROFILE: LearnerProfile = BOARD.profile(ThisRobot::ROBOT);
@@ -55,11 +66,35 @@ unsafe fn zeroed<const N: usize>(cell: *mut MaybeUninit<[Q16; N]>) -> &'static m
 /// Guards [`take`]: a second call panics, so every `&'static mut` is unique.
 static TAKEN: static_cell::StaticCell<()> = static_cell::StaticCell::new();
 
+/// A table in one memory: one static in `$section`, named `$symbol`.
+// (Unused by the F405's pendulum, whose table is split over two memories.)
+#[allow(unused_macros)]
+macro_rules! one_memory {
+    ($memory:pat, $section:literal, $symbol:literal) => {
+        use super::*;
+
+        const _: () = assert!(matches!(PROFILE.memory, $memory), "the profile puts the table elsewhere");
+
+        #[link_section = $section]
+        #[export_name = $symbol]
+        static mut TABLE: MaybeUninit<[Q16; WEIGHTS]> = MaybeUninit::uninit();
+
+        /// The table.
+        pub type Table = &'static mut [Q16; WEIGHTS];
+
+        pub fn take() -> Table {
+            TAKEN.init(());
+            // SAFETY: reached once (TAKEN), and nothing else names the static.
+            unsafe { zeroed(core::ptr::addr_of_mut!(TABLE)) }
+        }
+    };
+}
+
 // ---------------------------------------------------------------------------
 // The pendulum on an F405: all of CCM, then the rest in SRAM.
 // ---------------------------------------------------------------------------
 
-#[cfg(not(feature = "robot-leo"))]
+#[cfg(all(not(feature = "stm32f429"), not(feature = "robot-leo")))]
 mod layout {
     use super::*;
     use pada_core::weights::Split;
@@ -71,8 +106,10 @@ mod layout {
     const REST: usize = WEIGHTS - CCM;
 
     #[link_section = ".ccmram"]
+    #[export_name = "PADA_TABLE_CCM"]
     static mut IN_CCM: MaybeUninit<[Q16; CCM]> = MaybeUninit::uninit();
     #[link_section = ".uninit.pada_table"]
+    #[export_name = "PADA_TABLE_SRAM"]
     static mut IN_SRAM: MaybeUninit<[Q16; REST]> = MaybeUninit::uninit();
 
     /// The table.
@@ -90,33 +127,30 @@ mod layout {
     }
 }
 
-// ---------------------------------------------------------------------------
 // LEO on an F405: the 64 KiB of CCM.
-// ---------------------------------------------------------------------------
-
-#[cfg(feature = "robot-leo")]
+#[cfg(all(not(feature = "stm32f429"), feature = "robot-leo"))]
 mod layout {
-    use super::*;
+    one_memory!(Memory::Ccm, ".ccmram", "PADA_TABLE_CCM");
+}
 
-    const _: () = assert!(matches!(PROFILE.memory, Memory::Ccm), "the F405's LEO table is in CCM");
+// The pendulum on the F429: 97.5 KiB of its 192 KiB SRAM.
+#[cfg(all(feature = "stm32f429", not(feature = "robot-leo")))]
+mod layout {
+    one_memory!(Memory::Sram, ".uninit.pada_table", "PADA_TABLE_SRAM");
+}
 
-    #[link_section = ".ccmram"]
-    static mut IN_CCM: MaybeUninit<[Q16; WEIGHTS]> = MaybeUninit::uninit();
-
-    /// The table.
-    pub type Table = &'static mut [Q16; WEIGHTS];
-
-    pub fn take() -> Table {
-        TAKEN.init(());
-        // SAFETY: reached once (TAKEN), and nothing else names the static.
-        unsafe { zeroed(core::ptr::addr_of_mut!(IN_CCM)) }
-    }
+// LEO on the F429: all 8 MiB of the SDRAM.
+#[cfg(all(feature = "stm32f429", feature = "robot-leo"))]
+mod layout {
+    one_memory!(Memory::Sdram, ".sdram", "PADA_TABLE_SDRAM");
 }
 
 pub use layout::Table;
 
-/// The weight table, zeroed; once (a second call panics).
-pub fn take() -> Table {
+/// The weight table, zeroed; once (a second call panics). `memory` is the
+/// board layer's word that the table's memory works.
+pub fn take(memory: TableMemory) -> Table {
+    let _: TableMemory = memory;
     layout::take()
 }
 

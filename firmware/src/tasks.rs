@@ -20,7 +20,7 @@ use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 use embassy_time::{Duration, Instant, Ticker};
 use heapless::Vec;
-use pada_core::checkpoint::{LoadOutcome, SaveError};
+use pada_core::checkpoint::{CheckpointStore, LoadOutcome, SaveError};
 use pada_core::safety::Transition;
 use pada_core::wire::{self, FrameDecoder, FrameEncoder, NackReason, ToChip, ToHost, MAX_FRAME_LEN};
 use pada_firmware::bus::{BusConfig, BusStats, ServoBus};
@@ -84,6 +84,9 @@ pub static FROM_HOST: Channel<Mutex, (u32, ToChip), 4> = Channel::new();
 pub static WATCHDOG: Channel<Mutex, WatchdogRequest, 2> = Channel::new();
 /// Watchdog → control: the last `Extend` is in force.
 pub static WATCHDOG_DONE: Signal<Mutex, ()> = Signal::new();
+/// Servo bus → boot: the servos were told torque off (before the weight
+/// table is filled, which takes about 0.7 s on the F429's 8 MiB table).
+pub static SERVOS_OFF: Signal<Mutex, ()> = Signal::new();
 
 /// Sends a message the host must get (waits for room).
 pub async fn send_reliable(msg: ToHost) {
@@ -100,6 +103,7 @@ pub async fn servo_bus(port: ServoPort, joints: &'static [Joint]) -> ! {
         bus.torque_all(false).await.ok();
         bus.stop_all().await.ok();
     }
+    SERVOS_OFF.signal(());
     for joint in joints {
         match bus.setup(joint.id).await {
             Ok(s) => info!("servo {=u8}: model {=u16}, settings {}", joint.id, s.model, if s.wrote { "written" } else { "ok" }),
@@ -257,7 +261,7 @@ pub async fn control(mut cl: ControlLoop) -> ! {
         // Host commands.
         while let Ok((seq, cmd)) = FROM_HOST.try_receive() {
             if handle_command(&mut cl, seq, &cmd, &mut weights_job).await {
-                // A flash operation stalled the CPU: restart the schedule
+                // A flash operation or a fresh learner stalled the loop: restart the schedule
                 // and do not count this period as an overrun.
                 ticker.reset();
                 readings.last_period_overran = false;
@@ -379,7 +383,8 @@ async fn report_transition(t: &Transition, ctl: &Ctl, time_ms: u32) {
     }
 }
 
-/// Carries out one host command; true if it stalled the CPU on flash.
+/// Carries out one host command; true if it stalled the loop (a flash
+/// operation, or a fresh learner on a large table).
 async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut Option<WeightsJob>) -> bool {
     let ack = |r: Result<(), NackReason>| match r {
         Ok(()) => ToHost::Ack(wire::Ack { seq }),
@@ -396,8 +401,14 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
             if cl.ctl.torque_enabled() {
                 Err(NackReason::Busy)
             } else {
-                stalled = true;
-                let result = with_long_watchdog(|| cl.ctl.save_checkpoint(&mut cl.flash)).await;
+                // A checkpoint larger than a slot is refused before any
+                // erase: no long watchdog, no stalled period.
+                let result = if cl.ctl.checkpoint_bytes() <= cl.flash.capacity() {
+                    stalled = true;
+                    with_long_watchdog(|| cl.ctl.save_checkpoint(&mut cl.flash)).await
+                } else {
+                    cl.ctl.save_checkpoint(&mut cl.flash)
+                };
                 match result {
                     Ok(saved) => {
                         info!("checkpoint saved: generation {=u32}, slot {=u8}", saved.generation, saved.slot);
@@ -410,8 +421,19 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
                         send_reliable(ToHost::Checkpoint(wire::CheckpointReport::SaveFailed)).await;
                         Err(NackReason::FlashWear)
                     }
+                    Err(CheckpointError::Save(SaveError::TooLarge { needed, capacity })) => {
+                        warn!(
+                            "checkpoint save refused ({=u32} failed since boot): it needs {=usize} bytes, a flash slot holds {=usize}",
+                            cl.ctl.saves_failed(),
+                            needed,
+                            capacity
+                        );
+                        let report = wire::CheckpointReport::TooLarge { needed: needed as u32, capacity: capacity as u32 };
+                        send_reliable(ToHost::Checkpoint(report)).await;
+                        Err(NackReason::CheckpointFailed)
+                    }
                     Err(e) => {
-                        warn!("checkpoint save failed: {}", defmt::Debug2Format(&e));
+                        warn!("checkpoint save failed ({=u32} since boot): {}", cl.ctl.saves_failed(), defmt::Debug2Format(&e));
                         send_reliable(ToHost::Checkpoint(wire::CheckpointReport::SaveFailed)).await;
                         Err(NackReason::CheckpointFailed)
                     }
@@ -448,7 +470,20 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
             }
         }
         _ => {
-            let (result, transition) = cl.ctl.command(cmd);
+            // A new policy starts a fresh learner: every weight is written
+            // and the table's checksum recomputed. On the F429's 8 MiB LEO
+            // table that is 2^21 SDRAM writes and reads, about 0.7 s at
+            // 180 MHz by the estimate in firmware/README.md — longer than
+            // the watchdog's normal 250 ms. The controller allows it only
+            // with torque off, so the pause harms nothing; the schedule
+            // restarts after it, as after a flash operation.
+            let rebuilds = matches!(cmd, ToChip::SetPolicy(_)) && !cl.ctl.torque_enabled();
+            let (result, transition) = if rebuilds {
+                stalled = true;
+                with_long_watchdog(|| cl.ctl.command(cmd)).await
+            } else {
+                cl.ctl.command(cmd)
+            };
             if let Some(t) = transition.filter(|t| t.changed()) {
                 report_transition(&t, &cl.ctl, Instant::now().as_millis() as u32).await;
             }
@@ -463,7 +498,8 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
     stalled
 }
 
-/// Runs a flash operation with the watchdog's long timeout.
+/// Runs a long operation (flash, a fresh learner) with the watchdog's long
+/// timeout.
 async fn with_long_watchdog<T>(op: impl FnOnce() -> T) -> T {
     WATCHDOG_DONE.reset();
     WATCHDOG.send(WatchdogRequest::Extend(true)).await;

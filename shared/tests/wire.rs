@@ -111,6 +111,7 @@ fn all_to_host() -> Vec<ToHost> {
         ToHost::Checkpoint(CheckpointReport::SaveFailed),
         ToHost::Policy(PolicyReport { step: 7, built: PolicyKind::Pada { delta: 0.5 }, switched_to_sarsa: true }),
         ToHost::Policy(PolicyReport { step: u32::MAX, built: PolicyKind::LowPass { alpha: 0.834 }, switched_to_sarsa: false }),
+        ToHost::Checkpoint(CheckpointReport::TooLarge { needed: 8_389_136, capacity: 131_072 }),
     ];
     for o in [
         LoadOutcome::Loaded { generation: 9, slot: 1 },
@@ -223,7 +224,7 @@ fn the_protocol_version_changes_with_the_layout() {
 }
 
 /// [`layout_fingerprint`] of protocol 4.
-const EXPECTED_FINGERPRINT: u32 = 0xa605_d408;
+const EXPECTED_FINGERPRINT: u32 = 0xa7ab_e8bb;
 
 #[test]
 fn every_chip_message_round_trips() {

@@ -1,11 +1,13 @@
-//! Flash and RAM use of the firmware ELF, read from its section headers (no
-//! binutils needed, so it works with rust-lld builds too).
+//! Flash and RAM use of the firmware ELF, read from its section headers and
+//! symbol table (no binutils needed, so it works with rust-lld builds too).
 //!
 //! Sections are counted as Berkeley `size` does: allocated, read-only →
 //! text; allocated, writable, with contents → data (stored in flash, copied
 //! to RAM at reset); allocated without contents (NOBITS) → bss. Sections in
-//! the CCM RAM region of memory.x are counted apart as ccm.
-//! flash = text + data, RAM = data + bss (the stack comes on top).
+//! the CCMRAM and SDRAM regions of the linker script are counted apart, as
+//! ccm and sdram. flash = text + data, RAM = data + bss (the stack comes on
+//! top). The weight table's pieces are the symbols `PADA_TABLE_*` (their
+//! address and size), each placed in the region that holds it.
 
 use std::fmt::Write as _;
 
@@ -76,6 +78,71 @@ pub fn section_sizes(elf: &[u8]) -> Result<Vec<Section>, String> {
     Ok(sections)
 }
 
+/// A symbol of the ELF's symbol table.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Symbol {
+    pub name: String,
+    pub addr: u32,
+    pub size: u32,
+}
+
+const SHT_SYMTAB: u32 = 2;
+const SYM_LEN: usize = 16;
+
+/// The symbols whose name starts with `prefix`, from every symbol table of
+/// a 32-bit little-endian ELF (none if it has no symbol table: a stripped
+/// ELF).
+pub fn symbols(elf: &[u8], prefix: &str) -> Result<Vec<Symbol>, String> {
+    if elf.len() < 52 || &elf[..4] != b"\x7fELF" || elf[4] != 1 || elf[5] != 1 {
+        return Err("not a 32-bit little-endian ELF".into());
+    }
+    let u16_at = |off: usize| -> Result<usize, String> {
+        elf.get(off..off + 2)
+            .map(|b| u16::from_le_bytes([b[0], b[1]]) as usize)
+            .ok_or_else(|| format!("truncated at {off:#x}"))
+    };
+    let u32_at = |off: usize| -> Result<u32, String> {
+        elf.get(off..off + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .ok_or_else(|| format!("truncated at {off:#x}"))
+    };
+    let shoff = u32_at(0x20)? as usize;
+    let shentsize = u16_at(0x2e)?;
+    let shnum = u16_at(0x30)?;
+    if shentsize < 40 {
+        return Err("bad section header table".into());
+    }
+    let header = |i: usize| shoff + i * shentsize;
+    let mut found = Vec::new();
+    for i in 1..shnum {
+        let h = header(i);
+        if u32_at(h + 4)? != SHT_SYMTAB {
+            continue;
+        }
+        let (offset, size) = (u32_at(h + 16)? as usize, u32_at(h + 20)? as usize);
+        let link = u32_at(h + 24)? as usize;
+        if link >= shnum {
+            return Err(format!("symbol table {i} links to section {link} of {shnum}"));
+        }
+        let strtab = u32_at(header(link) + 16)? as usize;
+        for s in (offset..offset + size).step_by(SYM_LEN) {
+            let name_off = strtab + u32_at(s)? as usize;
+            let bytes = elf.get(name_off..).unwrap_or_default();
+            let end = bytes.iter().position(|&b| b == 0).unwrap_or(bytes.len());
+            if !bytes[..end].starts_with(prefix.as_bytes()) {
+                continue;
+            }
+            found.push(Symbol {
+                name: String::from_utf8_lossy(&bytes[..end]).into_owned(),
+                addr: u32_at(s + 4)?,
+                size: u32_at(s + 8)?,
+            });
+        }
+    }
+    found.sort_by_key(|s| s.addr);
+    Ok(found)
+}
+
 /// A MEMORY region of the linker script.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Region {
@@ -139,23 +206,30 @@ fn parse_number(s: &str) -> Option<u32> {
     n.checked_mul(scale)
 }
 
-/// Totals in the categories of Berkeley `size`, plus CCM.
+/// Totals in the categories of Berkeley `size`, plus CCM and SDRAM.
 #[derive(Debug, Default, PartialEq, Eq)]
 pub struct Usage {
     pub text: u64,
     pub data: u64,
     pub bss: u64,
     pub ccm: u64,
+    pub sdram: u64,
 }
+
+/// The region of the linker script each named region is called by.
+const CCM_REGION: &str = "CCMRAM";
+const SDRAM_REGION: &str = "SDRAM";
 
 impl Usage {
     pub fn classify(sections: &[Section], regions: &[Region]) -> Usage {
-        let ccm = regions.iter().find(|r| r.name == "CCMRAM");
+        let within = |name: &str, addr: u32| regions.iter().any(|r| r.name == name && r.contains(addr));
         let mut usage = Usage::default();
         for s in sections {
             let size = s.size as u64;
-            if ccm.is_some_and(|r| r.contains(s.addr)) {
+            if within(CCM_REGION, s.addr) {
                 usage.ccm += size;
+            } else if within(SDRAM_REGION, s.addr) {
+                usage.sdram += size;
             } else if s.nobits {
                 usage.bss += size;
             } else if s.writable {
@@ -175,8 +249,9 @@ impl Usage {
         self.data + self.bss
     }
 
-    /// The size table and the use of each region, as printed by the xtask.
-    pub fn report(&self, regions: &[Region]) -> String {
+    /// The size table, the use of each region, and where the weight table
+    /// (`table`: its `PADA_TABLE_*` symbols) lies, as printed by the xtask.
+    pub fn report(&self, regions: &[Region], table: &[Symbol]) -> String {
         let of = |name: &str, used: u64| -> String {
             match regions.iter().find(|r| r.name == name) {
                 Some(r) => format!(
@@ -187,96 +262,177 @@ impl Usage {
                 None => format!("{used:>7} B"),
             }
         };
+        let has = |name: &str| regions.iter().any(|r| r.name == name);
         let mut out = String::new();
-        let _ = writeln!(out, "{:>9} {:>9} {:>9} {:>9}", "text", "data", "bss", "ccm");
+        let _ = writeln!(out, "{:>9} {:>9} {:>9} {:>9} {:>9}", "text", "data", "bss", "ccm", "sdram");
         let _ = writeln!(
             out,
-            "{:>9} {:>9} {:>9} {:>9}",
-            self.text, self.data, self.bss, self.ccm
+            "{:>9} {:>9} {:>9} {:>9} {:>9}",
+            self.text, self.data, self.bss, self.ccm, self.sdram
         );
-        let _ = writeln!(out, "flash (text+data): {}", of("FLASH", self.flash()));
-        let _ = writeln!(out, "RAM   (data+bss):  {} + stack", of("RAM", self.ram()));
-        if self.ccm > 0 {
-            let _ = writeln!(out, "CCM RAM:           {}", of("CCMRAM", self.ccm));
+        let _ = writeln!(out, "flash (text+data):  {}", of("FLASH", self.flash()));
+        let _ = writeln!(out, "RAM   (data+bss):   {} + stack", of("RAM", self.ram()));
+        if self.ccm > 0 || has(CCM_REGION) {
+            let _ = writeln!(out, "CCM RAM:            {}", of(CCM_REGION, self.ccm));
         }
+        if self.sdram > 0 || has(SDRAM_REGION) {
+            let _ = writeln!(out, "SDRAM:              {}", of(SDRAM_REGION, self.sdram));
+        }
+        let _ = writeln!(out, "{}", table_placement(table, regions));
         out
     }
+}
+
+/// `weight table: 65536 B in CCMRAM at 0x10000000 + 34304 B in RAM at … =
+/// 99840 B`, or a note that the ELF names no table.
+pub fn table_placement(table: &[Symbol], regions: &[Region]) -> String {
+    if table.is_empty() {
+        return "weight table: no PADA_TABLE_* symbol in the ELF (stripped?)".into();
+    }
+    let pieces: Vec<String> = table
+        .iter()
+        .map(|s| {
+            let region = regions
+                .iter()
+                .find(|r| r.contains(s.addr))
+                .map_or("no region", |r| r.name.as_str());
+            format!("{} B in {region} at {:#010x} ({})", s.size, s.addr, s.name)
+        })
+        .collect();
+    let total: u64 = table.iter().map(|s| s.size as u64).sum();
+    format!("weight table: {} = {total} B", pieces.join(" + "))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// A minimal ELF32 LE with the given (name, type, flags, addr, size)
-    /// sections after the null section, and .shstrtab last.
-    fn tiny_elf(sections: &[(&str, u32, u32, u32, u32)]) -> Vec<u8> {
-        let mut strtab = vec![0u8];
+    /// One section of a test ELF: name, type, flags, address, size, link,
+    /// and its bytes in the file (for a symbol or string table).
+    struct Spec<'a> {
+        name: &'a str,
+        ty: u32,
+        flags: u32,
+        addr: u32,
+        size: u32,
+        link: u32,
+        bytes: Vec<u8>,
+    }
+
+    fn alloc(name: &str, ty: u32, flags: u32, addr: u32, size: u32) -> Spec<'_> {
+        Spec { name, ty, flags, addr, size, link: 0, bytes: Vec::new() }
+    }
+
+    /// A minimal ELF32 LE with `sections` after the null section, and
+    /// .shstrtab last. A section with bytes has them in the file and its
+    /// size is their length.
+    fn tiny_elf(sections: &[Spec]) -> Vec<u8> {
+        let mut shstrtab = vec![0u8];
         let mut names = Vec::new();
-        for (name, ..) in sections.iter().chain([&(".shstrtab", 3, 0, 0, 0)]) {
-            names.push(strtab.len() as u32);
-            strtab.extend_from_slice(name.as_bytes());
-            strtab.push(0);
+        for name in sections.iter().map(|s| s.name).chain([".shstrtab"]) {
+            names.push(shstrtab.len() as u32);
+            shstrtab.extend_from_slice(name.as_bytes());
+            shstrtab.push(0);
         }
-        let strtab_off = 52u32;
-        let shoff = strtab_off + strtab.len() as u32;
-        let shnum = sections.len() as u16 + 2;
         let mut elf = vec![0u8; 52];
         elf[..6].copy_from_slice(b"\x7fELF\x01\x01");
+        let mut offsets = Vec::new();
+        for s in sections {
+            offsets.push(elf.len() as u32);
+            elf.extend_from_slice(&s.bytes);
+        }
+        let shstrtab_off = elf.len() as u32;
+        elf.extend_from_slice(&shstrtab);
+        let shoff = elf.len() as u32;
+        let shnum = sections.len() as u16 + 2;
         elf[0x20..0x24].copy_from_slice(&shoff.to_le_bytes());
         elf[0x2e..0x30].copy_from_slice(&40u16.to_le_bytes());
         elf[0x30..0x32].copy_from_slice(&shnum.to_le_bytes());
         elf[0x32..0x34].copy_from_slice(&(shnum - 1).to_le_bytes());
-        elf.extend_from_slice(&strtab);
         elf.extend_from_slice(&[0u8; 40]);
-        let strtab_header = (
-            names[sections.len()],
-            3,
-            0,
-            0,
-            strtab_off,
-            strtab.len() as u32,
-        );
-        for (i, &(_, ty, flags, addr, size)) in sections.iter().enumerate() {
-            for field in [names[i], ty, flags, addr, 0, size, 0, 0, 4, 0] {
+        for (i, s) in sections.iter().enumerate() {
+            let size = if s.bytes.is_empty() { s.size } else { s.bytes.len() as u32 };
+            for field in [names[i], s.ty, s.flags, s.addr, offsets[i], size, s.link, 0, 4, 0] {
                 elf.extend_from_slice(&field.to_le_bytes());
             }
         }
-        let (n, ty, flags, addr, off, size) = strtab_header;
-        for field in [n, ty, flags, addr, off, size, 0, 0, 1, 0] {
+        let n = names[sections.len()];
+        for field in [n, 3, 0, 0, shstrtab_off, shstrtab.len() as u32, 0, 0, 1, 0] {
             elf.extend_from_slice(&field.to_le_bytes());
         }
         elf
     }
 
+    const PROGBITS: u32 = 1;
+    const STRTAB: u32 = 3;
+    const AX: u32 = SHF_ALLOC | 0x4;
+    const WA: u32 = SHF_ALLOC | SHF_WRITE;
+
+    fn f429_regions() -> Vec<Region> {
+        parse_memory_x(include_str!("../../firmware/memory-f429.x"))
+    }
+
     #[test]
     fn counts_like_berkeley_size_with_ccm_apart() {
-        const PROGBITS: u32 = 1;
-        const AX: u32 = SHF_ALLOC | 0x4;
-        const WA: u32 = SHF_ALLOC | SHF_WRITE;
         let elf = tiny_elf(&[
-            (".vector_table", PROGBITS, SHF_ALLOC, 0x0800_0000, 1024),
-            (".text", PROGBITS, AX, 0x0800_0400, 3000),
-            (".data", PROGBITS, WA, 0x2000_0000, 16),
-            (".bss", SHT_NOBITS, WA, 0x2000_0010, 400),
-            (".ccmram", SHT_NOBITS, WA, 0x1000_0000, 8192),
-            (".debug_info", PROGBITS, 0, 0, 99999),
+            alloc(".vector_table", PROGBITS, SHF_ALLOC, 0x0800_0000, 1024),
+            alloc(".text", PROGBITS, AX, 0x0800_0400, 3000),
+            alloc(".data", PROGBITS, WA, 0x2000_0000, 16),
+            alloc(".bss", SHT_NOBITS, WA, 0x2000_0010, 400),
+            alloc(".ccmram", SHT_NOBITS, WA, 0x1000_0000, 8192),
+            alloc(".debug_info", PROGBITS, 0, 0, 99999),
         ]);
         let sections = section_sizes(&elf).unwrap();
         assert_eq!(sections.len(), 5, "{sections:?}");
         assert_eq!(sections[1].name, ".text");
         let regions = parse_memory_x(include_str!("../../memory.x"));
         let usage = Usage::classify(&sections, &regions);
-        assert_eq!(
-            usage,
-            Usage {
-                text: 4024,
-                data: 16,
-                bss: 400,
-                ccm: 8192
-            }
-        );
+        assert_eq!(usage, Usage { text: 4024, data: 16, bss: 400, ccm: 8192, sdram: 0 });
         assert_eq!((usage.flash(), usage.ram()), (4040, 416));
-        assert!(usage.report(&regions).contains("8192 B of   65536 B"));
+        let report = usage.report(&regions, &[]);
+        assert!(report.contains("8192 B of   65536 B"), "{report}");
+        // The F405 has no SDRAM region: no SDRAM line.
+        assert!(!report.contains("SDRAM:"), "{report}");
+    }
+
+    #[test]
+    fn counts_the_sdram_apart_and_places_the_table_by_its_symbols() {
+        // A symbol table with the F429 LEO image's table and one other
+        // symbol; its string table.
+        let strtab = b"\0PADA_TABLE_SDRAM\0main\0".to_vec();
+        let mut symtab = vec![0u8; SYM_LEN];
+        for (name, addr, size) in [(1u32, 0xD000_0000u32, 8 << 20), (18, 0x0800_0400, 12)] {
+            for field in [name, addr, size] {
+                symtab.extend_from_slice(&field.to_le_bytes());
+            }
+            symtab.extend_from_slice(&[0, 0, 1, 0]);
+        }
+        let mut symtab_spec = alloc(".symtab", SHT_SYMTAB, 0, 0, 0);
+        symtab_spec.bytes = symtab;
+        // Sections are numbered from 1 after the null section: .strtab is 4.
+        symtab_spec.link = 4;
+        let mut strtab_spec = alloc(".strtab", STRTAB, 0, 0, 0);
+        strtab_spec.bytes = strtab;
+        let elf = tiny_elf(&[
+            alloc(".text", PROGBITS, AX, 0x0800_0400, 3000),
+            alloc(".sdram", SHT_NOBITS, WA, 0xD000_0000, 8 << 20),
+            symtab_spec,
+            strtab_spec,
+        ]);
+        let regions = f429_regions();
+        let usage = Usage::classify(&section_sizes(&elf).unwrap(), &regions);
+        assert_eq!(usage, Usage { text: 3000, sdram: 8 << 20, ..Usage::default() });
+        let table = symbols(&elf, "PADA_TABLE_").unwrap();
+        assert_eq!(table, vec![Symbol { name: "PADA_TABLE_SDRAM".into(), addr: 0xD000_0000, size: 8 << 20 }]);
+        let report = usage.report(&regions, &table);
+        assert!(report.contains("SDRAM:              8388608 B of 8388608 B (100.0%)"), "{report}");
+        assert!(report.contains("CCM RAM:                  0 B of   65536 B"), "{report}");
+        assert!(
+            report.contains("weight table: 8388608 B in SDRAM at 0xd0000000 (PADA_TABLE_SDRAM) = 8388608 B"),
+            "{report}"
+        );
+        // Without a symbol table the report says so instead of guessing.
+        assert!(table_placement(&[], &regions).contains("no PADA_TABLE_"));
     }
 
     #[test]
@@ -299,8 +455,25 @@ mod tests {
     }
 
     #[test]
+    fn reads_the_f429s_regions_two_128k_sectors_at_the_end_of_bank_2() {
+        let regions = f429_regions();
+        let find = |n: &str| regions.iter().find(|r| r.name == n).cloned().unwrap();
+        // The program in bank 1 (sectors 0–11), all of it.
+        assert_eq!((find("FLASH").origin, find("FLASH").length), (0x0800_0000, 1024 * 1024));
+        // Sectors 22 and 23: 2 × 128 KB ending at the end of the 2 MB.
+        let cp = find("CHECKPOINT");
+        assert_eq!((cp.origin, cp.length), (0x081C_0000, 256 * 1024));
+        assert_eq!(cp.origin + cp.length, 0x0800_0000 + 2 * 1024 * 1024);
+        // SRAM1 + SRAM2 + SRAM3, CCM, and the DISC1's SDRAM on bank 2.
+        assert_eq!(find("RAM").length, 192 * 1024);
+        assert_eq!((find("CCMRAM").origin, find("CCMRAM").length), (0x1000_0000, 65536));
+        assert_eq!((find("SDRAM").origin, find("SDRAM").length), (0xD000_0000, 8 * 1024 * 1024));
+    }
+
+    #[test]
     fn rejects_what_is_not_an_elf32() {
         assert!(section_sizes(b"not an elf at all").is_err());
         assert!(section_sizes(&[0x7f, b'E', b'L', b'F', 2, 1, 0, 0]).is_err());
+        assert!(symbols(b"not an elf at all", "PADA").is_err());
     }
 }

@@ -1,15 +1,17 @@
 //! Build orchestration for pada: `cargo xtask <task>`.
 //!
 //! Tasks:
-//! - `firmware [--release] [--chip f405|f407|f446]`: build the firmware ELF
-//!   for thumbv7em-none-eabihf with whichever toolchain this machine has
-//!   (see [`toolchain`]), then print its flash and RAM use (see [`elf`]).
+//! - `firmware [--release] [--board f405|f429-sdram] [--chip f405|f407|f429]
+//!   [--robot …]`: build the firmware ELF of a board's learner profile for
+//!   thumbv7em-none-eabihf with whichever toolchain this machine has (see
+//!   [`toolchain`]), then print its use of each memory region and where the
+//!   weight table lies (see [`elf`]).
 //! - `qemu`, `sil`: the same firmware for the emulated board (QEMU's
 //!   `netduinoplus2`), and a software-in-the-loop run of it (`pada sil`).
 //! - `fuzz [--seconds S]`: the decoders that face untrusted bytes, fuzzed
 //!   on stable Rust (`fuzz/`, package `pada-fuzz`).
 //!
-//! The xtask has no dependencies. Its command line is two flags and a
+//! The xtask has no dependencies. Its command line is a few flags and a
 //! subcommand, so a hand-written parser is shorter than the argument-parser
 //! crate it would replace and keeps `cargo xtask` quick to build on a fresh
 //! CI machine.
@@ -31,11 +33,16 @@ const USAGE: &str = "\
 usage: cargo xtask <task>
 
 tasks:
-  firmware [--release] [--chip f405|f407|f446] [--robot pendulum|pendulum-20hz|leo]
-        build the firmware ELF for thumbv7em-none-eabihf (debug unless
-        --release; chip f405 unless --chip; the 33 Hz pendulum unless
-        --robot) and print its flash/RAM use
-  flash [--release] [--chip ...] [--robot ...]
+  firmware [--release] [--board f405|f429-sdram] [--chip f405|f407|f429]
+           [--robot pendulum|pendulum-20hz|leo]
+        build the firmware ELF of a board's learner profile for
+        thumbv7em-none-eabihf (debug unless --release; board f405 unless
+        --board; the 33 Hz pendulum unless --robot) and print its use of
+        flash, SRAM, CCM and SDRAM and where the weight table lies.
+        --board f405 builds the STM32F405RG (--chip f407: the
+        STM32F4-Discovery's F407VG, same profile); --board f429-sdram the
+        STM32F429I-DISC1 (--chip f429)
+  flash [--release] [--board ...] [--chip ...] [--robot ...]
         build as `firmware`, then flash it and show its defmt log through
         a debug probe (`probe-rs run`)
   firmware-test
@@ -56,21 +63,54 @@ tasks:
         the inputs per second of each; fails if any invariant broke
   help  print this message";
 
-/// A microcontroller the firmware can be built for (one cargo feature each).
+/// A microcontroller the firmware can be built for (one cargo feature each),
+/// on the board whose pins the firmware uses for it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Chip {
     F405,
     F407,
-    F446,
+    F429,
 }
+
+/// The board learner profiles (`pada_core::profile::Board`'s names) a
+/// chip's image is built with.
+const PROFILES: &str = "f405 or f429-sdram";
 
 impl Chip {
     fn parse(s: &str) -> Option<Chip> {
         match s.to_ascii_lowercase().trim_start_matches("stm32") {
             "f405" => Some(Chip::F405),
             "f407" => Some(Chip::F407),
-            "f446" => Some(Chip::F446),
+            "f429" => Some(Chip::F429),
             _ => None,
+        }
+    }
+
+    /// The chip a board learner profile is built for unless `--chip` says
+    /// otherwise.
+    fn for_profile(profile: &str) -> Option<Chip> {
+        match profile.to_ascii_lowercase().as_str() {
+            "f405" => Some(Chip::F405),
+            "f429-sdram" => Some(Chip::F429),
+            _ => None,
+        }
+    }
+
+    /// The board learner profile the firmware takes on this chip
+    /// (`firmware/src/table.rs`).
+    pub fn profile(self) -> &'static str {
+        match self {
+            Chip::F405 | Chip::F407 => "f405",
+            Chip::F429 => "f429-sdram",
+        }
+    }
+
+    /// The board whose pins the firmware uses.
+    pub fn board(self) -> &'static str {
+        match self {
+            Chip::F405 => "a generic STM32F405RG board",
+            Chip::F407 => "the STM32F4-Discovery",
+            Chip::F429 => "the STM32F429I-DISC1",
         }
     }
 
@@ -79,7 +119,7 @@ impl Chip {
         match self {
             Chip::F405 => "stm32f405",
             Chip::F407 => "stm32f407",
-            Chip::F446 => "stm32f446",
+            Chip::F429 => "stm32f429",
         }
     }
 
@@ -88,7 +128,7 @@ impl Chip {
     pub fn memory_x(self) -> &'static str {
         match self {
             Chip::F405 | Chip::F407 => "memory.x",
-            Chip::F446 => "firmware/memory-f446.x",
+            Chip::F429 => "firmware/memory-f429.x",
         }
     }
 
@@ -97,7 +137,7 @@ impl Chip {
         match self {
             Chip::F405 => "STM32F405RGTx",
             Chip::F407 => "STM32F407VGTx",
-            Chip::F446 => "STM32F446RETx",
+            Chip::F429 => "STM32F429ZITx",
         }
     }
 }
@@ -188,34 +228,65 @@ fn parse_args(args: &[String]) -> Result<Task, String> {
     match task.as_str() {
         "help" | "-h" | "--help" => Ok(Task::Help),
         "firmware" | "flash" => {
-            let mut build = Build { release: false, chip: Chip::F405, robot: Robot::Pendulum };
+            let mut release = false;
+            let (mut board, mut chip, mut robot) = (None, None, Robot::Pendulum);
             let mut rest = rest.iter();
             while let Some(arg) = rest.next() {
                 let (key, value) = match arg.as_str() {
                     "--release" | "-r" => {
-                        build.release = true;
+                        release = true;
                         continue;
                     }
                     "-h" | "--help" => return Ok(Task::Help),
-                    "--chip" => ("--chip", rest.next().ok_or("--chip needs a value: f405, f407 or f446")?.as_str()),
-                    "--robot" => (
-                        "--robot",
-                        rest.next().ok_or("--robot needs a value: pendulum, pendulum-20hz or leo")?.as_str(),
-                    ),
-                    other => match (other.strip_prefix("--chip="), other.strip_prefix("--robot=")) {
-                        (Some(v), _) => ("--chip", v),
-                        (_, Some(v)) => ("--robot", v),
-                        _ => return Err(format!("unknown argument `{other}` for `{task}`")),
+                    key @ ("--board" | "--chip" | "--robot") => {
+                        let choices = match key {
+                            "--board" => PROFILES,
+                            "--chip" => "f405, f407 or f429",
+                            _ => "pendulum, pendulum-20hz or leo",
+                        };
+                        (key, rest.next().ok_or_else(|| format!("{key} needs a value: {choices}"))?.as_str())
+                    }
+                    other => match ["--board", "--chip", "--robot"]
+                        .into_iter()
+                        .find_map(|key| Some((key, other.strip_prefix(key)?.strip_prefix('=')?)))
+                    {
+                        Some(pair) => pair,
+                        None => return Err(format!("unknown argument `{other}` for `{task}`")),
                     },
                 };
-                if key == "--chip" {
-                    build.chip = Chip::parse(value)
-                        .ok_or_else(|| format!("unknown chip `{value}`: expected f405, f407 or f446"))?;
-                } else {
-                    build.robot = Robot::parse(value)
-                        .ok_or_else(|| format!("unknown robot `{value}`: expected pendulum, pendulum-20hz or leo"))?;
+                match key {
+                    "--board" => {
+                        board = Some(
+                            Chip::for_profile(value)
+                                .ok_or_else(|| format!("unknown board `{value}`: expected {PROFILES}"))?,
+                        )
+                    }
+                    "--chip" => {
+                        chip = Some(
+                            Chip::parse(value)
+                                .ok_or_else(|| format!("unknown chip `{value}`: expected f405, f407 or f429"))?,
+                        )
+                    }
+                    _ => {
+                        robot = Robot::parse(value)
+                            .ok_or_else(|| format!("unknown robot `{value}`: expected pendulum, pendulum-20hz or leo"))?
+                    }
                 }
             }
+            let chip = match (board, chip) {
+                (Some(b), Some(c)) if b.profile() != c.profile() => {
+                    return Err(format!(
+                        "--chip {} is built with the board profile {}, not {}",
+                        c.feature().trim_start_matches("stm32"),
+                        c.profile(),
+                        b.profile()
+                    ))
+                }
+                (_, Some(c)) => c,
+                (Some(b), None) => b,
+                (None, None) => Chip::F405,
+            };
+            let build = Build { release, chip, robot };
             Ok(if task == "flash" { Task::Flash(build) } else { Task::Firmware(build) })
         }
         "qemu" | "sil" => parse_emulated(task, rest),
@@ -331,8 +402,10 @@ fn firmware(root: &Path, build: Build) -> Result<PathBuf, String> {
     }
 
     println!(
-        "xtask: building pada-firmware ({profile}, {}, {}) for {TARGET}",
+        "xtask: building pada-firmware ({profile}, board profile {}: {} on {}, {}) for {TARGET}",
+        chip.profile(),
         chip.feature(),
+        chip.board(),
         robot.feature().unwrap_or("robot-pendulum-33hz (default)")
     );
     let started = Instant::now();
@@ -360,6 +433,8 @@ fn firmware(root: &Path, build: Build) -> Result<PathBuf, String> {
         .map(|text| elf::parse_memory_x(&text))
         .unwrap_or_default();
     let usage = elf::Usage::classify(&sizes, &regions);
+    let table = elf::symbols(&bytes, "PADA_TABLE_")
+        .map_err(|e| format!("{}: unreadable symbol table: {e}", elf_path.display()))?;
 
     println!(
         "xtask: built in {:.1} s with {}",
@@ -367,7 +442,7 @@ fn firmware(root: &Path, build: Build) -> Result<PathBuf, String> {
         toolchain.short_name()
     );
     println!("xtask: firmware ELF: {}", elf_path.display());
-    print!("{}", usage.report(&regions));
+    print!("{}", usage.report(&regions, &table));
     println!(
         "xtask: flash with: probe-rs run --chip {} {}",
         chip.probe_rs_name(),
@@ -546,12 +621,36 @@ mod tests {
 
     #[test]
     fn firmware_flags_in_any_order_and_both_chip_spellings() {
-        let want = Ok(Task::Firmware(Build { release: true, chip: Chip::F446, robot: Robot::Pendulum }));
-        assert_eq!(parse_args(&args("firmware --chip f446 --release")), want);
+        let want = Ok(Task::Firmware(Build { release: true, chip: Chip::F407, robot: Robot::Pendulum }));
+        assert_eq!(parse_args(&args("firmware --chip f407 --release")), want);
+        assert_eq!(parse_args(&args("firmware --release --chip=stm32F407")), want);
+    }
+
+    #[test]
+    fn a_board_profile_picks_its_chip_and_a_chip_its_profile() {
+        let f429_leo = Ok(Task::Firmware(Build { release: true, chip: Chip::F429, robot: Robot::Leo }));
+        assert_eq!(parse_args(&args("firmware --release --board f429-sdram --robot leo")), f429_leo);
+        assert_eq!(parse_args(&args("firmware --robot=leo --board=F429-SDRAM --release")), f429_leo);
+        assert_eq!(parse_args(&args("firmware --release --chip f429 --robot leo")), f429_leo);
+        assert_eq!(parse_args(&args("firmware --release --board f429-sdram --chip stm32f429 --robot leo")), f429_leo);
         assert_eq!(
-            parse_args(&args("firmware --release --chip=stm32F446")),
-            want
+            parse_args(&args("firmware --board f405")),
+            Ok(Task::Firmware(Build { release: false, chip: Chip::F405, robot: Robot::Pendulum }))
         );
+        // The Discovery's F407 is an f405-profile board.
+        assert_eq!(
+            parse_args(&args("flash --board f405 --chip f407")),
+            Ok(Task::Flash(Build { release: false, chip: Chip::F407, robot: Robot::Pendulum }))
+        );
+        assert_eq!((Chip::F407.profile(), Chip::F429.profile()), ("f405", "f429-sdram"));
+        assert_eq!(Chip::F429.memory_x(), "firmware/memory-f429.x");
+        // A chip of another profile, an unknown board, the dropped F446.
+        let err = parse_args(&args("firmware --board f429-sdram --chip f407")).unwrap_err();
+        assert!(err.contains("f405") && err.contains("f429-sdram"), "{err}");
+        assert!(parse_args(&args("firmware --board f405 --chip f429")).is_err());
+        assert!(parse_args(&args("firmware --board host")).unwrap_err().contains("f405 or f429-sdram"));
+        assert!(parse_args(&args("firmware --board")).is_err());
+        assert!(parse_args(&args("firmware --chip f446")).is_err());
     }
 
     #[test]

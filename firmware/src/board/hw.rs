@@ -1,18 +1,21 @@
 //! The real board on embassy-stm32: clocks, the two USARTs, the encoder
-//! timer, the foot switches, flash, watchdog, cycle counter.
+//! timer, the foot switches, flash, watchdog, cycle counter, and the table's
+//! memory. Which peripheral and pin does which job, and the clocks, are the
+//! chip's (`super::chip`: `f40x.rs` or `f429.rs`); the drivers here are the
+//! same for every chip.
 //!
 //! Each type here implements one of `pada_firmware::io`'s traits (or
 //! `pada_core::checkpoint::CheckpointStore`) and does nothing else.
 
-use super::pins::{self, Pins};
+use super::chip::{self, Irqs, Resources};
+use super::{MemoryFault, TableMemory};
 use core::task::Poll;
 use embassy_stm32::gpio::{Input, Level, Output, Pull, Speed};
 use embassy_stm32::mode::Async;
-use embassy_stm32::time::Hertz;
 use embassy_stm32::timer::qei::{Qei, QeiMode};
 use embassy_stm32::usart::{self, RingBufferedUartRx, Uart, UartTx};
 use embassy_stm32::wdg::IndependentWatchdog;
-use embassy_stm32::{bind_interrupts, dma, flash, peripherals, Config};
+use embassy_stm32::{flash, peripherals};
 use embassy_time::{with_deadline, Instant};
 use pada_core::checkpoint::CheckpointStore;
 use pada_firmware::io::{self, PortError};
@@ -22,56 +25,22 @@ use static_cell::StaticCell;
 // its own (semihosting).
 use {defmt_rtt as _, panic_probe as _};
 
-bind_interrupts!(struct Irqs {
-    USART1 => usart::InterruptHandler<peripherals::USART1>;
-    USART2 => usart::InterruptHandler<peripherals::USART2>;
-    DMA2_STREAM7 => dma::InterruptHandler<peripherals::DMA2_CH7>;
-    DMA2_STREAM2 => dma::InterruptHandler<peripherals::DMA2_CH2>;
-    DMA1_STREAM6 => dma::InterruptHandler<peripherals::DMA1_CH6>;
-    DMA1_STREAM5 => dma::InterruptHandler<peripherals::DMA1_CH5>;
-});
-
-/// Core clock: 8 MHz HSE → PLL → 168 MHz (APB1 42 MHz, APB2 84 MHz).
-pub const CPU_HZ: u32 = 168_000_000;
+pub use chip::CPU_HZ;
 /// The servo bus's baud rate (Dynamixel's 1 Mbps, Baud Rate register 1).
 pub const SERVO_BAUD: u32 = 1_000_000;
 /// The telemetry link's baud rate.
 pub const TELEMETRY_BAUD: u32 = 921_600;
 /// Watchdog timeout in normal operation \[µs\].
 pub const WATCHDOG_US: u32 = 250_000;
-/// Watchdog timeout while a flash sector is erased (the CPU stalls for up
-/// to 2 s per 128 KiB sector, RM0090 / datasheet t_ERASE128KB) \[µs\].
+/// Watchdog timeout while a flash sector is erased: up to 2 s per 128 KiB
+/// sector (datasheets, t_ERASE128KB), during which the F405 stalls its CPU
+/// and every chip waits in the blocking erase \[µs\].
 pub const WATCHDOG_FLASH_US: u32 = 8_000_000;
 
 /// Bytes of the servo bus's circular DMA receive buffer.
 const SERVO_RX_BUF: usize = 256;
 /// Bytes of the telemetry link's circular DMA receive buffer.
 const TELEMETRY_RX_BUF: usize = 512;
-
-fn clock_config() -> Config {
-    use embassy_stm32::rcc::{
-        AHBPrescaler, APBPrescaler, Hse, HseMode, Pll, PllMul, PllPDiv, PllPreDiv, PllQDiv, PllSource, Sysclk,
-    };
-    let mut config = Config::default();
-    config.rcc.hse = Some(Hse {
-        freq: Hertz(8_000_000),
-        mode: if pins::HSE_BYPASS { HseMode::Bypass } else { HseMode::Oscillator },
-    });
-    config.rcc.pll_src = PllSource::HSE;
-    // 8 MHz / 4 = 2 MHz × 168 = 336 MHz VCO; /2 = 168 MHz; /7 = 48 MHz.
-    config.rcc.pll = Some(Pll {
-        prediv: PllPreDiv::DIV4,
-        mul: PllMul::MUL168,
-        divp: Some(PllPDiv::DIV2),
-        divq: Some(PllQDiv::DIV7),
-        divr: None,
-    });
-    config.rcc.sys = Sysclk::PLL1_P;
-    config.rcc.ahb_pre = AHBPrescaler::DIV1;
-    config.rcc.apb1_pre = APBPrescaler::DIV4;
-    config.rcc.apb2_pre = APBPrescaler::DIV2;
-    config
-}
 
 /// Everything the tasks get from the board.
 pub struct Board {
@@ -93,30 +62,36 @@ pub struct Board {
     pub led: Led,
     /// Whether the last reset came from the independent watchdog.
     pub watchdog_reset: bool,
+    /// The weight table's memory, started and checked (the F429's SDRAM),
+    /// or why not.
+    pub table_memory: Result<TableMemory, MemoryFault>,
 }
 
 impl Board {
-    /// Clocks, pins and peripherals. Call once.
+    /// Clocks, pins and peripherals, and the table's memory. Call once.
     pub fn init() -> Board {
         // The reset cause, before anything clears it.
         let csr = embassy_stm32::pac::RCC.csr().read();
         let watchdog_reset = csr.wdgrstf();
         embassy_stm32::pac::RCC.csr().modify(|w| w.set_rmvf(true));
 
-        let p = embassy_stm32::init(clock_config());
-        let pins: Pins = pins::take_pins!(p);
+        let p = embassy_stm32::init(chip::clock_config());
+        let (r, table_memory_pins): (Resources, chip::TableMemoryPins) = chip::split(p);
+        // Before anything else may touch the table (it needs the token).
+        let table_memory = chip::start_table_memory(table_memory_pins);
 
-        // Servo bus: USART1, 1 Mbps, RX pulled up (the transceiver's
+        // Servo bus: 1 Mbps, RX pulled up (the transceiver's
         // receiver is off while the driver is on).
         let mut servo_config = usart::Config::default();
         servo_config.baudrate = SERVO_BAUD;
         servo_config.rx_pull = Pull::Up;
+        let (servo_tx_pin, servo_rx_pin, servo_de_pin) = r.servo_pins;
         let servo = Uart::new(
-            p.USART1,
-            pins.servo_rx,
-            pins.servo_tx,
-            p.DMA2_CH7,
-            p.DMA2_CH2,
+            r.servo_uart,
+            servo_rx_pin,
+            servo_tx_pin,
+            r.servo_dma.0,
+            r.servo_dma.1,
             Irqs,
             servo_config,
         )
@@ -124,29 +99,30 @@ impl Board {
         let (servo_tx, servo_rx) = servo.split();
         static SERVO_BUF: StaticCell<[u8; SERVO_RX_BUF]> = StaticCell::new();
         let servo_rx = servo_rx.into_ring_buffered(SERVO_BUF.init([0; SERVO_RX_BUF]));
-        let de = Output::new(pins.servo_de, Level::Low, Speed::VeryHigh);
+        let de = Output::new(servo_de_pin, Level::Low, Speed::VeryHigh);
 
-        // Telemetry: USART2.
+        // Telemetry.
         let mut tele_config = usart::Config::default();
         tele_config.baudrate = TELEMETRY_BAUD;
         tele_config.rx_pull = Pull::Up;
-        let tele = Uart::new(p.USART2, pins.tele_rx, pins.tele_tx, p.DMA1_CH6, p.DMA1_CH5, Irqs, tele_config)
+        let (tele_tx_pin, tele_rx_pin) = r.tele_pins;
+        let tele = Uart::new(r.tele_uart, tele_rx_pin, tele_tx_pin, r.tele_dma.0, r.tele_dma.1, Irqs, tele_config)
             .unwrap_or_else(|_| defmt::panic!("telemetry USART configuration"));
         let (tele_tx, tele_rx) = tele.split();
         static TELE_BUF: StaticCell<[u8; TELEMETRY_RX_BUF]> = StaticCell::new();
         let tele_rx = tele_rx.into_ring_buffered(TELE_BUF.init([0; TELEMETRY_RX_BUF]));
 
-        // Encoder: TIM3 in encoder mode 3 (both edges of both channels).
+        // Encoder: encoder mode 3 (both edges of both channels).
         let mut qei_config = embassy_stm32::timer::qei::Config::default();
         qei_config.mode = QeiMode::Mode3;
         qei_config.ch1_pull = Pull::Up;
         qei_config.ch2_pull = Pull::Up;
-        let qei = Qei::new(p.TIM3, pins.enc_a, pins.enc_b, qei_config);
-        let [c0, c1, c2, c3] = pins.contacts;
+        let qei = Qei::new(r.encoder_timer, r.encoder_pins.0, r.encoder_pins.1, qei_config);
+        let [c0, c1, c2, c3] = r.contacts;
         let contacts = [c0, c1, c2, c3].map(|pin| Input::new(pin, Pull::Up));
 
         let led = Led {
-            pin: Output::new(pins.led, if pins::LED_ACTIVE_HIGH { Level::Low } else { Level::High }, Speed::Low),
+            pin: Output::new(r.led, if chip::LED_ACTIVE_HIGH { Level::Low } else { Level::High }, Speed::Low),
         };
 
         Board {
@@ -154,16 +130,17 @@ impl Board {
             telemetry_tx: TelemetryTx { tx: tele_tx },
             telemetry_rx: TelemetryRx { rx: tele_rx },
             sensors: BoardSensors { qei, contacts },
-            flash: FlashStore::new(flash::Flash::new_blocking(p.FLASH)),
-            watchdog: Watchdog { iwdg: IndependentWatchdog::new(p.IWDG, WATCHDOG_FLASH_US) },
+            flash: FlashStore::new(flash::Flash::new_blocking(r.flash)),
+            watchdog: Watchdog { iwdg: IndependentWatchdog::new(r.iwdg, WATCHDOG_FLASH_US) },
             cycles: Cycles::start(),
             led,
             watchdog_reset,
+            table_memory,
         }
     }
 }
 
-/// The servo bus: USART1 with a software driver-enable line.
+/// The servo bus: a USART with a software driver-enable line.
 pub struct ServoPort {
     tx: UartTx<'static, Async>,
     rx: RingBufferedUartRx<'static>,
@@ -206,7 +183,7 @@ impl io::BusPort for ServoPort {
     }
 }
 
-/// Telemetry out: USART2 TX with DMA.
+/// Telemetry out: a USART's TX with DMA.
 pub struct TelemetryTx {
     tx: UartTx<'static, Async>,
 }
@@ -217,7 +194,7 @@ impl io::ByteSink for TelemetryTx {
     }
 }
 
-/// Commands in: USART2 RX into a circular DMA buffer.
+/// Commands in: a USART's RX into a circular DMA buffer.
 pub struct TelemetryRx {
     rx: RingBufferedUartRx<'static>,
 }
@@ -230,7 +207,7 @@ impl io::ByteSource for TelemetryRx {
 
 /// The encoder timer and the foot switches.
 pub struct BoardSensors {
-    qei: Qei<'static, peripherals::TIM3>,
+    qei: Qei<'static, chip::EncoderTimer>,
     contacts: [Input<'static>; 4],
 }
 
@@ -312,12 +289,12 @@ pub struct Led {
 impl Led {
     /// Lights or darkens it.
     pub fn set(&mut self, on: bool) {
-        self.pin.set_level(if on == pins::LED_ACTIVE_HIGH { Level::High } else { Level::Low });
+        self.pin.set_level(if on == chip::LED_ACTIVE_HIGH { Level::High } else { Level::Low });
     }
 }
 
-/// The two checkpoint flash sectors (`memory.x`: `__checkpoint_slot_a`,
-/// `__checkpoint_slot_b`, `__checkpoint_slot_size`).
+/// The two checkpoint flash sectors (`memory.x`, `memory-f429.x`:
+/// `__checkpoint_slot_a`, `__checkpoint_slot_b`, `__checkpoint_slot_size`).
 pub struct FlashStore {
     flash: flash::Flash<'static, flash::Blocking>,
     slots: [u32; 2],

@@ -3,39 +3,51 @@
 //!
 //! # Pins
 //!
-//! | function | STM32F405RG (generic LQFP64 board) | STM32F407VG (STM32F4-Discovery) | STM32F446RE (Nucleo-F446RE) |
+//! | function | STM32F405RG (generic LQFP64 board) | STM32F407VG (STM32F4-Discovery) | STM32F429ZI (STM32F429I-DISC1) |
 //! |---|---|---|---|
-//! | servo bus TX (USART1, AF7) → transceiver DI | PA9 | PB6 | PA9 (D8) |
-//! | servo bus RX (USART1, AF7) ← transceiver RO | PA10 | PB7 | PA10 (D2) |
-//! | servo bus driver enable → transceiver DE and /RE | PA8 | PB8 | PA8 (D7) |
-//! | telemetry TX (USART2, AF7) → host RX | PA2 | PA2 | PA2 (ST-LINK virtual COM port) |
-//! | telemetry RX (USART2, AF7) ← host TX | PA3 | PA3 | PA3 (ST-LINK virtual COM port) |
-//! | encoder A (TIM3 CH1, AF2) | PA6 | PB4 | PA6 (D12) |
-//! | encoder B (TIM3 CH2, AF2) | PA7 | PB5 | PA7 (D11) |
-//! | foot switch toe R / heel R / toe L / heel L (to GND, pull-up) | PB12 / PB13 / PB14 / PB15 | PE7 / PE8 / PE10 / PE12 | PB12 / PB13 / PB14 / PB15 |
-//! | status LED | PC13 (active low) | PD12 (green, active high) | PA5 (LD2, active high) |
-//! | HSE | 8 MHz crystal | 8 MHz crystal | 8 MHz from the ST-LINK (bypass) |
+//! | servo bus TX → transceiver DI | PA9 (USART1, AF7) | PB6 (USART1, AF7) | PC12 (UART5, AF8) |
+//! | servo bus RX ← transceiver RO | PA10 (USART1, AF7) | PB7 (USART1, AF7) | PD2 (UART5, AF8) |
+//! | servo bus driver enable → transceiver DE and /RE | PA8 | PB8 | PC11 |
+//! | telemetry TX → host RX | PA2 (USART2, AF7) | PA2 (USART2, AF7) | PA9 (USART1, AF7: the ST-LINK's virtual COM port) |
+//! | telemetry RX ← host TX | PA3 (USART2, AF7) | PA3 (USART2, AF7) | PA10 (USART1, AF7: the ST-LINK's virtual COM port) |
+//! | encoder A | PA6 (TIM3 CH1, AF2) | PB4 (TIM3 CH1, AF2) | PA5 (TIM2 CH1, AF1) |
+//! | encoder B | PA7 (TIM3 CH2, AF2) | PB5 (TIM3 CH2, AF2) | PB3 (TIM2 CH2, AF1) |
+//! | foot switch toe R / heel R / toe L / heel L (to GND, pull-up) | PB12 / PB13 / PB14 / PB15 | PE7 / PE8 / PE10 / PE12 | PE2 / PE3 / PE4 / PE5 |
+//! | status LED | PC13 (active low) | PD12 (green, active high) | PG13 (LD3, green, active high) |
+//! | HSE | 8 MHz crystal | 8 MHz crystal | 8 MHz crystal |
 //! | debug | SWDIO PA13, SWCLK PA14 | idem | idem |
 //!
-//! Why these: USART1 sits on APB2 (84 MHz), where 1 Mbps divides exactly
-//! (USARTDIV 5.25); USART2 on APB1 (42 MHz) gives 921 600 baud at −0.9 %,
-//! well inside a UART's tolerance. USART1 and USART2 are also the two
-//! serial ports QEMU's `netduinoplus2` connects first (issue 6). TIM2 is
-//! embassy's time base (32-bit), TIM3 counts the encoder. On the
-//! Discovery, PA9 carries the USB VBUS sense and PA0 the user button, so its
-//! servo bus and encoder move to port B. On the Nucleo, USART2 is wired to
-//! the ST-LINK, so telemetry needs no extra adapter.
+//! Why these, on the F405 and F407: USART1 sits on APB2 (84 MHz), where
+//! 1 Mbps divides exactly (USARTDIV 5.25); USART2 on APB1 (42 MHz) gives
+//! 921 600 baud at −0.9 %, well inside a UART's tolerance. USART1 and
+//! USART2 are also the two serial ports QEMU's `netduinoplus2` connects
+//! first (issue 6). TIM2 is embassy's time base (32-bit), TIM3 counts the
+//! encoder. On the Discovery, PA9 carries the USB VBUS sense and PA0 the
+//! user button, so its servo bus and encoder move to port B.
 //!
-//! | peripheral | use |
-//! |---|---|
-//! | USART1 + DMA2 stream 7 (TX) / stream 2 (RX, circular) | servo bus, 1 Mbps 8N1 |
-//! | USART2 + DMA1 stream 6 (TX) / stream 5 (RX, circular) | telemetry and commands, 921 600 8N1 |
-//! | TIM2 | embassy-time driver (1 MHz ticks) |
-//! | TIM3 | quadrature encoder, ×4 decoding |
-//! | IWDG | independent watchdog, 250 ms (8 s while flash is erased) |
-//! | FLASH sectors 10–11 (F405/F407) or 6–7 (F446) | checkpoint slots A/B (`memory.x`) |
-//! | CCM RAM (F405/F407) | the weight table, 64 KiB |
-//! | DWT CYCCNT | control-loop and agent-step timing |
+//! On the F429I-DISC1 the SDRAM, the LCD (LTDC and its SPI), the gyroscope,
+//! the touch controller and USB OTG HS take most pins (UM1670, table 6;
+//! the SDRAM's 38 pins are in [`f429`]). What is left: USART1 on PA9/PA10
+//! is wired to the ST-LINK's virtual COM port, so telemetry needs no
+//! adapter; UART5 (PC12/PD2) is the only other UART with both pins free,
+//! and on APB1 (45 MHz) it divides 1 Mbps exactly (UARTDIV 2.8125); every
+//! TIM3/TIM4 channel pair has a pin on the SDRAM or the LCD, so TIM2
+//! counts the encoder on PA5 and PB3 (PB3 is the SWO trace line, which
+//! this firmware does not use: defmt goes over RTT) and TIM5 is embassy's
+//! time base; PE2–PE5, PC11 and the green LD3 (PG13) are free. USART1 on
+//! APB2 (90 MHz) gives 921 600 baud at −0.35 %.
+//!
+//! | peripheral | F405/F407 | F429I-DISC1 |
+//! |---|---|---|
+//! | servo bus, 1 Mbps 8N1 | USART1 + DMA2 stream 7 (TX) / stream 2 (RX, circular) | UART5 + DMA1 stream 7 (TX) / stream 0 (RX, circular) |
+//! | telemetry and commands, 921 600 8N1 | USART2 + DMA1 stream 6 (TX) / stream 5 (RX, circular) | USART1 + DMA2 stream 7 (TX) / stream 2 (RX, circular) |
+//! | embassy-time driver (1 MHz ticks) | TIM2 | TIM5 |
+//! | quadrature encoder, ×4 decoding | TIM3 | TIM2 (its 32-bit counter read as 16 bits, as TIM3's) |
+//! | independent watchdog, 250 ms (8 s while flash is erased) | IWDG | IWDG |
+//! | checkpoint slots A/B (`memory.x`, `memory-f429.x`) | flash sectors 10–11 | flash sectors 22–23 (bank 2) |
+//! | the weight table (`crate::table`) | CCM (+ SRAM for the pendulum's exact table) | SDRAM (LEO), SRAM (pendulum) |
+//! | external memory | — | FMC SDRAM bank 2: IS42S16400J, 8 MB at 0xD000_0000 ([`sdram`]) |
+//! | control-loop and agent-step timing | DWT CYCCNT | DWT CYCCNT |
 //!
 //! # RS-485
 //!
@@ -52,176 +64,64 @@
 //!
 //! # Variants
 //!
-//! `hw` is the real board on embassy-stm32. `qemu` (cargo feature `qemu`)
-//! is the emulated board of QEMU's `netduinoplus2` for the
-//! software-in-the-loop run: the same type names (`ServoPort`,
-//! `TelemetryTx`, `TelemetryRx`, `BoardSensors`, `FlashStore`, `Watchdog`,
-//! `Cycles`, `Led`, `Board`) implementing the same `pada_firmware::io`
-//! traits, built on a few PAC register accesses, with a lock-step time
-//! driver; everything above (tasks, controller, agent) stays as it is.
+//! `hw` is the real board on embassy-stm32, with the chip's pins,
+//! peripherals and clocks from one file per board family, chosen by cargo
+//! feature: [`f40x`] (F405, F407) or [`f429`] (F429I-DISC1, whose SDRAM
+//! [`sdram`] starts). `qemu` (cargo feature `qemu`) is the emulated board
+//! of QEMU's `netduinoplus2` for the software-in-the-loop run: the same
+//! type names (`ServoPort`, `TelemetryTx`, `TelemetryRx`, `BoardSensors`,
+//! `FlashStore`, `Watchdog`, `Cycles`, `Led`, `Board`) implementing the
+//! same `pada_firmware::io` traits, built on a few PAC register accesses,
+//! with a lock-step time driver; everything above (tasks, controller,
+//! agent) stays as it is.
 
 #[cfg(not(feature = "qemu"))]
 mod hw;
 #[cfg(not(feature = "qemu"))]
 pub use hw::*;
 
+#[cfg(any(feature = "stm32f405", feature = "stm32f407"))]
+mod f40x;
+#[cfg(any(feature = "stm32f405", feature = "stm32f407"))]
+use f40x as chip;
+
+#[cfg(feature = "stm32f429")]
+mod f429;
+#[cfg(feature = "stm32f429")]
+mod sdram;
+#[cfg(feature = "stm32f429")]
+use f429 as chip;
+
 #[cfg(feature = "qemu")]
 mod qemu;
 #[cfg(feature = "qemu")]
 pub use qemu::*;
 
-/// Pins of the generic STM32F405RG board.
-#[cfg(feature = "stm32f405")]
-pub mod pins {
-    use embassy_stm32::peripherals::*;
-    use embassy_stm32::Peri;
+/// Proof that the memory the weight table lives in works: only the board
+/// layer makes one, after it started that memory (the F429's SDRAM, which
+/// reads garbage and ignores writes before its power-up sequence) and
+/// checked it. `crate::table::take` needs one, so nothing touches the table
+/// before.
+pub struct TableMemory(());
 
-    /// This board's pins, by function.
-    pub struct Pins {
-        /// Servo bus TX.
-        pub servo_tx: Peri<'static, PA9>,
-        /// Servo bus RX.
-        pub servo_rx: Peri<'static, PA10>,
-        /// Servo bus driver enable.
-        pub servo_de: Peri<'static, PA8>,
-        /// Telemetry TX.
-        pub tele_tx: Peri<'static, PA2>,
-        /// Telemetry RX.
-        pub tele_rx: Peri<'static, PA3>,
-        /// Encoder channel A.
-        pub enc_a: Peri<'static, PA6>,
-        /// Encoder channel B.
-        pub enc_b: Peri<'static, PA7>,
-        /// Foot switches: toe R, heel R, toe L, heel L.
-        pub contacts: [Peri<'static, embassy_stm32::gpio::AnyPin>; 4],
-        /// Status LED.
-        pub led: Peri<'static, embassy_stm32::gpio::AnyPin>,
+impl TableMemory {
+    /// Memory that works from reset (internal SRAM and CCM), or external
+    /// memory the board layer has started and checked.
+    fn ready() -> TableMemory {
+        TableMemory(())
     }
-
-    /// Whether the LED lights on a high level.
-    pub const LED_ACTIVE_HIGH: bool = false;
-    /// Whether the 8 MHz HSE is an external clock (bypass) rather than a crystal.
-    pub const HSE_BYPASS: bool = false;
-
-    /// Moves this board's pins out of the peripherals `$p`.
-    macro_rules! take_pins {
-        ($p:ident) => {
-            $crate::board::pins::Pins {
-                servo_tx: $p.PA9,
-                servo_rx: $p.PA10,
-                servo_de: $p.PA8,
-                tele_tx: $p.PA2,
-                tele_rx: $p.PA3,
-                enc_a: $p.PA6,
-                enc_b: $p.PA7,
-                contacts: [$p.PB12.into(), $p.PB13.into(), $p.PB14.into(), $p.PB15.into()],
-                led: $p.PC13.into(),
-            }
-        };
-    }
-    pub(crate) use take_pins;
 }
 
-/// Pins of the STM32F4-Discovery (STM32F407VG).
-#[cfg(feature = "stm32f407")]
-pub mod pins {
-    use embassy_stm32::peripherals::*;
-    use embassy_stm32::Peri;
-
-    /// This board's pins, by function.
-    pub struct Pins {
-        /// Servo bus TX.
-        pub servo_tx: Peri<'static, PB6>,
-        /// Servo bus RX.
-        pub servo_rx: Peri<'static, PB7>,
-        /// Servo bus driver enable.
-        pub servo_de: Peri<'static, PB8>,
-        /// Telemetry TX.
-        pub tele_tx: Peri<'static, PA2>,
-        /// Telemetry RX.
-        pub tele_rx: Peri<'static, PA3>,
-        /// Encoder channel A.
-        pub enc_a: Peri<'static, PB4>,
-        /// Encoder channel B.
-        pub enc_b: Peri<'static, PB5>,
-        /// Foot switches: toe R, heel R, toe L, heel L.
-        pub contacts: [Peri<'static, embassy_stm32::gpio::AnyPin>; 4],
-        /// Status LED.
-        pub led: Peri<'static, embassy_stm32::gpio::AnyPin>,
-    }
-
-    /// Whether the LED lights on a high level.
-    pub const LED_ACTIVE_HIGH: bool = true;
-    /// Whether the 8 MHz HSE is an external clock (bypass) rather than a crystal.
-    pub const HSE_BYPASS: bool = false;
-
-    /// Moves this board's pins out of the peripherals `$p`.
-    macro_rules! take_pins {
-        ($p:ident) => {
-            $crate::board::pins::Pins {
-                servo_tx: $p.PB6,
-                servo_rx: $p.PB7,
-                servo_de: $p.PB8,
-                tele_tx: $p.PA2,
-                tele_rx: $p.PA3,
-                enc_a: $p.PB4,
-                enc_b: $p.PB5,
-                contacts: [$p.PE7.into(), $p.PE8.into(), $p.PE10.into(), $p.PE12.into()],
-                led: $p.PD12.into(),
-            }
-        };
-    }
-    pub(crate) use take_pins;
-}
-
-/// Pins of the Nucleo-F446RE.
-#[cfg(feature = "stm32f446")]
-pub mod pins {
-    use embassy_stm32::peripherals::*;
-    use embassy_stm32::Peri;
-
-    /// This board's pins, by function.
-    pub struct Pins {
-        /// Servo bus TX.
-        pub servo_tx: Peri<'static, PA9>,
-        /// Servo bus RX.
-        pub servo_rx: Peri<'static, PA10>,
-        /// Servo bus driver enable.
-        pub servo_de: Peri<'static, PA8>,
-        /// Telemetry TX.
-        pub tele_tx: Peri<'static, PA2>,
-        /// Telemetry RX.
-        pub tele_rx: Peri<'static, PA3>,
-        /// Encoder channel A.
-        pub enc_a: Peri<'static, PA6>,
-        /// Encoder channel B.
-        pub enc_b: Peri<'static, PA7>,
-        /// Foot switches: toe R, heel R, toe L, heel L.
-        pub contacts: [Peri<'static, embassy_stm32::gpio::AnyPin>; 4],
-        /// Status LED.
-        pub led: Peri<'static, embassy_stm32::gpio::AnyPin>,
-    }
-
-    /// Whether the LED lights on a high level.
-    pub const LED_ACTIVE_HIGH: bool = true;
-    /// Whether the 8 MHz HSE is an external clock (bypass) rather than a crystal.
-    pub const HSE_BYPASS: bool = true;
-
-    /// Moves this board's pins out of the peripherals `$p`.
-    macro_rules! take_pins {
-        ($p:ident) => {
-            $crate::board::pins::Pins {
-                servo_tx: $p.PA9,
-                servo_rx: $p.PA10,
-                servo_de: $p.PA8,
-                tele_tx: $p.PA2,
-                tele_rx: $p.PA3,
-                enc_a: $p.PA6,
-                enc_b: $p.PA7,
-                contacts: [$p.PB12.into(), $p.PB13.into(), $p.PB14.into(), $p.PB15.into()],
-                led: $p.PA5.into(),
-            }
-        };
-    }
-    pub(crate) use take_pins;
+/// The table's memory failed its check at boot: a word read back other
+/// than written (a data, byte-lane or address line stuck or shorted, or
+/// wrong timings).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, defmt::Format)]
+pub struct MemoryFault {
+    /// The address that read back wrong.
+    pub address: u32,
+    /// What was written there (or, for the address-line check, what the
+    /// word should still hold).
+    pub wrote: u32,
+    /// What was read.
+    pub read: u32,
 }

@@ -34,6 +34,7 @@ use heapless::Deque;
 use pada_core::checkpoint::{self, CheckpointStore};
 use pada_core::wire::{encode_frame, FrameDecoder};
 use pada_firmware::bus::{BusConfig, ServoBus};
+use super::{MemoryFault, TableMemory};
 use crate::table::{PROFILE, WEIGHTS};
 use pada_firmware::io::{self, PortError};
 use pada_firmware::sil::{self, FromBoard, ToBoard, CLOCK_FRAME_LEN, SENSOR_ID};
@@ -433,6 +434,8 @@ pub struct Board {
     pub led: Led,
     /// Never: there is no watchdog to reset the emulated chip.
     pub watchdog_reset: bool,
+    /// The table's memory: CCM and SRAM, which QEMU 10 models from reset.
+    pub table_memory: Result<TableMemory, MemoryFault>,
 }
 
 impl Board {
@@ -476,6 +479,7 @@ impl Board {
             cycles: Cycles(()),
             led: Led(()),
             watchdog_reset: false,
+            table_memory: Ok(TableMemory::ready()),
         }
     }
 }

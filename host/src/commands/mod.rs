@@ -2,6 +2,7 @@
 
 pub mod capture;
 pub mod demo;
+pub mod leo;
 pub mod mtbf;
 pub mod paper;
 pub mod paper_leo;

@@ -14,7 +14,8 @@ pub use crate::safety::RunMode;
 /// a message's layout (3: `Health` reports the checkpoint sectors' wear,
 /// `Saved` the erase count, `NackReason::FlashWear`; `SetPolicy` carries
 /// [`PolicyKind`] itself, in the same bytes as before; 4: the
-/// [`ToHost::Policy`] report, appended last).
+/// [`ToHost::Policy`] report and [`CheckpointReport::TooLarge`], appended
+/// last).
 pub const PROTOCOL_VERSION: u16 = 4;
 /// State dimensions a [`Step`] carries.
 pub const MAX_STATE_DIMS: usize = 16;
@@ -222,6 +223,16 @@ pub enum CheckpointReport {
     SaveFailed,
     /// What a load found (at boot or on command).
     Load(LoadOutcome),
+    /// A save refused before flash was touched: the checkpoint (header,
+    /// learner state and weights) does not fit a slot — LEO's 8 MiB table
+    /// on the F429 against its 128 KiB flash sectors. (Appended last, so
+    /// the earlier variants keep their encoding.)
+    TooLarge {
+        /// Bytes the checkpoint needs.
+        needed: u32,
+        /// Bytes a slot holds.
+        capacity: u32,
+    },
 }
 
 /// Severity of a [`Log`].
