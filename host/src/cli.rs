@@ -50,6 +50,9 @@ pub enum Command {
     Render(RenderArgs),
     /// The LEO model on its own: `pada leo passive` (the passive rollout).
     Leo(commands::leo::LeoArgs),
+    /// Run one trial of a plan (written with --plan DIR), as a Slurm array
+    /// task or a Kubernetes indexed job.
+    Trial(commands::trial::TrialArgs),
 }
 
 /// Options shared by the commands that run trials.
@@ -143,6 +146,9 @@ pub struct RunArgs {
     /// Seed and threads.
     #[command(flatten)]
     pub trial: TrialOptions,
+    /// Plans, merges and Slurm (issue 14).
+    #[command(flatten)]
+    pub cluster: crate::plan::mode::ClusterOptions,
 }
 
 /// `pada render`.
@@ -219,6 +225,9 @@ pub struct PaperArgs {
     /// Seed and threads.
     #[command(flatten)]
     pub trial: TrialOptions,
+    /// Plans, merges and Slurm (issue 14).
+    #[command(flatten)]
+    pub cluster: crate::plan::mode::ClusterOptions,
 }
 
 /// `pada mtbf`.
@@ -330,7 +339,7 @@ where
                     )))
                 }
                 ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => Err(usage(
-                    "no command given: valid commands are run, demo, paper, mtbf, render, sil, capture, watch, leo (see pada --help)",
+                    "no command given: valid commands are run, demo, paper, mtbf, render, sil, capture, watch, leo, trial (see pada --help)",
                 )),
                 _ => Err(usage(clap_one_line(&e))),
             };
@@ -346,5 +355,6 @@ where
         Command::Watch(a) => commands::watch::run(a),
         Command::Render(a) => commands::render::run(a),
         Command::Leo(a) => commands::leo::run(a),
+        Command::Trial(a) => commands::trial::run(a),
     }
 }

@@ -9,4 +9,5 @@ pub mod paper_leo;
 pub mod render;
 pub mod run;
 pub mod sil;
+pub mod trial;
 pub mod watch;

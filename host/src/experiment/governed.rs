@@ -13,10 +13,10 @@ use anyhow::anyhow;
 use pada_core::fatigue::{FatigueCounter, GearboxParams};
 use pada_core::governor::{Governor, GovernorConfig, GOVERNED_JOINTS};
 use pada_core::policy::PolicyKind;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// What one trial's governor did.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct GovernorTrial {
     /// The budget \[s\].
     pub budget_s: f32,
