@@ -172,6 +172,10 @@ pub struct GovernorState {
     pub steps: u64,
     /// Actions after which the window was over budget.
     pub over_budget_steps: u64,
+    /// The headroom right after the last move (or at the start), Q16.48,
+    /// clamped to `i64`: a later headroom below it means the rung in force
+    /// spends more than the budget earns.
+    pub headroom_at_move: i64,
     /// Damage per gearbox and bucket, Q16.48.
     pub buckets: [[u64; WINDOW_BUCKETS]; GOVERNED_JOINTS],
 }
@@ -303,6 +307,7 @@ impl Governor {
                 moves: 0,
                 steps: 0,
                 over_budget_steps: 0,
+                headroom_at_move: 0,
                 buckets: [[0; WINDOW_BUCKETS]; GOVERNED_JOINTS],
             },
         })
@@ -407,19 +412,24 @@ impl Governor {
         }
         s.since_move = s.since_move.saturating_add(1);
         let (reserve, worst) = (self.reserve as i128, self.worst as i128);
+        // Whether the rung in force spends the window's allowance faster
+        // than the budget earns it: the headroom fell since the last move.
+        let spending = headroom < s.headroom_at_move as i128;
         let rung = if headroom < worst {
+            // The next action could break the budget: one rung per action,
+            // without waiting for the last move to show.
             s.calm_steps = 0;
-            0
+            s.rung.saturating_sub(1)
         } else if headroom < reserve {
             s.calm_steps = 0;
-            if s.since_move >= self.relax_after {
+            if s.since_move >= self.relax_after && spending {
                 s.rung.saturating_sub(1)
             } else {
                 s.rung
             }
         } else {
             s.calm_steps = s.calm_steps.saturating_add(1);
-            if headroom >= reserve + worst && s.calm_steps >= self.relax_after && s.rung + 1 < self.rungs {
+            if headroom >= reserve + worst && s.calm_steps >= self.relax_after && !spending && s.rung + 1 < self.rungs {
                 s.rung + 1
             } else {
                 s.rung
@@ -431,6 +441,7 @@ impl Governor {
         s.rung = rung;
         s.calm_steps = 0;
         s.since_move = 0;
+        s.headroom_at_move = headroom.clamp(i64::MIN as i128, i64::MAX as i128) as i64;
         s.moves = s.moves.saturating_add(1);
         Some(self.parameter())
     }

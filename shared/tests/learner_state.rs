@@ -385,10 +385,10 @@ fn governor_state() -> impl Strategy<Value = Option<GovernorState>> {
             any::<bool>(),
             any::<[u8; 4]>(),
             any::<(u32, u32, u64, u64)>(),
-            any::<u32>(),
+            (any::<u32>(), any::<i64>()),
             any::<[[u64; 12]; 4]>(),
         )
-            .prop_map(|(budget_bits, alpha, [rung, cursor, filled, in_bucket], (calm_steps, moves, steps, over), since_move, buckets)| {
+            .prop_map(|(budget_bits, alpha, [rung, cursor, filled, in_bucket], (calm_steps, moves, steps, over), (since_move, headroom_at_move), buckets)| {
                 GovernorState {
                     budget_bits,
                     restricts: if alpha { Restricts::Alpha } else { Restricts::Delta },
@@ -398,6 +398,7 @@ fn governor_state() -> impl Strategy<Value = Option<GovernorState>> {
                     in_bucket,
                     calm_steps,
                     since_move,
+                    headroom_at_move,
                     moves,
                     steps,
                     over_budget_steps: over,
@@ -620,6 +621,7 @@ fn records_that_cannot_be_decoded_are_refused_by_name() {
         in_bucket: 7,
         calm_steps: 2,
         since_move: 4,
+        headroom_at_move: -3,
         moves: 5,
         steps: 307,
         over_budget_steps: 0,

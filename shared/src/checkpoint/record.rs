@@ -68,12 +68,13 @@ pub(super) mod at {
     pub const GOV_STEPS: usize = 536;
     pub const GOV_OVER: usize = 544;
     pub const GOV_BUCKETS: usize = 552;
-    pub const GOV_END: usize = GOV_BUCKETS + 8 * super::GOVERNED_JOINTS * super::WINDOW_BUCKETS;
+    pub const GOV_HEADROOM_AT_MOVE: usize = GOV_BUCKETS + 8 * super::GOVERNED_JOINTS * super::WINDOW_BUCKETS;
+    pub const GOV_END: usize = GOV_HEADROOM_AT_MOVE + 8;
 }
 
 const _: () = assert!(at::FATIGUE + MAX_JOINTS * at::JOINT_LEN == at::ERASES);
 const _: () = assert!(at::OPERATING_S + 8 == at::GOVERNOR);
-const _: () = assert!(at::GOV_END == 936 && at::GOV_END <= STATE_LEN);
+const _: () = assert!(at::GOV_END == 944 && at::GOV_END <= STATE_LEN);
 // The record has four action dimensions: previous levels and outputs.
 const _: () = assert!(MAX_ACTION_DIMS == 4 && at::PREVIOUS + MAX_ACTION_DIMS <= at::RESERVED_A);
 const _: () = assert!(at::OUTPUT + 4 * MAX_ACTION_DIMS == at::EPSILON);
@@ -215,6 +216,7 @@ impl LearnerState {
             put(&mut b, at::GOV_CALM, &g.calm_steps.to_le_bytes());
             put(&mut b, at::GOV_MOVES, &g.moves.to_le_bytes());
             put(&mut b, at::GOV_SINCE_MOVE, &g.since_move.to_le_bytes());
+            put(&mut b, at::GOV_HEADROOM_AT_MOVE, &g.headroom_at_move.to_le_bytes());
             put(&mut b, at::GOV_STEPS, &g.steps.to_le_bytes());
             put(&mut b, at::GOV_OVER, &g.over_budget_steps.to_le_bytes());
             for (j, row) in g.buckets.iter().enumerate() {
@@ -354,6 +356,7 @@ fn governor_of(r: &Record<'_>) -> Result<Option<GovernorState>, ConfigError> {
         moves: r.u32(at::GOV_MOVES),
         steps: r.u64(at::GOV_STEPS),
         over_budget_steps: r.u64(at::GOV_OVER),
+        headroom_at_move: r.u64(at::GOV_HEADROOM_AT_MOVE) as i64,
         buckets,
     }))
 }
