@@ -199,6 +199,19 @@ pub enum PaperExperiment {
     /// Section VIII: SARSA(λ), PADA and low-pass on LEO, with and without
     /// the switch back to SARSA(λ) at half the run.
     Leo,
+    /// Learning on a wear budget: every strategy (the six and the gentle
+    /// explorations) over a sweep and the wear governor at three budgets;
+    /// end performance against both MTBFs with the Pareto front.
+    Wear,
+}
+
+/// The task of `pada paper wear`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum WearTask {
+    /// The simulated pendulum (29 trials of 3000 s).
+    Pendulum,
+    /// The LEO model (3 trials of 3600 s by default).
+    Leo,
 }
 
 /// `pada paper`.
@@ -219,6 +232,9 @@ pub struct PaperArgs {
     /// 3000; LEO: 14666, the paper's).
     #[arg(long, value_name = "S")]
     pub seconds: Option<f64>,
+    /// The task of `pada paper wear` (default pendulum).
+    #[arg(long, value_enum)]
+    pub task: Option<WearTask>,
     /// Learning time per trial on the physical pendulum [s].
     #[arg(long, value_name = "S", default_value_t = 1500.0)]
     pub physical_seconds: f64,

@@ -22,6 +22,7 @@
 //! held joints and resets, and the switch back to SARSA(λ) at the first
 //! period at or after `--switch-at` rather than at the exact step.
 
+use crate::experiment::governed::GovernorStats;
 use crate::experiment::metrics::{end_performance, rise_time};
 use crate::experiment::runner::RunConfig;
 use crate::experiment::{TestPoint, TrialResult};
@@ -163,6 +164,11 @@ fn run<R: RobotAdapter, W: WeightStore>(
     // (a fresh learner from the seed) and starts the first test run.
     let mut ctl = Controller::<W, R>::new(profile, PolicyKind::Sarsa, table, seed).map_err(|e| anyhow!("{e}"))?;
     ctl.set_policy(cfg.policy).map_err(|e| anyhow!("--algo {:?} on board {}: {e:?}", cfg.policy, profile.board.name()))?;
+    if let Some(budget) = cfg.mtbf_budget_s {
+        // As the host would: the wire command, after the policy.
+        command(&mut ctl, ToChip::SetMtbfBudget(Some(budget)))?;
+    }
+    let mut governed = GovernorStats::default();
     command(&mut ctl, ToChip::Start(RunMode::Testing))?;
 
     let hw = hardware(R::ROBOT);
@@ -221,6 +227,11 @@ fn run<R: RobotAdapter, W: WeightStore>(
         k += 1;
         rig.advance_to(k * period_us);
         if learning_action {
+            // The parameter this action was chosen with (the period's own
+            // move, if any, applies to the next decision).
+            if let Some(g) = ctl.governor() {
+                governed.record(g);
+            }
             let mut com = [0.0f32; COUNTED];
             let mut sim = [0.0f32; COUNTED];
             let mut est = [0.0f32; COUNTED];
@@ -297,7 +308,13 @@ fn run<R: RobotAdapter, W: WeightStore>(
         end_speed_m_s: walked.map(|w| w / tail.iter().map(|p| p.duration_s).sum::<f64>()),
         saturations: stats.saturations,
         trace_drops: stats.trace_drops,
-        governor: None,
+        governor: ctl.governor().map(|g| {
+            governed.finish(
+                g,
+                paper.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
+                simulated.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
+            )
+        }),
         curve,
     };
     Ok(BoardTrial {

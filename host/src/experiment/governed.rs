@@ -39,14 +39,47 @@ pub struct GovernorTrial {
     pub over_budget_steps: u64,
 }
 
-/// A trial's governor and its running statistics.
-pub struct TrialGovernor {
-    governor: Governor,
-    gearboxes: usize,
+/// What a governor did over a trial's learning actions, counted as they
+/// happen (by the host trial and by `pada run --board`).
+#[derive(Debug, Clone, Default)]
+pub struct GovernorStats {
     /// Sum of the parameter in force over the learning actions.
     parameter_sum: f64,
     floor_steps: u64,
     steps: u64,
+}
+
+impl GovernorStats {
+    /// One learning action taken with `governor`'s Δ or α in force.
+    pub fn record(&mut self, governor: &Governor) {
+        self.parameter_sum += governor.parameter() as f64;
+        self.floor_steps += (governor.rung() == 0) as u64;
+        self.steps += 1;
+    }
+
+    /// The trial's record, given its two MTBFs.
+    pub fn finish(&self, governor: &Governor, mtbf_s: f64, physical_mtbf_s: f64) -> GovernorTrial {
+        let status = governor.status();
+        let budget = governor.budget_s() as f64;
+        let n = self.steps.max(1) as f64;
+        GovernorTrial {
+            budget_s: governor.budget_s(),
+            held: mtbf_s >= budget,
+            physical_held: physical_mtbf_s >= budget,
+            final_parameter: status.parameter,
+            mean_parameter: self.parameter_sum / n,
+            floor_fraction: self.floor_steps as f64 / n,
+            moves: status.moves,
+            over_budget_steps: governor.state().over_budget_steps,
+        }
+    }
+}
+
+/// A trial's governor and its running statistics.
+pub struct TrialGovernor {
+    governor: Governor,
+    gearboxes: usize,
+    stats: GovernorStats,
 }
 
 impl TrialGovernor {
@@ -63,7 +96,7 @@ impl TrialGovernor {
             joints: gearboxes as u8,
         };
         let governor = Governor::new(policy, &spec.motor, &config).map_err(|e| anyhow!("--mtbf-budget: {e}"))?;
-        Ok(TrialGovernor { governor, gearboxes, parameter_sum: 0.0, floor_steps: 0, steps: 0 })
+        Ok(TrialGovernor { governor, gearboxes, stats: GovernorStats::default() })
     }
 
     /// The Δ or α in force.
@@ -80,36 +113,17 @@ impl TrialGovernor {
     /// before `fatigue` counted it. Returns the new Δ or α if the governor
     /// moved.
     pub fn observe<const N: usize>(&mut self, before: &[u64; N], fatigue: &FatigueCounter<N>) -> Option<f32> {
-        self.parameter_sum += self.governor.parameter() as f64;
-        self.floor_steps += (self.governor.rung() == 0) as u64;
-        self.steps += 1;
+        self.stats.record(&self.governor);
         let mut increments = [0u64; GOVERNED_JOINTS];
         for (j, inc) in increments.iter_mut().enumerate().take(self.gearboxes.min(N)) {
             *inc = fatigue.joints()[j].damage_raw() - before[j];
         }
-        let r = self.governor.observe(&increments);
-        if std::env::var("GOVDBG").is_ok() && self.steps % 2000 == 0 {
-            let st = self.governor.status();
-            eprintln!("step {} rung {} param {} mtbf_w {:.0} headroom/d {:.1} reserve/d {:.1}", self.steps, st.rung, st.parameter, st.window_mtbf_s, self.governor.headroom_raw() as f64 / self.governor.worst_raw() as f64, self.governor.reserve_raw() as f64 / self.governor.worst_raw() as f64);
-        }
-        r
+        self.governor.observe(&increments)
     }
 
     /// The trial's record, given its two MTBFs.
     pub fn finish(&self, mtbf_s: f64, physical_mtbf_s: f64) -> GovernorTrial {
-        let status = self.governor.status();
-        let budget = self.governor.budget_s() as f64;
-        let n = self.steps.max(1) as f64;
-        GovernorTrial {
-            budget_s: self.governor.budget_s(),
-            held: mtbf_s >= budget,
-            physical_held: physical_mtbf_s >= budget,
-            final_parameter: status.parameter,
-            mean_parameter: self.parameter_sum / n,
-            floor_fraction: self.floor_steps as f64 / n,
-            moves: status.moves,
-            over_budget_steps: self.governor.state().over_budget_steps,
-        }
+        self.stats.finish(&self.governor, mtbf_s, physical_mtbf_s)
     }
 }
 

@@ -21,6 +21,8 @@ pub enum ExperimentKind {
     PaperPendulum,
     /// `pada paper leo`: Section VIII.
     PaperLeo,
+    /// `pada paper wear`: every strategy and the wear governor.
+    PaperWear,
 }
 
 impl ExperimentKind {
@@ -36,6 +38,7 @@ impl ExperimentKind {
             ExperimentKind::Run => "pada run",
             ExperimentKind::PaperPendulum => "pada paper pendulum",
             ExperimentKind::PaperLeo => "pada paper leo",
+            ExperimentKind::PaperWear => "pada paper wear",
         }
     }
 }

@@ -55,7 +55,7 @@ const SWEPT: [Algo; 5] = [
     Algo::Pada,
 ];
 
-fn finite_ci(e: &Estimate) -> f64 {
+pub(crate) fn finite_ci(e: &Estimate) -> f64 {
     if e.ci95.is_finite() {
         e.ci95
     } else {
@@ -64,7 +64,7 @@ fn finite_ci(e: &Estimate) -> f64 {
 }
 
 /// A log range covering `values` with some room.
-fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
+pub(crate) fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
     let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
     for v in values.filter(|v| v.is_finite() && *v > 0.0) {
         lo = lo.min(v);
@@ -77,7 +77,7 @@ fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
 }
 
 /// A linear range covering `values` with 6% room.
-fn lin_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
+pub(crate) fn lin_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for v in values.filter(|v| v.is_finite()) {
         lo = lo.min(v);
