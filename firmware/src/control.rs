@@ -1339,6 +1339,143 @@ mod tests {
         }
     }
 
+    // -----------------------------------------------------------------------
+    // Learning on a wear budget
+    // -----------------------------------------------------------------------
+
+    /// The budget the governed tests hold: on the crude pendulum of
+    /// `run_pendulum`, tight enough that the governor moves Δ both ways.
+    const TEST_BUDGET_S: f32 = 2.0e8;
+
+    #[test]
+    fn the_wear_budget_command_starts_a_governor_for_pada_and_lowpass_only() {
+        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Pada { delta: 1.0 }, table(), 3).unwrap();
+        assert_eq!(c.command(&wire::ToChip::SetMtbfBudget(Some(1.0e3))).0, Ok(()));
+        assert_eq!(c.governor().map(|g| g.budget_s()), Some(1.0e3));
+        assert_eq!(c.policy(), PolicyKind::Pada { delta: 0.5 }, "starts at the floor, one level");
+        assert!(c.policy_report().governor.is_some(), "telemetry carries its status");
+        for bad in [0.0, -1.0, f32::NAN, f32::INFINITY, 2.0e10] {
+            assert_eq!(c.command(&wire::ToChip::SetMtbfBudget(Some(bad))).0, Err(NackReason::InvalidParameter), "{bad}");
+            assert_eq!(c.governor().map(|g| g.budget_s()), Some(1.0e3), "a refused budget changes nothing");
+        }
+        start(&mut c, RunMode::Learning);
+        assert_eq!(c.command(&wire::ToChip::SetMtbfBudget(None)).0, Err(NackReason::Busy));
+        stop(&mut c);
+        assert_eq!(c.command(&wire::ToChip::SetMtbfBudget(None)).0, Ok(()));
+        assert!(c.governor().is_none());
+        assert_eq!(c.policy(), PolicyKind::Pada { delta: 0.5 }, "stopping keeps the Δ in force");
+        assert_eq!(c.command(&wire::ToChip::SetMtbfBudget(Some(1.0e3))).0, Ok(()));
+        assert_eq!(c.command(&wire::ToChip::SetPolicy(PolicyKind::LowPass { alpha: 0.5 })).0, Ok(()));
+        assert!(c.governor().is_none(), "a new learner starts without one");
+        assert_eq!(c.command(&wire::ToChip::SetMtbfBudget(Some(1.0e3))).0, Ok(()));
+        assert_eq!(c.policy(), PolicyKind::LowPass { alpha: 0.1 });
+        for k in [PolicyKind::Sarsa, PolicyKind::Integrator { delta: 0.5 }, PolicyKind::OrnsteinUhlenbeck { theta: 0.15, sigma: 0.2 }] {
+            assert_eq!(c.command(&wire::ToChip::SetPolicy(k)).0, Ok(()));
+            assert_eq!(c.command(&wire::ToChip::SetMtbfBudget(Some(1.0e3))).0, Err(NackReason::InvalidParameter), "{k:?}");
+            assert!(c.governor().is_none());
+        }
+    }
+
+    /// A governed run's records in the order the board sends them.
+    enum Sent {
+        Step(wire::Step),
+        Policy(wire::PolicyReport),
+    }
+
+    fn run_governed(c: &mut Controller<Box<[Q16]>, Pendulum33>, angle: &mut f32, periods: u32) -> std::vec::Vec<Sent> {
+        let clock = Clock(Cell::new(0));
+        let mut out = PeriodOutput::default();
+        let mut sent = std::vec::Vec::new();
+        for k in 0..periods {
+            let counts = (*angle / (2.0 * PI) * 4096.0).round() as i64;
+            c.period(&pendulum_readings(counts.rem_euclid(65536) as u16, k * 30), &clock, &mut out);
+            if let Some(s) = out.step.take() {
+                sent.push(Sent::Step(s));
+            }
+            if let Some(p) = out.policy.take() {
+                sent.push(Sent::Policy(p));
+            }
+            let u = c.applied[0];
+            *angle += 0.02 * u - 0.05 * libm::sinf(*angle);
+        }
+        sent
+    }
+
+    #[test]
+    fn a_governed_run_replays_bit_for_bit_from_its_telemetry() {
+        // The board's Step records and the Policy reports of the
+        // governor's moves, replayed through a host agent that takes each
+        // reported Δ when it arrives, give the same actions and weights.
+        let seed = 11;
+        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Pada { delta: 0.5 }, table(), seed).unwrap();
+        assert_eq!(c.command(&wire::ToChip::SetMtbfBudget(Some(TEST_BUDGET_S))).0, Ok(()));
+        start(&mut c, RunMode::Learning);
+        let mut angle = 0.0;
+        let sent = run_governed(&mut c, &mut angle, 3000);
+        let moves = c.governor().unwrap().status().moves;
+        assert!(moves >= 2, "the governor moved {moves} times: the test needs it to move");
+
+        let robot = Robot::Pendulum33;
+        let mut rng = rand_pcg::Pcg32::seed_from_u64(seed);
+        let mut agent = robot.spec().agent::<_, TILINGS, TRACE>(PolicyKind::Pada { delta: 0.5 }, profile(robot).layout, table()).unwrap();
+        agent.reset_weights(&mut rng);
+        let (mut compared, mut reports) = (0, 0);
+        for r in &sent {
+            let s = match r {
+                Sent::Policy(p) => {
+                    let g = p.governor.expect("a governed board reports its governor");
+                    agent.set_policy_parameter(g.parameter).unwrap();
+                    assert_eq!(p.built, PolicyKind::Pada { delta: g.parameter });
+                    reports += 1;
+                    continue;
+                }
+                Sent::Step(s) => s,
+            };
+            agent.set_mode(if s.mode == RunMode::Testing { Mode::Testing } else { Mode::Learning });
+            match s.kind {
+                StepKind::Start => assert_eq!(agent.start_episode(&s.state, &mut rng).unwrap().action, s.action),
+                StepKind::Step => assert_eq!(agent.step(s.reward, &s.state, &mut rng).unwrap().action, s.action, "step {}", s.step),
+                StepKind::Absorbing => agent.end_episode(s.reward, EpisodeEnd::Absorbing, &mut rng).unwrap(),
+                StepKind::Timeout => agent.end_episode(s.reward, EpisodeEnd::Timeout(&s.state), &mut rng).unwrap(),
+            }
+            compared += 1;
+        }
+        assert!(compared > 1000 && reports >= moves, "{compared} steps, {reports} reports");
+        assert_eq!(agent.weights_checksum(), c.agent().weights_checksum());
+    }
+
+    #[test]
+    fn a_checkpoint_carries_the_governor() {
+        let mut store = Store::new();
+        let mut a = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Pada { delta: 0.5 }, table(), 5).unwrap();
+        assert_eq!(a.command(&wire::ToChip::SetMtbfBudget(Some(TEST_BUDGET_S))).0, Ok(()));
+        start(&mut a, RunMode::Learning);
+        let mut angle = 0.0;
+        run_governed(&mut a, &mut angle, 2000);
+        stop(&mut a);
+        let governor = a.governor().unwrap().clone();
+        assert!(governor.state().steps > 1000);
+        a.save_checkpoint(&mut store).unwrap();
+
+        let mut b = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Pada { delta: 0.5 }, table(), 99).unwrap();
+        assert_eq!(b.load_checkpoint(&store), Ok(LoadOutcome::Loaded { generation: 1, slot: 0 }));
+        assert_eq!(b.governor(), Some(&governor));
+        assert_eq!(b.policy(), a.policy(), "the governor's rung is the Δ in force");
+        assert_eq!(b.learner_state(), a.learner_state());
+        // Both go on the same way (from the pendulum hanging still, as
+        // after a reset).
+        start(&mut a, RunMode::Learning);
+        start(&mut b, RunMode::Learning);
+        let (mut x, mut y) = (0.0, 0.0);
+        let sa = run_governed(&mut a, &mut x, 1500);
+        let sb = run_governed(&mut b, &mut y, 1500);
+        assert!(sa.len() > 300);
+        assert_eq!(sa.len(), sb.len());
+        assert!(b.governor().unwrap().state().steps > governor.state().steps + 300);
+        assert_eq!(a.governor(), b.governor());
+        assert_eq!(a.agent().weights_checksum(), b.agent().weights_checksum());
+    }
+
     #[test]
     fn a_checkpoint_carries_the_learner_across_a_reset() {
         let mut store = Store::new();
