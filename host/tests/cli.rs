@@ -373,3 +373,20 @@ fn paper_pendulum_writes_the_report_and_the_figures() {
     assert_eq!(summary["simulated"].as_array().unwrap().len(), 24);
     assert_eq!(summary["physical"].as_array().unwrap().len(), 3);
 }
+
+#[test]
+fn mtbf_budget_errors_name_the_flag_and_the_range() {
+    assert_bad_input(&["run", "--algo", "sarsa", "--mtbf-budget", "2600"], &["--mtbf-budget", "pada and lowpass"]);
+    assert_bad_input(&["run", "--algo", "ou", "--mtbf-budget", "2600"], &["--mtbf-budget", "not to ou"]);
+    assert_bad_input(&["run", "--algo", "pada", "--delta", "0.5", "--mtbf-budget", "2600"], &["--delta", "--mtbf-budget"]);
+    assert_bad_input(&["run", "--algo", "lowpass", "--alpha", "0.5", "--mtbf-budget", "2600"], &["--alpha", "--mtbf-budget"]);
+    for bad in ["0", "-5", "NaN", "inf", "2e10"] {
+        assert_bad_input(&["run", "--algo", "pada", "--mtbf-budget", bad, "--seconds", "10"], &["--mtbf-budget", "0 < budget <= 1e10"]);
+    }
+    assert_bad_input(
+        &["run", "--algo", "pada", "--mtbf-budget", "2600", "--switch-at", "10"],
+        &["--switch-at", "--mtbf-budget"],
+    );
+    assert_bad_input(&["paper", "pendulum", "--task", "leo"], &["--task", "pada paper wear"]);
+    assert_bad_input(&["paper", "wear", "--task", "moon"], &["moon", "pendulum", "leo"]);
+}
