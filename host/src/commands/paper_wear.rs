@@ -78,7 +78,7 @@ pub fn run(args: PaperArgs) -> Result<(), CliError> {
         .iter()
         .filter_map(|c| {
             let g = c.summary.governor.as_ref()?;
-            Some(format!("{} {:.0} %", c.label, 100.0 * g.held_fraction))
+            Some(format!("{} {:.1} %", c.label, 100.0 * g.held_fraction))
         })
         .collect();
     outln!(

@@ -326,7 +326,7 @@ pub fn render(r: &WearResults, command: &str, wall_s: f64, workers: &str) -> Str
     for c in &r.configs {
         let m = &c.summary;
         let held = match &m.governor {
-            Some(g) => format!("{:.0} % ({:.0} % physical)", 100.0 * g.held_fraction, 100.0 * g.physical_held_fraction),
+            Some(g) => format!("{:.1} % ({:.1} % physical)", 100.0 * g.held_fraction, 100.0 * g.physical_held_fraction),
             None => "–".into(),
         };
         let strategy = match c.budget_s {
@@ -431,7 +431,7 @@ fn targets(s: &mut String, r: &WearResults) {
             let held = (g.held_fraction * n as f64).round() as u32;
             let _ = writeln!(
                 s,
-                "- {}: held in {held}/{n} trials ({:.0} %, target ≥ 90 %: {}), MTBF {}, {:.0} % of learning actions at the floor, {:.0} moves per trial.",
+                "- {}: held in {held}/{n} trials ({:.1} %, target ≥ 90 %: {}), MTBF {}, {:.0} % of learning actions at the floor, {:.0} moves per trial.",
                 c.label,
                 100.0 * g.held_fraction,
                 if g.held_fraction >= 0.9 { "met" } else { "**missed**" },

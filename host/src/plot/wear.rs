@@ -61,6 +61,8 @@ impl WearPareto {
             .map_err(plot_err)?;
         chart
             .configure_mesh()
+            .light_line_style(WHITE)
+            .x_labels(6)
             .x_desc("predicted MTBF over the first 1200 actions [s]")
             .y_desc("end performance")
             .x_label_formatter(&|v| format!("{v:.0}"))
@@ -127,7 +129,7 @@ impl WearPareto {
                 .label_font((FONT, 12))
                 .background_style(WHITE.mix(0.85))
                 .border_style(BLACK)
-                .position(SeriesLabelPosition::LowerLeft)
+                .position(SeriesLabelPosition::LowerRight)
                 .draw()
                 .map_err(plot_err)?;
         }
