@@ -390,3 +390,45 @@ fn mtbf_budget_errors_name_the_flag_and_the_range() {
     assert_bad_input(&["paper", "pendulum", "--task", "leo"], &["--task", "pada paper wear"]);
     assert_bad_input(&["paper", "wear", "--task", "moon"], &["moon", "pendulum", "leo"]);
 }
+
+#[test]
+fn paper_wear_writes_the_report_the_figures_and_a_plan() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("wear");
+    let args = ["paper", "wear", "--trials", "2", "--seconds", "60", "--out", out_dir.to_str().unwrap()];
+    let out = pada(&args);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let report = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
+    for needle in [
+        "# Learning on a wear budget (pendulum)",
+        "| strategy | parameters | MTBF [s] | physical MTBF [s] | end performance | rise time [s]",
+        "| pada + governor | budget 2594 s; mean Δ",
+        "| lowpass + governor | budget 3891 s; mean α",
+        "| ou | theta 0.150, sigma 0.400 |",
+        "| action-penalty | weight 3.000 |",
+        "## Pareto front, end performance against the paper's MTBF",
+        "## Pareto front, end performance against the physical MTBF",
+        "pada at a budget of 2594 s (2× SARSA(λ))",
+        "held in ",
+    ] {
+        assert!(report.contains(needle), "report.md lacks {needle:?}:\n{report}");
+    }
+    for f in ["summary.json", "configurations.csv", "timing.json", "wear-pareto.png", "wear-pareto.svg", "wear-curves.png"] {
+        assert!(out_dir.join(f).is_file(), "{f}");
+    }
+    let csv = std::fs::read_to_string(out_dir.join("configurations.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 23, "a header and 23 configurations");
+    // The same report from the same command.
+    let again = dir.path().join("again");
+    let mut args2 = args;
+    args2[7] = again.to_str().unwrap();
+    assert_eq!(pada(&args2).status.code(), Some(0));
+    assert_eq!(std::fs::read_to_string(again.join("report.md")).unwrap(), report);
+    // As a plan for a cluster: one trial file per trial.
+    let plan = dir.path().join("plan");
+    let out = pada(&["paper", "wear", "--trials", "2", "--seconds", "60", "--plan", plan.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let plan_json = std::fs::read_to_string(plan.join("plan.json")).unwrap();
+    assert!(plan_json.contains("\"paper-wear\"") && plan_json.contains("\"mtbf_budget_s\""), "{plan_json}");
+    assert_eq!(std::fs::read_dir(plan.join("trials")).unwrap().count(), 46);
+}

@@ -62,7 +62,7 @@ pub fn run(args: PaperArgs) -> Result<(), CliError> {
         Trials::Results(r, t) => (r, t),
     };
     let r = wear::assemble(&o, &experiment, per_config)?;
-    let report = wear::render(&r, &command, timing.wall_s, &timing.workers());
+    let report = wear::render(&r, &command);
     out.write_all(&[
         ("report.md".to_string(), report.into_bytes()),
         (

@@ -299,12 +299,13 @@ fn parameters(c: &WearResult) -> String {
     names.iter().zip(values).map(|(n, v)| format!("{n} {v:.3}")).collect::<Vec<_>>().join(", ")
 }
 
-/// report.md.
-pub fn render(r: &WearResults, command: &str, wall_s: f64, workers: &str) -> String {
+/// report.md: it depends only on the command (the wall time and threads
+/// are in timing.json), as `pada paper pendulum`'s.
+pub fn render(r: &WearResults, command: &str) -> String {
     let mut s = String::new();
     let sarsa = &r.configs[0].summary;
     let _ = writeln!(s, "# Learning on a wear budget ({})\n", r.task);
-    let _ = writeln!(s, "Command: `{command}` — {wall_s:.0} s wall, {workers}.\n");
+    let _ = writeln!(s, "Command: `{command}`\n");
     let _ = writeln!(
         s,
         "Every strategy over a short sweep and the wear governor (`--mtbf-budget`) on PADA and the \
