@@ -431,4 +431,15 @@ fn paper_wear_writes_the_report_the_figures_and_a_plan() {
     let plan_json = std::fs::read_to_string(plan.join("plan.json")).unwrap();
     assert!(plan_json.contains("\"paper-wear\"") && plan_json.contains("\"mtbf_budget_s\""), "{plan_json}");
     assert_eq!(std::fs::read_dir(plan.join("trials")).unwrap().count(), 46);
+    for i in 0..46 {
+        let out = pada(&["trial", "--plan", plan.to_str().unwrap(), "--index", &i.to_string()]);
+        assert_eq!(out.status.code(), Some(0), "trial {i}: {}", String::from_utf8_lossy(&out.stderr));
+    }
+    // The merge reports exactly what the local run reported.
+    let merged = dir.path().join("merged");
+    let out = pada(&[
+        "paper", "wear", "--trials", "2", "--seconds", "60", "--merge", plan.to_str().unwrap(), "--out", merged.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(std::fs::read_to_string(merged.join("report.md")).unwrap(), report);
 }
