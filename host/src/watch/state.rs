@@ -145,8 +145,13 @@ impl PolicyView {
         let mut label = crate::experiment::algo::label(&kind);
         if let Some(g) = &report.governor {
             label += &format!(
-                " (wear governor: budget {:.0} s, window MTBF {:.0} s over {} actions)",
-                g.budget_s, g.window_mtbf_s, g.window_steps
+                " (wear governor: budget {:.0} s, rung {}/{}, damage rate {:.3e} per s, window MTBF {:.0} s over {} actions)",
+                g.budget_s,
+                g.rung + 1,
+                g.rungs,
+                g.damage_rate,
+                g.window_mtbf_s,
+                g.window_steps
             );
         }
         if report.switched_to_sarsa {
