@@ -110,7 +110,7 @@ fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
     if args.json {
         outln!("{}", summary.to_json())?;
     } else {
-        print_summary(&summary.run, &label(&policy))?;
+        print_summary(&summary.run, &run_label(&policy, cfg.mtbf_budget_s))?;
         outln!(
             "  board                {}: {} {} weights ({} KiB, {}-bit) in {}",
             board.name(),
@@ -123,6 +123,11 @@ fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
         outln!("wrote {}", out.path().display())?;
     }
     Ok(())
+}
+
+/// The run's label: the policy, or the governed policy and its budget.
+fn run_label(policy: &pada_core::policy::PolicyKind, budget_s: Option<f32>) -> String {
+    crate::paper::wear::WearResult::label_of(policy, budget_s)
 }
 
 /// The policy of the flags, checked.
@@ -283,7 +288,7 @@ impl TaskVisitor for RunVisitor {
         if args.json {
             outln!("{}", summary.to_json())?;
         } else {
-            print_summary(&summary, &label(&policy))?;
+            print_summary(&summary, &run_label(&policy, cfg.mtbf_budget_s))?;
             outln!("wrote {}", out.path().display())?;
         }
         Ok(())
