@@ -30,5 +30,6 @@ pub mod qemu;
 pub mod replay;
 pub mod run;
 pub mod twin;
+pub mod wall;
 
 pub use run::{run, SilConfig, SilSummary, SilTask};

@@ -22,6 +22,7 @@
 //! `ClearFault` and `Start` again, as an operator would.
 
 use super::bus::{BusEmulator, BusStats, Reply};
+use super::wall::{Account, WallClock, WallTime};
 use super::fault::FaultSpec;
 use crate::rig::{LeoStandIn, PendulumRig, Rig, SUPPLY_V};
 use super::qemu::{Emulator, QemuSetup};
@@ -237,6 +238,8 @@ pub struct SilSummary {
     pub speedup: f64,
     /// Lock-step exchanges.
     pub exchanges: u64,
+    /// Where the wall-clock time of the lock-step loop went.
+    pub wall_time: WallTime,
     /// Instructions the firmware executed (outside its idle loop).
     pub instructions: u64,
     /// Learning episodes finished.
@@ -316,6 +319,8 @@ struct Session<'a> {
     resumed_after: Vec<u64>,
     exchanges: u64,
     instructions: u64,
+    wall: WallClock,
+    loop_s: f64,
     booted: bool,
     episodes_csv: csv::Writer<std::fs::File>,
     raw: std::io::BufWriter<std::fs::File>,
@@ -389,13 +394,17 @@ pub fn run(cfg: &SilConfig) -> anyhow::Result<SilSummary> {
         resumed_after: Vec::new(),
         exchanges: 0,
         instructions: 0,
+        wall: WallClock::default(),
+        loop_s: 0.0,
         booted: false,
         episodes_csv,
         raw: std::io::BufWriter::new(raw),
         sink,
         bar,
     };
+    let loop_started = Instant::now();
     let result = s.run_loop();
+    s.loop_s = loop_started.elapsed().as_secs_f64();
     let status = s.emu.stop();
     if let Some(bar) = &s.bar {
         bar.finish_and_clear();
@@ -467,7 +476,8 @@ impl Session<'_> {
             if let Some(m) = self.clock_queue.pop_front() {
                 return Ok(m);
             }
-            let chunk = match self.emu.clock_rx.recv_timeout(self.cfg.hang_timeout) {
+            let (rx, timeout) = (&self.emu.clock_rx, self.cfg.hang_timeout);
+            let chunk = match self.wall.time(Account::Board, || rx.recv_timeout(timeout)) {
                 Ok(c) => c,
                 Err(RecvTimeoutError::Timeout) => {
                     if let Some(st) = self.emu.exited() {
@@ -512,7 +522,8 @@ impl Session<'_> {
             } else {
                 &self.emu.bus_rx
             };
-            let chunk = rx.recv_timeout(self.cfg.hang_timeout).map_err(|_| {
+            let timeout = self.cfg.hang_timeout;
+            let chunk = self.wall.time(Account::Board, || rx.recv_timeout(timeout)).map_err(|_| {
                 anyhow!(
                     "{} bytes the board counted never arrived",
                     if telemetry { "telemetry" } else { "bus" }
@@ -585,12 +596,14 @@ impl Session<'_> {
                     self.exchanges += 1;
                     let bus_bytes = self.take(false, bus_tx)?;
                     if !bus_bytes.is_empty() {
-                        let replies = self.bus.receive(self.now_us, &bus_bytes, self.rig.as_mut());
+                        let (bus, rig, now) = (&mut self.bus, self.rig.as_mut(), self.now_us);
+                        let replies = self.wall.time(Account::Plant, || bus.receive(now, &bus_bytes, rig));
                         self.replies.extend(replies);
                         self.replies.sort_by_key(|r| r.at_us);
                     }
                     let tele_bytes = self.take(true, telemetry_tx)?;
                     if !tele_bytes.is_empty() {
+                        let t0 = Instant::now();
                         std::io::Write::write_all(&mut self.raw, &tele_bytes)?;
                         if let Some(sink) = self.sink.as_mut() {
                             sink.forward(&tele_bytes);
@@ -600,6 +613,8 @@ impl Session<'_> {
                         for f in frames {
                             self.on_frame(f)?;
                         }
+                        let spent = t0.elapsed();
+                        self.wall.add(Account::Telemetry, spent);
                     }
                     if self.phase == Phase::Done {
                         return Ok(());
@@ -915,6 +930,7 @@ impl Session<'_> {
             wall_s,
             speedup: if wall_s > 0.0 { self.now_s() / wall_s } else { 0.0 },
             exchanges: self.exchanges,
+            wall_time: self.wall.report(self.loop_s),
             instructions: self.instructions,
             learning_episodes: self.learning_episodes,
             first_test_return: returns.first().copied(),
