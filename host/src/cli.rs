@@ -48,6 +48,11 @@ pub enum Command {
     Watch(commands::watch::WatchArgs),
     /// Draw a learned LEO gait (saved weights) as a strip of stick figures.
     Render(RenderArgs),
+    /// The LEO model on its own: `pada leo passive` (the passive rollout).
+    Leo(commands::leo::LeoArgs),
+    /// Run one trial of a plan (written with --plan DIR), as a Slurm array
+    /// task or a Kubernetes indexed job.
+    Trial(commands::trial::TrialArgs),
 }
 
 /// Options shared by the commands that run trials.
@@ -123,6 +128,9 @@ pub struct RunArgs {
     /// Seed and threads.
     #[command(flatten)]
     pub trial: TrialOptions,
+    /// Plans, merges and Slurm (issue 14).
+    #[command(flatten)]
+    pub cluster: crate::plan::mode::ClusterOptions,
 }
 
 /// `pada render`.
@@ -199,6 +207,9 @@ pub struct PaperArgs {
     /// Seed and threads.
     #[command(flatten)]
     pub trial: TrialOptions,
+    /// Plans, merges and Slurm (issue 14).
+    #[command(flatten)]
+    pub cluster: crate::plan::mode::ClusterOptions,
 }
 
 /// `pada mtbf`.
@@ -259,6 +270,21 @@ fn clap_one_line(e: &clap::Error) -> String {
     line.strip_prefix("error: ").unwrap_or(&line).to_string()
 }
 
+/// The subcommands of `pada <parent>`, comma-separated (without `help`).
+fn subcommands_of(parent: &str) -> String {
+    use clap::CommandFactory;
+    Cli::command()
+        .find_subcommand(parent)
+        .map(|c| {
+            c.get_subcommands()
+                .map(|s| s.get_name().to_string())
+                .filter(|n| n != "help")
+                .collect::<Vec<_>>()
+                .join(", ")
+        })
+        .unwrap_or_default()
+}
+
 /// Parses `args` and runs the command. Help and version requests print and
 /// return `Ok`.
 pub fn run<I, T>(args: I) -> Result<(), CliError>
@@ -266,17 +292,36 @@ where
     I: IntoIterator<Item = T>,
     T: Into<OsString> + Clone,
 {
-    let cli = match Cli::try_parse_from(args) {
+    let args: Vec<OsString> = args.into_iter().map(Into::into).collect();
+    let cli = match Cli::try_parse_from(&args) {
         Ok(cli) => cli,
         Err(e) => {
             use clap::error::ErrorKind;
+            let nested = args.get(1).and_then(|a| a.to_str()).filter(|&a| a == "leo");
             return match e.kind() {
                 ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
                     let _ = e.print();
                     Ok(())
                 }
+                ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand | ErrorKind::MissingSubcommand
+                    if nested.is_some() =>
+                {
+                    let parent = nested.unwrap_or_default();
+                    Err(usage(format!(
+                        "pada {parent} needs a subcommand: valid is {} (see pada {parent} --help)",
+                        subcommands_of(parent)
+                    )))
+                }
+                ErrorKind::InvalidSubcommand if nested.is_some() => {
+                    let parent = nested.unwrap_or_default();
+                    Err(usage(format!(
+                        "{} of pada {parent}: valid is {}",
+                        clap_one_line(&e),
+                        subcommands_of(parent)
+                    )))
+                }
                 ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => Err(usage(
-                    "no command given: valid commands are run, demo, paper, mtbf, render, sil, capture, watch (see pada --help)",
+                    "no command given: valid commands are run, demo, paper, mtbf, render, sil, capture, watch, leo, trial (see pada --help)",
                 )),
                 _ => Err(usage(clap_one_line(&e))),
             };
@@ -291,5 +336,7 @@ where
         Command::Capture(a) => commands::capture::run(a),
         Command::Watch(a) => commands::watch::run(a),
         Command::Render(a) => commands::render::run(a),
+        Command::Leo(a) => commands::leo::run(a),
+        Command::Trial(a) => commands::trial::run(a),
     }
 }

@@ -84,13 +84,19 @@ pub struct RunSummary {
     pub learning_falls: Estimate,
     /// Falls in greedy test runs, per trial.
     pub test_falls: Estimate,
-    /// Wall-clock time of the run \[s\].
+    /// Wall-clock time of the run \[s\]; absent where it is not measured
+    /// (a configuration of `pada paper`, whose trials share one pool), so
+    /// that such a summary depends only on the seed.
+    #[serde(skip_serializing_if = "not_measured")]
     pub wall_s: f64,
     /// Environment steps (learning and test runs, all trials).
     pub env_steps: u64,
-    /// Environment steps per wall-clock second, all threads together.
+    /// Environment steps per wall-clock second, all threads together
+    /// (absent with `wall_s`).
+    #[serde(skip_serializing_if = "not_measured")]
     pub env_steps_per_s: f64,
-    /// Worker threads.
+    /// Worker threads (0 and absent where `wall_s` is not measured).
+    #[serde(skip_serializing_if = "no_threads")]
     pub threads: usize,
     /// Per-trial results.
     pub per_trial: Vec<TrialResult>,
@@ -155,7 +161,11 @@ impl RunSummary {
             } else {
                 f64::NAN
             },
-            threads: rayon::current_num_threads(),
+            threads: if wall_s.is_nan() {
+                0
+            } else {
+                rayon::current_num_threads()
+            },
             per_trial: results.to_vec(),
         }
     }
@@ -164,6 +174,14 @@ impl RunSummary {
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
     }
+}
+
+fn not_measured(x: &f64) -> bool {
+    x.is_nan()
+}
+
+fn no_threads(n: &usize) -> bool {
+    *n == 0
 }
 
 /// A trial's learning curve as CSV:

@@ -29,7 +29,7 @@ use crate::fixed::{Frac, Q16};
 use crate::policy::{uniform_below, Candidates, Policy, PolicyKind, PolicyState};
 use crate::tile_coding::{Layout, StateCode, StateDim, TileCoder, MAX_STATE_DIMS};
 use crate::trace::{Trace, TraceKind};
-use crate::weights::{entry_hash, WeightStore};
+use crate::weights::{entry_factor, WeightStore};
 use heapless::Vec;
 use rand_core::RngCore;
 
@@ -740,8 +740,8 @@ where
                     let old = weights.raw(i);
                     saturations += weights.add(i, inc, dither) as u32;
                     if let Some(c) = checksum.as_mut() {
-                        let new = weights.raw(i);
-                        *c = c.wrapping_add(entry_hash(i, new)).wrapping_sub(entry_hash(i, old));
+                        let change = weights.raw(i).wrapping_sub(old);
+                        *c = c.wrapping_add(change.wrapping_mul(entry_factor(i)));
                     }
                 }
             }

@@ -104,29 +104,27 @@ pub trait WeightStore {
     /// `i16` of a 16-bit one, sign-extended), 0 outside the table.
     fn raw(&self, i: usize) -> u32;
 
-    /// The table's checksum ([`entry_hash`] summed over every weight): equal
-    /// on every machine for equal tables, and cheap to keep up to date one
-    /// write at a time ([`crate::agent::Agent`] does), so that a board with
-    /// millions of weights need not read them all at every episode's end.
+    /// The table's checksum, `Σ raw(i) · entry_factor(i)` (wrapping,
+    /// [`entry_factor`]): equal on every machine for equal tables, and cheap
+    /// to keep up to date one write at a time ([`crate::agent::Agent`]
+    /// does), so that a board with millions of weights need not read them
+    /// all at every episode's end.
     fn checksum(&self) -> u32 {
-        (0..self.len()).fold(0u32, |sum, i| sum.wrapping_add(entry_hash(i, self.raw(i))))
+        (0..self.len()).fold(0u32, |sum, i| sum.wrapping_add(self.raw(i).wrapping_mul(entry_factor(i))))
     }
 }
 
-/// One weight's share of the table checksum: MurmurHash3's 32-bit
-/// finaliser of its index and stored bits. The checksum is the wrapping sum
-/// of these, so a write changes it by `entry_hash(i, new) −
-/// entry_hash(i, old)`; a sum of well-mixed terms still detects any single
-/// change and, with overwhelming probability, any divergence of two
-/// learners.
+/// The multiplier of weight `i` in the table checksum: `(2i + 1)·φ`, with
+/// φ = 0x9E37_79B9 (the golden ratio's 32-bit fraction), odd for every `i`.
+/// The checksum is `Σ raw_i · entry_factor(i)` (wrapping), linear in each
+/// weight, so a write changes it by `(new − old) · entry_factor(i)`: one
+/// multiplication, which the chip can afford on every weight write. An odd
+/// factor is invertible modulo 2³², so any single change of a weight
+/// changes the checksum; it is a check that two learners stayed the same
+/// (a replay), not a cryptographic hash.
 #[inline]
-pub fn entry_hash(i: usize, raw: u32) -> u32 {
-    let mut h = (i as u32).wrapping_mul(0x9E37_79B1) ^ raw.wrapping_mul(0x85EB_CA77);
-    h ^= h >> 16;
-    h = h.wrapping_mul(0x85EB_CA6B);
-    h ^= h >> 13;
-    h = h.wrapping_mul(0xC2B2_AE35);
-    h ^ (h >> 16)
+pub fn entry_factor(i: usize) -> u32 {
+    (2 * i as u32).wrapping_add(1).wrapping_mul(0x9E37_79B9)
 }
 
 impl<T: AsRef<[Q16]> + AsMut<[Q16]> + ?Sized> WeightStore for T {
@@ -434,5 +432,24 @@ mod tests {
         let mut g = Half::<_, 12>::new([0i16; 3]);
         g.load_le(1, &b);
         assert_eq!(g.data, [0, -2, 0]);
+    }
+
+    #[test]
+    fn the_checksum_sees_any_single_change_and_is_the_running_sum() {
+        let mut t = [Q16::ZERO; 64];
+        for (i, w) in t.iter_mut().enumerate() {
+            *w = Q16((i as i32 - 30) * 977);
+        }
+        let base = t.checksum();
+        for i in [0usize, 1, 31, 63] {
+            for delta in [1i32, -1, 2, 1 << 16, i32::MIN] {
+                let mut u = t;
+                u[i] = Q16(u[i].0.wrapping_add(delta));
+                assert_ne!(u.checksum(), base, "weight {i} changed by {delta}");
+                // The running update of one write gives the whole sum.
+                let change = (u[i].0 as u32).wrapping_sub(t[i].0 as u32);
+                assert_eq!(base.wrapping_add(change.wrapping_mul(entry_factor(i))), u.checksum());
+            }
+        }
     }
 }

@@ -2,10 +2,12 @@
 
 pub mod capture;
 pub mod demo;
+pub mod leo;
 pub mod mtbf;
 pub mod paper;
 pub mod paper_leo;
 pub mod render;
 pub mod run;
 pub mod sil;
+pub mod trial;
 pub mod watch;

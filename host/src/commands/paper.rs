@@ -10,9 +10,11 @@ use crate::paper::figure_data::{curves, point};
 use crate::paper::numbers::{PHYS_TRIALS, SIM_TRIALS};
 use crate::paper::pendulum::{self, ConfigResult, PendulumOptions, PendulumResults};
 use crate::paper::report;
+use crate::plan::mode::{obtain, Trials};
 use crate::plot::figures::{LearningCurves, Measure, MtbfSweep, PerformanceVsMtbf, SweepPoint};
 use crate::plot::save;
 use crate::progress::steps_bar;
+use crate::timing::RunTiming;
 
 /// Runs `pada paper`.
 pub fn run(args: PaperArgs) -> Result<(), CliError> {
@@ -36,11 +38,8 @@ fn pendulum_cmd(args: PaperArgs) -> Result<(), CliError> {
             .clone()
             .unwrap_or_else(|| "pada-out/paper-pendulum".into()),
     )?;
+    let mode = args.cluster.mode(out.path())?;
     set_threads(args.trial.threads)?;
-
-    let bar = steps_bar(pendulum::expected_steps(&options), "Section VII");
-    let results = pendulum::run(&options, &|n| bar.inc(n))?;
-    bar.finish_and_clear();
 
     let mut command = format!("pada paper pendulum --seed {}", options.seed);
     if let Some(t) = args.trials {
@@ -52,6 +51,18 @@ fn pendulum_cmd(args: PaperArgs) -> Result<(), CliError> {
     if options.phys_seconds != 1500.0 {
         command += &format!(" --physical-seconds {}", options.phys_seconds);
     }
+    let experiment = pendulum::experiment(&options, command.clone());
+    let (per_config, timing) = match obtain(&mode, &experiment, false, || {
+        let bar = steps_bar(pendulum::expected_steps(&options), "Section VII");
+        let r = pendulum::run_local(&experiment, &|n| bar.inc(n));
+        bar.finish_and_clear();
+        r
+    })? {
+        Trials::PlanWritten => return Ok(()),
+        Trials::Results(r, t) => (r, t),
+    };
+    let results = pendulum::assemble(&options, &experiment, per_config)?;
+
     let report = report::render(&results, &command);
     let files = vec![
         ("report.md".to_string(), report.clone().into_bytes()),
@@ -65,6 +76,7 @@ fn pendulum_cmd(args: PaperArgs) -> Result<(), CliError> {
             configs_csv(&results.simulated)?,
         ),
         ("physical.csv".to_string(), configs_csv(&results.physical)?),
+        ("timing.json".to_string(), timing.to_json()),
         (
             "physical-curves.csv".to_string(),
             curves_csv(&results.physical)?,
@@ -76,24 +88,24 @@ fn pendulum_cmd(args: PaperArgs) -> Result<(), CliError> {
     ];
     out.write_all(&files)?;
     draw_figures(&results, &out)?;
-    outln!("{}", headline(&results))?;
+    outln!("{}", headline(&results, &timing))?;
     outln!("wrote {}/report.md and the figures", out.path().display())?;
     Ok(())
 }
 
 /// A few lines for the terminal.
-fn headline(r: &PendulumResults) -> String {
+fn headline(r: &PendulumResults, t: &RunTiming) -> String {
     let s = &r.simulated[0].summary;
     format!(
-        "SARSA(λ): end {:.0} ± {:.0} (paper −851 ± 39), rise {:.0} ± {:.0} s (paper 681 ± 67), MTBF {:.0} ± {:.0} s (paper 1596 ± 34); {:.1} s wall on {} threads",
+        "SARSA(λ): end {:.0} ± {:.0} (paper −851 ± 39), rise {:.0} ± {:.0} s (paper 681 ± 67), MTBF {:.0} ± {:.0} s (paper 1596 ± 34); {:.1} s wall, {}",
         s.end_performance.mean,
         s.end_performance.ci95,
         s.rise_time_s.mean,
         s.rise_time_s.ci95,
         s.mtbf_s.mean,
         s.mtbf_s.ci95,
-        r.wall_s,
-        r.threads
+        t.wall_s,
+        t.workers()
     )
 }
 

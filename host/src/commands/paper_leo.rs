@@ -11,6 +11,7 @@ use crate::output::OutDir;
 use crate::paper::figure_data::{curves, point};
 use crate::paper::leo::{self, LeoOptions, LeoResults};
 use crate::paper::objective::Objective;
+use crate::plan::mode::{obtain, Trials};
 use crate::plot::figures::{LearningCurves, Measure, PerformanceVsMtbf, SweepPoint};
 use crate::plot::save;
 use crate::progress::steps_bar;
@@ -32,14 +33,30 @@ pub fn run(args: PaperArgs) -> Result<(), CliError> {
             .clone()
             .unwrap_or_else(|| "pada-out/paper-leo".into()),
     )?;
+    let mode = args.cluster.mode(out.path())?;
     set_threads(args.trial.threads)?;
-    let bar = steps_bar(leo::expected_steps(&o), "Section VIII (LEO)");
-    let (r, best) = leo::run(&o, &|n| bar.inc(n))?;
-    bar.finish_and_clear();
     let command = format!(
         "pada paper leo --trials {} --seconds {} --seed {}",
         o.trials, o.seconds, o.seed
     );
+    let experiment = leo::experiment(&o, command.clone());
+    let mut kept = None;
+    let (per_config, timing) = match obtain(&mode, &experiment, false, || {
+        let bar = steps_bar(leo::expected_steps(&o), "Section VIII (LEO)");
+        let (r, best) = leo::run_local(&experiment, &|n| bar.inc(n))?;
+        bar.finish_and_clear();
+        kept = Some(best);
+        Ok(r)
+    })? {
+        Trials::PlanWritten => return Ok(()),
+        Trials::Results(r, t) => (r, t),
+    };
+    let best = match (kept, mode.plan_dir()) {
+        (Some(best), _) => best,
+        (None, Some(dir)) => leo::best_of_plan(dir, &experiment, &per_config)?,
+        (None, None) => leo::rerun_best(&experiment, &per_config)?,
+    };
+    let r = leo::assemble(&o, &experiment, per_config)?;
     let report = render(&r, &command);
     out.write_all(&[
         ("report.md".to_string(), report.clone().into_bytes()),
@@ -47,6 +64,7 @@ pub fn run(args: PaperArgs) -> Result<(), CliError> {
             "summary.json".to_string(),
             (serde_json::to_string_pretty(&r).map_err(anyhow::Error::from)? + "\n").into_bytes(),
         ),
+        ("timing.json".to_string(), timing.to_json()),
     ])?;
     draw(&r, &out)?;
     // The gait of the best learner of the whole run: its weights and 10 s
@@ -72,6 +90,12 @@ pub fn run(args: PaperArgs) -> Result<(), CliError> {
         outln!("{title}")?;
     }
     outln!("{report}")?;
+    outln!(
+        "{:.0} s wall, {}, {:.0} environment steps/s",
+        timing.wall_s,
+        timing.workers(),
+        timing.env_steps_per_s
+    )?;
     outln!(
         "wrote {}/report.md, the figures, best.weights and the gait (gait.svg/png, gait-animation.svg)",
         out.path().display()
@@ -101,16 +125,13 @@ pub fn render(r: &LeoResults, command: &str) -> String {
     let _ = writeln!(s, "Command: `{command}`\n");
     let _ = writeln!(
         s,
-        "Scale: {} trials × {} s of learning per configuration (paper: {} trials × {} s), {} configurations, {:.0} s wall on {} threads, {} environment steps ({:.0} steps/s).\n",
+        "Scale: {} trials × {} s of learning per configuration (paper: {} trials × {} s), {} configurations, {} environment steps. (Wall time and threads: timing.json; this report depends only on the command, so a run merged from a cluster's results gives the same bytes.)\n",
         r.options.trials,
         r.options.seconds,
         leo::PAPER_TRIALS,
         leo::PAPER_SECONDS,
         r.configs.len(),
-        r.wall_s,
-        r.threads,
         r.env_steps,
-        r.env_steps as f64 / r.wall_s
     );
     let _ = writeln!(
         s,

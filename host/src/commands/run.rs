@@ -5,7 +5,7 @@ use crate::console::outln;
 use crate::cli::{check_seconds, set_threads, RunArgs};
 use crate::display::{fmt_estimate, fmt_mtbf};
 use crate::error::{usage, CliError};
-use crate::experiment::algo::{label, policy_kind, Algo};
+use crate::experiment::algo::{label, parameter_of, policy_kind, Algo};
 use crate::board::trial::table_len;
 use crate::board::{robot_of_task, run_board};
 use crate::experiment::task::{Task, TaskSpec};
@@ -17,8 +17,10 @@ use pada_core::profile::{Board, TILINGS};
 use pada_core::robot::Robot;
 use pada_core::tile_coding::Layout;
 use pada_core::weights::WeightFormat;
-use crate::experiment::{build_agent, run_trials, run_trials_observed, RunConfig};
+use crate::experiment::{build_agent, run_trials, run_trials_observed, RunConfig, TrialResult};
 use crate::output::OutDir;
+use crate::plan::mode::{obtain, Mode, Trials};
+use crate::plan::{Experiment, ExperimentKind};
 use crate::progress::steps_bar;
 use crate::summary::{run_files, RunSummary};
 use crate::telemetry::{parse_target, TelemetrySink};
@@ -43,6 +45,13 @@ fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
                 "{flag} is not available with --board (the board streams its own telemetry: `pada sil --telemetry`)"
             )));
         }
+    }
+    if args.cluster.plan.is_some() || args.cluster.merge.is_some() || args.cluster.slurm {
+        // A plan's configurations leave room for a board (plan::Configuration::board),
+        // but its trials run on the host's learner only, so far.
+        return Err(usage(
+            "--plan, --merge and --slurm run the host's learner: they do not combine with --board yet",
+        ));
     }
     let mut profile = board.profile(robot);
     let format = match args.weight_bits.as_deref() {
@@ -156,54 +165,78 @@ impl TaskVisitor for RunVisitor {
             .clone()
             .unwrap_or_else(|| PathBuf::from(format!("pada-out/run-{}-{}", spec.name, args.algo)));
         let out = OutDir::check(&out_path)?;
+        let mode = args.cluster.mode(out.path())?;
+        if mode != Mode::Local && (args.telemetry.is_some() || args.save_weights.is_some()) {
+            return Err(usage(
+                "--telemetry and --save-weights need the trials in this process: they do not combine with --plan, --merge or --slurm",
+            ));
+        }
         let mut telemetry = match &args.telemetry {
             Some(t) => Some(TelemetrySink::open(&parse_target(t)?)?),
             None => None,
         };
         set_threads(args.trial.threads)?;
 
-        let total = cfg.trials as u64
-            * cfg.expected_steps(
-                spec.control_period_s,
-                spec.episode_steps,
-                spec.test_interval,
-            );
-        let bar = steps_bar(total, &format!("{} {}", spec.name, label(&policy)));
-        let start = Instant::now();
-        let results = if telemetry.is_none() && args.save_weights.is_none() {
-            run_trials(task, &cfg, &|n| bar.inc(n))?
-        } else {
-            let weight_count = build_agent(spec, policy)?.weights().len() as u32;
-            let mut observer = telemetry.as_mut().map(|sink| {
-                sink.send(&ToHost::Hello(wire::Hello {
-                    protocol: wire::PROTOCOL_VERSION,
-                    // 0: a host run, not a firmware configuration.
-                    config_hash: 0,
-                    weight_count,
-                    period_us: (spec.control_period_s * 1e6).round() as u32,
-                    state_dims: spec.state.len() as u8,
-                    joints: spec.motor.dims() as u8,
-                }));
-                move |msg: ToHost| sink.send(&msg)
-            });
-            let (results, agent, switched) = run_trials_observed(
-                task,
-                &cfg,
-                &|n| bar.inc(n),
-                observer
-                    .as_mut()
-                    .map(|o| o as &mut (dyn FnMut(ToHost) + Send)),
-            )?;
-            if let Some(path) = &args.save_weights {
-                crate::weights::save(path, spec, cfg.policy, switched, &agent)?;
-            }
-            results
+        let experiment = Experiment::new(
+            ExperimentKind::Run,
+            command_line(&args, &cfg),
+            &[(args.task, cfg)],
+        );
+        let local = || -> anyhow::Result<Vec<Vec<TrialResult>>> {
+            let total = cfg.trials as u64
+                * cfg.expected_steps(
+                    spec.control_period_s,
+                    spec.episode_steps,
+                    spec.test_interval,
+                );
+            let bar = steps_bar(total, &format!("{} {}", spec.name, label(&policy)));
+            let results = if telemetry.is_none() && args.save_weights.is_none() {
+                run_trials(task, &cfg, &|n| bar.inc(n))?
+            } else {
+                let weight_count = build_agent(spec, policy)?.weights().len() as u32;
+                let mut observer = telemetry.as_mut().map(|sink| {
+                    sink.send(&ToHost::Hello(wire::Hello {
+                        protocol: wire::PROTOCOL_VERSION,
+                        // 0: a host run, not a firmware configuration.
+                        config_hash: 0,
+                        weight_count,
+                        period_us: (spec.control_period_s * 1e6).round() as u32,
+                        state_dims: spec.state.len() as u8,
+                        joints: spec.motor.dims() as u8,
+                    }));
+                    move |msg: ToHost| sink.send(&msg)
+                });
+                let (results, agent, switched) = run_trials_observed(
+                    task,
+                    &cfg,
+                    &|n| bar.inc(n),
+                    observer
+                        .as_mut()
+                        .map(|o| o as &mut (dyn FnMut(ToHost) + Send)),
+                )?;
+                if let Some(path) = &args.save_weights {
+                    crate::weights::save(path, spec, cfg.policy, switched, &agent)?;
+                }
+                results
+            };
+            bar.finish_and_clear();
+            Ok(vec![results])
         };
-        let wall = start.elapsed().as_secs_f64();
-        bar.finish_and_clear();
+        let (mut per_config, timing) = match obtain(&mode, &experiment, args.json, local)? {
+            Trials::PlanWritten => return Ok(()),
+            Trials::Results(r, t) => (r, t),
+        };
+        let results = per_config.pop().unwrap_or_default();
 
-        let summary = RunSummary::new(spec, &cfg, &results, wall);
-        out.write_all(&run_files(&summary)?)?;
+        let mut summary = RunSummary::new(spec, &cfg, &results, timing.wall_s);
+        // From a plan: the most trials that ran at once, not this process's
+        // thread pool.
+        summary.threads = timing.threads;
+        let mut files = run_files(&summary)?;
+        if mode != Mode::Local {
+            files.push(("timing.json".to_string(), timing.to_json()));
+        }
+        out.write_all(&files)?;
         if let Some(sink) = telemetry {
             let totals = sink.finish()?;
             if !args.json {
@@ -221,6 +254,24 @@ impl TaskVisitor for RunVisitor {
         }
         Ok(())
     }
+}
+
+/// The command line that describes a run, with every value explicit (a
+/// plan's identity, and the merge command it prints).
+fn command_line(args: &RunArgs, cfg: &RunConfig) -> String {
+    let mut c = format!("pada run --task {} --algo {}", args.task, args.algo);
+    match parameter_of(&cfg.policy) {
+        Some(a) if args.algo.takes_alpha() => c += &format!(" --alpha {a}"),
+        Some(d) => c += &format!(" --delta {d}"),
+        None => {}
+    }
+    if let Some(s) = cfg.switch_at_s {
+        c += &format!(" --switch-at {s}");
+    }
+    c + &format!(
+        " --trials {} --seconds {} --seed {}",
+        cfg.trials, cfg.seconds, cfg.seed
+    )
 }
 
 /// A short human-readable summary.

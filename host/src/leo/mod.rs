@@ -20,7 +20,9 @@
 pub mod constants;
 pub mod gait;
 pub mod model;
+pub mod passive;
 pub mod rl;
+pub mod stiction;
 /// The walking task's rules (§3): the robot's one definition in pada-core,
 /// shared with the firmware.
 pub use pada_core::robot::leo as task;

@@ -5,32 +5,38 @@
 //!
 //! - **Planar motion** (§1.4: GRL keeps LEO planar only by symmetry). Here
 //!   the robot is one reduced-coordinate multibody whose root is a fixed
-//!   anchor and whose first joint is a planar joint (free: x, z translation
-//!   and rotation about y; locked: y translation, rotation about x and z).
-//!   Out-of-plane motion has no coordinate at all, so it cannot drift.
+//!   anchor and whose first joint is free in x, z and pitch, locked in roll
+//!   and yaw, and held at y = 0 by a stiff implicit spring (the lateral tie,
+//!   [`LATERAL_TIE`]: with y locked outright rapier's contact friction
+//!   fails, see there). Out-of-plane rotation has no coordinate at all.
 //! - **The boom** (§1.4) is folded into the torso's mass, CoM and inertia
 //!   (see the constants) plus the extra vertical force, applied at its torso
 //!   point every physics step. GRL's massless `virtualBoom` body is not
-//!   needed: the planar joint's angle is the torso pitch.
+//!   needed: the root joint's angle is the torso pitch.
 //! - **Hinges** (§1.5) are revolute multibody joints about −y, so that
 //!   rapier's joint coordinate equals ODE's q = θ_parent − θ_child (§1.2).
-//! - **Soft joint stops** (§1.5): when a joint is beyond a limit, a
-//!   force-based motor on the joint pulls it back with the stop's spring K
-//!   and (while the joint moves further in) damper D. Rapier solves the
-//!   motor implicitly, which is what ODE's ERP/CFM limit with the same K and
-//!   D does; it is switched per physics step, so the stop never pulls a
-//!   joint into the limit.
+//! - **Soft joint stops** (§1.5): when a joint is beyond a limit, rapier's
+//!   implicit joint spring pulls it back with the stop's K, and (while the
+//!   joint moves further in) the damper D is added to the joint's implicit
+//!   damping: what ODE's ERP/CFM limit with the same K and D does. Switched
+//!   per physics step, so the stop never pulls a joint into the limit.
 //! - **RX-28 servos** (§2.1) in their rigid-armature form
 //!   ([`pada_core::rx28::ReducedJoint`]): the reflected rotor inertia is the
 //!   multibody's per-DoF armature, the back-EMF is its per-DoF (implicit)
-//!   damping, the dry friction of 0.2 N m is its per-DoF friction loss (a
-//!   velocity constraint bounded by the friction torque, exactly ODE's
-//!   "motor with target velocity 0 and maximum torque 0.2"), and the held
-//!   voltage becomes a constant joint torque η·G·k·U/R over the control
-//!   period, applied as opposite torques on the two bodies of the joint.
+//!   damping, and the held voltage becomes a constant joint torque
+//!   η·G·k·U/R over the control period, applied as opposite torques on the
+//!   two bodies of the joint.
+//! - **Dry friction** of 0.2 N m (§1.5, ODE's "motor with target velocity
+//!   0 and maximum torque 0.2"): stick and slip per joint
+//!   ([`super::stiction`]); a held joint is tied to its angle by a stiff
+//!   implicit spring, a sliding one feels the constant friction torque.
+//!   Rapier's own per-DoF friction loss is the same constraint as ODE's but
+//!   its solver leaves a held joint creeping at a rate set by the step.
 //! - **Contacts** (§1.6–1.7): balls on the bodies, the floor a half-space
 //!   z ≤ 0; only robot–floor pairs collide (collision groups). Friction uses
 //!   the minimum of the two coefficients (floor 100, rubber 100, foam 10).
+//!   The contacts are stiff (rigid in effect), not the reference's soft
+//!   springs: see [`CONTACT_NATURAL_FREQUENCY`].
 //!
 //! The step size, solver iterations and contact softness are chosen in
 //! `README.md` next to this file.
@@ -43,6 +49,30 @@ use pada_core::rx28::ReducedJoint;
 use rapier3d::prelude::*;
 
 use super::constants::*;
+use super::stiction::{FrictionState, Stiction};
+
+/// Index of a revolute joint's free axis (rotation about its local x) in
+/// rapier's 6-DoF spatial layout, for the joint springs.
+const ANGULAR_X: usize = 3;
+/// Index of the lateral (y) translation in rapier's spatial layout.
+const LINEAR_Y: usize = 1;
+
+/// The lateral tie of the root: stiffness (N/m) and damping (N s/m) of an
+/// implicit spring that holds the robot at y = 0.
+///
+/// Why y is a DoF at all: with y locked, the contacts' out-of-plane
+/// friction direction has no mobility, and rapier's solver divides by a
+/// rounding error there (1/(J·M⁻¹·Jᵀ) of a row that should be 0 but is
+/// not once the bodies are pitched). The resulting impulses fill the whole
+/// friction cone, which rapier caps as one 2-D vector, so nothing was left
+/// for the in-plane direction: the standing robot slid under a 1 N push as
+/// if the floor had no friction, whatever μ (measured, `README.md`). With y
+/// free and tied, that row has the robot's mass behind it. The tie is the
+/// boom's lateral stiffness in spirit but not a fact of the reference:
+/// 1e7 N/m moves LEO (≈ 2.3 kg) by 0.5 µm under a 5 N side push, and the
+/// damper (≈ 2·√(k·m)) keeps it from ringing; rapier integrates both
+/// implicitly, so they are stable at any step.
+const LATERAL_TIE: [f32; 2] = [1.0e7, 1.0e4];
 
 /// The eight bodies of LEO (§1.3; GRL's `virtualBoom` is not needed).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -326,7 +356,7 @@ pub struct ModelOptions {
     /// `LeoModel::correct_motor_lag`); on by default.
     pub motor_lag_correction: bool,
     /// Weld the torso to the world in its starting pose instead of the
-    /// planar joint (for the energy and joint-limit checks: the legs and
+    /// root joint (for the energy and joint-limit checks: the legs and
     /// the arm become a tree of pendulums).
     pub fixed_torso: bool,
 }
@@ -476,6 +506,9 @@ pub struct LeoModel {
     built: Option<(Snapshot, InitialPose)>,
     /// Whether rapier has stepped (its mass-matrix factorisation exists).
     stepped: bool,
+    /// The servos' dry friction (§1.5) and each joint's stick/slip state.
+    friction: Stiction,
+    friction_states: [FrictionState; NUM_JOINTS],
     /// A constant external force and torque (world frame) on one body.
     disturbance: Option<(Body, [f32; 3], [f32; 3])>,
 }
@@ -495,12 +528,16 @@ pub struct Snapshot {
     voltages: [f32; NUM_JOINTS],
     time: f64,
     stepped: bool,
+    friction_states: [FrictionState; NUM_JOINTS],
 }
 
-/// The DoF order of the planar root joint: x, z, pitch.
+/// The DoF order of the root joint: x, y (the lateral tie), z, pitch.
 const ROOT_X: usize = 0;
-const ROOT_Z: usize = 1;
-const ROOT_PITCH: usize = 2;
+const ROOT_Y: usize = 1;
+const ROOT_Z: usize = 2;
+const ROOT_PITCH: usize = 3;
+/// The root's free DoFs.
+const ROOT_DOFS: usize = 4;
 
 impl LeoModel {
     /// Builds LEO in `pose` at rest, voltages 0 (§1.8).
@@ -525,6 +562,14 @@ impl LeoModel {
         // The default recycles contacts until a pair moved 5 cm, far more
         // than LEO's 3.5 mm wheels allow.
         p.contact_recycling = false;
+        // Contact friction in both solver passes, not only the relaxing one:
+        // the positions are integrated after the biased pass, and without
+        // friction there the stance foot crept backwards under the falling
+        // robot (0.4 mm in 0.3 s at 4 steps per period, 9 mm at 1; with it
+        // < 0.02 mm at every step, test `the_stance_foot_does_not_slide_on_
+        // the_floor`). Rapier leaves it off by default for tall stacks of
+        // loose boxes, which LEO is not.
+        p.friction_in_bias_pass = true;
 
         let robot_groups =
             InteractionGroups::new(Group::GROUP_1, Group::GROUP_2, InteractionTestMode::And);
@@ -583,11 +628,10 @@ impl LeoModel {
                 .contacts_enabled(false)
                 .build()
         } else {
-            GenericJointBuilder::new(
-                JointAxesMask::LIN_Y | JointAxesMask::ANG_X | JointAxesMask::ANG_Z,
-            )
-            .contacts_enabled(false)
-            .build()
+            // y stays a DoF, held by the lateral tie (see `LATERAL_TIE`).
+            GenericJointBuilder::new(JointAxesMask::ANG_X | JointAxesMask::ANG_Z)
+                .contacts_enabled(false)
+                .build()
         };
         world
             .multibody_joints
@@ -641,7 +685,7 @@ impl LeoModel {
         // the multibody has looked at its body type.
         mb.forward_kinematics(&world.bodies, true);
         let root_link = torso_link.id;
-        let root_dofs = if options.fixed_torso { 0 } else { 3 };
+        let root_dofs = if options.fixed_torso { 0 } else { ROOT_DOFS };
         let root_dof = mb
             .link(root_link)
             .ok_or(ModelError::Topology)?
@@ -657,11 +701,11 @@ impl LeoModel {
         // damping of 0.1 on angular DoFs is removed as well).
         mb.damping_mut().fill(0.0);
         mb.armature_mut().fill(0.0);
+        // The dry friction is not rapier's friction loss (see `stiction`).
         mb.frictions_mut().fill(0.0);
         for &d in &dofs {
             mb.damping_mut()[d] = servo.damping;
             mb.armature_mut()[d] = servo.armature;
-            mb.frictions_mut()[d] = servo.dry_friction;
         }
         // Joint coordinates of the pose: the multibody starts at zero
         // coordinates, so the pose is a displacement.
@@ -670,7 +714,13 @@ impl LeoModel {
             mb.link_mut(root_link)
                 .ok_or(ModelError::Topology)?
                 .joint
-                .apply_displacement(&[torso[0], torso[1], pitch[Body::Torso as usize]]);
+                .apply_displacement(&[torso[0], 0.0, torso[1], pitch[Body::Torso as usize]]);
+            // The lateral tie: a stiff implicit spring and damper at y = 0.
+            mb.link_mut(root_link)
+                .ok_or(ModelError::Topology)?
+                .joint
+                .set_spring(LINEAR_Y, LATERAL_TIE[0], 0.0);
+            mb.damping_mut()[root_dof + ROOT_Y] = LATERAL_TIE[1];
         }
         let angles = pose.joint_angles();
         for k in 0..NUM_JOINTS {
@@ -697,6 +747,8 @@ impl LeoModel {
             time: 0.0,
             built: None,
             stepped: false,
+            friction: Stiction::new(servo.dry_friction),
+            friction_states: held_at(&pose.joint_angles()),
             disturbance: None,
         };
         model.built = Some((model.snapshot(), *pose));
@@ -722,6 +774,7 @@ impl LeoModel {
             voltages: self.voltages,
             time: self.time,
             stepped: self.stepped,
+            friction_states: self.friction_states,
         }
     }
 
@@ -740,6 +793,7 @@ impl LeoModel {
         self.voltages = snapshot.voltages;
         self.time = snapshot.time;
         self.stepped = snapshot.stepped;
+        self.friction_states = snapshot.friction_states;
     }
 
     /// Puts the robot into `pose` at rest with 0 V and time 0, as if just
@@ -782,6 +836,7 @@ impl LeoModel {
             let c = root.joint.coords();
             root.joint.apply_displacement(&[
                 root_target[0] - c[0],
+                -c[1],
                 root_target[1] - c[2],
                 root_target[2] - c[4],
             ]);
@@ -796,7 +851,13 @@ impl LeoModel {
         mb.generalized_velocity_mut().fill(0.0);
         mb.forward_kinematics(&self.world.bodies, false);
         mb.update_rigid_bodies(&mut self.world.bodies, true);
+        self.friction_states = held_at(&angles);
         Ok(())
+    }
+
+    /// Each joint's dry-friction state ([`Joint`] order).
+    pub fn friction_states(&self) -> [FrictionState; NUM_JOINTS] {
+        self.friction_states
     }
 
     /// The options the model was built with.
@@ -908,8 +969,9 @@ impl LeoModel {
         let (angles, rates) = self.joint_state();
         let root = mb.link(self.root_link).map(|l| l.joint.coords());
         let (x, z, pitch) = match (root, self.root_dof) {
-            // Free DoFs of the planar joint: coords[0] = x, coords[2] = z,
-            // coords[4] = rotation about y (not wrapped).
+            // Coordinates of the root joint: coords[0] = x, coords[1] = y
+            // (the lateral tie's), coords[2] = z, coords[4] = rotation
+            // about y (not wrapped).
             (Some(c), Some(_)) => (c[0], c[2], c[4]),
             _ => {
                 let pose = self.body_pose(Body::Torso);
@@ -920,7 +982,7 @@ impl LeoModel {
         let clear = self.foot_clearances();
         RawState {
             torso_pitch: pitch,
-            torso_rate: self.root_velocity()[ROOT_PITCH],
+            torso_rate: self.root_velocity()[2],
             torso_position: [x, z],
             angles,
             rates,
@@ -953,6 +1015,7 @@ impl LeoModel {
             }
             if let Some(r) = root_dof {
                 v[r + ROOT_X] = root[0];
+                v[r + ROOT_Y] = 0.0;
                 v[r + ROOT_Z] = root[1];
                 v[r + ROOT_PITCH] = root[2];
             }
@@ -1000,6 +1063,21 @@ impl LeoModel {
             let p = self.body_point(Body::Torso, BOOM_FORCE_POINT);
             potential += (-BOOM_EXTRA_FORCE_Z * p[1]) as f64;
         }
+        // The lateral tie's spring and the friction ties' springs.
+        if self.root_dof.is_some() {
+            let y = mb
+                .link(self.root_link)
+                .map_or(0.0, |l| l.joint.coords()[LINEAR_Y]);
+            potential += 0.5 * (LATERAL_TIE[0] * y * y) as f64;
+        }
+        for k in 0..NUM_JOINTS {
+            if let (FrictionState::Stick { anchor }, true) =
+                (self.friction_states[k], self.friction.is_active())
+            {
+                let d = q[k] - anchor;
+                potential += 0.5 * (self.friction.stiffness * d * d) as f64;
+            }
+        }
         Energy {
             kinetic: kinetic as f32,
             potential: potential as f32,
@@ -1035,43 +1113,11 @@ impl LeoModel {
         Ok(())
     }
 
-    /// One physics step of length h with the held voltages: soft stops,
-    /// boom force and voltage torques set, then rapier steps.
+    /// One physics step of length h with the held voltages: the joints'
+    /// springs and dampers (stops, friction ties) and the external forces
+    /// set, then rapier steps, then the friction states follow the motion.
     pub fn physics_step(&mut self) -> Result<(), BlowUp> {
-        let (q, qd) = self.joint_state();
-        // Soft stops (§1.5).
-        if let Some(mb) = self
-            .world
-            .multibody_joints
-            .get_multibody_mut(self.multibody)
-        {
-            for k in 0..NUM_JOINTS {
-                let Some((limits, [stiffness, damping])) = JOINT_SPECS[k].stop else {
-                    continue;
-                };
-                let Some(link) = mb.link_mut(self.links[k]) else {
-                    continue;
-                };
-                let data = &mut link.joint.data;
-                let (target, inward) = if !self.options.joint_stops {
-                    continue;
-                } else if q[k] > limits[1] {
-                    (limits[1], qd[k] > 0.0)
-                } else if q[k] < limits[0] {
-                    (limits[0], qd[k] < 0.0)
-                } else {
-                    data.motor_axes.remove(JointAxesMask::ANG_X);
-                    continue;
-                };
-                let d = if inward && self.options.stop_damping {
-                    damping
-                } else {
-                    0.0
-                };
-                data.set_motor_model(JointAxis::AngX, MotorModel::ForceBased);
-                data.set_motor(JointAxis::AngX, target, 0.0, stiffness, d);
-            }
-        }
+        let friction_torques = self.set_joint_springs();
         // External forces: the boom (§1.4) and the servos' voltage torques (§2.1).
         for &h in &self.bodies {
             let rb = &mut self.world.bodies[h];
@@ -1096,7 +1142,7 @@ impl LeoModel {
             rb.add_torque(Vector::new(t[0], t[1], t[2]), false);
         }
         for k in 0..NUM_JOINTS {
-            let tau = self.servo.voltage_torque(self.voltages[k]);
+            let tau = self.servo.voltage_torque(self.voltages[k]) + friction_torques[k];
             if tau == 0.0 {
                 continue;
             }
@@ -1110,7 +1156,132 @@ impl LeoModel {
         self.world.step();
         self.stepped = true;
         self.time += self.options.dt() as f64;
-        self.check()
+        self.check()?;
+        self.follow_friction();
+        Ok(())
+    }
+
+    /// Sets every servo joint's implicit spring and damping for the next
+    /// physics step and returns the sliding joints' friction torques.
+    ///
+    /// - Soft stops (§1.5): beyond a limit, a spring K toward the limit and
+    ///   (while the joint moves further in) a damper D. Rapier integrates
+    ///   both implicitly, as ODE's ERP/CFM limit with the same K and D does;
+    ///   they are switched per physics step, so a stop never pulls a joint
+    ///   into the limit.
+    /// - Dry friction (§1.5, [`super::stiction`]): a held joint's tie, or a
+    ///   sliding joint's constant friction torque.
+    /// - The back-EMF damping of the servo (§2.1) underneath.
+    ///
+    /// Two springs on one joint add up to one: stiffness k₁ + k₂ toward
+    /// (k₁·r₁ + k₂·r₂)/(k₁ + k₂).
+    fn set_joint_springs(&mut self) -> [f32; NUM_JOINTS] {
+        let (q, qd) = self.joint_state();
+        let mut torques = [0.0f32; NUM_JOINTS];
+        let Some(mb) = self
+            .world
+            .multibody_joints
+            .get_multibody_mut(self.multibody)
+        else {
+            return torques;
+        };
+        for k in 0..NUM_JOINTS {
+            let load = self.friction.load(self.friction_states[k]);
+            let mut stiffness = load.stiffness;
+            let mut moment = load.stiffness * load.rest;
+            let mut damping = self.servo.damping + load.damping;
+            torques[k] = load.torque;
+            if let (Some((limits, [stop_k, stop_d])), true) =
+                (JOINT_SPECS[k].stop, self.options.joint_stops)
+            {
+                let beyond = if q[k] > limits[1] {
+                    Some((limits[1], qd[k] > 0.0))
+                } else if q[k] < limits[0] {
+                    Some((limits[0], qd[k] < 0.0))
+                } else {
+                    None
+                };
+                if let Some((limit, inward)) = beyond {
+                    stiffness += stop_k;
+                    moment += stop_k * limit;
+                    if inward && self.options.stop_damping {
+                        damping += stop_d;
+                    }
+                }
+            }
+            let rest = if stiffness > 0.0 {
+                moment / stiffness
+            } else {
+                0.0
+            };
+            if let Some(link) = mb.link_mut(self.links[k]) {
+                link.joint.set_spring(ANGULAR_X, stiffness, rest);
+            }
+            mb.damping_mut()[self.dofs[k]] = damping;
+        }
+        torques
+    }
+
+    /// After a physics step: every joint's friction state follows its
+    /// motion (break-away, or a stop inside the step); the joints that
+    /// stopped inside the step get their rate set to 0 together, by one
+    /// generalized impulse on their DoFs (`stop_joints`).
+    fn follow_friction(&mut self) {
+        let (q, qd) = self.joint_state();
+        let mut stopped = [false; NUM_JOINTS];
+        for k in 0..NUM_JOINTS {
+            let u = self.friction.update(self.friction_states[k], q[k], qd[k]);
+            self.friction_states[k] = u.state;
+            stopped[k] = u.stop;
+        }
+        if stopped.iter().any(|&s| s) {
+            self.stop_joints(&stopped);
+        }
+    }
+
+    /// Sets the rates of the `stopped` joints to 0 with the generalized
+    /// impulse λ on those DoFs alone that does it: v + A⁻¹·E·λ has zero
+    /// entries there, (A⁻¹)_SS·λ = −v_S, with A the matrix rapier just
+    /// factorised (mass, armature, h·damping, h²·springs). The friction
+    /// torque over-acted within the step (the joint stopped part-way); this
+    /// hands the excess back consistently with the rest of the tree.
+    fn stop_joints(&mut self, stopped: &[bool; NUM_JOINTS]) {
+        use rapier3d::na::{DMatrix, DVector};
+        let dofs = self.dofs;
+        let Some(mb) = self
+            .world
+            .multibody_joints
+            .get_multibody_mut(self.multibody)
+        else {
+            return;
+        };
+        let n = mb.ndofs();
+        let set: Vec<usize> = (0..NUM_JOINTS).filter(|&k| stopped[k]).collect();
+        // Columns of A⁻¹ for the stopped DoFs.
+        let mut columns = Vec::with_capacity(set.len());
+        for &k in &set {
+            let mut e = DVector::<f32>::zeros(n);
+            e[dofs[k]] = 1.0;
+            if !mb.inv_augmented_mass().solve_mut(&mut e) {
+                return;
+            }
+            columns.push(e);
+        }
+        let m = set.len();
+        let block = DMatrix::from_fn(m, m, |i, j| columns[j][dofs[set[i]]]);
+        let v = mb.generalized_velocity();
+        let rhs = DVector::from_fn(m, |i, _| -v[dofs[set[i]]]);
+        let Some(lambda) = block.lu().solve(&rhs) else {
+            return;
+        };
+        let mut v = mb.generalized_velocity_mut();
+        for (j, column) in columns.iter().enumerate() {
+            v.axpy(lambda[j], column, 1.0);
+        }
+        // Exactly 0, not a rounding error away from it.
+        for &k in &set {
+            v[dofs[k]] = 0.0;
+        }
     }
 
     /// Simulates one control period (1/30 s) with the held voltages and
@@ -1148,7 +1319,8 @@ impl LeoModel {
     /// armature a), time constant J/d ≈ 8–20 ms. Rapier integrates the
     /// damping implicitly (backward Euler), which over a step h makes the
     /// velocity decay by J/(J + h·d) instead of exp(−h·d/J): at h = 11 ms
-    /// a voltage step reaches ≈ 9% less speed after one control period.
+    /// a voltage step reaches ≈ 9% less speed after one control period
+    /// (≈ 7% at the 8.3 ms default).
     /// Backward Euler gives the exact decay if the inertia it sees is
     /// J' = h·d/(exp(h·d/J) − 1) < J, which changes neither the stall
     /// torque nor the no-load speed (inertia has no static effect). So once
@@ -1164,6 +1336,7 @@ impl LeoModel {
             return;
         }
         let dofs = self.dofs;
+        let links = self.links;
         let stepped = self.stepped;
         let Some(mb) = self
             .world
@@ -1173,11 +1346,15 @@ impl LeoModel {
             return;
         };
         // (M⁻¹)_dd: after a step, from the factorisation rapier already has
-        // of M + armature + h·damping (cheap: one solve per DoF); before
-        // the first step, from a fresh assembly of M + armature.
+        // of M + armature + h·damping + h²·springs (cheap: one solve per
+        // DoF); before the first step, from a fresh assembly of M +
+        // armature. Adding δ to a diagonal entry adds exactly δ to
+        // 1/(M⁻¹)_dd (a Schur complement), so the DoF's own damping and
+        // spring terms are taken off again below; the other DoFs' stay in,
+        // so a neighbour held by its friction tie moves with this DoF.
         let n = mb.ndofs();
         let mut inv = [0.0f32; NUM_JOINTS];
-        let mut damped = 0.0;
+        let mut own = [0.0f32; NUM_JOINTS];
         if stepped {
             let mut e = rapier3d::na::DVector::<f32>::zeros(n);
             for (i, &k) in dofs.iter().enumerate() {
@@ -1189,7 +1366,12 @@ impl LeoModel {
                     f32::NAN
                 };
             }
-            damped = h * d;
+            for (i, &k) in dofs.iter().enumerate() {
+                let spring = mb
+                    .link(links[i])
+                    .map_or(0.0, |l| l.joint.spring(ANGULAR_X).0);
+                own[i] = h * mb.damping()[k] + h * h * spring;
+            }
         } else {
             let all = mb.dof_inverse_inertia(&self.world.bodies);
             for (i, &k) in dofs.iter().enumerate() {
@@ -1199,7 +1381,7 @@ impl LeoModel {
         for (i, &k) in dofs.iter().enumerate() {
             let current = mb.armature()[k];
             // The DoF's inertia with the true armature.
-            let j = 1.0 / inv[i] - damped - current + a;
+            let j = 1.0 / inv[i] - own[i] - current + a;
             let x = h * d / j;
             if !(j.is_finite() && j > 0.0 && x.is_finite() && x > 1e-6) {
                 mb.armature_mut()[k] = a;
@@ -1209,6 +1391,11 @@ impl LeoModel {
             mb.armature_mut()[k] = (a - (j - fitted)).max(0.0);
         }
     }
+}
+
+/// Every joint held where it stands (the start of an episode: at rest).
+fn held_at(angles: &[f32; NUM_JOINTS]) -> [FrictionState; NUM_JOINTS] {
+    angles.map(|anchor| FrictionState::Stick { anchor })
 }
 
 /// The servo of §2.1 in rigid-armature form, with the options' switches.

@@ -8,11 +8,16 @@
 //! each without and with the switch at half the learning time (the paper's
 //! 7,333 s of 14,666 s).
 
-use crate::experiment::{run_configs_keeping, FinishedTrial, HostAgent, RunConfig};
+use crate::console::errln;
+use crate::experiment::task::Task;
+use crate::experiment::tasks::TaskName;
+use crate::experiment::{
+    run_configs_keeping, run_trial_keep, FinishedTrial, HostAgent, RunConfig, TrialResult,
+};
 use crate::leo::rl::LeoTask;
 use crate::paper::pendulum::{mean_curve, ConfigResult};
+use crate::plan::{Experiment, ExperimentKind};
 use crate::summary::RunSummary;
-use crate::experiment::task::Task;
 use pada_core::policy::PolicyKind;
 use serde::Serialize;
 
@@ -74,7 +79,8 @@ pub fn leo_configs() -> Vec<LeoConfigSpec> {
     v
 }
 
-/// The results of Section VIII.
+/// The results of Section VIII: a function of the options and the trials'
+/// results only (wall time and threads: [`crate::timing::RunTiming`]).
 #[derive(Debug, Clone, Serialize)]
 pub struct LeoResults {
     /// Options used.
@@ -83,12 +89,8 @@ pub struct LeoResults {
     pub configs: Vec<ConfigResult>,
     /// Whether each configuration switched, parallel to `configs`.
     pub switched: Vec<bool>,
-    /// Wall time \[s\].
-    pub wall_s: f64,
     /// Environment steps.
     pub env_steps: u64,
-    /// Worker threads.
-    pub threads: usize,
 }
 
 fn run_configs_of(o: &LeoOptions) -> Vec<RunConfig> {
@@ -131,40 +133,166 @@ pub struct BestTrial {
     pub agent: HostAgent,
 }
 
-/// Runs Section VIII: every trial of every configuration in parallel.
-/// Returns the results and the best trial's learner (`None` only when no
-/// trial has a finite end performance).
-pub fn run(o: &LeoOptions, progress: &(dyn Fn(u64) + Sync)) -> anyhow::Result<(LeoResults, Option<BestTrial>)> {
-    let start = std::time::Instant::now();
+/// Section VIII as an experiment, in [`leo_configs`] order.
+pub fn experiment(o: &LeoOptions, command: String) -> Experiment {
+    let configs: Vec<(TaskName, RunConfig)> = run_configs_of(o)
+        .into_iter()
+        .map(|c| (TaskName::Leo, c))
+        .collect();
+    Experiment::new(ExperimentKind::PaperLeo, command, &configs)
+}
+
+/// Whether trial `(config, trial)` with end performance `e` beats the best
+/// so far: a higher finite end performance, ties going to the earlier
+/// configuration and trial, so the choice does not depend on which trial
+/// finished first.
+fn beats(e: f64, at: (usize, u32), best: Option<(f64, (usize, u32))>) -> bool {
+    e.is_finite() && best.is_none_or(|(b, b_at)| e > b || (e == b && at < b_at))
+}
+
+/// The best trial of the results: `(configuration, trial)`.
+pub fn best_of(per_config: &[Vec<TrialResult>]) -> Option<(usize, u32)> {
+    let mut best: Option<(f64, (usize, u32))> = None;
+    for (c, results) in per_config.iter().enumerate() {
+        for r in results {
+            if beats(r.end_performance, (c, r.trial), best) {
+                best = Some((r.end_performance, (c, r.trial)));
+            }
+        }
+    }
+    best.map(|(_, at)| at)
+}
+
+/// Runs Section VIII in this process: every trial of every configuration in
+/// parallel. Returns the results per configuration and the best trial's
+/// learner (`None` only when no trial has a finite end performance).
+pub fn run_local(
+    experiment: &Experiment,
+    progress: &(dyn Fn(u64) + Sync),
+) -> anyhow::Result<(Vec<Vec<TrialResult>>, Option<BestTrial>)> {
     let task = LeoTask::default();
-    let cfgs = run_configs_of(o);
+    let cfgs = experiment
+        .configurations
+        .iter()
+        .map(|c| c.run_config())
+        .collect::<anyhow::Result<Vec<_>>>()?;
     // Only the best learner so far is kept (16 MiB each), not all of them.
     let best: std::sync::Mutex<Option<BestTrial>> = std::sync::Mutex::new(None);
     let results = run_configs_keeping(&task, &cfgs, progress, &|f: FinishedTrial| {
         let e = f.result.end_performance;
         let mut b = best.lock().unwrap_or_else(|p| p.into_inner());
-        if e.is_finite() && b.as_ref().is_none_or(|b| e > b.end_performance) {
-            *b = Some(BestTrial { config: f.config, trial: f.trial, end_performance: e, switched: f.switched, agent: f.agent });
+        let so_far = b.as_ref().map(|b| (b.end_performance, (b.config, b.trial)));
+        if beats(e, (f.config, f.trial), so_far) {
+            *b = Some(BestTrial {
+                config: f.config,
+                trial: f.trial,
+                end_performance: e,
+                switched: f.switched,
+                agent: f.agent,
+            });
         }
     })?;
-    let wall_s = start.elapsed().as_secs_f64();
-    let configs: Vec<ConfigResult> = cfgs
-        .iter()
-        .zip(results)
-        .map(|(cfg, r)| ConfigResult {
-            policy: cfg.policy,
-            summary: RunSummary::new(task.spec(), cfg, &r, f64::NAN),
-            curve: mean_curve(&r),
-        })
-        .collect();
-    let env_steps = configs.iter().map(|c| c.summary.env_steps).sum();
-    let results = LeoResults {
-        options: *o,
-        switched: cfgs.iter().map(|c| c.switch_at_s.is_some()).collect(),
-        configs,
-        wall_s,
-        env_steps,
-        threads: rayon::current_num_threads(),
+    Ok((
+        results,
+        best.into_inner().unwrap_or_else(|p| p.into_inner()),
+    ))
+}
+
+/// Runs the best trial again to get its learner, for a run whose trials ran
+/// elsewhere (a merged plan): a trial is reproducible bit for bit from its
+/// seed, so this is the learner the local run kept.
+pub fn rerun_best(
+    experiment: &Experiment,
+    per_config: &[Vec<TrialResult>],
+) -> anyhow::Result<Option<BestTrial>> {
+    let Some((config, trial)) = best_of(per_config) else {
+        return Ok(None);
     };
-    Ok((results, best.into_inner().unwrap_or_else(|p| p.into_inner())))
+    let cfg = experiment.configurations[config].run_config()?;
+    let (result, agent, switched) = run_trial_keep(&LeoTask::default(), &cfg, trial, &|_| {})?;
+    anyhow::ensure!(
+        result == per_config[config][trial as usize],
+        "the best trial ({}, trial {trial}) ran again differently from its stored result",
+        experiment.configurations[config].label
+    );
+    Ok(Some(BestTrial {
+        config,
+        trial,
+        end_performance: result.end_performance,
+        switched,
+        agent,
+    }))
+}
+
+/// The best trial's learner for a run of the plan in `dir`: the weights
+/// its trial kept there ([`crate::plan::best`]), or, if they are missing,
+/// the trial run again ([`rerun_best`]).
+pub fn best_of_plan(
+    dir: &std::path::Path,
+    experiment: &Experiment,
+    per_config: &[Vec<TrialResult>],
+) -> anyhow::Result<Option<BestTrial>> {
+    let Some((config, trial)) = best_of(per_config) else {
+        return Ok(None);
+    };
+    let index = experiment
+        .trials()
+        .iter()
+        .position(|t| t.config == config && t.trial == trial)
+        .ok_or_else(|| anyhow::anyhow!("the best trial is not in the plan"))? as u32;
+    let path = crate::plan::best::weights_path(dir, index);
+    if !path.exists() {
+        errln!(
+            "{} is missing: running the best trial again for its weights and gait",
+            path.display()
+        );
+        return rerun_best(experiment, per_config);
+    }
+    let (header, agent) = crate::weights::load(&path, LeoTask::default().spec())?;
+    let cfg = experiment.configurations[config].run_config()?;
+    anyhow::ensure!(
+        header.policy == cfg.policy,
+        "{} holds the weights of another configuration",
+        path.display()
+    );
+    Ok(Some(BestTrial {
+        config,
+        trial,
+        end_performance: per_config[config][trial as usize].end_performance,
+        switched: header.switched,
+        agent,
+    }))
+}
+
+/// The results of Section VIII from every configuration's trials.
+pub fn assemble(
+    o: &LeoOptions,
+    experiment: &Experiment,
+    per_config: Vec<Vec<TrialResult>>,
+) -> anyhow::Result<LeoResults> {
+    anyhow::ensure!(
+        per_config.len() == experiment.configurations.len(),
+        "Section VIII has {} configurations, not {}",
+        experiment.configurations.len(),
+        per_config.len()
+    );
+    let task = LeoTask::default();
+    let mut configs = Vec::with_capacity(per_config.len());
+    let mut switched = Vec::with_capacity(per_config.len());
+    for (c, r) in experiment.configurations.iter().zip(per_config) {
+        let cfg = c.run_config()?;
+        switched.push(cfg.switch_at_s.is_some());
+        configs.push(ConfigResult {
+            policy: cfg.policy,
+            summary: RunSummary::new(task.spec(), &cfg, &r, f64::NAN),
+            curve: mean_curve(&r),
+        });
+    }
+    let env_steps = configs.iter().map(|c| c.summary.env_steps).sum();
+    Ok(LeoResults {
+        options: *o,
+        configs,
+        switched,
+        env_steps,
+    })
 }

@@ -13,9 +13,11 @@
 
 use crate::experiment::algo::{algo_of, Algo};
 use crate::experiment::task::Task;
-use crate::experiment::{run_configs, RunConfig, TrialResult};
+use crate::experiment::tasks::TaskName;
+use crate::experiment::{RunConfig, TrialResult};
 use crate::paper::objective::{Objective, Verdict};
 use crate::pendulum::{PhysicalPendulumTask, SimulatedPendulumTask};
+use crate::plan::{Experiment, ExperimentKind};
 use crate::stats::Estimate;
 use crate::summary::RunSummary;
 use pada_core::policy::PolicyKind;
@@ -75,7 +77,9 @@ impl ConfigResult {
     }
 }
 
-/// Everything `pada paper pendulum` measured.
+/// Everything `pada paper pendulum` measured: a function of the options
+/// and the trials' results only (the run's wall time and threads are in
+/// [`crate::timing::RunTiming`], so a merged run reports the same bytes).
 #[derive(Debug, Clone, Serialize)]
 pub struct PendulumResults {
     /// The options used.
@@ -89,12 +93,8 @@ pub struct PendulumResults {
     pub verdicts: Vec<Verdict>,
     /// Physical pendulum: SARSA(λ), low-pass α = 0.834, PADA Δ = 0.5.
     pub physical: Vec<ConfigResult>,
-    /// Wall-clock time of everything \[s\].
-    pub wall_s: f64,
     /// Environment steps of everything.
     pub env_steps: u64,
-    /// Worker threads.
-    pub threads: usize,
 }
 
 /// The simulated-pendulum configurations, SARSA(λ) first.
@@ -161,29 +161,76 @@ pub fn expected_steps(o: &PendulumOptions) -> u64 {
     )
 }
 
-/// Runs the whole of Section VII.
-pub fn run(
-    o: &PendulumOptions,
+/// Section VII as an experiment: the simulated pendulum's configurations
+/// (SARSA(λ) first), then the physical pendulum's. `command` is the command
+/// line the report names.
+pub fn experiment(o: &PendulumOptions, command: String) -> Experiment {
+    let cfg = |policy, trials, seconds| RunConfig {
+        policy,
+        switch_at_s: None,
+        seconds,
+        trials,
+        seed: o.seed,
+    };
+    let mut configs: Vec<(TaskName, RunConfig)> = simulated_policies()
+        .into_iter()
+        .map(|p| (TaskName::Pendulum, cfg(p, o.sim_trials, o.sim_seconds)))
+        .collect();
+    configs.extend(physical_policies().into_iter().map(|p| {
+        (
+            TaskName::PhysicalPendulum,
+            cfg(p, o.phys_trials, o.phys_seconds),
+        )
+    }));
+    Experiment::new(ExperimentKind::PaperPendulum, command, &configs)
+}
+
+/// Runs the whole of Section VII in this process: the trials of every
+/// configuration of [`experiment`], per configuration.
+pub fn run_local(
+    experiment: &Experiment,
     progress: &(dyn Fn(u64) + Sync),
+) -> anyhow::Result<Vec<Vec<TrialResult>>> {
+    crate::plan::local::run_experiment(experiment, progress)
+}
+
+/// The results of Section VII from every configuration's trials (in
+/// [`experiment`]'s order), however they were run.
+pub fn assemble(
+    o: &PendulumOptions,
+    experiment: &Experiment,
+    per_config: Vec<Vec<TrialResult>>,
 ) -> anyhow::Result<PendulumResults> {
-    let start = std::time::Instant::now();
-    let simulated = run_task(
-        &SimulatedPendulumTask::default(),
-        &simulated_policies(),
-        o.sim_trials,
-        o.sim_seconds,
-        o.seed,
-        progress,
-    )?;
-    let physical = run_task(
-        &PhysicalPendulumTask::default(),
-        &physical_policies(),
-        o.phys_trials,
-        o.phys_seconds,
-        o.seed,
-        progress,
-    )?;
-    let wall_s = start.elapsed().as_secs_f64();
+    let n_sim = simulated_policies().len();
+    anyhow::ensure!(
+        per_config.len() == n_sim + physical_policies().len()
+            && per_config.len() == experiment.configurations.len(),
+        "Section VII has {} configurations, not {}",
+        experiment.configurations.len(),
+        per_config.len()
+    );
+    let sim_task = SimulatedPendulumTask::default();
+    let phys_task = PhysicalPendulumTask::default();
+    let mut simulated = Vec::with_capacity(n_sim);
+    let mut physical = Vec::new();
+    for (c, results) in experiment.configurations.iter().zip(per_config) {
+        let cfg = c.run_config()?;
+        let spec = if (c.index as usize) < n_sim {
+            sim_task.spec()
+        } else {
+            phys_task.spec()
+        };
+        let r = ConfigResult {
+            policy: cfg.policy,
+            summary: RunSummary::new(spec, &cfg, &results, f64::NAN),
+            curve: mean_curve(&results),
+        };
+        if (c.index as usize) < n_sim {
+            simulated.push(r);
+        } else {
+            physical.push(r);
+        }
+    }
     let sarsa = &simulated[0].summary;
     let objective =
         Objective::from_sarsa(&sarsa.end_performance, &sarsa.rise_time_s, &sarsa.mtbf_s);
@@ -208,40 +255,8 @@ pub fn run(
         objective,
         verdicts,
         physical,
-        wall_s,
         env_steps,
-        threads: rayon::current_num_threads(),
     })
-}
-
-fn run_task<T: Task>(
-    task: &T,
-    policies: &[PolicyKind],
-    trials: u32,
-    seconds: f64,
-    seed: u64,
-    progress: &(dyn Fn(u64) + Sync),
-) -> anyhow::Result<Vec<ConfigResult>> {
-    let cfgs: Vec<RunConfig> = policies
-        .iter()
-        .map(|&policy| RunConfig {
-            policy,
-            switch_at_s: None,
-            seconds,
-            trials,
-            seed,
-        })
-        .collect();
-    let results = run_configs(task, &cfgs, progress)?;
-    Ok(cfgs
-        .iter()
-        .zip(results)
-        .map(|(cfg, r)| ConfigResult {
-            policy: cfg.policy,
-            summary: RunSummary::new(task.spec(), cfg, &r, f64::NAN),
-            curve: mean_curve(&r),
-        })
-        .collect())
 }
 
 /// The mean learning curve over trials, test run by test run (up to the

@@ -92,7 +92,8 @@ pub fn render(r: &PendulumResults, command: &str) -> String {
         s,
         "Produced by `{command}`: {} configurations × {} trials × {} s of learning on the simulated pendulum, \
          {} configurations × {} trials × {} s on the physical pendulum's model (master seed {}); \
-         {:.2e} environment steps in {:.1} s of wall time on {} threads ({:.0} steps/s).\n",
+         {:.2e} environment steps. (The run's wall time and threads are in timing.json: this report depends \
+         only on the command, so a run merged from a cluster's results gives the same bytes as a local run.)\n",
         r.simulated.len(),
         o.sim_trials,
         o.sim_seconds,
@@ -101,9 +102,6 @@ pub fn render(r: &PendulumResults, command: &str) -> String {
         o.phys_seconds,
         o.seed,
         r.env_steps as f64,
-        r.wall_s,
-        r.threads,
-        r.env_steps as f64 / r.wall_s
     );
     let _ = writeln!(
         s,
