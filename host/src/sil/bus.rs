@@ -187,7 +187,7 @@ impl BusEmulator {
                 let ids: Vec<String> = servos.iter().map(|s| s.id.to_string()).collect();
                 return Err(format!("--fault {f}: no servo {} on {}'s bus (its servos: {})", f.servo, robot.name(), ids.join(", ")));
             };
-            if f.kind == FaultKind::PastLimit && !servo.joint.is_some_and(|(_, l)| l.is_some()) {
+            if f.kind == FaultKind::PastLimit && servo.joint.is_none_or(|(_, l)| l.is_none()) {
                 return Err(format!("--fault {f}: servo {}'s joint has no soft limit on {}", f.servo, robot.name()));
             }
         }
