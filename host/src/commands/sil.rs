@@ -104,6 +104,7 @@ pub fn run(args: SilArgs) -> Result<(), CliError> {
         .map(|f| fault::parse(f))
         .collect::<Result<Vec<_>, _>>()
         .map_err(usage)?;
+    sil::bus::check_faults(args.task.robot(), &faults).map_err(usage)?;
     if !(1..=3600).contains(&args.hang_timeout) {
         return Err(usage(format!(
             "--hang-timeout {} is out of range: valid is 1..=3600 s",

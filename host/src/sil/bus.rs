@@ -159,6 +159,39 @@ struct Answer {
     past_limit: bool,
 }
 
+/// Servos `ids` with the calibration and soft limits of `robot`'s joints.
+fn servos(robot: Robot, ids: &[u8]) -> Vec<Servo> {
+    let hw = hardware(robot);
+    let joint_of = |id: u8| {
+        let k = hw.joints.iter().position(|j| j.id == id)?;
+        Some((hw.joints[k], hw.soft_limits.get(k).copied().flatten()))
+    };
+    ids.iter().map(|&id| Servo::new(id, joint_of(id))).collect()
+}
+
+/// Why a fault cannot apply to `servos`: no such servo, or a `past-limit`
+/// fault on a joint without a soft limit.
+fn check_faults_on(servos: &[Servo], robot: Robot, faults: &[FaultSpec]) -> Result<(), String> {
+    for f in faults {
+        let Some(servo) = servos.iter().find(|s| s.id == f.servo) else {
+            let ids: Vec<String> = servos.iter().map(|s| s.id.to_string()).collect();
+            return Err(format!("--fault {f}: no servo {} on {}'s bus (its servos: {})", f.servo, robot.name(), ids.join(", ")));
+        };
+        if f.kind == FaultKind::PastLimit && servo.joint.is_none_or(|(_, l)| l.is_none()) {
+            return Err(format!("--fault {f}: servo {}'s joint has no soft limit on {}", f.servo, robot.name()));
+        }
+    }
+    Ok(())
+}
+
+/// Checks `faults` against `robot`'s servos (the IDs of its hardware
+/// configuration, which the rigs use) before a run, so that a fault that
+/// cannot apply is bad input, not a failed run.
+pub fn check_faults(robot: Robot, faults: &[FaultSpec]) -> Result<(), String> {
+    let ids: Vec<u8> = hardware(robot).joints.iter().map(|j| j.id).collect();
+    check_faults_on(&servos(robot, &ids), robot, faults)
+}
+
 /// The emulated bus.
 #[derive(Debug)]
 pub struct BusEmulator {
@@ -176,21 +209,8 @@ impl BusEmulator {
     /// `robot`'s joints), the sensor device, and `faults`; the error says
     /// why a fault cannot apply.
     pub fn new(rig: &dyn Rig, robot: Robot, faults: Vec<FaultSpec>) -> Result<Self, String> {
-        let hw = hardware(robot);
-        let joint_of = |id: u8| {
-            let k = hw.joints.iter().position(|j| j.id == id)?;
-            Some((hw.joints[k], hw.soft_limits.get(k).copied().flatten()))
-        };
-        let servos: Vec<Servo> = rig.servo_ids().iter().map(|&id| Servo::new(id, joint_of(id))).collect();
-        for f in &faults {
-            let Some(servo) = servos.iter().find(|s| s.id == f.servo) else {
-                let ids: Vec<String> = servos.iter().map(|s| s.id.to_string()).collect();
-                return Err(format!("--fault {f}: no servo {} on {}'s bus (its servos: {})", f.servo, robot.name(), ids.join(", ")));
-            };
-            if f.kind == FaultKind::PastLimit && servo.joint.is_none_or(|(_, l)| l.is_none()) {
-                return Err(format!("--fault {f}: servo {}'s joint has no soft limit on {}", f.servo, robot.name()));
-            }
-        }
+        let servos = servos(robot, rig.servo_ids());
+        check_faults_on(&servos, robot, &faults)?;
         let mut sensor = [0u8; sensor_table::TABLE_LEN];
         sensor[sensor_table::MODEL_NUMBER as usize..][..2].copy_from_slice(&sensor_table::MODEL.to_le_bytes());
         sensor[table::ID as usize] = SENSOR_ID;
