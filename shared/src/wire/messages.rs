@@ -16,7 +16,7 @@ pub use crate::safety::RunMode;
 /// [`PolicyKind`] itself, in the same bytes as before; 4: the
 /// [`ToHost::Policy`] report and [`CheckpointReport::TooLarge`], appended
 /// last).
-pub const PROTOCOL_VERSION: u16 = 4;
+pub const PROTOCOL_VERSION: u16 = 5;
 /// State dimensions a [`Step`] carries.
 pub const MAX_STATE_DIMS: usize = 16;
 /// Action dimensions (motor outputs) a [`Step`] carries.
@@ -131,6 +131,10 @@ pub struct Step {
     pub td_error: i32,
     /// Whether the action was an exploratory draw.
     pub explored: bool,
+    /// Whether the policy's memory was mirrored before this call (a
+    /// footstep of LEO, `RobotSpec::footstep_remap`): a replay must do the
+    /// same to take the same action.
+    pub footstep: bool,
     /// Fatigue per learned joint.
     pub joints: Vec<JointFatigue, MAX_JOINTS>,
     /// Duration of this control period's work, µs.
