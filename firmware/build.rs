@@ -5,9 +5,21 @@
 use std::{env, fs, path::PathBuf};
 
 fn main() {
-    let chips: Vec<&str> = ["stm32f405", "stm32f407", "stm32f429", "qemu"]
+    // `emulated`: a board of the software-in-the-loop run (src/board/lockstep.rs);
+    // `profile_f429`: the f429-sdram board learner profile (the F429I-DISC1
+    // and its emulation on mps2-an386).
+    println!("cargo::rustc-check-cfg=cfg(emulated)");
+    println!("cargo::rustc-check-cfg=cfg(profile_f429)");
+    let feature = |f: &str| env::var_os(format!("CARGO_FEATURE_{}", f.to_uppercase())).is_some();
+    if feature("qemu") || feature("mps2") {
+        println!("cargo:rustc-cfg=emulated");
+    }
+    if feature("stm32f429") || feature("mps2") {
+        println!("cargo:rustc-cfg=profile_f429");
+    }
+    let chips: Vec<&str> = ["stm32f405", "stm32f407", "stm32f429", "qemu", "mps2"]
         .into_iter()
-        .filter(|c| env::var_os(format!("CARGO_FEATURE_{}", c.to_uppercase())).is_some())
+        .filter(|c| feature(c))
         .collect();
     let for_chip = env::var("CARGO_CFG_TARGET_OS").as_deref() == Ok("none");
     // On the host only the library is built (its tests, and the host's
@@ -18,19 +30,20 @@ fn main() {
     }
     if chips.len() != 1 {
         panic!(
-            "pada-firmware: enable exactly one board feature (stm32f405, stm32f407, stm32f429, qemu); \
+            "pada-firmware: enable exactly one board feature (stm32f405, stm32f407, stm32f429, qemu, mps2); \
              got {chips:?}. For a non-default board use --no-default-features --features <board>."
         );
     }
     let manifest_dir = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").unwrap());
     // The workspace's memory.x describes the STM32F405RG and the F407VG
     // (same layout; QEMU's netduinoplus2 is an F405RG); the STM32F429ZI
-    // (2 MB of flash in two banks, 192 KB SRAM, the DISC1's SDRAM) has its
-    // own. Either is copied under the name link.x includes.
-    let memory_x = if chips.first() == Some(&"stm32f429") {
-        manifest_dir.join("memory-f429.x")
-    } else {
-        manifest_dir.join("..").join("memory.x")
+    // (2 MB of flash in two banks, 192 KB SRAM, the DISC1's SDRAM) and
+    // QEMU's mps2-an386 (its emulation) have their own. Each is copied
+    // under the name link.x includes.
+    let memory_x = match chips.first() {
+        Some(&"stm32f429") => manifest_dir.join("memory-f429.x"),
+        Some(&"mps2") => manifest_dir.join("memory-mps2.x"),
+        _ => manifest_dir.join("..").join("memory.x"),
     };
     let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());
     let contents = fs::read(&memory_x)

@@ -903,7 +903,7 @@ where
         match result {
             Some(Ok(decision)) => {
                 self.phase = Phase::Running { steps: 0 };
-                self.record(StepKind::Start, &obs[..dims], 0.0, Some(decision), readings.time_ms, out);
+                self.record(StepKind::Start, &obs[..dims], 0.0, Some(decision), false, readings.time_ms, out);
             }
             // A non-finite observation (a broken sensor): try again next
             // period.
@@ -918,7 +918,8 @@ where
         let timeout = steps >= self.spec.episode_steps;
         // A footstep: the policy's memory moves with the joints before the
         // next decision.
-        if let (true, Some(map)) = (self.robot.footstep(), self.spec.footstep_remap) {
+        let footstep = self.robot.footstep() && self.spec.footstep_remap.is_some();
+        if let (true, Some(map)) = (footstep, self.spec.footstep_remap) {
             self.agent_mut().remap_memory(&map);
         }
         let t0 = cycles.cycles();
@@ -937,7 +938,7 @@ where
         match result {
             Ok(decision) => {
                 self.episode_return += reward;
-                self.record(kind, &obs[..dims], reward, decision, readings.time_ms, out);
+                self.record(kind, &obs[..dims], reward, decision, footstep, readings.time_ms, out);
                 if decision.is_some() {
                     self.phase = Phase::Running { steps };
                 } else {
@@ -958,12 +959,14 @@ where
     }
 
     /// Fills the step record.
+    #[allow(clippy::too_many_arguments)]
     fn record(
         &mut self,
         kind: StepKind,
         obs: &[f32],
         reward: f32,
         decision: Option<Decision>,
+        footstep: bool,
         time_ms: u32,
         out: &mut PeriodOutput,
     ) {
@@ -1003,6 +1006,7 @@ where
             reward,
             td_error,
             explored: decision.is_some_and(|d| d.explored),
+            footstep,
             joints,
             loop_us: 0,
             agent_cycles: out.agent_cycles.unwrap_or(0),

@@ -27,18 +27,17 @@ use pada_core::checkpoint::CheckpointStore;
 use pada_core::policy::PolicyKind;
 use pada_core::weights::WeightStore;
 use pada_core::wire::{self, ToHost};
-use pada_firmware::config::DEFAULT_SEED;
 use pada_firmware::robot::RobotAdapter;
 use table::{Ctl, ThisRobot, PROFILE};
 
 /// The policy at boot; the host chooses another with `SetPolicy`.
 const BOOT_POLICY: PolicyKind = PolicyKind::Sarsa;
 
-// The real boards run embassy's thread-mode executor; the emulated board
-// its own, which advances the lock-step clock when nothing is left to run.
-#[cfg_attr(not(feature = "qemu"), embassy_executor::main)]
+// The real boards run embassy's thread-mode executor; the emulated boards
+// their own, which advances the lock-step clock when nothing is left to run.
+#[cfg_attr(not(emulated), embassy_executor::main)]
 #[cfg_attr(
-    feature = "qemu",
+    emulated,
     embassy_executor::main(entry = "cortex_m_rt::entry", executor = "crate::board::Executor")
 )]
 async fn main(spawner: Spawner) {
@@ -79,7 +78,8 @@ async fn main(spawner: Spawner) {
         }
     };
 
-    let mut ctl: Ctl = match Ctl::new(PROFILE, BOOT_POLICY, table::take(table_memory), DEFAULT_SEED) {
+    // DEFAULT_SEED on a real board; the emulated boards take the run's.
+    let mut ctl: Ctl = match Ctl::new(PROFILE, BOOT_POLICY, table::take(table_memory), board.seed) {
         Ok(ctl) => ctl,
         // The profiles are constants checked by the host tests.
         Err(e) => defmt::panic!("controller configuration: {}", defmt::Debug2Format(&e)),

@@ -5,7 +5,10 @@
 //! | board (cargo feature) | pendulum | LEO |
 //! |---|---|---|
 //! | F405/F407, and QEMU's netduinoplus2 (`stm32f405`, `stm32f407`, `qemu`) | exact table: all 64 KiB of CCM, then 33.5 KiB of SRAM (`Split`) | 2^14 weights in CCM |
-//! | F429I-DISC1 (`stm32f429`) | exact table, 97.5 KiB of SRAM | 2^21 weights, all 8 MiB of the SDRAM |
+//! | F429I-DISC1 (`stm32f429`), and QEMU's mps2-an386 (`mps2`) | exact table, 97.5 KiB of SRAM | 2^21 weights, all 8 MiB of the SDRAM (on mps2-an386: its PSRAM, `.sdram` in `memory-mps2.x`) |
+//!
+//! (`profile_f429` is build.rs's cfg for the `stm32f429` and `mps2`
+//! features: the boards of the f429-sdram profile.)
 //!
 //! The statics are NOLOAD (CCM, SDRAM) or `.uninit` (SRAM): the startup
 //! code leaves them alone; [`take`] zeroes them once — after the board
@@ -34,10 +37,11 @@ pub type ThisRobot = pada_firmware::pendulum::Pendulum20;
 pub type ThisRobot = pada_firmware::pendulum::Pendulum33;
 
 /// The board's learner profile: F405-class chips (and their emulation).
-#[cfg(not(feature = "stm32f429"))]
+#[cfg(not(profile_f429))]
 pub const BOARD: Board = Board::F405;
-/// The board's learner profile: the F429I-DISC1 with its SDRAM.
-#[cfg(feature = "stm32f429")]
+/// The board's learner profile: the F429I-DISC1 with its SDRAM (and its
+/// emulation).
+#[cfg(profile_f429)]
 pub const BOARD: Board = Board::F429Sdram;
 
 /// The learner of this image.
@@ -94,7 +98,7 @@ macro_rules! one_memory {
 // The pendulum on an F405: all of CCM, then the rest in SRAM.
 // ---------------------------------------------------------------------------
 
-#[cfg(all(not(feature = "stm32f429"), not(feature = "robot-leo")))]
+#[cfg(all(not(profile_f429), not(feature = "robot-leo")))]
 mod layout {
     use super::*;
     use pada_core::weights::Split;
@@ -128,19 +132,19 @@ mod layout {
 }
 
 // LEO on an F405: the 64 KiB of CCM.
-#[cfg(all(not(feature = "stm32f429"), feature = "robot-leo"))]
+#[cfg(all(not(profile_f429), feature = "robot-leo"))]
 mod layout {
     one_memory!(Memory::Ccm, ".ccmram", "PADA_TABLE_CCM");
 }
 
 // The pendulum on the F429: 97.5 KiB of its 192 KiB SRAM.
-#[cfg(all(feature = "stm32f429", not(feature = "robot-leo")))]
+#[cfg(all(profile_f429, not(feature = "robot-leo")))]
 mod layout {
     one_memory!(Memory::Sram, ".uninit.pada_table", "PADA_TABLE_SRAM");
 }
 
 // LEO on the F429: all 8 MiB of the SDRAM.
-#[cfg(all(feature = "stm32f429", feature = "robot-leo"))]
+#[cfg(all(profile_f429, feature = "robot-leo"))]
 mod layout {
     one_memory!(Memory::Sdram, ".sdram", "PADA_TABLE_SDRAM");
 }

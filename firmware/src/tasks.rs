@@ -233,6 +233,7 @@ pub async fn control(mut cl: ControlLoop) -> ! {
     let mut readings = Readings::default();
     let mut out = PeriodOutput::default();
     let mut ticker = Ticker::every(Duration::from_micros(period_us as u64));
+    align(&mut ticker, period_us);
     let mut skipped = 0u32;
     let mut drops = 0u32;
     let mut weights_job: Option<WeightsJob> = None;
@@ -263,7 +264,7 @@ pub async fn control(mut cl: ControlLoop) -> ! {
             if handle_command(&mut cl, seq, &cmd, &mut weights_job).await {
                 // A flash operation or a fresh learner stalled the loop: restart the schedule
                 // and do not count this period as an overrun.
-                ticker.reset();
+                align(&mut ticker, period_us);
                 readings.last_period_overran = false;
             }
         }
@@ -354,6 +355,20 @@ pub async fn control(mut cl: ControlLoop) -> ! {
 
         WATCHDOG.send(WatchdogRequest::Alive).await;
     }
+}
+
+/// Puts the ticker's next tick on the next multiple of the period since
+/// boot. The ticks keep that phase, so a control period always starts at
+/// k · period: on the emulated boards, where `pada sil`'s plant advances
+/// LEO in whole control periods on those same boundaries (as `pada run
+/// --board` does on the host), each period reads the robot as the
+/// period's step left it. On a real board the phase is arbitrary and this
+/// costs nothing.
+fn align(ticker: &mut Ticker, period_us: u32) {
+    let now = Instant::now().as_micros();
+    let last = now - now % period_us as u64;
+    // The tick after `last`: the next boundary after now.
+    ticker.reset_at(Instant::from_micros(last));
 }
 
 /// Sends up to four chunks of a weights read; true when done.

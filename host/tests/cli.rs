@@ -48,6 +48,21 @@ fn unknown_names_list_the_valid_values() {
     assert_bad_input(&[], &["run, demo, paper, mtbf"]);
 }
 
+/// A fault that cannot apply to the robot's bus is bad input, refused
+/// before anything is built or booted.
+#[test]
+fn sil_faults_that_cannot_apply_are_refused() {
+    assert_bad_input(
+        &["sil", "--task", "leo", "--fault", "drop:servo=9"],
+        &["no servo 9 on leo's bus", "1, 3, 2, 5, 4, 7, 6"],
+    );
+    assert_bad_input(
+        &["sil", "--fault", "past-limit:at=2"],
+        &["servo 1's joint has no soft limit on physical-pendulum"],
+    );
+    assert_bad_input(&["sil", "--fault", "wobble"], &["wobble", "past-limit"]);
+}
+
 #[test]
 fn parameters_out_of_range_name_the_range() {
     assert_bad_input(

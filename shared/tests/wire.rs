@@ -34,6 +34,7 @@ fn full_step() -> Step {
         reward: f32::MIN,
         td_error: i32::MIN,
         explored: true,
+        footstep: true,
         joints: HVec::from_slice(&[JointFatigue { damage: 1e-300, reengagements: u32::MAX }; MAX_JOINTS]).unwrap(),
         loop_us: u32::MAX,
         agent_cycles: u32::MAX,
@@ -72,6 +73,7 @@ fn all_to_host() -> Vec<ToHost> {
         reward: -1.0,
         td_error: -65536,
         explored: false,
+        footstep: false,
         joints: HVec::from_slice(&[JointFatigue { damage: 3.2e-9, reengagements: 4 }]).unwrap(),
         loop_us: 812,
         agent_cycles: 41_000,
@@ -266,11 +268,13 @@ fn the_protocol_version_changes_with_the_layout() {
     // A change of any message's layout changes this fingerprint: then bump
     // PROTOCOL_VERSION and put the new pair here (with the docs that name
     // the version: docs/sil.md, firmware/README.md, README.md).
-    assert_eq!((PROTOCOL_VERSION, layout_fingerprint()), (5, EXPECTED_FINGERPRINT), "{:#010x}", layout_fingerprint());
+    assert_eq!((PROTOCOL_VERSION, layout_fingerprint()), (6, EXPECTED_FINGERPRINT), "{:#010x}", layout_fingerprint());
 }
 
-/// [`layout_fingerprint`] of protocol 5.
-const EXPECTED_FINGERPRINT: u32 = 0xee43_7aa7;
+/// [`layout_fingerprint`] of protocol 6 (the gentle explorations in
+/// `PolicyKind`, the governor in `PolicyReport`, `SetMtbfBudget`; 5 added
+/// `Step::footstep`).
+const EXPECTED_FINGERPRINT: u32 = 0x9109_396b;
 
 #[test]
 fn every_chip_message_round_trips() {
@@ -693,6 +697,7 @@ fn arb_step() -> impl Strategy<Value = Step> {
                 reward,
                 td_error: td,
                 explored: ex,
+                footstep: !ex,
                 joints: j.into_iter().map(|(damage, reengagements)| JointFatigue { damage, reengagements }).collect(),
                 loop_us: lus,
                 agent_cycles: lus.rotate_left(7),

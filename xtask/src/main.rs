@@ -6,8 +6,9 @@
 //!   thumbv7em-none-eabihf with whichever toolchain this machine has (see
 //!   [`toolchain`]), then print its use of each memory region and where the
 //!   weight table lies (see [`elf`]).
-//! - `qemu`, `sil`: the same firmware for the emulated board (QEMU's
-//!   `netduinoplus2`), and a software-in-the-loop run of it (`pada sil`).
+//! - `qemu`, `sil`: the same firmware for the emulated board of a board
+//!   profile (QEMU's `netduinoplus2` for `f405`, `mps2-an386` for
+//!   `f429-sdram`), and a software-in-the-loop run of it (`pada sil`).
 //! - `fuzz [--seconds S]`: the decoders that face untrusted bytes, fuzzed
 //!   on stable Rust (`fuzz/`, package `pada-fuzz`).
 //!
@@ -48,14 +49,18 @@ tasks:
   firmware-test
         run the firmware library's tests on the host (controller, servo-bus
         transactions, LEO and pendulum observers)
-  qemu [--debug] [--robot ...]
-        build the firmware for the emulated board (QEMU's netduinoplus2, an
-        STM32F405RG; cargo feature `qemu`) into target/firmware-qemu-<robot>,
-        release unless --debug; its ELF path is the last line printed
-  sil [--debug] [--robot ...] [-- <pada sil options>]
+  qemu [--debug] [--board f405|f429-sdram] [--robot ...]
+        build the firmware for the emulated board of a board profile
+        (f405: QEMU's netduinoplus2, an STM32F405RG, cargo feature `qemu`;
+        f429-sdram: QEMU's mps2-an386, a Cortex-M4F whose PSRAM holds LEO's
+        8 MiB table, feature `mps2`; f405 unless --board) into
+        target/firmware-emulated/images/<board>-<robot>.elf, release unless
+        --debug; its ELF path is the last line printed
+  sil [--debug] [--board ...] [--robot ...] [-- <pada sil options>]
         build as `qemu`, then run it in qemu-system-arm against the
         simulated plant: `pada sil --elf <ELF> <options>` (release build
-        of the host); the robot's task is passed on (--task)
+        of the host); the robot's task and the board are passed on
+        (--task, --board)
   fuzz [--seconds S] [--seed K]
         fuzz every decoder that faces untrusted bytes (wire frames of host
         and chip, Dynamixel status and instruction packets, checkpoint load
@@ -132,6 +137,15 @@ impl Chip {
         }
     }
 
+    /// The emulated board of this chip's profile: the firmware's cargo
+    /// feature, QEMU's machine, and the linker memory layout.
+    pub fn emulated(self) -> (&'static str, &'static str, &'static str) {
+        match self {
+            Chip::F405 | Chip::F407 => ("qemu", "netduinoplus2", "memory.x"),
+            Chip::F429 => ("mps2", "mps2-an386", "firmware/memory-mps2.x"),
+        }
+    }
+
     /// The name probe-rs knows the usual package of this chip by.
     pub fn probe_rs_name(self) -> &'static str {
         match self {
@@ -158,6 +172,15 @@ impl Robot {
             "pendulum-20hz" => Some(Robot::Pendulum20),
             "leo" => Some(Robot::Leo),
             _ => None,
+        }
+    }
+
+    /// The robot's name on the command line (and `pada sil --task`'s).
+    pub fn name(self) -> &'static str {
+        match self {
+            Robot::Pendulum => "pendulum",
+            Robot::Pendulum20 => "pendulum-20hz",
+            Robot::Leo => "leo",
         }
     }
 
@@ -193,8 +216,8 @@ enum Task {
     Fuzz(Vec<String>),
 }
 
-/// `qemu` and `sil`: release unless `--debug`, a robot, and for `sil`
-/// everything after `--`.
+/// `qemu` and `sil`: release unless `--debug`, a board profile, a robot,
+/// and for `sil` everything after `--`.
 fn parse_emulated(task: &str, rest: &[String]) -> Result<Task, String> {
     let mut build = Build { release: true, chip: Chip::F405, robot: Robot::Pendulum };
     let (own, passed) = match rest.iter().position(|a| a == "--") {
@@ -203,20 +226,30 @@ fn parse_emulated(task: &str, rest: &[String]) -> Result<Task, String> {
     };
     let mut own = own.iter();
     while let Some(arg) = own.next() {
-        let value = match arg.as_str() {
+        let (key, value) = match arg.as_str() {
             "--debug" => {
                 build.release = false;
                 continue;
             }
             "-h" | "--help" => return Ok(Task::Help),
-            "--robot" => own.next().ok_or("--robot needs a value: pendulum, pendulum-20hz or leo")?.as_str(),
-            other => match other.strip_prefix("--robot=") {
-                Some(v) => v,
+            key @ ("--robot" | "--board") => {
+                let choices = if key == "--robot" { "pendulum, pendulum-20hz or leo" } else { PROFILES };
+                (key, own.next().ok_or_else(|| format!("{key} needs a value: {choices}"))?.as_str())
+            }
+            other => match ["--robot", "--board"]
+                .into_iter()
+                .find_map(|key| Some((key, other.strip_prefix(key)?.strip_prefix('=')?)))
+            {
+                Some(pair) => pair,
                 None => return Err(format!("unknown argument `{other}` for `{task}`")),
             },
         };
-        build.robot = Robot::parse(value)
-            .ok_or_else(|| format!("unknown robot `{value}`: expected pendulum, pendulum-20hz or leo"))?;
+        if key == "--board" {
+            build.chip = Chip::for_profile(value).ok_or_else(|| format!("unknown board `{value}`: expected {PROFILES}"))?;
+        } else {
+            build.robot = Robot::parse(value)
+                .ok_or_else(|| format!("unknown robot `{value}`: expected pendulum, pendulum-20hz or leo"))?;
+        }
     }
     Ok(if task == "sil" { Task::Sil(build, passed) } else { Task::Qemu(build) })
 }
@@ -356,7 +389,7 @@ fn main() -> ExitCode {
         Task::Fuzz(args) => fuzz(&workspace_root(), &args),
         Task::Qemu(build) => qemu_image(&workspace_root(), build).map(|_| ()),
         Task::Sil(build, args) => {
-            qemu_image(&workspace_root(), build).and_then(|elf| sil(&workspace_root(), &elf, build.robot, &args))
+            qemu_image(&workspace_root(), build).and_then(|elf| sil(&workspace_root(), &elf, build, &args))
         }
     };
     match result {
@@ -452,20 +485,26 @@ fn firmware(root: &Path, build: Build) -> Result<PathBuf, String> {
 }
 
 /// Builds the emulated board's image; returns the ELF's path.
+///
+/// Every emulated image builds in one target directory
+/// (`target/firmware-emulated`: the dependencies of both machines and all
+/// robots are built once, about 700 MB, instead of once per image) and is
+/// copied to `images/<board>-<robot>.elf` there, under a lock on the
+/// directory so that two builds of different images cannot swap their
+/// ELFs between build and copy.
 fn qemu_image(root: &Path, build: Build) -> Result<PathBuf, String> {
     let toolchain = toolchain::detect()?;
     println!("xtask: toolchain: {}", toolchain.describe());
     let firmware_dir = root.join("firmware");
-    // A target directory of its own per robot: the real board's image, and
-    // the other robots' emulated images, keep their paths.
-    let robot_name = match build.robot {
-        Robot::Pendulum => "pendulum",
-        Robot::Pendulum20 => "pendulum-20hz",
-        Robot::Leo => "leo",
-    };
-    let target_dir = root.join("target").join(format!("firmware-qemu-{robot_name}"));
+    let target_dir = root.join("target").join("firmware-emulated");
+    let images = target_dir.join("images");
+    std::fs::create_dir_all(&images).map_err(|e| format!("cannot create {}: {e}", images.display()))?;
+    let lock_path = target_dir.join(".image.lock");
+    let lock = std::fs::File::create(&lock_path).map_err(|e| format!("cannot create {}: {e}", lock_path.display()))?;
+    lock.lock().map_err(|e| format!("cannot lock {}: {e}", lock_path.display()))?;
     let profile = if build.release { "release" } else { "debug" };
-    let mut features = vec!["qemu"];
+    let (machine_feature, machine, memory_x) = build.chip.emulated();
+    let mut features = vec![machine_feature];
     features.extend(build.robot.feature());
     let mut cmd = toolchain.cargo_build(&firmware_dir);
     cmd.arg("--manifest-path")
@@ -479,7 +518,8 @@ fn qemu_image(root: &Path, build: Build) -> Result<PathBuf, String> {
         cmd.arg("--release");
     }
     println!(
-        "xtask: building pada-firmware ({profile}, emulated board `qemu`, {}) for {TARGET}",
+        "xtask: building pada-firmware ({profile}, board profile {} emulated on QEMU's {machine}, {}) for {TARGET}",
+        build.chip.profile(),
         build.robot.feature().unwrap_or("robot-pendulum-33hz (default)")
     );
     let started = Instant::now();
@@ -489,30 +529,37 @@ fn qemu_image(root: &Path, build: Build) -> Result<PathBuf, String> {
     if !status.success() {
         return Err(format!("emulated-board build failed ({status}); cargo's errors are above"));
     }
-    let elf = target_dir.join(TARGET).join(profile).join("pada-firmware");
-    if !elf.is_file() {
-        return Err(format!("build succeeded but {} is missing", elf.display()));
-    }
+    let built = target_dir.join(TARGET).join(profile).join("pada-firmware");
+    let debug = if build.release { "" } else { "-debug" };
+    let elf = images.join(format!("{}-{}{debug}.elf", build.chip.profile(), build.robot.name()));
+    std::fs::copy(&built, &elf).map_err(|e| format!("cannot copy {} to {}: {e}", built.display(), elf.display()))?;
+    drop(lock);
     println!("xtask: built in {:.1} s", started.elapsed().as_secs_f64());
+    if let Ok(bytes) = std::fs::read(&elf) {
+        let regions = std::fs::read_to_string(root.join(memory_x)).map(|t| elf::parse_memory_x(&t)).unwrap_or_default();
+        if let (Ok(sizes), Ok(table)) = (elf::section_sizes(&bytes), elf::symbols(&bytes, "PADA_TABLE_")) {
+            print!("{}", elf::Usage::classify(&sizes, &regions).report(&regions, &table));
+        }
+    }
     println!("xtask: firmware ELF: {}", elf.display());
     Ok(elf)
 }
 
-/// Runs `pada sil --elf <elf> --task <robot's task> <args>` (release build).
-fn sil(root: &Path, elf: &Path, robot: Robot, args: &[String]) -> Result<(), String> {
+/// Runs `pada sil --elf <elf> --task <robot's task> --board <profile> <args>`
+/// (release build).
+fn sil(root: &Path, elf: &Path, build: Build, args: &[String]) -> Result<(), String> {
     let cargo = env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
-    let task = match robot {
-        Robot::Pendulum => "pendulum",
-        Robot::Pendulum20 => "pendulum-20hz",
-        Robot::Leo => "leo",
-    };
     let mut cmd = std::process::Command::new(&cargo);
     toolchain::clean_env(&mut cmd, false);
     cmd.current_dir(root)
         .args(["run", "--release", "--quiet", "--package", "pada", "--", "sil", "--elf"])
         .arg(elf);
-    if !args.iter().any(|a| a == "--task" || a.starts_with("--task=")) {
-        cmd.args(["--task", task]);
+    let given = |flag: &str| args.iter().any(|a| a == flag || a.starts_with(&format!("{flag}=")));
+    if !given("--task") {
+        cmd.args(["--task", build.robot.name()]);
+    }
+    if !given("--board") {
+        cmd.args(["--board", build.chip.profile()]);
     }
     cmd.args(args);
     let status = cmd.status().map_err(|e| format!("cannot start cargo: {e}"))?;
@@ -684,6 +731,14 @@ mod tests {
         assert!(parse_args(&args("qemu --release")).is_err());
         assert!(parse_args(&args("qemu -- --json")).is_err());
         assert!(parse_args(&args("sil --robot")).is_err());
+        // The f429-sdram profile is emulated on mps2-an386.
+        let f429_leo = Build { release: true, chip: Chip::F429, robot: Robot::Leo };
+        assert_eq!(parse_args(&args("qemu --board f429-sdram --robot leo")), Ok(Task::Qemu(f429_leo)));
+        assert_eq!(parse_args(&args("sil --robot=leo --board=f429-sdram -- --seconds 5")), Ok(Task::Sil(f429_leo, args("--seconds 5"))));
+        assert_eq!(Chip::F429.emulated(), ("mps2", "mps2-an386", "firmware/memory-mps2.x"));
+        assert_eq!(Chip::F405.emulated().1, "netduinoplus2");
+        assert!(parse_args(&args("qemu --board host")).unwrap_err().contains("f405 or f429-sdram"));
+        assert!(parse_args(&args("qemu --board")).is_err());
     }
 
     #[test]

@@ -65,6 +65,9 @@ pub struct Board {
     /// The weight table's memory, started and checked (the F429's SDRAM),
     /// or why not.
     pub table_memory: Result<TableMemory, MemoryFault>,
+    /// The learner's seed: `DEFAULT_SEED` (the emulated boards take their
+    /// run's).
+    pub seed: u64,
 }
 
 impl Board {
@@ -136,6 +139,7 @@ impl Board {
             led,
             watchdog_reset,
             table_memory,
+            seed: pada_firmware::config::DEFAULT_SEED,
         }
     }
 }

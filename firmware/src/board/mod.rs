@@ -67,17 +67,20 @@
 //! `hw` is the real board on embassy-stm32, with the chip's pins,
 //! peripherals and clocks from one file per board family, chosen by cargo
 //! feature: [`f40x`] (F405, F407) or [`f429`] (F429I-DISC1, whose SDRAM
-//! [`sdram`] starts). `qemu` (cargo feature `qemu`) is the emulated board
-//! of QEMU's `netduinoplus2` for the software-in-the-loop run: the same
+//! [`sdram`] starts). The emulated boards for the software-in-the-loop run
+//! are `lockstep` (the lock-step clock, bus, telemetry and checkpoints over
+//! semihosting) on one of two QEMU machines: `qemu` (cargo feature `qemu`:
+//! `netduinoplus2`, an STM32F405, for the `f405` profile) or `mps2`
+//! (feature `mps2`: `mps2-an386`, a Cortex-M4 whose PSRAM stands in for the
+//! F429I-DISC1's SDRAM, for the `f429-sdram` profile). They have the same
 //! type names (`ServoPort`, `TelemetryTx`, `TelemetryRx`, `BoardSensors`,
 //! `FlashStore`, `Watchdog`, `Cycles`, `Led`, `Board`) implementing the
-//! same `pada_firmware::io` traits, built on a few PAC register accesses,
-//! with a lock-step time driver; everything above (tasks, controller,
+//! same `pada_firmware::io` traits; everything above (tasks, controller,
 //! agent) stays as it is.
 
-#[cfg(not(feature = "qemu"))]
+#[cfg(not(emulated))]
 mod hw;
-#[cfg(not(feature = "qemu"))]
+#[cfg(not(emulated))]
 pub use hw::*;
 
 #[cfg(any(feature = "stm32f405", feature = "stm32f407"))]
@@ -92,10 +95,19 @@ mod sdram;
 #[cfg(feature = "stm32f429")]
 use f429 as chip;
 
+// The emulated boards: one lock-step layer, two machines.
+#[cfg(emulated)]
+mod lockstep;
+#[cfg(emulated)]
+pub use lockstep::*;
 #[cfg(feature = "qemu")]
 mod qemu;
 #[cfg(feature = "qemu")]
-pub use qemu::*;
+use qemu as machine;
+#[cfg(feature = "mps2")]
+mod mps2;
+#[cfg(feature = "mps2")]
+use mps2 as machine;
 
 /// Proof that the memory the weight table lives in works: only the board
 /// layer makes one, after it started that memory (the F429's SDRAM, which

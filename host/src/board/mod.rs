@@ -11,10 +11,12 @@
 //! board will learn; `pada sil` shows that the binary does the same, bit
 //! for bit.
 //!
+//! - [`protocol`]: the run protocol and seeds, shared with `pada sil`;
 //! - [`trial`]: one trial, the controller and the rig in lock step;
 //! - [`run_board`]: the trials of a run in parallel, with the same
 //!   [`TrialResult`]s (and so the same `summary.json`) as `pada run`.
 
+pub mod protocol;
 pub mod trial;
 
 use crate::experiment::runner::RunConfig;
@@ -24,7 +26,8 @@ use pada_core::robot::Robot;
 use rayon::prelude::*;
 use serde::Serialize;
 
-pub use trial::{run_board_trial, BoardTrial};
+pub use protocol::{EpisodeOutcome, Phase, RunProtocol};
+pub use trial::{run_board_trial, run_board_trial_on, standard_rig, BoardTrial};
 
 /// A board's learner, as `summary.json` reports it.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -1,20 +1,28 @@
 //! One trial of a board's learner on the host: the firmware's controller
 //! and a [`Rig`] in lock step, one control period at a time, with the run
-//! protocol of `pada sil` and `pada run` (a greedy test run before
+//! protocol of `pada sil` ([`super::protocol`]: a greedy test run before
 //! learning, the controller's own test run after every tenth learning
 //! episode, a final test run once the learning time is spent).
 //!
-//! Per period `k` (at `t = k·T`):
+//! Per period `k` (at `t = k·T`, where the firmware's control ticks lie,
+//! `pada_firmware`'s control task):
 //!
 //! 1. every servo's Present Position … Temperature and the sensors are read
 //!    from the rig at `t` (the state at the period boundary, see
 //!    [`crate::rig::leo`]);
 //! 2. the controller runs its period, as on the chip;
-//! 3. its Moving Speeds (ratios of the supply) drive the rig from `t`;
-//!    an episode's end or start tells the rig's operator;
+//! 3. its Moving Speeds (ratios of the rig's supply) drive the rig from
+//!    `t`; an episode's end or start tells the rig's operator at `t`;
 //! 4. the rig advances to `t + T`; if the period applied a learning action,
 //!    the gearbox torques of the learned joints over it go to the MTBF
 //!    count, as `pada run` counts them.
+//!
+//! This is what the SIL run does on the emulated bus: its reads and writes
+//! of period `k` fall within `[k·T, (k+1)·T)`, the operator hears of an
+//! episode's end in the same period, and LEO's rig advances in whole
+//! periods on the same boundaries; so for LEO, `pada sil` and this trial
+//! with the same seed give the same episodes, bit for bit (`pada sil`
+//! checks it). The walked distance is the rig's measure.
 //!
 //! Differences to `pada run` that are the board's: the table (the board's
 //! profile), the sensors (counts, differenced rates), the seeds (the
@@ -22,10 +30,11 @@
 //! held joints and resets, and the switch back to SARSA(λ) at the first
 //! period at or after `--switch-at` rather than at the exact step.
 
+use super::protocol::{EpisodeOutcome, RunProtocol};
 use crate::experiment::governed::GovernorStats;
 use crate::experiment::metrics::{end_performance, rise_time};
 use crate::experiment::runner::RunConfig;
-use crate::experiment::{TestPoint, TrialResult};
+use crate::experiment::TrialResult;
 use crate::leo::model::ModelOptions;
 use crate::pendulum::PhysicalPendulumParams;
 use crate::rig::{LeoRig, PendulumRig, Rig};
@@ -37,7 +46,7 @@ use pada_core::policy::PolicyKind;
 use pada_core::profile::{LearnerProfile, TILINGS};
 use pada_core::robot::Robot;
 use pada_core::weights::{Half, WeightFormat, WeightStore};
-use pada_core::wire::{RunMode, StepKind, ToChip};
+use pada_core::wire::{Episode, RunMode, StepKind, ToChip};
 use pada_firmware::config::hardware;
 use pada_firmware::control::{Controller, PeriodOutput, Readings};
 use pada_firmware::io::CycleCounter;
@@ -68,6 +77,10 @@ pub struct BoardTrial {
     pub board_estimated_mtbf_s: f64,
     /// Control periods run, with the waits between episodes.
     pub periods: u64,
+    /// Every episode as the board reports it (for `pada sil`'s
+    /// comparison; not in `summary.json`).
+    #[serde(skip)]
+    pub episodes: Vec<Episode>,
 }
 
 /// The cycle counter of a controller off the chip: none.
@@ -101,11 +114,34 @@ pub fn table_len(profile: &LearnerProfile, policy: PolicyKind) -> anyhow::Result
     coder.exact_size().ok_or_else(|| anyhow!("a hashed profile has a fixed size"))
 }
 
-/// Trial `trial` of `cfg` with `profile`'s learner against its robot's rig.
+/// The rig a board trial of `robot` runs against: the physical pendulum's
+/// model with an operator who stops it between episodes, or the rapier3d
+/// LEO.
+pub fn standard_rig(robot: Robot) -> anyhow::Result<Box<dyn Rig>> {
+    Ok(match robot {
+        Robot::Leo => Box::new(LeoRig::new(ModelOptions::default())?),
+        _ => Box::new(PendulumRig::with_operator(PhysicalPendulumParams::default())),
+    })
+}
+
+/// Trial `trial` of `cfg` with `profile`'s learner against its robot's
+/// [`standard_rig`].
 pub fn run_board_trial(
     profile: LearnerProfile,
     cfg: &RunConfig,
     trial: u32,
+    progress: &(dyn Fn(u64) + Sync),
+) -> anyhow::Result<BoardTrial> {
+    let mut rig = standard_rig(profile.robot)?;
+    run_board_trial_on(profile, cfg, trial, rig.as_mut(), progress)
+}
+
+/// Trial `trial` of `cfg` with `profile`'s learner against `rig`.
+pub fn run_board_trial_on(
+    profile: LearnerProfile,
+    cfg: &RunConfig,
+    trial: u32,
+    rig: &mut dyn Rig,
     progress: &(dyn Fn(u64) + Sync),
 ) -> anyhow::Result<BoardTrial> {
     let n = table_len(&profile, cfg.policy)?;
@@ -114,33 +150,21 @@ pub fn run_board_trial(
     // addresses the same weights in the same order.
     match (profile.robot, profile.format) {
         (Robot::Pendulum33, WeightFormat::Q16) => {
-            let mut rig = PendulumRig::with_operator(PhysicalPendulumParams::default());
-            run::<Pendulum33, _>(profile, vec![Q16::ZERO; n].into_boxed_slice(), &mut rig, cfg, trial, seed, progress)
+            run::<Pendulum33, _>(profile, vec![Q16::ZERO; n].into_boxed_slice(), rig, cfg, trial, seed, progress)
         }
         (Robot::Leo, WeightFormat::Q16) => {
-            let mut rig = LeoRig::new(ModelOptions::default())?;
-            run::<Leo, _>(profile, vec![Q16::ZERO; n].into_boxed_slice(), &mut rig, cfg, trial, seed, progress)
+            run::<Leo, _>(profile, vec![Q16::ZERO; n].into_boxed_slice(), rig, cfg, trial, seed, progress)
         }
         (Robot::Leo, WeightFormat::Half { shift: pada_core::robot::leo::HALF_SHIFT }) => {
-            let mut rig = LeoRig::new(ModelOptions::default())?;
             let table = Half::<_, { pada_core::robot::leo::HALF_SHIFT as u32 }>::new(vec![0i16; n].into_boxed_slice());
-            run::<Leo, _>(profile, table, &mut rig, cfg, trial, seed, progress)
+            run::<Leo, _>(profile, table, rig, cfg, trial, seed, progress)
         }
         (Robot::Pendulum33, WeightFormat::Half { shift: pada_core::robot::pendulum::HALF_SHIFT }) => {
-            let mut rig = PendulumRig::with_operator(PhysicalPendulumParams::default());
             let table = Half::<_, { pada_core::robot::pendulum::HALF_SHIFT as u32 }>::new(vec![0i16; n].into_boxed_slice());
-            run::<Pendulum33, _>(profile, table, &mut rig, cfg, trial, seed, progress)
+            run::<Pendulum33, _>(profile, table, rig, cfg, trial, seed, progress)
         }
         (robot, format) => bail!("no board runner for {} with {format:?} weights", robot.name()),
     }
-}
-
-/// Where the run protocol is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Phase {
-    FirstTest,
-    Learning,
-    FinalTest,
 }
 
 fn command<W: WeightStore, R: RobotAdapter>(ctl: &mut Controller<W, R>, cmd: ToChip) -> anyhow::Result<()> {
@@ -163,13 +187,18 @@ fn run<R: RobotAdapter, W: WeightStore>(
     // As the SIL run: the board boots with SARSA, the host sets the policy
     // (a fresh learner from the seed) and starts the first test run.
     let mut ctl = Controller::<W, R>::new(profile, PolicyKind::Sarsa, table, seed).map_err(|e| anyhow!("{e}"))?;
-    ctl.set_policy(cfg.policy).map_err(|e| anyhow!("--algo {:?} on board {}: {e:?}", cfg.policy, profile.board.name()))?;
-    if let Some(budget) = cfg.mtbf_budget_s {
-        // As the host would: the wire command, after the policy.
-        command(&mut ctl, ToChip::SetMtbfBudget(Some(budget)))?;
+    for cmd in RunProtocol::start(cfg.policy) {
+        let starts = matches!(cmd, ToChip::Start(_));
+        if let (true, Some(budget)) = (starts, cfg.mtbf_budget_s) {
+            // As the host would: the wire command, after the policy and
+            // before the first run (torque off).
+            command(&mut ctl, ToChip::SetMtbfBudget(Some(budget)))?;
+        }
+        command(&mut ctl, cmd).map_err(|e| anyhow!("--algo {:?} on board {}: {e}", cfg.policy, profile.board.name()))?;
     }
     let mut governed = GovernorStats::default();
-    command(&mut ctl, ToChip::Start(RunMode::Testing))?;
+    let mut protocol = RunProtocol::new(cfg.seconds, spec.period_us);
+    let mut episodes = Vec::new();
 
     let hw = hardware(R::ROBOT);
     let counted = R::reported_joints();
@@ -182,16 +211,13 @@ fn run<R: RobotAdapter, W: WeightStore>(
     let mut estimated = fatigue(()).map_err(|e| anyhow!("{e}"))?;
     let mut volts_of = [0.0f32; 256];
 
-    let budget = (cfg.seconds / period_s).round() as u64;
     let switch_step = cfg.switch_at_s.map(|s| (s / period_s).round() as u64);
     let mut switched = false;
-    let mut phase = Phase::FirstTest;
     let mut out = PeriodOutput::default();
-    let mut curve: Vec<TestPoint> = Vec::new();
-    let (mut learning_steps, mut test_steps, mut learning_falls, mut learning_episodes) = (0u64, 0u64, 0u64, 0u32);
+    let (mut learning_actions, mut test_steps, mut learning_falls) = (0u64, 0u64, 0u64);
     let mut last_kind = StepKind::Start;
     // Generous: every episode may be followed by a wait of up to 15 s.
-    let limit = (budget + 1) * 20 + 100_000;
+    let limit = (protocol.budget_steps() + 1) * 20 + 100_000;
     let mut k: u64 = 0;
     loop {
         let t = k * period_us;
@@ -209,7 +235,7 @@ fn run<R: RobotAdapter, W: WeightStore>(
         // 2. The controller's period.
         ctl.period(&readings, &NoCycles, &mut out);
         // 3. Drive, and tell the operator.
-        let supply = hw.supply_nominal_v as f64;
+        let supply = rig.supply_v();
         for &(id, speed) in &out.speeds {
             let volts = pada_core::dynamixel::table::ratio_from_moving_speed(speed) as f64 * supply;
             rig.drive(t, id, out.torque, volts);
@@ -219,10 +245,17 @@ fn run<R: RobotAdapter, W: WeightStore>(
         if let Some(s) = &out.step {
             last_kind = s.kind;
             if s.kind == StepKind::Start {
-                rig.episode_started();
+                rig.episode_started(t);
             }
             learning_action = s.mode == RunMode::Learning && matches!(s.kind, StepKind::Start | StepKind::Step);
         }
+        // The operator hears of an episode's end in its period, before the
+        // next boundary, as in the SIL run; the distance is the plant's.
+        let ended = out.episode.map(|e| {
+            let outcome = EpisodeOutcome { fell: last_kind == StepKind::Absorbing, walked_m: rig.walked_m() };
+            rig.episode_ended(t);
+            (e, outcome)
+        });
         // 4. Advance; count the learning action's torques.
         k += 1;
         rig.advance_to(k * period_us);
@@ -243,46 +276,29 @@ fn run<R: RobotAdapter, W: WeightStore>(
             paper.update(&com).map_err(|e| anyhow!("{e}"))?;
             simulated.update(&sim).map_err(|e| anyhow!("{e}"))?;
             estimated.update(&est).map_err(|e| anyhow!("{e}"))?;
-            learning_steps += 1;
-            if !switched && switch_step.is_some_and(|s| learning_steps >= s) {
+            learning_actions += 1;
+            if !switched && switch_step.is_some_and(|s| learning_actions >= s) {
                 command(&mut ctl, ToChip::SwitchToSarsa)?;
                 switched = true;
             }
         }
-        let Some(e) = out.episode else { continue };
-        rig.episode_ended();
-        let fell = last_kind == StepKind::Absorbing;
+        let Some((e, outcome)) = ended else { continue };
         progress(e.length as u64);
         match e.mode {
-            RunMode::Learning => {
-                learning_episodes += 1;
-                learning_falls += fell as u64;
-            }
-            RunMode::Testing => {
-                test_steps += e.length as u64;
-                curve.push(TestPoint {
-                    learning_time_s: learning_steps as f64 * period_s,
-                    learning_episodes,
-                    test_return: e.total_reward as f64,
-                    walked_m: ctl.walked_m().map(|w| w as f64),
-                    fell,
-                    duration_s: e.length as f64 * period_s,
-                });
-            }
+            RunMode::Learning => learning_falls += outcome.fell as u64,
+            RunMode::Testing => test_steps += e.length as u64,
         }
-        match phase {
-            Phase::FirstTest if e.mode == RunMode::Testing => {
-                phase = Phase::Learning;
-                command(&mut ctl, ToChip::Start(RunMode::Learning))?;
-            }
-            Phase::Learning if e.mode == RunMode::Learning && learning_steps >= budget => {
-                phase = Phase::FinalTest;
-                command(&mut ctl, ToChip::Start(RunMode::Testing))?;
-            }
-            Phase::FinalTest if e.mode == RunMode::Testing => break,
-            _ => {}
+        episodes.push(e);
+        if let Some(cmd) = protocol.on_episode(&e, outcome) {
+            command(&mut ctl, cmd)?;
+        }
+        if protocol.done() {
+            break;
         }
     }
+    let learning_steps = protocol.learning_steps();
+    let learning_episodes = protocol.learning_episodes();
+    let curve = protocol.into_curve();
     let times: Vec<f64> = curve.iter().map(|p| p.learning_time_s).collect();
     let returns: Vec<f64> = curve.iter().map(|p| p.test_return).collect();
     let tail_n = curve.len().div_ceil(10).max(1).min(curve.len());
@@ -324,5 +340,6 @@ fn run<R: RobotAdapter, W: WeightStore>(
         weights_checksum: ctl.weights().checksum(),
         board_estimated_mtbf_s: estimated.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
         periods: k,
+        episodes,
     })
 }

@@ -6,6 +6,7 @@ use crate::cli::check_seconds;
 use crate::error::{usage, CliError};
 use crate::experiment::algo::{label, policy_kind, Algo};
 use crate::output::OutDir;
+use crate::board::BoardName;
 use crate::sil::{self, fault, SilConfig, SilSummary, SilTask};
 use anyhow::{anyhow, Context};
 use clap::Args;
@@ -16,9 +17,28 @@ use std::time::Duration;
 #[derive(Debug, Clone, Args)]
 pub struct SilArgs {
     /// The robot: the physical pendulum (against its model), or LEO
-    /// (against a stand-in holding its start pose: instruction counts only).
+    /// (against the rapier3d LEO, with an operator who sets it up between
+    /// episodes).
     #[arg(long, value_enum, default_value_t = SilTask::Pendulum)]
     pub task: SilTask,
+    /// The board learner profile the image is built for, and so the
+    /// emulated board: f405 (QEMU's netduinoplus2, an STM32F405) or
+    /// f429-sdram (QEMU's mps2-an386, whose PSRAM holds LEO's 8 MiB table
+    /// as the F429I-DISC1's SDRAM would). Default: f405 for the pendulum,
+    /// f429-sdram for LEO.
+    #[arg(long, value_enum)]
+    pub board: Option<BoardName>,
+    /// Master seed, as `pada run`'s: the board learns with trial 0's seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Do not forecast the bus's answers: every answer costs a lock-step
+    /// exchange (the same run, slower; to measure the forecasts).
+    #[arg(long)]
+    pub no_forecast: bool,
+    /// Skip the comparison with the same controller on the host (`pada run
+    /// --board`'s runner).
+    #[arg(long)]
+    pub no_compare: bool,
     /// Learning time to reach [s of emulated learning episodes] (default:
     /// 600 for the pendulum, 60 for LEO).
     #[arg(long, value_name = "S")]
@@ -35,11 +55,11 @@ pub struct SilArgs {
     pub delta: Option<f32>,
     /// Inject a fault on the servo bus (repeatable):
     /// KIND[:at=S][:for=S][:servo=ID][:ms=MS][:bits=NAME] with KIND drop,
-    /// corrupt, delay or error-bits (docs/sil.md).
+    /// corrupt, delay, error-bits or past-limit (docs/sil.md).
     #[arg(long, value_name = "SPEC")]
     pub fault: Vec<String>,
     /// The firmware ELF built for the emulated board (default: build it
-    /// with `cargo xtask qemu` in this repository).
+    /// with `cargo xtask qemu --board B --robot R` in this repository).
     #[arg(long, value_name = "FILE")]
     pub elf: Option<PathBuf>,
     /// The QEMU to run (10 or later).
@@ -47,7 +67,7 @@ pub struct SilArgs {
     pub qemu: PathBuf,
     /// Output directory: telemetry.bin (the raw stream), telemetry.csv,
     /// episodes.csv, summary.json, the firmware's log (default:
-    /// pada-out/sil-<task>-<algo>).
+    /// pada-out/sil-<task>-<algo>-<board>).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Wall-clock seconds without a word from the board before the run is
@@ -71,12 +91,20 @@ pub fn run(args: SilArgs) -> Result<(), CliError> {
         SilTask::Leo => 60.0,
     };
     let seconds = check_seconds("--seconds", args.seconds.unwrap_or(default_seconds))?;
+    let board = args.board.map(BoardName::board).unwrap_or(args.task.default_board());
+    if sil::machine(board).is_none() {
+        return Err(usage(format!(
+            "--board {}: no emulated board; valid are f405 (netduinoplus2) and f429-sdram (mps2-an386)",
+            board.name()
+        )));
+    }
     let faults = args
         .fault
         .iter()
         .map(|f| fault::parse(f))
         .collect::<Result<Vec<_>, _>>()
         .map_err(usage)?;
+    sil::bus::check_faults(args.task.robot(), &faults).map_err(usage)?;
     if !(1..=3600).contains(&args.hang_timeout) {
         return Err(usage(format!(
             "--hang-timeout {} is out of range: valid is 1..=3600 s",
@@ -88,27 +116,27 @@ pub fn run(args: SilArgs) -> Result<(), CliError> {
         .as_deref()
         .map(crate::telemetry::parse_target)
         .transpose()?;
-    let task_name = match args.task {
-        SilTask::Pendulum => "pendulum",
-        SilTask::Leo => "leo",
-    };
     let out_path = args
         .out
         .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("pada-out/sil-{task_name}-{}", args.algo)));
+        .unwrap_or_else(|| PathBuf::from(format!("pada-out/sil-{}-{}-{}", args.task.name(), args.algo, board.name())));
     OutDir::check(&out_path)?;
     let elf = match &args.elf {
         Some(p) if p.is_file() => p.clone(),
         Some(p) => return Err(usage(format!("--elf {}: no such file", p.display()))),
-        None => build_image(args.task)?,
+        None => build_image(args.task, board)?,
     };
     let cfg = SilConfig {
         qemu: args.qemu.clone(),
         elf,
         task: args.task,
+        board,
         policy,
         seconds,
+        seed: args.seed,
         faults,
+        forecast: !args.no_forecast,
+        compare: !args.no_compare,
         out_dir: out_path.clone(),
         hang_timeout: Duration::from_secs(args.hang_timeout),
         progress: !args.json,
@@ -142,7 +170,7 @@ pub fn run(args: SilArgs) -> Result<(), CliError> {
 
 /// Builds the emulated board's image with `cargo xtask qemu` in the
 /// repository this binary was built from.
-fn build_image(task: SilTask) -> Result<PathBuf, CliError> {
+fn build_image(task: SilTask, board: pada_core::profile::Board) -> Result<PathBuf, CliError> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
         .map(Path::to_path_buf)
@@ -154,17 +182,12 @@ fn build_image(task: SilTask) -> Result<PathBuf, CliError> {
             root.display()
         )));
     }
-    let robot = match task {
-        SilTask::Pendulum => "pendulum",
-        SilTask::Leo => "leo",
-    };
-    errln!(
-        "pada sil: building the firmware for the emulated board (cargo xtask qemu --robot {robot})"
-    );
+    let (robot, board) = (task.name(), board.name());
+    errln!("pada sil: building the firmware for the emulated board (cargo xtask qemu --board {board} --robot {robot})");
     let output =
         std::process::Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()))
             .current_dir(&root)
-            .args(["xtask", "qemu", "--robot", robot])
+            .args(["xtask", "qemu", "--board", board, "--robot", robot])
             .stderr(std::process::Stdio::inherit())
             .output()
             .context("cannot start cargo to build the firmware (pass --elf FILE instead)")?;
@@ -187,16 +210,18 @@ fn build_image(task: SilTask) -> Result<PathBuf, CliError> {
 
 fn print_summary(s: &SilSummary, policy: &str) -> Result<(), CliError> {
     outln!(
-        "sil {} ({}), {policy}: {:.0} s learning in {:.0} s emulated, {:.1} s wall ({:.0}x real time)",
-        s.robot, s.plant, s.learning_s, s.emulated_s, s.wall_s, s.speedup
+        "sil {} on board {} ({}), {policy}, seed {}: {:.0} s learning in {:.0} s emulated, {:.1} s wall ({:.1}x real time, {:.2} exchanges per period)",
+        s.robot, s.board, s.machine, s.seed, s.learning_s, s.emulated_s, s.wall_s, s.speedup, s.exchanges_per_period
     )?;
+    outln!("  plant: {}", s.plant)?;
     let fmt = |x: Option<f64>| x.map(|v| format!("{v:.1}")).unwrap_or_else(|| "-".into());
     outln!(
-        "  test return: first {}, end performance {}, rise time {} s; {} learning episodes",
+        "  test return: first {}, end performance {}, rise time {} s; {} learning episodes{}",
         fmt(s.first_test_return),
         fmt(s.end_performance),
         fmt(s.rise_time_s),
-        s.learning_episodes
+        s.learning_episodes,
+        s.end_walked_m.map(|w| format!("; walked {w:.2} m per test run (last 10 %)")).unwrap_or_default()
     )?;
     let i = &s.agent_instructions;
     outln!(

@@ -275,6 +275,7 @@ impl<P: Plant> Trial<'_, '_, P> {
         learning: bool,
         reward: f32,
         decision: Option<&Decision>,
+        footstep: bool,
     ) {
         let Some(observer) = self.observer.as_mut() else {
             return;
@@ -323,6 +324,7 @@ impl<P: Plant> Trial<'_, '_, P> {
             reward,
             td_error,
             explored: decision.is_some_and(|d| d.explored),
+            footstep,
             joints,
             loop_us: 0,
             agent_cycles: 0,
@@ -410,14 +412,15 @@ impl<P: Plant> Trial<'_, '_, P> {
             .agent
             .start_episode(&self.obs[..n], &mut self.rng)
             .map_err(bad)?;
-        self.report_step(StepKind::Start, learning, 0.0, Some(&d));
+        self.report_step(StepKind::Start, learning, 0.0, Some(&d), false);
         let mut ret = 0.0f64;
         for k in 1..=spec.episode_steps {
             let command = &d.output[..motors];
             let step = self.plant.step(command, &mut self.obs[..n]);
             // A footstep: the policy's memory moves with the joints before
             // the next decision (the robot's definition).
-            if let (true, Some(map)) = (self.plant.footstep(), spec.footstep_remap) {
+            let footstep = self.plant.footstep() && spec.footstep_remap.is_some();
+            if let (true, Some(map)) = (footstep, spec.footstep_remap) {
                 self.agent.remap_memory(&map);
             }
             if learning {
@@ -453,7 +456,7 @@ impl<P: Plant> Trial<'_, '_, P> {
                 } else {
                     StepKind::Timeout
                 };
-                self.report_step(kind, learning, step.reward, None);
+                self.report_step(kind, learning, step.reward, None, footstep);
                 self.report_episode(learning, ret, k);
                 return Ok((ret, k, step.terminal));
             }
@@ -465,7 +468,7 @@ impl<P: Plant> Trial<'_, '_, P> {
                 .agent
                 .step(step.reward, obs, &mut self.rng)
                 .map_err(bad)?;
-            self.report_step(StepKind::Step, learning, step.reward, Some(&d));
+            self.report_step(StepKind::Step, learning, step.reward, Some(&d), footstep);
         }
         Ok((ret, spec.episode_steps, false))
     }

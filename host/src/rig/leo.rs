@@ -21,20 +21,24 @@
 //!   torso's pitch, so the counter reads the pitch, from vertical: LEO
 //!   powered up upright); the toe and heel switches as
 //!   `pada_firmware::leo::contact` bits.
-//! - **Between episodes.** When the firmware reports an episode's end, the
-//!   operator puts LEO back into the start pose of §1.8 (the state after its
-//!   first control period, as the simulation's episodes start) and holds it
-//!   still: the physics does not run, so the firmware reads the start pose
-//!   until it has seen the torso upright with a foot down for its second
-//!   and starts the next episode, when the operator lets go. LEO is held
-//!   from boot too.
+//! - **Between episodes.** When the firmware reports an episode's end (or a
+//!   fault), the operator puts LEO back into the start pose of §1.8 (the
+//!   state after its first control period, as the simulation's episodes
+//!   start) and holds it still: the physics does not run, so the firmware
+//!   reads the start pose until it has seen the torso upright with a foot
+//!   down for its second and starts the next episode, when the operator
+//!   lets go. LEO is held from boot too.
+//! - **Walked distance.** The plant measures it as the host's LEO task
+//!   does (`crate::leo`, §3.3): the sum of footstep lengths from the true
+//!   joint angles, torso pitch and foot contacts at every period boundary,
+//!   from the operator letting go.
 //! - **Torque off** (a fault, Stop): modelled as 0 V, the motor shorted,
 //!   which brakes the joint a little more than the RX-28's open winding.
 
 use super::{encoder_count, position_raw, Rig, TEMPERATURE_C};
 use crate::leo::model::{InitialPose, LeoModel, ModelOptions, Snapshot, NUM_JOINTS};
 use pada_core::dynamixel::table::{self, PresentState};
-use pada_core::robot::leo::{CONTROL_PERIOD_US, JOINTS};
+use pada_core::robot::leo::{ankle_x, Leg, StanceTracker, CONTROL_PERIOD_US, JOINTS};
 use pada_core::robot::Robot;
 use pada_core::rx28::{Rx28, LEO_SUPPLY_VOLTAGE};
 use pada_firmware::leo::contact;
@@ -60,6 +64,8 @@ pub struct LeoRig {
     /// resets LEO as after a fall).
     periods: u64,
     blow_ups: u64,
+    /// Footsteps since the operator let go.
+    stance: StanceTracker,
 }
 
 impl LeoRig {
@@ -85,6 +91,7 @@ impl LeoRig {
             torques: [0.0; NUM_JOINTS],
             periods: 0,
             blow_ups: 0,
+            stance: StanceTracker::new(),
         })
     }
 
@@ -122,6 +129,45 @@ impl LeoRig {
                 self.torques = [0.0; NUM_JOINTS];
             }
         }
+        self.track_stance();
+    }
+
+    /// The stance tracker sees the state at this boundary (§3.3, as
+    /// `crate::leo::LeoEnv` does).
+    fn track_stance(&mut self) {
+        let s = self.model.state();
+        let phi = -s.torso_pitch;
+        let ankle = |leg: Leg| ankle_x(phi, s.angles[leg.hip() as usize], s.angles[leg.knee() as usize]);
+        self.stance.update(s.contacts[0] || s.contacts[1], s.contacts[2] || s.contacts[3], ankle(Leg::Left), ankle(Leg::Right));
+    }
+
+    /// Servo `k`'s reading now.
+    fn reading(&self, k: usize) -> PresentState {
+        let (q, qd) = self.model.joint_state();
+        let rpm = qd[k] as f64 * 60.0 / std::f64::consts::TAU;
+        let speed = rpm / (table::SPEED_UNIT_RPM as f64 * table::MAGNITUDE_MAX as f64);
+        let stall = Rx28::LEO.estimate_joint_torque(LEO_SUPPLY_VOLTAGE, 0.0);
+        PresentState {
+            position: position_raw(q[k] as f64),
+            speed: table::encode_signed(speed.clamp(-1.0, 1.0) as f32),
+            load: table::encode_signed((self.torques[k] / stall).clamp(-1.0, 1.0)),
+            voltage: (LEO_SUPPLY_VOLTAGE * 10.0).round() as u8,
+            temperature: TEMPERATURE_C,
+        }
+    }
+
+    /// The boom's encoder and the foot switches now.
+    fn sensor_reading(&self) -> (u16, u8) {
+        let s = self.model.state();
+        let bits = [contact::TOE_L, contact::HEEL_L, contact::TOE_R, contact::HEEL_R];
+        let contacts = s.contacts.iter().zip(bits).filter(|(on, _)| **on).fold(0, |b, (_, bit)| b | bit);
+        (encoder_count(s.torso_pitch as f64), contacts)
+    }
+
+    /// Whether the state at `t_us` is the state now: no period boundary
+    /// to simulate before it (or the operator holds LEO still).
+    fn settled_until(&self, t_us: u64) -> bool {
+        self.held || t_us < self.next_step_us
     }
 }
 
@@ -149,42 +195,50 @@ impl Rig for LeoRig {
 
     fn present(&mut self, t_us: u64, id: u8) -> PresentState {
         self.advance_to(t_us);
-        let Some(k) = self.joint_of(id) else {
-            return PresentState { position: 0, speed: 0, load: 0, voltage: 0, temperature: TEMPERATURE_C };
-        };
-        let (q, qd) = self.model.joint_state();
-        let rpm = qd[k] as f64 * 60.0 / std::f64::consts::TAU;
-        let speed = rpm / (table::SPEED_UNIT_RPM as f64 * table::MAGNITUDE_MAX as f64);
-        let stall = Rx28::LEO.estimate_joint_torque(LEO_SUPPLY_VOLTAGE, 0.0);
-        PresentState {
-            position: position_raw(q[k] as f64),
-            speed: table::encode_signed(speed.clamp(-1.0, 1.0) as f32),
-            load: table::encode_signed((self.torques[k] / stall).clamp(-1.0, 1.0)),
-            voltage: (LEO_SUPPLY_VOLTAGE * 10.0).round() as u8,
-            temperature: TEMPERATURE_C,
+        match self.joint_of(id) {
+            Some(k) => self.reading(k),
+            None => PresentState { position: 0, speed: 0, load: 0, voltage: 0, temperature: TEMPERATURE_C },
         }
     }
 
     fn sensors(&mut self, t_us: u64) -> (u16, u8) {
         self.advance_to(t_us);
-        let s = self.model.state();
-        let bits = [contact::TOE_L, contact::HEEL_L, contact::TOE_R, contact::HEEL_R];
-        let contacts = s.contacts.iter().zip(bits).filter(|(on, _)| **on).fold(0, |b, (_, bit)| b | bit);
-        (encoder_count(s.torso_pitch as f64), contacts)
+        self.sensor_reading()
+    }
+
+    fn peek_present(&self, t_us: u64, id: u8) -> Option<PresentState> {
+        let k = self.joint_of(id)?;
+        self.settled_until(t_us).then(|| self.reading(k))
+    }
+
+    fn peek_sensors(&self, t_us: u64) -> Option<(u16, u8)> {
+        self.settled_until(t_us).then(|| self.sensor_reading())
+    }
+
+    fn supply_v(&self) -> f64 {
+        LEO_SUPPLY_VOLTAGE as f64
+    }
+
+    fn walked_m(&self) -> Option<f64> {
+        Some(self.stance.walked() as f64)
     }
 
     fn describe(&self) -> String {
         "LEO in rapier3d (grl-facts §1-2): 7 RX-28s, the boom's 4096-count encoder, 4 foot switches, set upright by an operator between episodes".into()
     }
 
-    fn episode_ended(&mut self) {
+    fn episode_ended(&mut self, _t_us: u64) {
         self.model.restore(&self.start);
         self.torques = [0.0; NUM_JOINTS];
         self.held = true;
     }
 
-    fn episode_started(&mut self) {
+    /// From the next period boundary on, LEO moves; the walked distance
+    /// counts from the start pose.
+    fn episode_started(&mut self, _t_us: u64) {
         self.held = false;
+        self.stance = StanceTracker::new();
+        self.track_stance();
     }
 
     fn gear_torque(&self, id: u8) -> f32 {
@@ -218,15 +272,22 @@ mod tests {
         // Held: a second passes, nothing moves, whatever is commanded.
         rig.drive(0, hip_r, true, 10.0);
         assert_eq!(at(&mut rig, 1_000_000), before);
+        assert_eq!(rig.peek_present(5_000_000, hip_r), Some(rig.present(1_000_000, hip_r)));
         // Released: 10 V on the right hip moves it within a few periods.
-        rig.episode_started();
+        rig.episode_started(1_000_000);
+        // Until the next boundary it stands; past it, only a simulation
+        // can tell.
+        let next = rig.next_step_us;
+        assert_eq!(rig.peek_present(next - 1, hip_r), Some(rig.present(next - 1, hip_r)));
+        assert_eq!(rig.peek_present(next, hip_r), None);
+        assert_eq!(rig.walked_m(), Some(0.0));
         let t0 = rig.next_step_us;
         rig.advance_to(t0 + 5 * CONTROL_PERIOD_US as u64);
         let after = at(&mut rig, t0 + 5 * CONTROL_PERIOD_US as u64);
         assert!(after.0 > before.0 + 3, "{before:?} → {after:?}");
         assert!(rig.gear_torque(hip_r) > 0.1, "{}", rig.gear_torque(hip_r));
         // The operator resets and holds it again.
-        rig.episode_ended();
+        rig.episode_ended(0);
         assert_eq!(at(&mut rig, t0 + 10 * CONTROL_PERIOD_US as u64), before);
     }
 }

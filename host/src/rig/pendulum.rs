@@ -9,17 +9,25 @@ use std::f64::consts::{PI, TAU};
 /// The physical pendulum of Section VII on one RX-28 in wheel mode (ID 1)
 /// with the quadrature encoder on its axis: the constants of
 /// [`crate::pendulum::PhysicalPendulum`] (GRL's model), integrated with RK4
-/// in steps of at most [`PendulumRig::MAX_STEP_S`].
+/// in steps of [`PendulumRig::STEP_US`].
 ///
 /// With torque on, the motor drives with the applied voltage and brakes
 /// with its back-EMF (`J·θ̈ = m·g·l·sin θ − b·θ̇ − (K²/R)·θ̇ + (K/R)·u`);
 /// with torque off the RX-28 cuts the motor's power and the pendulum swings
 /// freely (`J·θ̈ = m·g·l·sin θ − b·θ̇`).
+///
+/// The integration steps lie on a grid that starts at the last command (a
+/// drive change or the operator's hand); a reading between grid points is
+/// one shorter step from the last grid point and is not kept. So the
+/// trajectory depends only on the commands, not on when or how often the
+/// rig is read, and [`Rig::peek_present`] reads exactly what
+/// [`Rig::present`] would.
 #[derive(Debug, Clone)]
 pub struct PendulumRig {
     params: PhysicalPendulumParams,
-    /// θ (0 upright, unwrapped) and θ̇.
+    /// θ (0 upright, unwrapped) and θ̇ at `t_us`.
     x: [f64; 2],
+    /// A grid point: the last command plus whole steps \[µs\].
     t_us: u64,
     torque: bool,
     volts: f64,
@@ -28,8 +36,8 @@ pub struct PendulumRig {
 }
 
 impl PendulumRig {
-    /// The longest integration step \[s\]: the host model's 3 ms.
-    pub const MAX_STEP_S: f64 = 0.003;
+    /// The integration step \[µs\]: the host model's 3 ms.
+    pub const STEP_US: u64 = 3000;
 
     /// Hanging at rest at time 0, torque off.
     pub fn new(params: PhysicalPendulumParams) -> Self {
@@ -49,7 +57,7 @@ impl PendulumRig {
         PendulumRig { operator: true, ..Self::new(params) }
     }
 
-    /// θ (0 upright, unwrapped) and θ̇ now.
+    /// θ (0 upright, unwrapped) and θ̇ at the last grid point.
     pub fn state(&self) -> [f64; 2] {
         self.x
     }
@@ -64,39 +72,33 @@ impl PendulumRig {
         }
         [x[1], torque / p.inertia_kg_m2]
     }
-}
 
-impl Rig for PendulumRig {
-    fn servo_ids(&self) -> &[u8] {
-        &[1]
+    /// One RK4 step of `us` from `x`.
+    fn step(&self, x: [f64; 2], us: u64) -> [f64; 2] {
+        crate::integrator::integrate(x, us as f64 * 1e-6, 1, |y| self.derivative(y))
     }
 
-    fn advance_to(&mut self, t_us: u64) {
-        if t_us <= self.t_us {
-            return;
+    /// The state at `t_us` (at or after the last grid point, before the
+    /// next), without keeping it.
+    fn state_at(&self, t_us: u64) -> [f64; 2] {
+        match t_us.saturating_sub(self.t_us) {
+            0 => self.x,
+            us => self.step(self.x, us),
         }
-        let dt = (t_us - self.t_us) as f64 * 1e-6;
-        let steps = (dt / Self::MAX_STEP_S).ceil().max(1.0) as u32;
-        let this = self.clone();
-        self.x = crate::integrator::integrate(self.x, dt, steps, |y| this.derivative(y));
-        self.t_us = t_us;
     }
 
-    fn drive(&mut self, t_us: u64, id: u8, torque: bool, volts: f64) {
-        if id != 1 {
-            return;
-        }
+    /// Starts a new grid at `t_us` from the state there (a command).
+    fn restart_at(&mut self, t_us: u64) {
         self.advance_to(t_us);
-        self.torque = torque;
-        self.volts = volts;
+        self.x = self.state_at(t_us);
+        self.t_us = self.t_us.max(t_us);
     }
 
-    fn present(&mut self, t_us: u64, _id: u8) -> PresentState {
-        self.advance_to(t_us);
-        let rpm = self.x[1] * 60.0 / TAU;
+    fn reading(x: [f64; 2]) -> PresentState {
+        let rpm = x[1] * 60.0 / TAU;
         let speed_ratio = rpm / (table::SPEED_UNIT_RPM as f64 * table::MAGNITUDE_MAX as f64);
         PresentState {
-            position: position_raw(crate::pendulum::wrap_angle(self.x[0] - PI)),
+            position: position_raw(crate::pendulum::wrap_angle(x[0] - PI)),
             speed: table::encode_signed(speed_ratio.clamp(-1.0, 1.0) as f32),
             load: 0,
             voltage: (SUPPLY_V * 10.0).round() as u8,
@@ -104,10 +106,55 @@ impl Rig for PendulumRig {
         }
     }
 
+    /// The firmware takes the pose at boot (hanging, θ = π) as count 0.
+    fn encoder(x: [f64; 2]) -> (u16, u8) {
+        (encoder_count(x[0] - PI), 0)
+    }
+}
+
+impl Rig for PendulumRig {
+    fn servo_ids(&self) -> &[u8] {
+        &[1]
+    }
+
+    fn supply_v(&self) -> f64 {
+        SUPPLY_V
+    }
+
+    fn advance_to(&mut self, t_us: u64) {
+        while self.t_us + Self::STEP_US <= t_us {
+            self.x = self.step(self.x, Self::STEP_US);
+            self.t_us += Self::STEP_US;
+        }
+    }
+
+    fn drive(&mut self, t_us: u64, id: u8, torque: bool, volts: f64) {
+        if id != 1 || (torque, volts) == (self.torque, self.volts) {
+            return;
+        }
+        self.restart_at(t_us);
+        self.torque = torque;
+        self.volts = volts;
+    }
+
+    fn present(&mut self, t_us: u64, _id: u8) -> PresentState {
+        self.advance_to(t_us);
+        Self::reading(self.state_at(t_us))
+    }
+
     fn sensors(&mut self, t_us: u64) -> (u16, u8) {
         self.advance_to(t_us);
-        // The firmware takes the pose at boot (hanging, θ = π) as count 0.
-        (encoder_count(self.x[0] - PI), 0)
+        Self::encoder(self.state_at(t_us))
+    }
+
+    fn peek_present(&self, t_us: u64, _id: u8) -> Option<PresentState> {
+        let mut ahead = self.clone();
+        Some(ahead.present(t_us, 1))
+    }
+
+    fn peek_sensors(&self, t_us: u64) -> Option<(u16, u8)> {
+        let mut ahead = self.clone();
+        Some(ahead.sensors(t_us))
     }
 
     fn describe(&self) -> String {
@@ -119,8 +166,9 @@ impl Rig for PendulumRig {
     /// firmware then waits its second of stillness, and every episode
     /// starts as the simulated pendulum's do, without the up to 15 s of
     /// swinging out that the free pendulum takes.
-    fn episode_ended(&mut self) {
+    fn episode_ended(&mut self, t_us: u64) {
         if self.operator {
+            self.restart_at(t_us);
             self.x = [PI, 0.0];
         }
     }
@@ -183,5 +231,30 @@ mod tests {
             "{lost_braked} vs {lost_free}"
         );
         assert!(lost_free > 0.0);
+    }
+
+    #[test]
+    fn reading_does_not_change_the_trajectory_and_a_peek_reads_what_a_read_would() {
+        let params = PhysicalPendulumParams::default();
+        let mut read_often = PendulumRig::new(params);
+        let mut never_read = PendulumRig::new(params);
+        for k in 0..40u64 {
+            let t = k * 30_000 + 612;
+            let volts = if k % 3 == 0 { 3.0 } else { -2.0 };
+            for rig in [&mut read_often, &mut never_read] {
+                rig.drive(t, 1, true, volts);
+            }
+            for r in 1..30 {
+                let at = t + r * 997;
+                let peeked = read_often.peek_present(at, 1).unwrap();
+                assert_eq!(read_often.present(at, 1), peeked);
+                assert_eq!(read_often.peek_sensors(at + 5), Some(read_often.sensors(at + 5)));
+            }
+        }
+        let end = 40 * 30_000 + 612;
+        assert_eq!(read_often.present(end, 1), never_read.present(end, 1));
+        // Bit for bit, not just to the servo's resolution.
+        assert_eq!(read_often.state_at(end), never_read.state_at(end));
+        assert_ne!(read_often.state()[1], 0.0);
     }
 }

@@ -7,17 +7,31 @@
 //! takes effect when its last byte is in, and a servo answers after its
 //! Return Delay Time (2 µs units, control-table address 5) with a status
 //! packet that is delivered whole when its last byte is in.
+//!
+//! [`BusEmulator::forecast`] computes the answer a request would get,
+//! without changing anything (the rig is only peeked at): the SIL run's
+//! forecasts. [`BusEmulator::receive`] computes the same answer when the
+//! request comes, with its effects (counters, fault traces, the present
+//! values in the control table).
 
 use super::fault::{FaultKind, FaultSpec};
 use crate::rig::Rig;
-use pada_core::dynamixel::{
-    table, ErrorFlags, Instruction, InstructionDecoder, StatusPacket, BROADCAST_ID,
-};
+use pada_core::dynamixel::table::PresentState;
+use pada_core::dynamixel::{table, ErrorFlags, Instruction, InstructionDecoder, StatusPacket, BROADCAST_ID};
+use pada_core::robot::Robot;
+use pada_core::safety::SoftLimit;
+use pada_firmware::config::hardware;
+use pada_firmware::servo::{Joint, POSITION_UNIT_RAD};
 use pada_firmware::sil::{sensor_table, SENSOR_ID};
 use serde::Serialize;
 
 /// Microseconds per byte at 1 Mbps, 8N1.
 pub const BYTE_US: u64 = 10;
+
+/// How far past its soft limit a `past-limit` fault drives a joint \[rad\]:
+/// ten of the servo's position counts, so the reading is past the limit
+/// whatever the rounding.
+pub const PAST_LIMIT_RAD: f32 = 10.0 * POSITION_UNIT_RAD;
 
 /// A status packet on its way to the firmware.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -26,27 +40,30 @@ pub struct Reply {
     pub at_us: u64,
     /// The bytes.
     pub bytes: Vec<u8>,
+    /// The request it answers.
+    pub request: Vec<u8>,
 }
 
-/// One emulated RX-28: its control table.
+/// One emulated RX-28: its control table, and the joint it drives.
 #[derive(Debug, Clone)]
 struct Servo {
     id: u8,
     table: [u8; table::TABLE_LEN],
+    /// The firmware's calibration of the joint and its soft limit.
+    joint: Option<(Joint, Option<SoftLimit>)>,
 }
 
 impl Servo {
     /// Factory settings of an RX-28 at 1 Mbps (the firmware writes wheel
     /// mode, return delay and status return level itself).
-    fn new(id: u8) -> Self {
+    fn new(id: u8, joint: Option<(Joint, Option<SoftLimit>)>) -> Self {
         let mut t = [0u8; table::TABLE_LEN];
         t[table::MODEL_NUMBER as usize..][..2].copy_from_slice(&table::RX28_MODEL.to_le_bytes());
         t[table::FIRMWARE_VERSION as usize] = 0x24;
         t[table::ID as usize] = id;
         t[table::BAUD_RATE as usize] = table::BAUD_1MBPS;
         t[table::RETURN_DELAY_TIME as usize] = 250;
-        t[table::CCW_ANGLE_LIMIT as usize..][..2]
-            .copy_from_slice(&table::POSITION_MAX.to_le_bytes());
+        t[table::CCW_ANGLE_LIMIT as usize..][..2].copy_from_slice(&table::POSITION_MAX.to_le_bytes());
         t[table::HIGHEST_LIMIT_TEMPERATURE as usize] = 80;
         t[table::LOWEST_LIMIT_VOLTAGE as usize] = 60;
         t[table::HIGHEST_LIMIT_VOLTAGE as usize] = 160;
@@ -55,7 +72,7 @@ impl Servo {
         t[table::ALARM_LED as usize] = 0x24;
         t[table::ALARM_SHUTDOWN as usize] = 0x24;
         t[table::TORQUE_LIMIT as usize..][..2].copy_from_slice(&table::MAGNITUDE_MAX.to_le_bytes());
-        Servo { id, table: t }
+        Servo { id, table: t, joint }
     }
 
     fn torque(&self) -> bool {
@@ -63,10 +80,7 @@ impl Servo {
     }
 
     fn moving_speed(&self) -> u16 {
-        u16::from_le_bytes([
-            self.table[table::MOVING_SPEED as usize],
-            self.table[table::MOVING_SPEED as usize + 1],
-        ])
+        u16::from_le_bytes([self.table[table::MOVING_SPEED as usize], self.table[table::MOVING_SPEED as usize + 1]])
     }
 
     fn return_delay_us(&self) -> u64 {
@@ -80,6 +94,17 @@ impl Servo {
     /// The voltage its Moving Speed applies in wheel mode \[V\].
     fn volts(&self, supply: f64) -> f64 {
         table::ratio_from_moving_speed(self.moving_speed()) as f64 * supply
+    }
+
+    /// `table` with the present values `p`.
+    fn with_present(mut table: [u8; table::TABLE_LEN], p: &PresentState) -> [u8; table::TABLE_LEN] {
+        let mut put16 = |addr: u8, v: u16| table[addr as usize..addr as usize + 2].copy_from_slice(&v.to_le_bytes());
+        put16(table::PRESENT_POSITION, p.position);
+        put16(table::PRESENT_SPEED, p.speed);
+        put16(table::PRESENT_LOAD, p.load);
+        table[table::PRESENT_VOLTAGE as usize] = p.voltage;
+        table[table::PRESENT_TEMPERATURE as usize] = p.temperature;
+        table
     }
 }
 
@@ -102,6 +127,8 @@ pub struct BusStats {
     pub delayed: u64,
     /// Answers with injected error bits.
     pub error_bits: u64,
+    /// Readings past a joint's soft limit (a `past-limit` fault).
+    pub past_limit: u64,
 }
 
 /// What a fault window did, for the report.
@@ -109,16 +136,64 @@ pub struct BusStats {
 pub struct FaultTrace {
     /// The first answer the fault affected \[µs\].
     pub onset_us: Option<u64>,
-    /// Whether the affected servo had torque at the onset.
+    /// Whether every servo had torque at the onset.
     pub torque_at_onset: bool,
-    /// The first time after the onset that the servo's torque went off
+    /// The first time after the onset that every servo had torque off
     /// \[µs\].
     pub torque_off_us: Option<u64>,
-    /// The first time after the window that its torque came back on \[µs\].
+    /// The first time after the window that every servo had torque on
+    /// again \[µs\].
     pub torque_on_again_us: Option<u64>,
 }
 
+/// An answer, and what giving it changes besides.
+#[derive(Debug, Clone, Default)]
+struct Answer {
+    reply: Option<Reply>,
+    /// Fault windows whose first affected answer this is.
+    onsets: Vec<usize>,
+    dropped: bool,
+    corrupted: bool,
+    delayed: bool,
+    flagged: bool,
+    past_limit: bool,
+}
+
+/// Servos `ids` with the calibration and soft limits of `robot`'s joints.
+fn servos(robot: Robot, ids: &[u8]) -> Vec<Servo> {
+    let hw = hardware(robot);
+    let joint_of = |id: u8| {
+        let k = hw.joints.iter().position(|j| j.id == id)?;
+        Some((hw.joints[k], hw.soft_limits.get(k).copied().flatten()))
+    };
+    ids.iter().map(|&id| Servo::new(id, joint_of(id))).collect()
+}
+
+/// Why a fault cannot apply to `servos`: no such servo, or a `past-limit`
+/// fault on a joint without a soft limit.
+fn check_faults_on(servos: &[Servo], robot: Robot, faults: &[FaultSpec]) -> Result<(), String> {
+    for f in faults {
+        let Some(servo) = servos.iter().find(|s| s.id == f.servo) else {
+            let ids: Vec<String> = servos.iter().map(|s| s.id.to_string()).collect();
+            return Err(format!("--fault {f}: no servo {} on {}'s bus (its servos: {})", f.servo, robot.name(), ids.join(", ")));
+        };
+        if f.kind == FaultKind::PastLimit && servo.joint.is_none_or(|(_, l)| l.is_none()) {
+            return Err(format!("--fault {f}: servo {}'s joint has no soft limit on {}", f.servo, robot.name()));
+        }
+    }
+    Ok(())
+}
+
+/// Checks `faults` against `robot`'s servos (the IDs of its hardware
+/// configuration, which the rigs use) before a run, so that a fault that
+/// cannot apply is bad input, not a failed run.
+pub fn check_faults(robot: Robot, faults: &[FaultSpec]) -> Result<(), String> {
+    let ids: Vec<u8> = hardware(robot).joints.iter().map(|j| j.id).collect();
+    check_faults_on(&servos(robot, &ids), robot, faults)
+}
+
 /// The emulated bus.
+#[derive(Debug)]
 pub struct BusEmulator {
     decoder: InstructionDecoder<64>,
     servos: Vec<Servo>,
@@ -130,22 +205,25 @@ pub struct BusEmulator {
 }
 
 impl BusEmulator {
-    /// Servos with the rig's IDs, the sensor device, and `faults`.
-    pub fn new(rig: &dyn Rig, supply_v: f64, faults: Vec<FaultSpec>) -> Self {
+    /// Servos with the rig's IDs (the calibration and soft limits of
+    /// `robot`'s joints), the sensor device, and `faults`; the error says
+    /// why a fault cannot apply.
+    pub fn new(rig: &dyn Rig, robot: Robot, faults: Vec<FaultSpec>) -> Result<Self, String> {
+        let servos = servos(robot, rig.servo_ids());
+        check_faults_on(&servos, robot, &faults)?;
         let mut sensor = [0u8; sensor_table::TABLE_LEN];
-        sensor[sensor_table::MODEL_NUMBER as usize..][..2]
-            .copy_from_slice(&sensor_table::MODEL.to_le_bytes());
+        sensor[sensor_table::MODEL_NUMBER as usize..][..2].copy_from_slice(&sensor_table::MODEL.to_le_bytes());
         sensor[table::ID as usize] = SENSOR_ID;
         let traces = vec![FaultTrace::default(); faults.len()];
-        BusEmulator {
+        Ok(BusEmulator {
             decoder: InstructionDecoder::new(),
-            servos: rig.servo_ids().iter().map(|&id| Servo::new(id)).collect(),
+            servos,
             sensor,
             faults,
             traces,
             stats: BusStats::default(),
-            supply_v,
-        }
+            supply_v: rig.supply_v(),
+        })
     }
 
     /// Counters so far.
@@ -167,11 +245,14 @@ impl BusEmulator {
     /// they cause, in time order.
     pub fn receive(&mut self, now_us: u64, bytes: &[u8], rig: &mut dyn Rig) -> Vec<Reply> {
         let mut replies = Vec::new();
+        let mut start = 0;
         for (i, &b) in bytes.iter().enumerate() {
             self.stats.bytes_in += 1;
             let Some(result) = self.decoder.push(b) else {
                 continue;
             };
+            let request = bytes[start..=i].to_vec();
+            start = i + 1;
             let Ok(packet) = result else {
                 self.stats.bad_packets += 1;
                 continue;
@@ -183,7 +264,7 @@ impl BusEmulator {
             self.stats.packets += 1;
             // The packet's last byte is in.
             let done = now_us + (i as u64 + 1) * BYTE_US;
-            if let Some(reply) = self.execute(packet.id, &instruction, done, rig) {
+            if let Some(reply) = self.execute(packet.id, &instruction, done, &request, rig) {
                 replies.push(reply);
             }
         }
@@ -191,15 +272,48 @@ impl BusEmulator {
         replies
     }
 
-    fn execute(
-        &mut self,
-        id: u8,
-        ins: &Instruction<'_>,
-        t: u64,
-        rig: &mut dyn Rig,
-    ) -> Option<Reply> {
+    /// The answer `request` would get if the firmware sent it at `at_us`
+    /// (one whole READ or PING of one device), without changing anything;
+    /// `None` if it gets none or the rig cannot tell yet.
+    pub fn forecast(&self, at_us: u64, request: &[u8], rig: &dyn Rig) -> Option<Reply> {
+        if self.decoder.buffered() > 0 {
+            // Bytes of an unfinished packet would come first.
+            return None;
+        }
+        let mut decoder: InstructionDecoder<64> = InstructionDecoder::new();
+        let packets: Vec<_> = decoder.feed(request).collect();
+        let [Ok(packet)] = packets.as_slice() else { return None };
+        if decoder.buffered() > 0 {
+            return None;
+        }
+        let done = at_us + request.len() as u64 * BYTE_US;
+        let ins = packet.instruction().ok()?;
+        if packet.id == SENSOR_ID {
+            let (count, contacts) = rig.peek_sensors(done)?;
+            return self.sensor_answer(&ins, done, count, contacts, request);
+        }
+        let i = self.servos.iter().position(|s| s.id == packet.id)?;
+        let answer = match ins {
+            Instruction::Ping => self.answer(i, done, ErrorFlags::NONE, &[], request),
+            Instruction::Read { addr, len } => {
+                let present = self.plant_present(i, done, rig.peek_present(done, packet.id)?);
+                let table = Servo::with_present(self.servos[i].table, &present.0);
+                self.read_answer(i, &table, addr, len, done, request, present.1)?
+            }
+            _ => return None,
+        };
+        answer.reply
+    }
+
+    fn execute(&mut self, id: u8, ins: &Instruction<'_>, t: u64, request: &[u8], rig: &mut dyn Rig) -> Option<Reply> {
         if id == SENSOR_ID {
-            return self.sensor_device(ins, t, rig);
+            let (count, contacts) = rig.sensors(t);
+            let enc = sensor_table::ENCODER_COUNT as usize;
+            self.sensor[enc..enc + 2].copy_from_slice(&count.to_le_bytes());
+            self.sensor[sensor_table::CONTACTS as usize] = contacts;
+            let reply = self.sensor_answer(ins, t, count, contacts, request);
+            self.stats.replies += reply.is_some() as u64;
+            return reply;
         }
         let targets: Vec<usize> = self
             .servos
@@ -213,23 +327,18 @@ impl BusEmulator {
                 let &[i] = targets.as_slice() else {
                     return None;
                 };
-                self.answer(i, t, ErrorFlags::NONE, &[])
+                let a = self.answer(i, t, ErrorFlags::NONE, &[], request);
+                self.apply(i, t, a)
             }
             Instruction::Read { addr, len } => {
                 let &[i] = targets.as_slice() else {
                     return None;
                 };
-                self.refresh_present(i, t, rig);
-                let (addr, len) = (addr as usize, len as usize);
-                let table = &self.servos[i].table;
-                let (error, params) = match table.get(addr..addr + len) {
-                    Some(data) => (ErrorFlags::NONE, data.to_vec()),
-                    None => (ErrorFlags::RANGE, Vec::new()),
-                };
-                if self.servos[i].status_return_level() == 0 {
-                    return None;
-                }
-                self.answer(i, t, error, &params)
+                let (present, past_limit) = self.plant_present(i, t, rig.present(t, id));
+                self.servos[i].table = Servo::with_present(self.servos[i].table, &present);
+                let table = self.servos[i].table;
+                let a = self.read_answer(i, &table, addr, len, t, request, past_limit)?;
+                self.apply(i, t, a)
             }
             Instruction::Write { addr, data } | Instruction::RegWrite { addr, data } => {
                 for &i in &targets {
@@ -238,15 +347,14 @@ impl BusEmulator {
                 let &[i] = targets.as_slice() else {
                     return None;
                 };
-                (id != BROADCAST_ID && self.servos[i].status_return_level() >= 2)
-                    .then(|| self.answer(i, t, ErrorFlags::NONE, &[]))
-                    .flatten()
+                if id == BROADCAST_ID || self.servos[i].status_return_level() < 2 {
+                    return None;
+                }
+                let a = self.answer(i, t, ErrorFlags::NONE, &[], request);
+                self.apply(i, t, a)
             }
             Instruction::SyncWrite { addr, .. } => {
-                let entries: Vec<(u8, Vec<u8>)> = ins
-                    .sync_entries()
-                    .map(|(sid, d)| (sid, d.to_vec()))
-                    .collect();
+                let entries: Vec<(u8, Vec<u8>)> = ins.sync_entries().map(|(sid, d)| (sid, d.to_vec())).collect();
                 for (sid, data) in entries {
                     if let Some(i) = self.servos.iter().position(|s| s.id == sid) {
                         self.write(i, addr, &data, t, rig);
@@ -258,49 +366,66 @@ impl BusEmulator {
         }
     }
 
-    /// The sensor device: READ of its table, with the encoder and contacts
-    /// of this instant; it never faults (it stands for timer and GPIO
-    /// peripherals).
-    fn sensor_device(&mut self, ins: &Instruction<'_>, t: u64, rig: &mut dyn Rig) -> Option<Reply> {
-        let (count, contacts) = rig.sensors(t);
+    /// What servo `i` reads at `t`: the rig's state, or a joint past its
+    /// soft limit while a `past-limit` fault applies (and whether it did).
+    fn plant_present(&self, i: usize, t: u64, mut p: PresentState) -> (PresentState, bool) {
+        let s = &self.servos[i];
+        let past = self.faults.iter().any(|f| f.kind == FaultKind::PastLimit && f.applies(t, s.id));
+        if let (true, Some((joint, Some(limit)))) = (past, s.joint) {
+            let angle = limit.max + PAST_LIMIT_RAD;
+            let counts = joint.zero as f32 + joint.sign as f32 * angle / POSITION_UNIT_RAD;
+            p.position = counts.round().clamp(0.0, table::POSITION_MAX as f32) as u16;
+        }
+        (p, past)
+    }
+
+    /// Servo `i`'s answer to READ `addr`, `len` with its control table
+    /// `table`, if it answers reads.
+    #[allow(clippy::too_many_arguments)]
+    fn read_answer(
+        &self,
+        i: usize,
+        table: &[u8; table::TABLE_LEN],
+        addr: u8,
+        len: u8,
+        t: u64,
+        request: &[u8],
+        past_limit: bool,
+    ) -> Option<Answer> {
+        let (addr, len) = (addr as usize, len as usize);
+        let (error, params) = match table.get(addr..addr + len) {
+            Some(data) => (ErrorFlags::NONE, data.to_vec()),
+            None => (ErrorFlags::RANGE, Vec::new()),
+        };
+        if self.servos[i].status_return_level() == 0 {
+            return None;
+        }
+        let mut a = self.answer(i, t, error, &params, request);
+        a.past_limit = past_limit;
+        Some(a)
+    }
+
+    /// The sensor device's answer: READ of its table with the encoder and
+    /// contacts of this instant, or PING; it never faults (it stands for
+    /// timer and GPIO peripherals).
+    fn sensor_answer(&self, ins: &Instruction<'_>, t: u64, count: u16, contacts: u8, request: &[u8]) -> Option<Reply> {
+        let mut sensor = self.sensor;
         let enc = sensor_table::ENCODER_COUNT as usize;
-        self.sensor[enc..enc + 2].copy_from_slice(&count.to_le_bytes());
-        self.sensor[sensor_table::CONTACTS as usize] = contacts;
+        sensor[enc..enc + 2].copy_from_slice(&count.to_le_bytes());
+        sensor[sensor_table::CONTACTS as usize] = contacts;
         let params = match *ins {
             Instruction::Ping => Vec::new(),
-            Instruction::Read { addr, len } => self
-                .sensor
-                .get(addr as usize..addr as usize + len as usize)
-                .map(<[u8]>::to_vec)?,
+            Instruction::Read { addr, len } => sensor.get(addr as usize..addr as usize + len as usize).map(<[u8]>::to_vec)?,
             _ => return None,
         };
         let status = StatusPacket::<64>::new(SENSOR_ID, ErrorFlags::NONE, &params).ok()?;
         let mut buf = [0u8; 80];
         let bytes = status.encode(&mut buf).ok()?.to_vec();
-        self.stats.replies += 1;
         // The sensor device answers after the servos' 50 µs.
-        Some(Reply {
-            at_us: t + 50 + bytes.len() as u64 * BYTE_US,
-            bytes,
-        })
-    }
-
-    fn refresh_present(&mut self, i: usize, t: u64, rig: &mut dyn Rig) {
-        let id = self.servos[i].id;
-        let p = rig.present(t, id);
-        let tab = &mut self.servos[i].table;
-        let put16 = |tab: &mut [u8; table::TABLE_LEN], addr: u8, v: u16| {
-            tab[addr as usize..addr as usize + 2].copy_from_slice(&v.to_le_bytes())
-        };
-        put16(tab, table::PRESENT_POSITION, p.position);
-        put16(tab, table::PRESENT_SPEED, p.speed);
-        put16(tab, table::PRESENT_LOAD, p.load);
-        tab[table::PRESENT_VOLTAGE as usize] = p.voltage;
-        tab[table::PRESENT_TEMPERATURE as usize] = p.temperature;
+        Some(Reply { at_us: t + 50 + bytes.len() as u64 * BYTE_US, bytes, request: request.to_vec() })
     }
 
     fn write(&mut self, i: usize, addr: u8, data: &[u8], t: u64, rig: &mut dyn Rig) {
-        let before = self.servos[i].torque();
         let start = addr as usize;
         let end = (start + data.len()).min(table::TABLE_LEN);
         if start >= end {
@@ -308,75 +433,86 @@ impl BusEmulator {
         }
         self.servos[i].table[start..end].copy_from_slice(&data[..end - start]);
         let s = &self.servos[i];
-        let (id, torque) = (s.id, s.torque());
-        rig.drive(t, id, torque, s.volts(self.supply_v));
+        rig.drive(t, s.id, s.torque(), s.volts(self.supply_v));
+        let all_off = self.servos.iter().all(|s| !s.torque());
+        let all_on = self.servos.iter().all(Servo::torque);
         for (f, trace) in self.faults.iter().zip(self.traces.iter_mut()) {
-            if f.servo != id {
-                continue;
+            let Some(onset) = trace.onset_us else { continue };
+            if all_off && trace.torque_off_us.is_none() && t >= onset {
+                trace.torque_off_us = Some(t);
             }
-            if let Some(onset) = trace.onset_us {
-                if before && !torque && trace.torque_off_us.is_none() && t >= onset {
-                    trace.torque_off_us = Some(t);
-                }
-                if !before && torque && trace.torque_on_again_us.is_none() && t >= f.end_us {
-                    trace.torque_on_again_us = Some(t);
-                }
+            if all_on && trace.torque_off_us.is_some() && trace.torque_on_again_us.is_none() && t >= f.end_us {
+                trace.torque_on_again_us = Some(t);
             }
         }
     }
 
-    /// Servo `i`'s status packet, after the faults in force at `t`.
-    fn answer(&mut self, i: usize, t: u64, mut error: ErrorFlags, params: &[u8]) -> Option<Reply> {
+    /// Servo `i`'s status packet at `t`, after the faults in force then;
+    /// changes nothing ([`apply`](Self::apply) does).
+    fn answer(&self, i: usize, t: u64, mut error: ErrorFlags, params: &[u8], request: &[u8]) -> Answer {
         let id = self.servos[i].id;
-        let torque = self.servos[i].torque();
+        let mut a = Answer::default();
         let mut delay = 0;
-        let mut corrupt = false;
-        for (f, trace) in self.faults.iter().zip(self.traces.iter_mut()) {
+        for (k, (f, trace)) in self.faults.iter().zip(&self.traces).enumerate() {
             if !f.applies(t, id) {
                 continue;
             }
             if trace.onset_us.is_none() {
-                trace.onset_us = Some(t);
-                trace.torque_at_onset = torque;
+                a.onsets.push(k);
             }
             match f.kind {
                 FaultKind::Drop => {
-                    self.stats.dropped += 1;
-                    return None;
+                    a.dropped = true;
+                    return a;
                 }
-                FaultKind::Corrupt => corrupt = true,
+                FaultKind::Corrupt => a.corrupted = true,
                 FaultKind::Delay { us } => delay = delay.max(us),
                 FaultKind::ErrorBits { bits } => error = error | bits,
+                // The reading itself is past the limit (`plant_present`).
+                FaultKind::PastLimit => {}
             }
         }
-        let status = StatusPacket::<64>::new(id, error, params).ok()?;
+        let Ok(status) = StatusPacket::<64>::new(id, error, params) else { return a };
         let mut buf = [0u8; 80];
-        let mut bytes = status.encode(&mut buf).ok()?.to_vec();
-        if corrupt {
+        let Ok(bytes) = status.encode(&mut buf) else { return a };
+        let mut bytes = bytes.to_vec();
+        if a.corrupted {
             // Flip bits of the first parameter (or the error byte): the
             // checksum no longer matches.
             let k = if bytes.len() > 6 { 5 } else { 4 };
             bytes[k] ^= 0x5A;
-            self.stats.corrupted += 1;
         }
-        if delay > 0 {
-            self.stats.delayed += 1;
-        }
-        if !error.is_empty() {
-            self.stats.error_bits += 1;
-        }
-        self.stats.replies += 1;
+        a.delayed = delay > 0;
+        a.flagged = !error.is_empty();
         let at_us = t + self.servos[i].return_delay_us() + bytes.len() as u64 * BYTE_US + delay;
-        Some(Reply { at_us, bytes })
+        a.reply = Some(Reply { at_us, bytes, request: request.to_vec() });
+        a
+    }
+
+    /// Counts `a` and opens the fault windows it is the onset of.
+    fn apply(&mut self, _i: usize, t: u64, a: Answer) -> Option<Reply> {
+        let all_on = self.servos.iter().all(Servo::torque);
+        for k in a.onsets {
+            self.traces[k].onset_us = Some(t);
+            self.traces[k].torque_at_onset = all_on;
+        }
+        self.stats.dropped += a.dropped as u64;
+        self.stats.corrupted += a.corrupted as u64;
+        self.stats.delayed += a.delayed as u64;
+        self.stats.error_bits += a.flagged as u64;
+        self.stats.past_limit += a.past_limit as u64;
+        self.stats.replies += a.reply.is_some() as u64;
+        a.reply
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::leo::model::ModelOptions;
     use crate::pendulum::PhysicalPendulumParams;
+    use crate::rig::{LeoRig, PendulumRig};
     use crate::sil::fault;
-    use crate::rig::PendulumRig;
     use pada_core::dynamixel::{self, StatusDecoder};
 
     fn packet(f: impl FnOnce(&mut [u8]) -> usize) -> Vec<u8> {
@@ -394,14 +530,23 @@ mod tests {
         d.feed(bytes).next().expect("a whole packet")
     }
 
+    fn pendulum_bus(faults: &[&str]) -> (PendulumRig, BusEmulator) {
+        let rig = PendulumRig::new(PhysicalPendulumParams::default());
+        let faults = faults.iter().map(|f| fault::parse(f).unwrap()).collect();
+        let bus = BusEmulator::new(&rig, Robot::Pendulum33, faults).unwrap();
+        (rig, bus)
+    }
+
     #[test]
     fn answers_reads_after_the_wire_time_and_return_delay() {
-        let mut rig = PendulumRig::new(PhysicalPendulumParams::default());
-        let mut bus = BusEmulator::new(&rig, 12.0, vec![]);
+        let (mut rig, mut bus) = pendulum_bus(&[]);
         let req = read(1, table::PRESENT_BLOCK, table::PRESENT_BLOCK_LEN);
+        let forecast = bus.forecast(1000, &req, &rig).unwrap();
         let replies = bus.receive(1000, &req, &mut rig);
         assert_eq!(replies.len(), 1);
         let r = &replies[0];
+        assert_eq!(*r, forecast, "the forecast is the answer");
+        assert_eq!(r.request, req);
         // 8 bytes out, factory return delay 500 µs, 14 bytes back.
         assert_eq!(r.at_us, 1000 + 80 + 500 + 140);
         let status = decode(&r.bytes).unwrap();
@@ -409,48 +554,43 @@ mod tests {
         let present = table::PresentState::from_bytes(&status.params).unwrap();
         assert_eq!((present.voltage, present.temperature), (120, 40));
         // The sensor device: encoder 0 hanging at boot.
-        let replies = bus.receive(
-            2000,
-            &read(SENSOR_ID, sensor_table::ENCODER_COUNT, 3),
-            &mut rig,
-        );
-        assert_eq!(
-            decode(&replies[0].bytes).unwrap().params.as_slice(),
-            &[0, 0, 0]
-        );
-        // Nobody answers an unknown ID.
+        let sensor_read = read(SENSOR_ID, sensor_table::ENCODER_COUNT, 3);
+        let forecast = bus.forecast(2000, &sensor_read, &rig).unwrap();
+        let replies = bus.receive(2000, &sensor_read, &mut rig);
+        assert_eq!(replies, vec![forecast]);
+        assert_eq!(decode(&replies[0].bytes).unwrap().params.as_slice(), &[0, 0, 0]);
+        // Nobody answers an unknown ID; a write gets no forecast.
         assert!(bus.receive(3000, &read(9, 0, 2), &mut rig).is_empty());
+        assert!(bus.forecast(3000, &read(9, 0, 2), &rig).is_none());
+        let torque = packet(|b| dynamixel::write_data(1, table::TORQUE_ENABLE, &[1], b).unwrap().len());
+        assert!(bus.forecast(4000, &torque, &rig).is_none());
+        let stats = bus.stats();
+        assert_eq!((stats.packets, stats.replies), (3, 2), "forecasts count nothing");
     }
 
     #[test]
-    fn speed_and_torque_writes_drive_the_rig() {
-        let mut rig = PendulumRig::new(PhysicalPendulumParams::default());
-        let mut bus = BusEmulator::new(&rig, 12.0, vec![]);
-        let speed = packet(|b| {
-            dynamixel::sync_write_u16(table::MOVING_SPEED, &[(1, 256)], b)
-                .unwrap()
-                .len()
-        });
-        let torque = packet(|b| {
-            dynamixel::write_data(BROADCAST_ID, table::TORQUE_ENABLE, &[1], b)
-                .unwrap()
-                .len()
-        });
-        assert!(bus
-            .receive(0, &[speed, torque].concat(), &mut rig)
-            .is_empty());
+    fn speed_and_torque_writes_drive_the_rig_with_its_supply() {
+        let (mut rig, mut bus) = pendulum_bus(&[]);
+        let speed = packet(|b| dynamixel::sync_write_u16(table::MOVING_SPEED, &[(1, 256)], b).unwrap().len());
+        let torque = packet(|b| dynamixel::write_data(BROADCAST_ID, table::TORQUE_ENABLE, &[1], b).unwrap().len());
+        assert!(bus.receive(0, &[speed, torque].concat(), &mut rig).is_empty());
         assert_eq!(bus.torque(1), Some(true));
+        assert!((rig.gear_torque(1) - pada_core::robot::pendulum::gearbox_torque(256.0 / 1023.0 * 12.0) as f32).abs() < 1e-6);
         rig.advance_to(30_000);
         assert!(rig.state()[1] > 0.0, "256/1023 of 12 V turns it");
+        // LEO's servos run on its 14 V.
+        let leo = LeoRig::new(ModelOptions::default()).unwrap();
+        assert_eq!(BusEmulator::new(&leo, Robot::Leo, vec![]).unwrap().supply_v, 14.0);
     }
 
     #[test]
     fn faults_drop_corrupt_delay_and_flag_answers_in_their_window() {
         let req = read(1, table::PRESENT_BLOCK, table::PRESENT_BLOCK_LEN);
         let run = |spec: &str, t: u64| {
-            let mut rig = PendulumRig::new(PhysicalPendulumParams::default());
-            let mut bus = BusEmulator::new(&rig, 12.0, vec![fault::parse(spec).unwrap()]);
+            let (mut rig, mut bus) = pendulum_bus(&[spec]);
+            let forecast = bus.forecast(t, &req, &rig);
             let replies = bus.receive(t, &req, &mut rig);
+            assert_eq!(forecast.into_iter().collect::<Vec<_>>(), replies, "{spec}: forecast and answer");
             (replies, bus)
         };
         let (r, bus) = run("drop:at=1:for=1", 1_500_000);
@@ -459,16 +599,42 @@ mod tests {
         let (r, _) = run("drop:at=1:for=1", 2_000_000);
         assert_eq!(r.len(), 1, "the window is over");
         let (r, _) = run("corrupt:at=1", 1_000_000);
-        assert!(matches!(
-            decode(&r[0].bytes),
-            Err(dynamixel::DecodeError::BadChecksum { .. })
-        ));
+        assert!(matches!(decode(&r[0].bytes), Err(dynamixel::DecodeError::BadChecksum { .. })));
         let (r, _) = run("delay:at=1:ms=5", 1_000_000);
         assert_eq!(r[0].at_us, 1_000_000 + 80 + 500 + 140 + 5000);
         let (r, _) = run("error-bits:at=1", 1_000_000);
         assert_eq!(decode(&r[0].bytes).unwrap().error, ErrorFlags::OVERHEATING);
-        // Another servo's fault leaves servo 1 alone.
-        let (r, _) = run("drop:at=1:servo=2", 1_000_000);
-        assert_eq!(r.len(), 1);
+        // Another servo's fault leaves servo 1 alone (LEO has seven).
+        let mut leo = LeoRig::new(ModelOptions::default()).unwrap();
+        let mut bus = BusEmulator::new(&leo, Robot::Leo, vec![fault::parse("drop:at=1:servo=4").unwrap()]).unwrap();
+        assert_eq!(bus.receive(1_000_000, &req, &mut leo).len(), 1);
+        assert!(bus.receive(1_001_000, &read(4, table::PRESENT_BLOCK, table::PRESENT_BLOCK_LEN), &mut leo).is_empty());
+        // No servo 9 on LEO's bus; the pendulum's joint has no soft limit.
+        assert!(BusEmulator::new(&leo, Robot::Leo, vec![fault::parse("drop:servo=9").unwrap()]).unwrap_err().contains("no servo 9"));
+        let pendulum = PendulumRig::new(PhysicalPendulumParams::default());
+        let e = BusEmulator::new(&pendulum, Robot::Pendulum33, vec![fault::parse("past-limit").unwrap()]).unwrap_err();
+        assert!(e.contains("no soft limit"), "{e}");
+    }
+
+    #[test]
+    fn past_limit_reads_the_joint_beyond_its_soft_limit() {
+        let mut leo = LeoRig::new(ModelOptions::default()).unwrap();
+        let mut bus = BusEmulator::new(&leo, Robot::Leo, vec![fault::parse("past-limit:at=1:servo=4").unwrap()]).unwrap();
+        let req = read(4, table::PRESENT_BLOCK, table::PRESENT_BLOCK_LEN);
+        let angle = |bus: &mut BusEmulator, leo: &mut LeoRig, t: u64| {
+            let r = bus.receive(t, &req, leo);
+            let p = table::PresentState::from_bytes(&decode(&r[0].bytes).unwrap().params).unwrap();
+            let hw = hardware(Robot::Leo);
+            let k = hw.joints.iter().position(|j| j.id == 4).unwrap();
+            (hw.joints[k].angle(p.position), hw.soft_limits[k].unwrap())
+        };
+        let (before, limit) = angle(&mut bus, &mut leo, 500_000);
+        assert!(before < limit.max, "{before} inside {limit:?}");
+        let (during, _) = angle(&mut bus, &mut leo, 1_200_000);
+        assert!(during > limit.max + 0.5 * PAST_LIMIT_RAD, "{during} past {limit:?}");
+        let (after, _) = angle(&mut bus, &mut leo, 2_100_000);
+        assert_eq!(after, before);
+        assert_eq!(bus.stats().past_limit, 1);
+        assert_eq!(bus.faults().next().unwrap().1.onset_us, Some(1_200_080));
     }
 }

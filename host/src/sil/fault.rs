@@ -11,6 +11,7 @@
 //! | `corrupt` | arrive with one byte flipped (a bad checksum) |
 //! | `delay` | arrive `ms` late (default 5 ms, well past the 1 ms reply timeout) |
 //! | `error-bits` | carry error bits `bits` (`overheating` by default; `overload`, `input-voltage`) |
+//! | `past-limit` | read the servo's joint past its soft limit: the plant drives the joint [`PAST_LIMIT_RAD`](super::bus::PAST_LIMIT_RAD) beyond the upper end of the limit the firmware enforces (a joint with a soft limit only: LEO's) |
 //!
 //! `at` is the emulated time since boot at which the window opens (default
 //! 10 s), `for` its length (default 1 s), `servo` the Dynamixel ID whose
@@ -36,6 +37,8 @@ pub enum FaultKind {
         /// The bits.
         bits: ErrorFlags,
     },
+    /// The joint reads past its soft limit.
+    PastLimit,
 }
 
 impl FaultKind {
@@ -46,6 +49,7 @@ impl FaultKind {
             FaultKind::Corrupt => "corrupt",
             FaultKind::Delay { .. } => "delay",
             FaultKind::ErrorBits { .. } => "error-bits",
+            FaultKind::PastLimit => "past-limit",
         }
     }
 }
@@ -159,9 +163,10 @@ pub fn parse(spec: &str) -> Result<FaultSpec, String> {
         "error-bits" => FaultKind::ErrorBits {
             bits: bits.unwrap_or(ErrorFlags::OVERHEATING),
         },
+        "past-limit" => FaultKind::PastLimit,
         other => {
             return Err(format!(
-            "--fault {spec}: unknown kind `{other}`: valid are drop, corrupt, delay, error-bits"
+            "--fault {spec}: unknown kind `{other}`: valid are drop, corrupt, delay, error-bits, past-limit"
         ))
         }
     };
@@ -214,6 +219,7 @@ mod tests {
             "drop:at=1:for=2",
             "delay:ms=7",
             "error-bits:bits=input-voltage",
+            "past-limit:servo=4:at=3",
         ] {
             assert_eq!(
                 parse(&parse(s).unwrap().to_string()).unwrap(),

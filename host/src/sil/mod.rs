@@ -2,33 +2,40 @@
 //! against the simulated plant (`pada sil`, docs/sil.md).
 //!
 //! ```text
-//!  qemu-system-arm -machine netduinoplus2 -icount shift=0
+//!  qemu-system-arm -machine netduinoplus2 | mps2-an386 -icount shift=0
 //!  ┌──────────────────────────────────────┐
-//!  │ pada-firmware (feature qemu)         │ USART1 ─ bus.sock ────── BusEmulator ── Rig (pendulum model)
-//!  │ the real control loop, agent, safety │ USART2 ─ telemetry.sock ─ Recorder (CSV), commands
-//!  │ board: lock-step clock               │ FIFOs  ─ clock ────────── the lock-step loop (run.rs)
-//!  └──────────────────────────────────────┘
+//!  │ pada-firmware (feature qemu | mps2)  │  one semihosting channel (two FIFOs):
+//!  │ the real control loop, agent, safety │   servo-bus bytes ── BusEmulator ── Rig (pendulum model, rapier3d LEO)
+//!  │ board: lock-step clock, forecasts    │   telemetry bytes ── Recorder (CSV), operator, run protocol
+//!  └──────────────────────────────────────┘   clock ──────────── the lock-step loop (session.rs)
 //! ```
 //!
 //! - [`bus`]: RX-28 servos and the sensor device on the emulated Dynamixel
 //!   bus, with `--fault` injection ([`fault`]);
 //! - the robot behind the bus: a [`crate::rig::Rig`] (the physical
-//!   pendulum's model, or a LEO stand-in);
-//! - [`qemu`]: starting QEMU and connecting its channels;
-//! - [`run`]: the lock-step loop, the run's commands, the summary;
+//!   pendulum's model, or the rapier3d LEO with its operator);
+//! - [`qemu`]: starting QEMU and its channel;
+//! - [`session`]: the lock-step loop; [`forecast`]: the answers it sends
+//!   ahead, so a period's bus traffic takes one exchange;
+//! - [`run`]: what to run and setting it up;
+//! - [`report`]: the summary and its checks, with the comparison to the
+//!   same controller on the host (`crate::board`);
 //! - [`replay`]: the bit-for-bit replay through the host build of the
 //!   firmware's agent;
-//! - [`twin`]: the host-only run to compare with: the firmware's controller
-//!   on the host against the same model.
+//! - [`wall`]: where the wall-clock time goes.
 //!
-//! The board side is `firmware/src/board/qemu.rs`; the protocol between
+//! The board side is `firmware/src/board/lockstep.rs`; the protocol between
 //! them is `pada_firmware::sil`.
 
 pub mod bus;
 pub mod fault;
+pub mod forecast;
 pub mod qemu;
 pub mod replay;
+pub mod report;
 pub mod run;
-pub mod twin;
+pub mod session;
+pub mod wall;
 
-pub use run::{run, SilConfig, SilSummary, SilTask};
+pub use report::{SilSummary, LEARNING_CHECK_S, WALKING_CHECK_S};
+pub use run::{machine, run, SilConfig, SilTask};

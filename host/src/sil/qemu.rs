@@ -1,39 +1,38 @@
 //! Starting `qemu-system-arm` with the emulated board's image and wiring
-//! its channels to the host.
+//! its one channel to the host.
 //!
-//! - USART1 (servo bus) and USART2 (telemetry) are Unix sockets in a
-//!   private temporary directory; QEMU connects to them as a client.
-//! - The lock-step clock runs over two FIFOs in the same directory, which is
-//!   QEMU's working directory (the board opens them through semihosting,
-//!   together with its checkpoint file).
+//! - The channel is two FIFOs in a private temporary directory, which is
+//!   QEMU's working directory: the board opens them through semihosting,
+//!   together with its checkpoint file. Everything goes through them: the
+//!   clock, the servo bus's bytes and the telemetry's
+//!   ([`pada_firmware::sil`]).
 //! - QEMU's standard output is the firmware's defmt log (semihosting
 //!   console), its standard error QEMU's own messages; both go to files.
 //! - `-icount shift=0`: one instruction per nanosecond of QEMU's virtual
-//!   clock, so the board's TIM2 counts instructions (the board checks this
-//!   at boot, [`pada_firmware::sil::FromBoard::Boot`]).
+//!   clock, so the board's timer counts instructions (the board measures
+//!   this at boot, [`pada_firmware::sil::FromBoard::Boot`]).
 //!
-//! Each channel has a reader thread that forwards what arrives, so QEMU is
-//! never blocked writing (its USART model writes synchronously).
+//! The host reads the board's FIFO itself, without a reader thread: the
+//! lock-step loop waits for the board anyway, and a hand-over between
+//! threads would add its latency to every exchange.
 
 use anyhow::{anyhow, bail, Context};
 use pada_firmware::sil::{CLOCK_FROM_BOARD, CLOCK_TO_BOARD};
+use rustix::event::{poll, PollFd, PollFlags, Timespec};
 use std::fs::File;
-use std::io::{Read, Write};
-use std::os::unix::net::{UnixListener, UnixStream};
+use std::io::{ErrorKind, Read, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
-use std::sync::mpsc::{self, Receiver};
 use std::time::{Duration, Instant};
-
-/// How long QEMU may take to connect its serial ports.
-const CONNECT_TIMEOUT: Duration = Duration::from_secs(30);
 
 /// Where QEMU and the run's files are.
 #[derive(Debug, Clone)]
 pub struct QemuSetup {
     /// The `qemu-system-arm` to run.
     pub qemu: PathBuf,
-    /// The firmware ELF (built with the `qemu` feature).
+    /// QEMU's `-machine`.
+    pub machine: &'static str,
+    /// The firmware ELF (built for the emulated board of `machine`).
     pub elf: PathBuf,
     /// QEMU's standard output: the firmware's defmt log.
     pub defmt_log: PathBuf,
@@ -41,50 +40,39 @@ pub struct QemuSetup {
     pub qemu_log: PathBuf,
 }
 
-/// The running emulator and its channels.
+/// The running emulator and its channel.
 pub struct Emulator {
     child: Child,
-    /// The temporary directory of sockets, FIFOs and the checkpoint file.
+    /// The temporary directory of the FIFOs and the checkpoint file.
     dir: tempfile::TempDir,
-    /// Writes to USART1.
-    pub bus: UnixStream,
-    /// What USART1 sent.
-    pub bus_rx: Receiver<Vec<u8>>,
-    /// Writes to USART2.
-    pub telemetry: UnixStream,
-    /// What USART2 sent.
-    pub telemetry_rx: Receiver<Vec<u8>>,
-    /// Writes clock frames to the board.
-    pub clock: File,
-    /// Clock frames from the board.
-    pub clock_rx: Receiver<Vec<u8>>,
+    /// Frames to the board.
+    to_board: File,
+    /// Frames from the board.
+    from_board: File,
 }
 
-/// The command line of a run (without the image).
-pub fn qemu_args(dir: &Path) -> Vec<String> {
-    let sock = |name: &str| dir.join(name).display().to_string();
-    vec![
-        "-machine".into(),
-        "netduinoplus2".into(),
-        "-display".into(),
-        "none".into(),
-        "-monitor".into(),
-        "none".into(),
-        "-parallel".into(),
-        "none".into(),
-        "-icount".into(),
-        "shift=0".into(),
-        "-semihosting-config".into(),
-        "enable=on,target=native".into(),
-        "-chardev".into(),
-        format!("socket,id=bus,path={}", sock("bus.sock")),
-        "-chardev".into(),
-        format!("socket,id=telemetry,path={}", sock("telemetry.sock")),
-        "-serial".into(),
-        "chardev:bus".into(),
-        "-serial".into(),
-        "chardev:telemetry".into(),
+/// The command line of a run on `machine` (without the image).
+pub fn qemu_args(machine: &str) -> Vec<String> {
+    [
+        "-machine",
+        machine,
+        "-display",
+        "none",
+        "-monitor",
+        "none",
+        "-parallel",
+        "none",
+        // Nothing on the serial ports: the board's bytes go through the
+        // FIFOs.
+        "-serial",
+        "null",
+        "-icount",
+        "shift=0",
+        "-semihosting-config",
+        "enable=on,target=native",
     ]
+    .map(String::from)
+    .to_vec()
 }
 
 fn mkfifo(path: &Path) -> anyhow::Result<()> {
@@ -98,26 +86,8 @@ fn mkfifo(path: &Path) -> anyhow::Result<()> {
     .with_context(|| format!("cannot create the FIFO {}", path.display()))
 }
 
-fn reader<R: Read + Send + 'static>(mut r: R) -> Receiver<Vec<u8>> {
-    let (tx, rx) = mpsc::channel();
-    std::thread::spawn(move || {
-        let mut buf = vec![0u8; 65536];
-        loop {
-            match r.read(&mut buf) {
-                Ok(0) | Err(_) => break,
-                Ok(n) => {
-                    if tx.send(buf[..n].to_vec()).is_err() {
-                        break;
-                    }
-                }
-            }
-        }
-    });
-    rx
-}
-
 impl Emulator {
-    /// Starts QEMU and connects every channel.
+    /// Starts QEMU.
     pub fn start(setup: &QemuSetup) -> anyhow::Result<Emulator> {
         if !setup.elf.is_file() {
             bail!("firmware image {} does not exist", setup.elf.display());
@@ -126,18 +96,14 @@ impl Emulator {
             .prefix("pada-sil-")
             .tempdir()
             .context("cannot create a temporary directory")?;
-        let bus_listener = UnixListener::bind(dir.path().join("bus.sock"))
-            .context("cannot create the bus socket")?;
-        let tele_listener = UnixListener::bind(dir.path().join("telemetry.sock"))
-            .context("cannot create the telemetry socket")?;
-        let from_board = dir.path().join(CLOCK_FROM_BOARD);
-        let to_board = dir.path().join(CLOCK_TO_BOARD);
-        mkfifo(&from_board)?;
-        mkfifo(&to_board)?;
+        let from_path = dir.path().join(CLOCK_FROM_BOARD);
+        let to_path = dir.path().join(CLOCK_TO_BOARD);
+        mkfifo(&from_path)?;
+        mkfifo(&to_path)?;
         // Read-write opens of a FIFO do not wait for the other end.
         let rw = |p: &Path| std::fs::OpenOptions::new().read(true).write(true).open(p);
-        let clock_in = rw(&from_board).context("cannot open the clock FIFO")?;
-        let clock = rw(&to_board).context("cannot open the clock FIFO")?;
+        let from_board = rw(&from_path).context("cannot open the clock FIFO")?;
+        let to_board = rw(&to_path).context("cannot open the clock FIFO")?;
 
         let stdout = File::create(&setup.defmt_log)
             .with_context(|| format!("cannot create {}", setup.defmt_log.display()))?;
@@ -145,8 +111,8 @@ impl Emulator {
             .with_context(|| format!("cannot create {}", setup.qemu_log.display()))?;
         let elf = std::fs::canonicalize(&setup.elf)
             .with_context(|| format!("{}", setup.elf.display()))?;
-        let mut child = Command::new(&setup.qemu)
-            .args(qemu_args(dir.path()))
+        let child = Command::new(&setup.qemu)
+            .args(qemu_args(setup.machine))
             .arg("-kernel")
             .arg(&elf)
             .current_dir(dir.path())
@@ -160,52 +126,7 @@ impl Emulator {
                     setup.qemu.display()
                 )
             })?;
-
-        let accept =
-            |l: &UnixListener, child: &mut Child, what: &str| -> anyhow::Result<UnixStream> {
-                l.set_nonblocking(true)?;
-                let started = Instant::now();
-                loop {
-                    match l.accept() {
-                        Ok((s, _)) => {
-                            s.set_nonblocking(false)?;
-                            return Ok(s);
-                        }
-                        Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {
-                            if let Some(status) = child.try_wait()? {
-                                bail!(
-                                "QEMU exited ({status}) before connecting its {what} port; see {}",
-                                setup.qemu_log.display()
-                            );
-                            }
-                            if started.elapsed() > CONNECT_TIMEOUT {
-                                let _ = child.kill();
-                                bail!(
-                                    "QEMU did not connect its {what} port within {} s",
-                                    CONNECT_TIMEOUT.as_secs()
-                                );
-                            }
-                            std::thread::sleep(Duration::from_millis(5));
-                        }
-                        Err(e) => return Err(e.into()),
-                    }
-                }
-            };
-        let bus = accept(&bus_listener, &mut child, "servo-bus (USART1)")?;
-        let telemetry = accept(&tele_listener, &mut child, "telemetry (USART2)")?;
-        let bus_rx = reader(bus.try_clone()?);
-        let telemetry_rx = reader(telemetry.try_clone()?);
-        let clock_rx = reader(clock_in);
-        Ok(Emulator {
-            child,
-            dir,
-            bus,
-            bus_rx,
-            telemetry,
-            telemetry_rx,
-            clock,
-            clock_rx,
-        })
+        Ok(Emulator { child, dir, to_board, from_board })
     }
 
     /// The run's temporary directory (the board's working directory).
@@ -227,25 +148,37 @@ impl Emulator {
         self.child.wait().ok()
     }
 
-    /// Writes to the board's servo bus.
-    pub fn send_bus(&mut self, bytes: &[u8]) -> anyhow::Result<()> {
-        self.bus
-            .write_all(bytes)
-            .context("writing to the servo bus (QEMU gone?)")
+    /// Writes frames to the board.
+    pub fn send(&mut self, bytes: &[u8]) -> anyhow::Result<()> {
+        self.to_board.write_all(bytes).context("writing to the board's FIFO")
     }
 
-    /// Writes to the board's telemetry port.
-    pub fn send_telemetry(&mut self, bytes: &[u8]) -> anyhow::Result<()> {
-        self.telemetry
-            .write_all(bytes)
-            .context("writing to the telemetry port (QEMU gone?)")
-    }
-
-    /// Writes a clock frame.
-    pub fn send_clock(&mut self, bytes: &[u8]) -> anyhow::Result<()> {
-        self.clock
-            .write_all(bytes)
-            .context("writing to the clock FIFO")
+    /// Reads what the board wrote into `buf`, waiting at most `timeout` of
+    /// wall-clock time; the error says whether QEMU is gone or hung.
+    pub fn receive(&mut self, buf: &mut [u8], timeout: Duration) -> anyhow::Result<usize> {
+        let started = Instant::now();
+        loop {
+            // Wake at least once a second to notice QEMU exiting (the
+            // FIFO is open for writing here too, so it never ends).
+            let slice = (timeout.saturating_sub(started.elapsed())).min(Duration::from_secs(1));
+            let wait = Timespec { tv_sec: slice.as_secs() as i64, tv_nsec: slice.subsec_nanos() as i64 };
+            let mut fds = [PollFd::new(&self.from_board, PollFlags::IN)];
+            match poll(&mut fds, Some(&wait)) {
+                Ok(0) | Err(rustix::io::Errno::INTR) => {}
+                Ok(_) => match self.from_board.read(buf) {
+                    Ok(n) => return Ok(n),
+                    Err(e) if e.kind() == ErrorKind::Interrupted => {}
+                    Err(e) => return Err(e).context("reading the board's FIFO"),
+                },
+                Err(e) => return Err(e).context("waiting for the board's FIFO"),
+            }
+            if let Some(st) = self.exited() {
+                bail!("QEMU exited ({st}): the firmware stopped (a panic or fault is in firmware.log)");
+            }
+            if started.elapsed() >= timeout {
+                bail!("the board sent nothing for {} s of wall-clock time: hung", timeout.as_secs());
+            }
+        }
     }
 }
 

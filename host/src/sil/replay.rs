@@ -7,8 +7,8 @@
 //! The firmware's agent draws from its generator only in the agent calls
 //! (`pada_firmware::control`), and a `Step` frame says which call it was
 //! (start, step, absorbing end, time-limit end), with the observation, the
-//! reward and the mode, so the replay makes the same calls in the same
-//! order. A policy change (`SetPolicy`) starts a fresh learner from the
+//! reward and the mode, and whether the policy's memory was mirrored first
+//! (LEO's footsteps), so the replay makes the same calls in the same order. A policy change (`SetPolicy`) starts a fresh learner from the
 //! seed, as on the chip; the replay is given the policy the run used.
 
 use pada_core::agent::{EpisodeEnd, Mode};
@@ -77,6 +77,15 @@ pub fn replay(profile: &LearnerProfile, policy: PolicyKind, seed: u64, records: 
         match record {
             Record::Step(s) => {
                 report.steps += 1;
+                if s.footstep {
+                    match profile.robot.spec().footstep_remap {
+                        Some(map) => agent.remap_memory(&map),
+                        None => {
+                            report.error = Some(format!("step {}: a footstep on a robot without one", s.step));
+                            break;
+                        }
+                    }
+                }
                 agent.set_mode(if s.mode == RunMode::Testing {
                     Mode::Testing
                 } else {

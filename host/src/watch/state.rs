@@ -559,6 +559,7 @@ mod tests {
                 reward: 0.0,
                 td_error: 0,
                 explored: false,
+                footstep: false,
                 joints: [JointFatigue {
                     damage,
                     reengagements: reeng,

@@ -16,9 +16,10 @@ pub use crate::safety::RunMode;
 /// `Saved` the erase count, `NackReason::FlashWear`; `SetPolicy` carries
 /// [`PolicyKind`] itself, in the same bytes as before; 4: the
 /// [`ToHost::Policy`] report and [`CheckpointReport::TooLarge`], appended
-/// last; 5: the gentle explorations appended to [`PolicyKind`], the wear
-/// governor's status in [`PolicyReport`] and [`ToChip::SetMtbfBudget`]).
-pub const PROTOCOL_VERSION: u16 = 5;
+/// last; 5: `Step::footstep`; 6: the gentle explorations appended to
+/// [`PolicyKind`], the wear governor's status in [`PolicyReport`] and
+/// [`ToChip::SetMtbfBudget`]).
+pub const PROTOCOL_VERSION: u16 = 6;
 /// State dimensions a [`Step`] carries.
 pub const MAX_STATE_DIMS: usize = 16;
 /// Action dimensions (motor outputs) a [`Step`] carries.
@@ -133,6 +134,10 @@ pub struct Step {
     pub td_error: i32,
     /// Whether the action was an exploratory draw.
     pub explored: bool,
+    /// Whether the policy's memory was mirrored before this call (a
+    /// footstep of LEO, `RobotSpec::footstep_remap`): a replay must do the
+    /// same to take the same action.
+    pub footstep: bool,
     /// Fatigue per learned joint.
     pub joints: Vec<JointFatigue, MAX_JOINTS>,
     /// Duration of this control period's work, µs.

@@ -22,24 +22,27 @@ fn cargo() -> Command {
     c
 }
 
-/// The firmware image for QEMU's netduinoplus2 for `robot` (`pendulum` or
-/// `leo`), built once per test binary with `cargo xtask qemu` (which needs
-/// a toolchain for thumbv7em-none-eabihf; CI installs Debian's).
-pub fn image(robot: &str) -> PathBuf {
+/// The firmware image for the emulated board of board profile `board`
+/// (`f405`: QEMU's netduinoplus2; `f429-sdram`: mps2-an386) and `robot`
+/// (`pendulum` or `leo`), built once per test binary with `cargo xtask
+/// qemu` (which needs a toolchain for thumbv7em-none-eabihf; CI installs
+/// Debian's).
+pub fn image(board: &str, robot: &str) -> PathBuf {
     static BUILT: Mutex<Option<HashMap<String, PathBuf>>> = Mutex::new(None);
     let mut built = BUILT.lock().unwrap_or_else(|e| e.into_inner());
     let map = built.get_or_insert_with(HashMap::new);
-    if let Some(p) = map.get(robot) {
+    let key = format!("{board}-{robot}");
+    if let Some(p) = map.get(&key) {
         return p.clone();
     }
     let out = cargo()
-        .args(["xtask", "qemu", "--robot", robot])
+        .args(["xtask", "qemu", "--board", board, "--robot", robot])
         .output()
         .expect("cannot run cargo xtask qemu");
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         out.status.success(),
-        "cargo xtask qemu --robot {robot} failed (a thumbv7em-none-eabihf toolchain is needed, see .ci/run):\n{stdout}\n{}",
+        "cargo xtask qemu --board {board} --robot {robot} failed (a thumbv7em-none-eabihf toolchain is needed, see .ci/run):\n{stdout}\n{}",
         String::from_utf8_lossy(&out.stderr)
     );
     let elf = stdout
@@ -48,7 +51,7 @@ pub fn image(robot: &str) -> PathBuf {
         .find_map(|l| l.strip_prefix("xtask: firmware ELF: "))
         .map(PathBuf::from)
         .expect("xtask names the ELF");
-    map.insert(robot.to_string(), elf.clone());
+    map.insert(key, elf.clone());
     elf
 }
 

@@ -1,0 +1,470 @@
+//! The lock-step loop between the emulated board and the plant side.
+//!
+//! Every [`FromBoard::Idle`] says until when the board has nothing to do;
+//! the [`FromBoard::Output`]s before it carry what it wrote and when. The
+//! loop runs the servo-bus bytes through the [`BusEmulator`] (which
+//! schedules the answers) and the telemetry through the [`Recorder`] (the
+//! operator and the run protocol react to it), then advances the board's
+//! clock to the first of: its timer, the next answer, the next command;
+//! sends what is due at that instant, the forecasts of the answers to
+//! come ([`Forecaster`]), and [`ToBoard::Advance`]. Nothing depends on
+//! wall-clock time, so the same image gives the same run every time.
+
+use super::bus::{BusEmulator, Reply};
+use super::forecast::Forecaster;
+use super::qemu::Emulator;
+use super::replay::Record;
+use super::report::{self, Facts, SilSummary};
+use super::run::SilConfig;
+use super::wall::{Account, WallClock};
+use crate::board::{EpisodeOutcome, Phase, RunProtocol};
+use crate::capture::{mode_name, Recorder};
+use crate::rig::Rig;
+use anyhow::{anyhow, bail, Context};
+use pada_core::wire::{self, Decoded, FrameEncoder, RunMode, StepKind, ToChip, ToHost, MAX_FRAME_LEN};
+use pada_firmware::config::Robot;
+use pada_firmware::sil::{
+    Channel, FromBoard, ToBoard, CALIBRATION_INSTRUCTIONS, CHUNK_LEN, CLOCK_FRAME_LEN, CLOCK_PROTOCOL, NEVER,
+};
+use std::collections::VecDeque;
+use std::process::ExitStatus;
+use std::time::Instant;
+
+/// When the run sets the policy and starts the first test episode, after
+/// boot \[µs\] (the board's servo set-up is long done).
+const FIRST_COMMAND_US: u64 = 100_000;
+
+/// The state of one run.
+pub struct Session<'a> {
+    cfg: &'a SilConfig,
+    emu: Emulator,
+    rig: Box<dyn Rig>,
+    bus: BusEmulator,
+    forecaster: Forecaster,
+    recorder: Recorder,
+    decoder: wire::FrameDecoder<FromBoard, CLOCK_FRAME_LEN>,
+    inbox: VecDeque<FromBoard>,
+    read_buf: Vec<u8>,
+    /// Frames to the board, written at once.
+    outbox: Vec<u8>,
+    to_board_seq: u32,
+    encoder: FrameEncoder,
+    now_us: u64,
+    /// The horizon of the last `Advance`.
+    horizon_us: u64,
+    replies: Vec<Reply>,
+    commands: Vec<(u64, ToChip)>,
+    /// The request whose answer the board last got, and when (empty: it
+    /// woke without one): what its next request follows.
+    after: Option<(u64, Vec<u8>)>,
+    protocol: RunProtocol,
+    last_step_kind: StepKind,
+    records: Vec<Record>,
+    cycles: [Vec<u32>; 4],
+    fault_reports: Vec<(f64, String, String)>,
+    exchanges: u64,
+    instructions: u64,
+    booted: bool,
+    wall: WallClock,
+    loop_started: Instant,
+    loop_s: f64,
+    episodes_csv: csv::Writer<std::fs::File>,
+    raw: std::io::BufWriter<std::fs::File>,
+    sink: Option<crate::telemetry::TelemetrySink>,
+    bar: Option<indicatif::ProgressBar>,
+}
+
+impl<'a> Session<'a> {
+    /// A run of `cfg` on the started emulator, with its output files.
+    pub fn new(
+        cfg: &'a SilConfig,
+        emu: Emulator,
+        rig: Box<dyn Rig>,
+        bus: BusEmulator,
+        sink: Option<crate::telemetry::TelemetrySink>,
+    ) -> anyhow::Result<Self> {
+        let out = |name: &str| cfg.out_dir.join(name);
+        let csv_file = std::fs::File::create(out("telemetry.csv")).context("cannot create telemetry.csv")?;
+        let recorder = Recorder::new(Some(Box::new(std::io::BufWriter::new(csv_file))))?;
+        let raw = std::fs::File::create(out("telemetry.bin")).context("cannot create telemetry.bin")?;
+        let mut episodes_csv = csv::Writer::from_path(out("episodes.csv")).context("cannot create episodes.csv")?;
+        episodes_csv.write_record([
+            "index",
+            "mode",
+            "return",
+            "length",
+            "weights_checksum",
+            "walked_m",
+            "learning_time_s",
+            "emulated_time_s",
+        ])?;
+        let bar = cfg
+            .progress
+            .then(|| crate::progress::steps_bar((cfg.seconds * 1000.0).round() as u64, "sil: learning ms"));
+        Ok(Session {
+            cfg,
+            emu,
+            rig,
+            bus,
+            forecaster: Forecaster::new(cfg.forecast),
+            recorder,
+            decoder: wire::FrameDecoder::new(),
+            inbox: VecDeque::new(),
+            read_buf: vec![0; 1 << 16],
+            outbox: Vec::new(),
+            to_board_seq: 0,
+            encoder: FrameEncoder::new(),
+            now_us: 0,
+            horizon_us: 0,
+            replies: Vec::new(),
+            commands: Vec::new(),
+            after: None,
+            protocol: RunProtocol::new(cfg.seconds, cfg.task.robot().spec().period_us),
+            last_step_kind: StepKind::Start,
+            records: Vec::new(),
+            cycles: Default::default(),
+            fault_reports: Vec::new(),
+            exchanges: 0,
+            instructions: 0,
+            booted: false,
+            wall: WallClock::default(),
+            loop_started: Instant::now(),
+            loop_s: 0.0,
+            episodes_csv,
+            raw: std::io::BufWriter::new(raw),
+            sink,
+            bar,
+        })
+    }
+
+    /// The emulated time \[s\].
+    pub fn now_s(&self) -> f64 {
+        self.now_us as f64 * 1e-6
+    }
+
+    /// Ends QEMU.
+    pub fn stop(&mut self) -> Option<ExitStatus> {
+        self.loop_s = self.loop_started.elapsed().as_secs_f64();
+        if let Some(bar) = &self.bar {
+            bar.finish_and_clear();
+        }
+        self.emu.stop()
+    }
+
+    /// Writes out the recorded files.
+    pub fn flush(&mut self) -> anyhow::Result<()> {
+        self.recorder.flush()?;
+        self.episodes_csv.flush()?;
+        std::io::Write::flush(&mut self.raw)?;
+        Ok(())
+    }
+
+    /// The emulated time after which the run gives up: generous room for
+    /// resets between episodes (LEO learning to walk spends up to four
+    /// times its learning time falling and being set up again), test
+    /// episodes and faults.
+    fn time_limit_us(&self) -> u64 {
+        let fault_end = self.cfg.faults.iter().map(|f| f.end_us).max().unwrap_or(0);
+        ((self.cfg.seconds * 10.0 + 120.0) * 1e6) as u64 + fault_end
+    }
+
+    fn next_message(&mut self) -> anyhow::Result<FromBoard> {
+        loop {
+            if let Some(m) = self.inbox.pop_front() {
+                return Ok(m);
+            }
+            let (emu, buf, timeout) = (&mut self.emu, &mut self.read_buf, self.cfg.hang_timeout);
+            let n = self.wall.time(Account::Board, || emu.receive(buf, timeout))?;
+            for r in self.decoder.feed(&self.read_buf[..n]) {
+                match r {
+                    Ok(frame) => self.inbox.push_back(frame.msg),
+                    Err(e) => bail!("damaged clock frame from the board: {e:?}"),
+                }
+            }
+        }
+    }
+
+    fn queue(&mut self, msg: &ToBoard) -> anyhow::Result<()> {
+        let mut buf = [0u8; CLOCK_FRAME_LEN];
+        let frame = wire::encode_frame(msg, self.to_board_seq, &mut buf).map_err(|e| anyhow!("{e:?}"))?;
+        self.to_board_seq = self.to_board_seq.wrapping_add(1);
+        self.outbox.extend_from_slice(frame);
+        Ok(())
+    }
+
+    fn send_queued(&mut self) -> anyhow::Result<()> {
+        let bytes = std::mem::take(&mut self.outbox);
+        self.emu.send(&bytes)?;
+        self.outbox = bytes;
+        self.outbox.clear();
+        Ok(())
+    }
+
+    /// Sends `bytes` on `channel`, due at the next `Advance`.
+    fn queue_input(&mut self, channel: Channel, bytes: &[u8]) -> anyhow::Result<()> {
+        for piece in bytes.chunks(CHUNK_LEN) {
+            let bytes = heapless::Vec::from_slice(piece).map_err(|_| anyhow!("a chunk longer than {CHUNK_LEN}"))?;
+            self.queue(&ToBoard::Input { channel, bytes })?;
+        }
+        Ok(())
+    }
+
+    fn command_at(&mut self, t_us: u64, cmd: ToChip) {
+        let i = self.commands.partition_point(|(t, _)| *t <= t_us);
+        self.commands.insert(i, (t_us, cmd));
+    }
+
+    /// Runs until the run protocol is done (or fails).
+    pub fn run_loop(&mut self) -> anyhow::Result<()> {
+        self.loop_started = Instant::now();
+        loop {
+            match self.next_message()? {
+                FromBoard::Boot { protocol, robot, board, machine, calibration, resolution } => {
+                    self.on_boot(protocol, robot, &board, &machine, calibration, resolution)?
+                }
+                FromBoard::Output { channel: Channel::Bus, at_us, answered, bytes } => self.on_bus(at_us, answered, &bytes)?,
+                FromBoard::Output { channel: Channel::Telemetry, at_us, bytes, .. } => self.on_telemetry(at_us, &bytes)?,
+                FromBoard::Idle { now_us, until_us, instructions } => {
+                    if self.on_idle(now_us, until_us, instructions)? {
+                        return Ok(());
+                    }
+                }
+            }
+        }
+    }
+
+    fn on_boot(
+        &mut self,
+        protocol: u16,
+        robot: u8,
+        board: &str,
+        machine: &str,
+        calibration: u32,
+        resolution: u16,
+    ) -> anyhow::Result<()> {
+        if protocol != CLOCK_PROTOCOL {
+            bail!("the board speaks clock protocol {protocol}, this host {CLOCK_PROTOCOL}: rebuild one of them");
+        }
+        let want = self.cfg.task.robot();
+        let want_board = self.cfg.board.name();
+        if robot != want.code() || board != want_board {
+            let name = Robot::from_code(robot).map(|r| r.name()).unwrap_or("an unknown robot");
+            bail!(
+                "the image drives {name} on board {board} ({machine}), the run is for {} on {want_board}: build it with `cargo xtask qemu --board {want_board} --robot {}`",
+                want.name(),
+                self.cfg.task.name()
+            );
+        }
+        if calibration.abs_diff(CALIBRATION_INSTRUCTIONS) > resolution as u32 + 16 {
+            bail!(
+                "the board's instruction counter read {calibration} for {CALIBRATION_INSTRUCTIONS} instructions (resolution {resolution}): QEMU is not counting instructions (-icount shift=0)"
+            );
+        }
+        self.booted = true;
+        self.queue(&ToBoard::Configure { seed: self.cfg.learner_seed() })?;
+        self.send_queued()?;
+        // A fresh learner with the run's policy, then the first test episode.
+        for (k, cmd) in RunProtocol::start(self.cfg.policy).into_iter().enumerate() {
+            self.command_at(FIRST_COMMAND_US * (k as u64 + 1), cmd);
+        }
+        Ok(())
+    }
+
+    fn on_bus(&mut self, at_us: u64, answered: bool, bytes: &[u8]) -> anyhow::Result<()> {
+        if let Some((t, key)) = self.after.take() {
+            if t == at_us {
+                self.forecaster.observe(&key, bytes);
+            }
+        }
+        let (bus, rig) = (&mut self.bus, self.rig.as_mut());
+        let replies = self.wall.time(Account::Plant, || bus.receive(at_us, bytes, rig));
+        if answered {
+            self.forecaster.confirm(at_us, bytes, &replies).map_err(|e| anyhow!(e))?;
+            let at = replies[0].at_us;
+            self.now_us = at;
+            self.after = Some((at, bytes.to_vec()));
+        } else {
+            self.replies.extend(replies);
+            self.replies.sort_by_key(|r| r.at_us);
+        }
+        Ok(())
+    }
+
+    fn on_telemetry(&mut self, at_us: u64, bytes: &[u8]) -> anyhow::Result<()> {
+        let t0 = Instant::now();
+        std::io::Write::write_all(&mut self.raw, bytes)?;
+        if let Some(sink) = self.sink.as_mut() {
+            sink.forward(bytes);
+        }
+        let mut frames = Vec::new();
+        self.recorder.feed(bytes, at_us as f64 * 1e-6, &mut frames)?;
+        for f in frames {
+            self.on_frame(at_us, f)?;
+        }
+        self.wall.add(Account::Telemetry, t0.elapsed());
+        Ok(())
+    }
+
+    /// Takes the board's report; true when the run is over.
+    fn on_idle(&mut self, now_us: u64, until_us: u64, instructions: u64) -> anyhow::Result<bool> {
+        if !self.booted {
+            bail!("the board went idle before it booted");
+        }
+        // The board may have let its timers fire on its own, up to the
+        // horizon (pada_firmware::sil, "Forecasts").
+        if now_us < self.now_us || now_us > self.horizon_us {
+            bail!(
+                "the board's clock ({now_us} us) is outside what the host allowed ({} .. {} us)",
+                self.now_us,
+                self.horizon_us
+            );
+        }
+        self.now_us = now_us;
+        self.instructions = instructions;
+        self.exchanges += 1;
+        self.forecaster.void();
+        if self.protocol.done() {
+            return Ok(true);
+        }
+        if self.now_us > self.time_limit_us() {
+            bail!(
+                "learning time {:.1} s of {} s not reached within {:.0} s of emulated time",
+                self.protocol.learning_time_s(),
+                self.cfg.seconds,
+                self.time_limit_us() as f64 * 1e-6
+            );
+        }
+        let next_reply = self.replies.first().map_or(NEVER, |r| r.at_us);
+        let next_command = self.commands.first().map_or(NEVER, |c| c.0);
+        let next = until_us.min(next_reply).min(next_command).max(self.now_us);
+        if next == NEVER {
+            bail!("the board waits for nothing and nothing is scheduled: it would sleep forever");
+        }
+        let due = self.replies.partition_point(|r| r.at_us <= next);
+        let mut bus_in = Vec::new();
+        let mut key = Vec::new();
+        for r in self.replies.drain(..due) {
+            bus_in.extend_from_slice(&r.bytes);
+            key = r.request;
+        }
+        self.queue_input(Channel::Bus, &bus_in)?;
+        let due = self.commands.partition_point(|c| c.0 <= next);
+        let mut tele_in = Vec::new();
+        for (_, cmd) in self.commands.drain(..due).collect::<Vec<_>>() {
+            let mut buf = [0u8; MAX_FRAME_LEN];
+            tele_in.extend_from_slice(self.encoder.encode(&cmd, &mut buf).map_err(|e| anyhow!("{e:?}"))?);
+        }
+        self.queue_input(Channel::Telemetry, &tele_in)?;
+        self.now_us = next;
+        let horizon = self.commands.first().map_or(NEVER, |c| c.0).min(self.replies.first().map_or(NEVER, |r| r.at_us));
+        self.horizon_us = horizon;
+        if self.replies.is_empty() {
+            let (forecaster, bus, rig) = (&mut self.forecaster, &self.bus, self.rig.as_mut());
+            let chain = self.wall.time(Account::Plant, || {
+                // Nothing the board does from now can come before now.
+                rig.advance_to(next);
+                forecaster.plan(bus, rig, next, &key, horizon)
+            });
+            for f in chain {
+                let request = heapless::Vec::from_slice(&f.request).map_err(|_| anyhow!("a forecast request too long"))?;
+                let reply = heapless::Vec::from_slice(&f.reply.bytes).map_err(|_| anyhow!("a forecast answer too long"))?;
+                self.queue(&ToBoard::Forecast { request_at_us: f.request_at_us, request, reply_at_us: f.reply.at_us, reply })?;
+            }
+        }
+        self.after = Some((next, key));
+        self.queue(&ToBoard::Advance { now_us: next, horizon_us: horizon })?;
+        self.send_queued()?;
+        Ok(false)
+    }
+
+    fn on_frame(&mut self, at_us: u64, frame: Decoded<ToHost>) -> anyhow::Result<()> {
+        match frame.msg {
+            ToHost::Step(step) => {
+                let k = match (step.kind, step.mode) {
+                    (StepKind::Start, _) => 2,
+                    (StepKind::Absorbing | StepKind::Timeout, _) => 3,
+                    (StepKind::Step, RunMode::Learning) => 0,
+                    (StepKind::Step, RunMode::Testing) => 1,
+                };
+                self.cycles[k].push(step.agent_cycles);
+                self.last_step_kind = step.kind;
+                if step.kind == StepKind::Start {
+                    // The firmware started an episode: the operator lets go.
+                    self.rig.episode_started(at_us);
+                }
+                self.records.push(Record::Step(step));
+            }
+            ToHost::Episode(e) => {
+                // The firmware reports the episode's end and waits: the
+                // operator sets the robot up again (rig::leo).
+                let outcome = EpisodeOutcome { fell: self.last_step_kind == StepKind::Absorbing, walked_m: self.rig.walked_m() };
+                self.rig.episode_ended(at_us);
+                // (After the final test episode the run ends at the board's
+                // next report; the firmware stays idle with torque off.)
+                if let Some(cmd) = self.protocol.on_episode(&e, outcome) {
+                    self.command_at(at_us, cmd);
+                }
+                self.episodes_csv.write_record([
+                    e.index.to_string(),
+                    mode_name(e.mode).to_string(),
+                    e.total_reward.to_string(),
+                    e.length.to_string(),
+                    format!("{:08x}", e.weights_checksum),
+                    outcome.walked_m.map(|w| format!("{w:.4}")).unwrap_or_default(),
+                    format!("{:.3}", self.protocol.learning_time_s()),
+                    format!("{:.3}", at_us as f64 * 1e-6),
+                ])?;
+                self.records.push(Record::Episode(e));
+                if let Some(bar) = &self.bar {
+                    bar.set_position((self.protocol.learning_time_s() * 1000.0) as u64);
+                }
+            }
+            ToHost::Fault(f) => {
+                let (_, detail) = crate::capture::describe(&ToHost::Fault(f));
+                self.fault_reports.push((at_us as f64 * 1e-6, f.cause.name().to_string(), detail));
+                // Torque is off; a walking robot may be on the floor: the
+                // operator sets it up and holds it.
+                self.rig.episode_ended(at_us);
+                // Resume once every fault window that is open now is over.
+                let resume_from = self
+                    .cfg
+                    .faults
+                    .iter()
+                    .filter(|w| w.start_us <= at_us)
+                    .map(|w| w.end_us)
+                    .max()
+                    .unwrap_or(0)
+                    .max(at_us);
+                let mode = if self.protocol.phase() == Phase::Learning { RunMode::Learning } else { RunMode::Testing };
+                self.command_at(resume_from + 100_000, ToChip::ClearFault);
+                self.command_at(resume_from + 200_000, ToChip::Start(mode));
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// The run's summary (runs the replay and the host comparison).
+    pub fn summary(&mut self, wall_s: f64) -> SilSummary {
+        let facts = Facts {
+            emulated_s: self.now_s(),
+            wall_s,
+            loop_s: self.loop_s,
+            wall_time: self.wall.report(self.loop_s),
+            exchanges: self.exchanges,
+            instructions: self.instructions,
+            forecasts: self.forecaster.stats(),
+            records: std::mem::take(&mut self.records),
+            cycles: std::mem::take(&mut self.cycles),
+            fault_reports: std::mem::take(&mut self.fault_reports),
+            protocol: self.protocol.clone(),
+            plant: self.rig.describe(),
+            bus: &self.bus,
+            link: self.recorder.stats(),
+            messages: self.recorder.counts(),
+            latest: self.recorder.latest().clone(),
+            sink: self.sink.take(),
+        };
+        report::summarize(self.cfg, facts)
+    }
+}
