@@ -722,7 +722,8 @@ mod tests {
         let mut h = Governor::new(&PolicyKind::Pada { delta: 0.5 }, &leo(), &config(300.0, 4)).unwrap();
         h.restore(&s).unwrap();
         assert_eq!(h, g);
-        let cases: [(&str, fn(&mut GovernorState)); 7] = [
+        type Change = fn(&mut GovernorState);
+        let cases: [(&str, Change); 7] = [
             ("governor.budget", |s| s.budget_bits = 301.0f32.to_bits()),
             ("governor.restricts", |s| s.restricts = Restricts::Alpha),
             ("governor.rung", |s| s.rung = 6),

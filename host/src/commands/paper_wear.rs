@@ -195,5 +195,5 @@ fn configs_csv(r: &WearResults) -> anyhow::Result<Vec<u8>> {
             c.pareto_physical.to_string(),
         ])?;
     }
-    Ok(w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?)
+    w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))
 }

@@ -236,6 +236,7 @@ mod tests {
             let cfg = RunConfig {
                 policy,
                 switch_at_s: Some(7333.0),
+                mtbf_budget_s: None,
                 seconds: 14_666.0,
                 trials: 15,
                 seed: u64::MAX,
@@ -254,6 +255,7 @@ mod tests {
         let cfg = |trials| RunConfig {
             policy: PolicyKind::Sarsa,
             switch_at_s: None,
+            mtbf_budget_s: None,
             seconds: 60.0,
             trials,
             seed: 1,
@@ -290,6 +292,7 @@ mod tests {
         let cfg = RunConfig {
             policy: PolicyKind::Sarsa,
             switch_at_s: None,
+            mtbf_budget_s: None,
             seconds: 60.0,
             trials: 1,
             seed: 1,

@@ -363,6 +363,7 @@ mod tests {
                 RunConfig {
                     policy: PolicyKind::Pada { delta: 1.0 / 6.0 },
                     switch_at_s: None,
+                    mtbf_budget_s: None,
                     seconds: 60.0,
                     trials: 2,
                     seed: 9,
@@ -382,6 +383,8 @@ mod tests {
             mtbf_s: f64::INFINITY,
             window_reengagements: 349,
             physical_mtbf_s: 1.0e-300,
+            run_mtbf_s: f64::INFINITY,
+            governor: Some(crate::experiment::governed::GovernorTrial { budget_s: 2600.0, held: true, physical_held: false, final_parameter: 0.834, mean_parameter: 0.1 + 0.2, floor_fraction: 1.0 / 3.0, moves: 7, over_budget_steps: 2 }),
             physical_window_reengagements: 7,
             learning_steps: 1800,
             test_steps: 77,
