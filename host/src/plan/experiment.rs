@@ -129,13 +129,11 @@ impl Configuration {
         })?;
         let names = algo.parameter_names();
         let given = [self.parameter, self.parameter2];
-        if let Some(extra) = given.iter().skip(names.len()).position(Option::is_some) {
-            bail!(
-                "configuration {}: {algo} takes {} parameter(s), not {}",
-                self.index,
-                names.len(),
-                names.len() + extra + 1
-            )
+        if given.iter().skip(names.len()).any(Option::is_some) {
+            match names.len() {
+                0 => bail!("configuration {}: {algo} takes no parameter", self.index),
+                n => bail!("configuration {}: {algo} takes only {n} parameter(s) ({})", self.index, names.join(", ")),
+            }
         }
         let mut flags = PolicyFlags::default();
         for (name, value) in names.iter().zip(given) {
