@@ -458,3 +458,31 @@ fn paper_wear_writes_the_report_the_figures_and_a_plan() {
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
     assert_eq!(std::fs::read_to_string(merged.join("report.md")).unwrap(), report);
 }
+
+#[test]
+fn pada_run_on_a_board_learns_on_a_wear_budget() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |name: &str| {
+        let out = pada(&[
+            "run", "--board", "f405", "--task", "physical-pendulum", "--algo", "pada", "--mtbf-budget", "1.1e8", "--trials", "2",
+            "--seconds", "120", "--json", "--out", dir.path().join(name).to_str().unwrap(),
+        ]);
+        assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let a = run("a");
+    let g = &a["governor"];
+    assert_eq!(g["budget_s"], 1.1e8);
+    assert!(g["moves"]["mean"].as_f64().unwrap() > 0.0, "{g}");
+    assert_eq!(a["parameters"]["mtbf_budget_s"], 1.1e8);
+    for t in a["per_trial"].as_array().unwrap() {
+        assert_eq!(t["governor"]["held"], t["mtbf_s"].as_f64().unwrap() >= 1.1e8, "{t}");
+    }
+    // The board's run reproduces bit for bit.
+    let b = run("b");
+    assert_eq!(a["per_trial"], b["per_trial"]);
+    assert_bad_input(
+        &["run", "--board", "f405", "--task", "physical-pendulum", "--algo", "ou", "--mtbf-budget", "1e8"],
+        &["--mtbf-budget", "pada and lowpass"],
+    );
+}
