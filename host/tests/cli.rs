@@ -486,3 +486,14 @@ fn pada_run_on_a_board_learns_on_a_wear_budget() {
         &["--mtbf-budget", "pada and lowpass"],
     );
 }
+
+#[test]
+fn the_gentle_explorations_parameters_name_their_range() {
+    assert_bad_input(&["run", "--algo", "ou", "--theta", "0"], &["theta", "0 < theta <= 1"]);
+    assert_bad_input(&["run", "--algo", "ou", "--sigma", "5"], &["sigma", "0 < sigma <= 4"]);
+    assert_bad_input(&["run", "--algo", "pink", "--sigma", "NaN"], &["sigma"]);
+    assert_bad_input(&["run", "--algo", "action-penalty", "--weight", "-1"], &["weight", "10000"]);
+    assert_bad_input(&["run", "--algo", "epsilon-pada", "--delta", "1.5"], &["--delta", "0 < delta <= 1"]);
+    assert_bad_input(&["run", "--algo", "pink", "--theta", "0.2"], &["--theta applies only to ou", "not to pink"]);
+    assert_bad_input(&["run", "--algo", "sarsa", "--weight", "1"], &["--weight applies only to action-penalty"]);
+}
