@@ -59,7 +59,7 @@ pub struct StoredResult {
 #[derive(Debug, Clone, PartialEq)]
 pub enum ResultState {
     /// A result of this plan's trial whose checksum matches.
-    Verified(StoredResult),
+    Verified(Box<StoredResult>),
     /// No file.
     Missing,
     /// A file that is not this trial's intact result, and why.
@@ -285,7 +285,7 @@ pub fn read(dir: &Path, plan: &Plan, index: u32) -> ResultState {
         Err(e) => return ResultState::Corrupt(format!("cannot read {} ({e})", path.display())),
     };
     match verify(&bytes, plan, index) {
-        Ok(r) => ResultState::Verified(r),
+        Ok(r) => ResultState::Verified(Box::new(r)),
         Err(why) => ResultState::Corrupt(format!("{}: {why}", path.display())),
     }
 }
