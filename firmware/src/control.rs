@@ -29,9 +29,16 @@
 //! the same agent, fed the reported observations and rewards, draws the same
 //! numbers and takes the same actions.
 //!
+//! Learning on a wear budget: after `SetMtbfBudget` a wear governor
+//! ([`pada_core::governor`], [`crate::wear_budget`]) moves PADA's Δ or the
+//! low-pass filter's α after every learning period from the fatigue
+//! counter's damage of the learned joints, and the period's output carries
+//! a `Policy` report at every move and after every episode.
+//!
 //! Saved learning: [`Controller::save_checkpoint`] writes the weights and
 //! the learner's state — the agent's counters, ε, mode and policy, the
-//! fatigue counter of every servo, the generator, the episode counters — and
+//! fatigue counter of every servo, the generator, the episode counters, the
+//! wear governor — and
 //! [`Controller::load_checkpoint`] (at boot and on the host's command)
 //! restores them when the configuration matches and every field is in range
 //! for the running learner, so that a board that resets continues where it
@@ -43,12 +50,14 @@ use crate::config::{hardware, FirmwareAgent, LearnerProfile, RobotConfig, MAX_OB
 use crate::encoder::Unwrapper;
 use crate::io::CycleCounter;
 use crate::robot::{RobotAdapter, Sensed};
+use crate::wear_budget;
 use heapless::Vec;
 use pada_core::agent::{Decision, EpisodeEnd, Mode};
 use pada_core::checkpoint::{self, CheckpointStore, FlashWear, LearnerState, LoadOutcome, SaveError, Saved, WearBudget};
 use pada_core::dynamixel::{table::PresentState, ErrorFlags};
 use pada_core::error::ConfigError;
 use pada_core::fatigue::{FatigueCounter, FatigueError, GearboxParams, PAPER_WINDOW_STEPS};
+use pada_core::governor::Governor;
 use pada_core::policy::PolicyKind;
 use pada_core::profile::config_hash;
 use pada_core::rng::Pcg32;
@@ -105,6 +114,9 @@ pub struct PeriodOutput {
     /// The gearbox torque of each servo the fatigue counter saw this
     /// period \[N·m\] (the robot's estimate; 0 with torque off).
     pub torques: [f32; MAX_SERVOS],
+    /// A `Policy` report to send: the wear governor moved Δ or α this
+    /// period, or an episode ended while it runs.
+    pub policy: Option<wire::PolicyReport>,
 }
 
 /// A host command's result, for the `Ack`/`Nack`.
@@ -197,6 +209,8 @@ pub struct Controller<W, R> {
     operating_before_s: u64,
     /// Saves refused since boot to keep the flash within its budget.
     saves_refused: u32,
+    /// The wear governor, after `SetMtbfBudget`.
+    governor: Option<Governor>,
 }
 
 /// The record has room for every servo's fatigue counter.
@@ -278,6 +292,7 @@ where
             flash_wear: FlashWear::default(),
             operating_before_s: 0,
             saves_refused: 0,
+            governor: None,
         };
         controller.build(policy, weights)?;
         Ok(controller)
@@ -373,6 +388,7 @@ where
             joints: Vec::from_slice(&self.fatigue.state()).unwrap_or_default(),
             user,
             wear: FlashWear { erases: self.flash_wear.erases, operating_s: self.operating_s() },
+            governor: self.governor.as_ref().map(Governor::state),
         }
     }
 
@@ -407,9 +423,14 @@ where
     /// ([`pada_core::agent::Agent::check_state`]), the fatigue counters (one
     /// per servo, [`FatigueCounter::check_state`]), the generator's
     /// increment, learning episodes since the last test within the robot's
-    /// test interval, unused user counters 0.
+    /// test interval, unused user counters 0, and the wear governor's
+    /// state for the saved policy and budget
+    /// ([`Governor::check_state`]).
     pub fn check_learner_state(&self, state: &LearnerState) -> Result<(), ConfigError> {
         self.agent().check_state(&state.agent)?;
+        if let Some(g) = &state.governor {
+            self.governor_for(&state.agent.policy.kind, g.budget_s())?.check_state(g)?;
+        }
         self.fatigue.check_state(&state.joints).map_err(fatigue_error)?;
         state.rng.check()?;
         let since_test = state.user[user::SINCE_TEST];
@@ -433,9 +454,21 @@ where
     /// to its start and begins a new one.
     fn restore_learner_state(&mut self, state: &LearnerState) -> Result<(), ConfigError> {
         let rng = Pcg32::from_state(state.rng)?;
+        let governor = match &state.governor {
+            Some(g) => {
+                let mut governor = self.governor_for(&state.agent.policy.kind, g.budget_s())?;
+                governor.restore(g)?;
+                Some(governor)
+            }
+            None => None,
+        };
         self.fatigue.restore(&state.joints).map_err(fatigue_error)?;
         let agent = self.agent_mut();
         agent.restore_state(&state.agent)?;
+        // The governor's rung decides the parameter in force.
+        if let Some(g) = &governor {
+            agent.set_policy_parameter(g.parameter())?;
+        }
         let policy = agent.policy().built_kind();
         let previous = agent.policy().learner_space().encode(&agent.policy().previous());
         self.policy = policy;
@@ -445,9 +478,41 @@ where
         self.last_action = previous;
         self.last_output = [0.0; pada_core::action_space::MAX_ACTION_DIMS];
         self.episode_return = 0.0;
+        self.governor = governor;
         // Torque is off (the callers check): no episode runs.
         self.phase = Phase::Stopped;
         Ok(())
+    }
+
+    /// A fresh governor for the built `policy` holding `budget_s`.
+    fn governor_for(&self, policy: &PolicyKind, budget_s: f32) -> Result<Governor, ConfigError> {
+        wear_budget::governor(self.spec, policy, budget_s, self.reported_joints())
+    }
+
+    /// Starts the wear governor with `budget_s` (the smallest predicted
+    /// MTBF over the last 1200 learning actions it accepts \[s\]), at its
+    /// floor, or stops it (`None`: Δ or α stays where it is). Only with
+    /// torque off and for a `pada` or `lowpass` learner; an invalid budget
+    /// (`0 < budget <= 1e10 s`) changes nothing.
+    pub fn set_mtbf_budget(&mut self, budget_s: Option<f32>) -> CommandResult {
+        if self.torque_enabled() {
+            return Err(NackReason::Busy);
+        }
+        let Some(budget) = budget_s else {
+            self.governor = None;
+            return Ok(());
+        };
+        let policy = self.agent().policy().built_kind();
+        let governor = self.governor_for(&policy, budget).map_err(|_| NackReason::InvalidParameter)?;
+        self.agent_mut().set_policy_parameter(governor.parameter()).map_err(|_| NackReason::InvalidParameter)?;
+        self.policy = self.agent().policy().built_kind();
+        self.governor = Some(governor);
+        Ok(())
+    }
+
+    /// The wear governor, if one runs.
+    pub fn governor(&self) -> Option<&Governor> {
+        self.governor.as_ref()
     }
 
     /// Saves the weights and the learner's state ([`learner_state`](Self::learner_state))
@@ -612,8 +677,9 @@ where
         let policy = self.agent().policy();
         wire::PolicyReport {
             step: self.agent_stats().steps as u32,
-            built: policy.built_kind().into(),
+            built: policy.built_kind(),
             switched_to_sarsa: policy.switched(),
+            governor: self.governor.as_ref().map(Governor::status),
         }
     }
 
@@ -648,13 +714,15 @@ where
             wire::ToChip::SwitchToSarsa => {
                 self.agent_mut().switch_to_sarsa().map_err(|_| NackReason::InvalidParameter)
             }
+            wire::ToChip::SetMtbfBudget(budget) => self.set_mtbf_budget(budget),
             _ => Err(NackReason::Unsupported),
         };
         (result, None)
     }
 
     /// A fresh learner with `policy` (generator reseeded, weights
-    /// initialised); only while torque is off. An invalid parameter leaves
+    /// initialised, no wear governor: `SetMtbfBudget` starts one for the
+    /// new learner); only while torque is off. An invalid parameter leaves
     /// the running learner as it was.
     pub fn set_policy(&mut self, policy: PolicyKind) -> CommandResult {
         if self.torque_enabled() {
@@ -667,6 +735,7 @@ where
             return Err(NackReason::Busy);
         };
         let weights = agent.into_weights();
+        self.governor = None;
         // Validated above, so this builds.
         self.build(policy, weights).map_err(|_| NackReason::InvalidParameter)
     }
@@ -680,6 +749,7 @@ where
         out.speeds.clear();
         out.agent_cycles = None;
         out.torques = [0.0; MAX_SERVOS];
+        out.policy = None;
         self.steps = self.steps.wrapping_add(1);
         self.periods = self.periods.saturating_add(1);
         let now = readings.time_ms;
@@ -770,15 +840,38 @@ where
         }
 
         // 6. Fatigue from the estimated gearbox torque (servos past the
-        // robot's count stay at 0).
+        // robot's count stay at 0); the governor sees a learning action's.
         if torque {
             let mut torques = [0.0f32; MAX_SERVOS];
             self.robot.gear_torques(&self.applied, &mut torques);
             torques[n..].fill(0.0);
+            let before = wear_budget::damage_raws(&self.fatigue);
             let _ = self.fatigue.update(&torques);
             out.torques = torques;
+            let learning_action = out.step.as_ref().is_some_and(|s| {
+                s.mode == RunMode::Learning && matches!(s.kind, StepKind::Start | StepKind::Step)
+            });
+            if learning_action {
+                self.govern(&before, out);
+            }
+        }
+        if out.episode.is_some() && self.governor.is_some() {
+            out.policy = Some(self.policy_report());
         }
         out.torque = torque;
+    }
+
+    /// Feeds the governor this period's damage of the learned joints; a
+    /// move sets the policy's parameter for the next decision and is
+    /// reported.
+    fn govern(&mut self, before: &[u64; MAX_SERVOS], out: &mut PeriodOutput) {
+        let increments = wear_budget::increments(before, &self.fatigue, self.reported_joints());
+        let Some(moved) = self.governor.as_mut().and_then(|g| g.observe(&increments)) else { return };
+        // The governor's ladder is the policy's own range, so this is
+        // accepted; a refusal would leave the previous parameter in force.
+        let _ = self.agent_mut().set_policy_parameter(moved);
+        self.policy = self.agent().policy().built_kind();
+        out.policy = Some(self.policy_report());
     }
 
     fn begin_reset(&mut self) {
@@ -1248,6 +1341,143 @@ mod tests {
             }
             assert_eq!(mine.next_u64(), host.next_u64());
         }
+    }
+
+    // -----------------------------------------------------------------------
+    // Learning on a wear budget
+    // -----------------------------------------------------------------------
+
+    /// The budget the governed tests hold: on the crude pendulum of
+    /// `run_pendulum`, tight enough that the governor moves Δ both ways.
+    const TEST_BUDGET_S: f32 = 2.0e8;
+
+    #[test]
+    fn the_wear_budget_command_starts_a_governor_for_pada_and_lowpass_only() {
+        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Pada { delta: 1.0 }, table(), 3).unwrap();
+        assert_eq!(c.command(&wire::ToChip::SetMtbfBudget(Some(1.0e3))).0, Ok(()));
+        assert_eq!(c.governor().map(|g| g.budget_s()), Some(1.0e3));
+        assert_eq!(c.policy(), PolicyKind::Pada { delta: 0.5 }, "starts at the floor, one level");
+        assert!(c.policy_report().governor.is_some(), "telemetry carries its status");
+        for bad in [0.0, -1.0, f32::NAN, f32::INFINITY, 2.0e10] {
+            assert_eq!(c.command(&wire::ToChip::SetMtbfBudget(Some(bad))).0, Err(NackReason::InvalidParameter), "{bad}");
+            assert_eq!(c.governor().map(|g| g.budget_s()), Some(1.0e3), "a refused budget changes nothing");
+        }
+        start(&mut c, RunMode::Learning);
+        assert_eq!(c.command(&wire::ToChip::SetMtbfBudget(None)).0, Err(NackReason::Busy));
+        stop(&mut c);
+        assert_eq!(c.command(&wire::ToChip::SetMtbfBudget(None)).0, Ok(()));
+        assert!(c.governor().is_none());
+        assert_eq!(c.policy(), PolicyKind::Pada { delta: 0.5 }, "stopping keeps the Δ in force");
+        assert_eq!(c.command(&wire::ToChip::SetMtbfBudget(Some(1.0e3))).0, Ok(()));
+        assert_eq!(c.command(&wire::ToChip::SetPolicy(PolicyKind::LowPass { alpha: 0.5 })).0, Ok(()));
+        assert!(c.governor().is_none(), "a new learner starts without one");
+        assert_eq!(c.command(&wire::ToChip::SetMtbfBudget(Some(1.0e3))).0, Ok(()));
+        assert_eq!(c.policy(), PolicyKind::LowPass { alpha: 0.1 });
+        for k in [PolicyKind::Sarsa, PolicyKind::Integrator { delta: 0.5 }, PolicyKind::OrnsteinUhlenbeck { theta: 0.15, sigma: 0.2 }] {
+            assert_eq!(c.command(&wire::ToChip::SetPolicy(k)).0, Ok(()));
+            assert_eq!(c.command(&wire::ToChip::SetMtbfBudget(Some(1.0e3))).0, Err(NackReason::InvalidParameter), "{k:?}");
+            assert!(c.governor().is_none());
+        }
+    }
+
+    /// A governed run's records in the order the board sends them.
+    enum Sent {
+        Step(wire::Step),
+        Policy(wire::PolicyReport),
+    }
+
+    fn run_governed(c: &mut Controller<Box<[Q16]>, Pendulum33>, angle: &mut f32, periods: u32) -> std::vec::Vec<Sent> {
+        let clock = Clock(Cell::new(0));
+        let mut out = PeriodOutput::default();
+        let mut sent = std::vec::Vec::new();
+        for k in 0..periods {
+            let counts = (*angle / (2.0 * PI) * 4096.0).round() as i64;
+            c.period(&pendulum_readings(counts.rem_euclid(65536) as u16, k * 30), &clock, &mut out);
+            if let Some(s) = out.step.take() {
+                sent.push(Sent::Step(s));
+            }
+            if let Some(p) = out.policy.take() {
+                sent.push(Sent::Policy(p));
+            }
+            let u = c.applied[0];
+            *angle += 0.02 * u - 0.05 * libm::sinf(*angle);
+        }
+        sent
+    }
+
+    #[test]
+    fn a_governed_run_replays_bit_for_bit_from_its_telemetry() {
+        // The board's Step records and the Policy reports of the
+        // governor's moves, replayed through a host agent that takes each
+        // reported Δ when it arrives, give the same actions and weights.
+        let seed = 11;
+        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Pada { delta: 0.5 }, table(), seed).unwrap();
+        assert_eq!(c.command(&wire::ToChip::SetMtbfBudget(Some(TEST_BUDGET_S))).0, Ok(()));
+        start(&mut c, RunMode::Learning);
+        let mut angle = 0.0;
+        let sent = run_governed(&mut c, &mut angle, 3000);
+        let moves = c.governor().unwrap().status().moves;
+        assert!(moves >= 2, "the governor moved {moves} times: the test needs it to move");
+
+        let robot = Robot::Pendulum33;
+        let mut rng = rand_pcg::Pcg32::seed_from_u64(seed);
+        let mut agent = robot.spec().agent::<_, TILINGS, TRACE>(PolicyKind::Pada { delta: 0.5 }, profile(robot).layout, table()).unwrap();
+        agent.reset_weights(&mut rng);
+        let (mut compared, mut reports) = (0, 0);
+        for r in &sent {
+            let s = match r {
+                Sent::Policy(p) => {
+                    let g = p.governor.expect("a governed board reports its governor");
+                    agent.set_policy_parameter(g.parameter).unwrap();
+                    assert_eq!(p.built, PolicyKind::Pada { delta: g.parameter });
+                    reports += 1;
+                    continue;
+                }
+                Sent::Step(s) => s,
+            };
+            agent.set_mode(if s.mode == RunMode::Testing { Mode::Testing } else { Mode::Learning });
+            match s.kind {
+                StepKind::Start => assert_eq!(agent.start_episode(&s.state, &mut rng).unwrap().action, s.action),
+                StepKind::Step => assert_eq!(agent.step(s.reward, &s.state, &mut rng).unwrap().action, s.action, "step {}", s.step),
+                StepKind::Absorbing => agent.end_episode(s.reward, EpisodeEnd::Absorbing, &mut rng).unwrap(),
+                StepKind::Timeout => agent.end_episode(s.reward, EpisodeEnd::Timeout(&s.state), &mut rng).unwrap(),
+            }
+            compared += 1;
+        }
+        assert!(compared > 1000 && reports >= moves, "{compared} steps, {reports} reports");
+        assert_eq!(agent.weights_checksum(), c.agent().weights_checksum());
+    }
+
+    #[test]
+    fn a_checkpoint_carries_the_governor() {
+        let mut store = Store::new();
+        let mut a = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Pada { delta: 0.5 }, table(), 5).unwrap();
+        assert_eq!(a.command(&wire::ToChip::SetMtbfBudget(Some(TEST_BUDGET_S))).0, Ok(()));
+        start(&mut a, RunMode::Learning);
+        let mut angle = 0.0;
+        run_governed(&mut a, &mut angle, 2000);
+        stop(&mut a);
+        let governor = a.governor().unwrap().clone();
+        assert!(governor.state().steps > 1000);
+        a.save_checkpoint(&mut store).unwrap();
+
+        let mut b = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Pada { delta: 0.5 }, table(), 99).unwrap();
+        assert_eq!(b.load_checkpoint(&store), Ok(LoadOutcome::Loaded { generation: 1, slot: 0 }));
+        assert_eq!(b.governor(), Some(&governor));
+        assert_eq!(b.policy(), a.policy(), "the governor's rung is the Δ in force");
+        assert_eq!(b.learner_state(), a.learner_state());
+        // Both go on the same way (from the pendulum hanging still, as
+        // after a reset).
+        start(&mut a, RunMode::Learning);
+        start(&mut b, RunMode::Learning);
+        let (mut x, mut y) = (0.0, 0.0);
+        let sa = run_governed(&mut a, &mut x, 1500);
+        let sb = run_governed(&mut b, &mut y, 1500);
+        assert!(sa.len() > 300);
+        assert_eq!(sa.len(), sb.len());
+        assert!(b.governor().unwrap().state().steps > governor.state().steps + 300);
+        assert_eq!(a.governor(), b.governor());
+        assert_eq!(a.agent().weights_checksum(), b.agent().weights_checksum());
     }
 
     #[test]

@@ -311,6 +311,11 @@ pub async fn control(mut cl: ControlLoop) -> ! {
             info!("episode {=u32} ({}): return {=f32}, {=u32} steps", e.index, e.mode, e.total_reward, e.length);
             send_reliable(ToHost::Episode(e)).await;
         }
+        // The wear governor moved Δ or α, or an episode ended under it:
+        // its budget, parameter and damage rate.
+        if let Some(p) = out.policy.take() {
+            send_reliable(ToHost::Policy(p)).await;
+        }
         if let Some(job) = weights_job.as_mut() {
             if send_weights(&cl.ctl, job) {
                 send_reliable(ToHost::Ack(wire::Ack { seq: job.seq })).await;
@@ -502,7 +507,7 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
             if let Some(t) = transition.filter(|t| t.changed()) {
                 report_transition(&t, &cl.ctl, Instant::now().as_millis() as u32).await;
             }
-            let changes_policy = matches!(cmd, ToChip::SetPolicy(_) | ToChip::SwitchToSarsa);
+            let changes_policy = matches!(cmd, ToChip::SetPolicy(_) | ToChip::SwitchToSarsa | ToChip::SetMtbfBudget(_));
             if changes_policy && result.is_ok() {
                 send_reliable(ToHost::Policy(cl.ctl.policy_report())).await;
             }

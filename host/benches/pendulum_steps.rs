@@ -21,6 +21,7 @@ fn trial_steps<T: Task>(task: &T, policy: PolicyKind) -> u64 {
     let cfg = RunConfig {
         policy,
         switch_at_s: None,
+        mtbf_budget_s: None,
         seconds: SECONDS,
         trials: 1,
         seed: 1,

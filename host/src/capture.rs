@@ -399,7 +399,27 @@ pub fn describe(msg: &ToHost) -> (&'static str, String) {
         ToHost::Nack(n) => ("nack", format!("seq {} {:?}", n.seq, n.reason)),
         ToHost::Policy(p) => (
             "policy",
-            format!("{:?} switched {} at step {}", p.built, p.switched_to_sarsa, p.step),
+            match &p.governor {
+                // The wear governor's move or status: the Δ or α in force and
+                // the damage rate it measured.
+                Some(g) => format!(
+                    "{:?} switched {} at step {}; wear governor: budget {} s, {:?} {} (rung {} of {}), damage rate {:e} per s, window MTBF {} s over {} actions, {} moves, {} actions over budget",
+                    p.built,
+                    p.switched_to_sarsa,
+                    p.step,
+                    g.budget_s,
+                    g.restricts,
+                    g.parameter,
+                    g.rung + 1,
+                    g.rungs,
+                    g.damage_rate,
+                    g.window_mtbf_s,
+                    g.window_steps,
+                    g.moves,
+                    g.over_budget_steps
+                ),
+                None => format!("{:?} switched {} at step {}", p.built, p.switched_to_sarsa, p.step),
+            },
         ),
         ToHost::Step(_) => ("step", String::new()),
         ToHost::Episode(_) => ("episode", String::new()),

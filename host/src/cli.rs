@@ -72,18 +72,36 @@ pub struct RunArgs {
     /// The task.
     #[arg(long, value_enum, default_value_t = TaskName::Pendulum)]
     pub task: TaskName,
-    /// The algorithm (Section V).
+    /// The algorithm (Section V, and the gentle explorations epsilon-pada,
+    /// ou, pink, action-penalty).
     #[arg(long, value_parser = crate::experiment::algo::algo_parser())]
     pub algo: Algo,
     /// Low-pass α of Eq. 8, 0 < α ≤ 1 (lowpass, markov-lowpass; default 0.834).
     #[arg(long)]
     pub alpha: Option<f32>,
     /// Δ relative to the action range, 0 < Δ ≤ 1 (integrator,
-    /// markov-integrator, pada; default 0.5).
+    /// markov-integrator, pada, epsilon-pada; default 0.5).
     #[arg(long)]
     pub delta: Option<f32>,
+    /// OU's mean reversion per step, 0 < θ ≤ 1 (ou; default 0.15).
+    #[arg(long)]
+    pub theta: Option<f32>,
+    /// Noise scale, 0 < σ ≤ 4, in units of the largest distance from 0 to a
+    /// bound of the action range (ou, default 0.2; pink, default 0.38).
+    #[arg(long)]
+    pub sigma: Option<f32>,
+    /// The action-change penalty per squared full-range change,
+    /// 0 < w ≤ 10000 (action-penalty; default 1).
+    #[arg(long)]
+    pub weight: Option<f32>,
+    /// Learn on a wear budget: a governor moves PADA's Δ or the low-pass
+    /// filter's α while learning so that the predicted MTBF over the last
+    /// 1200 learning actions stays at or above this [s] (pada, lowpass;
+    /// 0 < budget <= 1e10; instead of --delta or --alpha).
+    #[arg(long, value_name = "SECONDS")]
+    pub mtbf_budget: Option<f32>,
     /// Switch back to SARSA(λ) after this much learning time [s]
-    /// (lowpass, pada; Section VIII).
+    /// (lowpass, pada and the gentle explorations; Section VIII).
     #[arg(long, value_name = "SECONDS")]
     pub switch_at: Option<f64>,
     /// Trials (default: the paper's count for the task, 29 or 28).
@@ -181,6 +199,19 @@ pub enum PaperExperiment {
     /// Section VIII: SARSA(λ), PADA and low-pass on LEO, with and without
     /// the switch back to SARSA(λ) at half the run.
     Leo,
+    /// Learning on a wear budget: every strategy (the six and the gentle
+    /// explorations) over a sweep and the wear governor at three budgets;
+    /// end performance against both MTBFs with the Pareto front.
+    Wear,
+}
+
+/// The task of `pada paper wear`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum WearTask {
+    /// The simulated pendulum (29 trials of 3000 s).
+    Pendulum,
+    /// The LEO model (3 trials of 3600 s by default).
+    Leo,
 }
 
 /// `pada paper`.
@@ -201,6 +232,9 @@ pub struct PaperArgs {
     /// 3000; LEO: 14666, the paper's).
     #[arg(long, value_name = "S")]
     pub seconds: Option<f64>,
+    /// The task of `pada paper wear` (default pendulum).
+    #[arg(long, value_enum)]
+    pub task: Option<WearTask>,
     /// Learning time per trial on the physical pendulum [s].
     #[arg(long, value_name = "S", default_value_t = 1500.0)]
     pub physical_seconds: f64,

@@ -13,8 +13,21 @@ use serde::Serialize;
 pub struct Parameters {
     /// Low-pass α (Eq. 8), for the low-pass algorithms.
     pub alpha: Option<f32>,
-    /// Δ relative to the action range (Eq. 9), for the integrators and PADA.
+    /// Δ relative to the action range (Eq. 9), for the integrators, PADA
+    /// and ε-PADA (with a wear governor: its floor, where it starts).
     pub delta: Option<f32>,
+    /// OU's mean reversion θ per step.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub theta: Option<f32>,
+    /// OU's or pink noise's σ.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sigma: Option<f32>,
+    /// The action-change penalty's weight.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub weight: Option<f32>,
+    /// The wear governor's MTBF budget \[s\], if one ran.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mtbf_budget_s: Option<f32>,
     /// Learning time of the switch back to SARSA(λ) \[s\], if any.
     pub switch_at_s: Option<f64>,
     /// Learning time per trial \[s\].
@@ -67,6 +80,8 @@ pub struct RunSummary {
     pub mtbf_s: Estimate,
     /// Backlash re-engagements within those actions (the paper's).
     pub window_reengagements: Estimate,
+    /// Predicted MTBF over all learning actions \[s\] (the paper's torques).
+    pub run_mtbf_s: Estimate,
     /// Predicted MTBF from the first 1200 actions \[s\] from the simulated
     /// gear torques.
     pub physical_mtbf_s: Estimate,
@@ -80,6 +95,9 @@ pub struct RunSummary {
     /// only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub end_speed_m_s: Option<Estimate>,
+    /// What the wear governor did, over the trials (with `--mtbf-budget`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub governor: Option<GovernorSummary>,
     /// Falls (absorbing ends) in learning episodes, per trial.
     pub learning_falls: Estimate,
     /// Falls in greedy test runs, per trial.
@@ -102,6 +120,47 @@ pub struct RunSummary {
     pub per_trial: Vec<TrialResult>,
 }
 
+/// What the wear governor did over a run's trials.
+#[derive(Debug, Clone, Serialize)]
+pub struct GovernorSummary {
+    /// The budget \[s\].
+    pub budget_s: f32,
+    /// The share of trials whose MTBF over the first 1200 learning actions
+    /// (the paper's, `mtbf_s`) is at least the budget.
+    pub held_fraction: f64,
+    /// The same for the physical MTBF, which the governor does not see.
+    pub physical_held_fraction: f64,
+    /// The mean Δ or α over the learning actions, per trial.
+    pub mean_parameter: Estimate,
+    /// The Δ or α at the end, per trial.
+    pub final_parameter: Estimate,
+    /// The share of learning actions at the floor, per trial.
+    pub floor_fraction: Estimate,
+    /// Moves per trial.
+    pub moves: Estimate,
+}
+
+impl GovernorSummary {
+    /// The summary of the trials' governor records (`None` if a trial had
+    /// none).
+    pub fn of(results: &[TrialResult]) -> Option<GovernorSummary> {
+        let g: Vec<&crate::experiment::governed::GovernorTrial> =
+            results.iter().map(|r| r.governor.as_ref()).collect::<Option<_>>()?;
+        let first = g.first()?;
+        let n = g.len() as f64;
+        let col = |f: fn(&crate::experiment::governed::GovernorTrial) -> f64| g.iter().map(|t| f(t)).collect::<Vec<_>>();
+        Some(GovernorSummary {
+            budget_s: first.budget_s,
+            held_fraction: g.iter().filter(|t| t.held).count() as f64 / n,
+            physical_held_fraction: g.iter().filter(|t| t.physical_held).count() as f64 / n,
+            mean_parameter: Estimate::of(&col(|t| t.mean_parameter)),
+            final_parameter: Estimate::of(&col(|t| t.final_parameter as f64)),
+            floor_fraction: Estimate::of(&col(|t| t.floor_fraction)),
+            moves: Estimate::of(&col(|t| t.moves as f64)),
+        })
+    }
+}
+
 impl RunSummary {
     /// Summarises `results` of `cfg` on a task with `spec`.
     pub fn new(
@@ -112,6 +171,10 @@ impl RunSummary {
     ) -> RunSummary {
         let algo = algo_of(&cfg.policy);
         let p = parameter_of(&cfg.policy);
+        let named = |name: &str| {
+            let i = algo.parameter_names().iter().position(|n| *n == name)?;
+            Some(cfg.policy.parameters()[i])
+        };
         let col = |f: fn(&TrialResult) -> f64| results.iter().map(f).collect::<Vec<_>>();
         let env_steps: u64 = results
             .iter()
@@ -124,6 +187,10 @@ impl RunSummary {
             parameters: Parameters {
                 alpha: if algo.takes_alpha() { p } else { None },
                 delta: if algo.takes_delta() { p } else { None },
+                theta: named("theta"),
+                sigma: named("sigma"),
+                weight: named("weight"),
+                mtbf_budget_s: cfg.mtbf_budget_s,
                 switch_at_s: cfg.switch_at_s,
                 seconds: cfg.seconds,
                 seed: cfg.seed,
@@ -148,10 +215,12 @@ impl RunSummary {
             rise_time_s: Estimate::of(&col(|r| r.rise_time_s)),
             mtbf_s: Estimate::of(&col(|r| r.mtbf_s)),
             window_reengagements: Estimate::of(&col(|r| r.window_reengagements as f64)),
+            run_mtbf_s: Estimate::of(&col(|r| r.run_mtbf_s)),
             physical_mtbf_s: Estimate::of(&col(|r| r.physical_mtbf_s)),
             physical_window_reengagements: Estimate::of(&col(|r| r.physical_window_reengagements as f64)),
             end_walked_m: walking.then(|| Estimate::of(&col(|r| r.end_walked_m.unwrap_or(f64::NAN)))),
             end_speed_m_s: walking.then(|| Estimate::of(&col(|r| r.end_speed_m_s.unwrap_or(f64::NAN)))),
+            governor: GovernorSummary::of(results),
             learning_falls: Estimate::of(&col(|r| r.learning_falls as f64)),
             test_falls: Estimate::of(&col(|r| r.test_falls as f64)),
             wall_s,

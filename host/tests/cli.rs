@@ -388,3 +388,112 @@ fn paper_pendulum_writes_the_report_and_the_figures() {
     assert_eq!(summary["simulated"].as_array().unwrap().len(), 24);
     assert_eq!(summary["physical"].as_array().unwrap().len(), 3);
 }
+
+#[test]
+fn mtbf_budget_errors_name_the_flag_and_the_range() {
+    assert_bad_input(&["run", "--algo", "sarsa", "--mtbf-budget", "2600"], &["--mtbf-budget", "pada and lowpass"]);
+    assert_bad_input(&["run", "--algo", "ou", "--mtbf-budget", "2600"], &["--mtbf-budget", "not to ou"]);
+    assert_bad_input(&["run", "--algo", "pada", "--delta", "0.5", "--mtbf-budget", "2600"], &["--delta", "--mtbf-budget"]);
+    assert_bad_input(&["run", "--algo", "lowpass", "--alpha", "0.5", "--mtbf-budget", "2600"], &["--alpha", "--mtbf-budget"]);
+    for bad in ["0", "-5", "NaN", "inf", "2e10"] {
+        assert_bad_input(&["run", "--algo", "pada", "--mtbf-budget", bad, "--seconds", "10"], &["--mtbf-budget", "0 < budget <= 1e10"]);
+    }
+    assert_bad_input(
+        &["run", "--algo", "pada", "--mtbf-budget", "2600", "--switch-at", "10"],
+        &["--switch-at", "--mtbf-budget"],
+    );
+    assert_bad_input(&["paper", "pendulum", "--task", "leo"], &["--task", "pada paper wear"]);
+    assert_bad_input(&["paper", "wear", "--task", "moon"], &["moon", "pendulum", "leo"]);
+}
+
+#[test]
+fn paper_wear_writes_the_report_the_figures_and_a_plan() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("wear");
+    let args = ["paper", "wear", "--trials", "2", "--seconds", "60", "--out", out_dir.to_str().unwrap()];
+    let out = pada(&args);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let report = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
+    for needle in [
+        "# Learning on a wear budget (pendulum)",
+        "| strategy | parameters | MTBF [s] | physical MTBF [s] | end performance | rise time [s]",
+        "| pada + governor | budget 2594 s; mean Δ",
+        "| lowpass + governor | budget 3891 s; mean α",
+        "| ou | theta 0.150, sigma 0.400 |",
+        "| action-penalty | weight 3.000 |",
+        "## Pareto front, end performance against the paper's MTBF",
+        "## Pareto front, end performance against the physical MTBF",
+        "pada at a budget of 2594 s (2× SARSA(λ))",
+        "held in ",
+    ] {
+        assert!(report.contains(needle), "report.md lacks {needle:?}:\n{report}");
+    }
+    for f in ["summary.json", "configurations.csv", "timing.json", "wear-pareto.png", "wear-pareto.svg", "wear-curves.png"] {
+        assert!(out_dir.join(f).is_file(), "{f}");
+    }
+    let csv = std::fs::read_to_string(out_dir.join("configurations.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 23, "a header and 23 configurations");
+    // The same report from the same command.
+    let again = dir.path().join("again");
+    let mut args2 = args;
+    args2[7] = again.to_str().unwrap();
+    assert_eq!(pada(&args2).status.code(), Some(0));
+    assert_eq!(std::fs::read_to_string(again.join("report.md")).unwrap(), report);
+    // As a plan for a cluster: one trial file per trial.
+    let plan = dir.path().join("plan");
+    let out = pada(&["paper", "wear", "--trials", "2", "--seconds", "60", "--plan", plan.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let plan_json = std::fs::read_to_string(plan.join("plan.json")).unwrap();
+    assert!(plan_json.contains("\"paper-wear\"") && plan_json.contains("\"mtbf_budget_s\""), "{plan_json}");
+    assert_eq!(std::fs::read_dir(plan.join("trials")).unwrap().count(), 46);
+    for i in 0..46 {
+        let out = pada(&["trial", "--plan", plan.to_str().unwrap(), "--index", &i.to_string()]);
+        assert_eq!(out.status.code(), Some(0), "trial {i}: {}", String::from_utf8_lossy(&out.stderr));
+    }
+    // The merge reports exactly what the local run reported.
+    let merged = dir.path().join("merged");
+    let out = pada(&[
+        "paper", "wear", "--trials", "2", "--seconds", "60", "--merge", plan.to_str().unwrap(), "--out", merged.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(std::fs::read_to_string(merged.join("report.md")).unwrap(), report);
+}
+
+#[test]
+fn pada_run_on_a_board_learns_on_a_wear_budget() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |name: &str| {
+        let out = pada(&[
+            "run", "--board", "f405", "--task", "physical-pendulum", "--algo", "pada", "--mtbf-budget", "1.1e8", "--trials", "2",
+            "--seconds", "120", "--json", "--out", dir.path().join(name).to_str().unwrap(),
+        ]);
+        assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let a = run("a");
+    let g = &a["governor"];
+    assert_eq!(g["budget_s"], 1.1e8);
+    assert!(g["moves"]["mean"].as_f64().unwrap() > 0.0, "{g}");
+    assert_eq!(a["parameters"]["mtbf_budget_s"], 1.1e8);
+    for t in a["per_trial"].as_array().unwrap() {
+        assert_eq!(t["governor"]["held"], t["mtbf_s"].as_f64().unwrap() >= 1.1e8, "{t}");
+    }
+    // The board's run reproduces bit for bit.
+    let b = run("b");
+    assert_eq!(a["per_trial"], b["per_trial"]);
+    assert_bad_input(
+        &["run", "--board", "f405", "--task", "physical-pendulum", "--algo", "ou", "--mtbf-budget", "1e8"],
+        &["--mtbf-budget", "pada and lowpass"],
+    );
+}
+
+#[test]
+fn the_gentle_explorations_parameters_name_their_range() {
+    assert_bad_input(&["run", "--algo", "ou", "--theta", "0"], &["theta", "0 < theta <= 1"]);
+    assert_bad_input(&["run", "--algo", "ou", "--sigma", "5"], &["sigma", "0 < sigma <= 4"]);
+    assert_bad_input(&["run", "--algo", "pink", "--sigma", "NaN"], &["sigma"]);
+    assert_bad_input(&["run", "--algo", "action-penalty", "--weight", "-1"], &["weight", "10000"]);
+    assert_bad_input(&["run", "--algo", "epsilon-pada", "--delta", "1.5"], &["--delta", "0 < delta <= 1"]);
+    assert_bad_input(&["run", "--algo", "pink", "--theta", "0.2"], &["--theta applies only to ou", "not to pink"]);
+    assert_bad_input(&["run", "--algo", "sarsa", "--weight", "1"], &["--weight applies only to action-penalty"]);
+}

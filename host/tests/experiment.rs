@@ -18,6 +18,7 @@ fn run<T: Task>(
     let cfg = RunConfig {
         policy,
         switch_at_s: None,
+        mtbf_budget_s: None,
         seconds,
         trials,
         seed,
@@ -130,6 +131,7 @@ fn switching_to_sarsa_changes_the_run_only_after_the_switch() {
     let cfg = RunConfig {
         policy: pada,
         switch_at_s: Some(60.0),
+        mtbf_budget_s: None,
         seconds: 120.0,
         trials: 1,
         seed: 4,
@@ -145,4 +147,31 @@ fn switching_to_sarsa_changes_the_run_only_after_the_switch() {
         .count();
     assert_eq!(plain[0].curve[..upto], switched[0].curve[..upto]);
     assert_ne!(plain[0].curve, switched[0].curve);
+}
+
+#[test]
+fn a_governed_run_reproduces_bit_for_bit_and_its_governor_moves() {
+    let task = SimulatedPendulumTask::default();
+    let cfg = |seed| RunConfig {
+        policy: PolicyKind::LowPass { alpha: 0.834 },
+        switch_at_s: None,
+        mtbf_budget_s: Some(2600.0),
+        seconds: 120.0,
+        trials: 2,
+        seed,
+    };
+    let a = run_trials(&task, &cfg(5), &|_| {}).unwrap();
+    let b = run_trials(&task, &cfg(5), &|_| {}).unwrap();
+    assert_eq!(a, b);
+    for r in &a {
+        let g = r.governor.as_ref().expect("a governed trial has a record");
+        assert!(g.moves > 2, "moves {}", g.moves);
+        assert_eq!(g.budget_s, 2600.0);
+        assert_eq!(g.held, r.mtbf_s >= 2600.0);
+        assert!((0.1..=1.0).contains(&g.mean_parameter));
+    }
+    // Without a budget the same policy runs with its own α: another run.
+    let fixed = run_trials(&task, &RunConfig { mtbf_budget_s: None, ..cfg(5) }, &|_| {}).unwrap();
+    assert_ne!(fixed, a);
+    assert!(fixed.iter().all(|r| r.governor.is_none()));
 }

@@ -143,3 +143,52 @@ fn telemetry_goes_to_loopback_only_and_bad_targets_are_usage_errors() {
         assert!(err.starts_with("error: --telemetry"), "{target}: {err}");
     }
 }
+
+#[test]
+fn a_governed_run_streams_the_governors_delta_and_damage_rate() {
+    let dir = tempfile::tempdir().unwrap();
+    let stream = dir.path().join("gov.bin");
+    let out = Command::new(env!("CARGO_BIN_EXE_pada"))
+        .args(["run", "--algo", "lowpass", "--mtbf-budget", "2600", "--trials", "1", "--seconds", "120", "--telemetry"])
+        .arg(&stream)
+        .arg("--out")
+        .arg(dir.path().join("run"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let bytes = std::fs::read(&stream).unwrap();
+    let mut d = HostDecoder::new();
+    let reports: Vec<_> = d
+        .feed(&bytes)
+        .filter_map(|f| match f.unwrap().msg {
+            ToHost::Policy(p) => Some(p),
+            _ => None,
+        })
+        .collect();
+    // The governor's every move and its status after every episode.
+    let governed: Vec<_> = reports.iter().filter_map(|p| p.governor.map(|g| (p.built, g))).collect();
+    assert!(governed.len() > 40, "{} governed reports", governed.len());
+    for (built, g) in &governed {
+        assert_eq!(*built, pada_core::policy::PolicyKind::LowPass { alpha: g.parameter }, "the α in force");
+        assert_eq!(g.budget_s, 2600.0);
+        assert!(g.damage_rate.is_finite() && g.damage_rate >= 0.0);
+        assert!(g.window_steps <= 1200);
+    }
+    let alphas: std::collections::BTreeSet<u32> = governed.iter().map(|(_, g)| g.parameter.to_bits()).collect();
+    assert!(alphas.len() >= 3, "α moved over {} values", alphas.len());
+    assert!(governed.iter().any(|(_, g)| g.damage_rate > 0.0));
+
+    // `pada capture --out` writes one CSV row per frame, the report's text
+    // in it.
+    let csv = dir.path().join("frames.csv");
+    let cap = Command::new(env!("CARGO_BIN_EXE_pada"))
+        .args(["capture", "--file"])
+        .arg(&stream)
+        .arg("--out")
+        .arg(&csv)
+        .output()
+        .unwrap();
+    assert!(cap.status.success(), "{}", String::from_utf8_lossy(&cap.stderr));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(text.contains("wear governor: budget 2600 s") && text.contains("damage rate"), "{text}");
+}

@@ -26,7 +26,7 @@ use crate::action_space::{ActionSpace, Levels, Output, MAX_ACTION_DIMS};
 use crate::action_tiles::{ActionTiles, MAX_ACTION_COMBOS};
 use crate::error::{check_range, ConfigError, StepError};
 use crate::fixed::{Frac, Q16};
-use crate::policy::{uniform_below, Candidates, Policy, PolicyKind, PolicyState};
+use crate::policy::{uniform_below, Candidates, Exploration, Policy, PolicyKind, PolicyState};
 use crate::tile_coding::{Layout, StateCode, StateDim, TileCoder, MAX_STATE_DIMS};
 use crate::trace::{Trace, TraceKind};
 use crate::weights::{entry_factor, WeightStore};
@@ -391,10 +391,19 @@ where
         Ok(())
     }
 
-    /// Switches PADA or the low-pass filter back to plain SARSA
-    /// (Section VIII).
+    /// Switches PADA, the low-pass filter or a gentle exploration back to
+    /// plain SARSA (Section VIII).
     pub fn switch_to_sarsa(&mut self) -> Result<(), StepError> {
         self.policy.switch_to_sarsa()
+    }
+
+    /// Moves the policy's parameter while learning — PADA's Δ, the low-pass
+    /// filter's α ([`Policy::set_parameter`]; the wear governor,
+    /// [`crate::governor`]). It restricts the next decision; the weights
+    /// mean the same, since these kinds share SARSA's learner. A refused
+    /// value changes nothing.
+    pub fn set_policy_parameter(&mut self, value: f32) -> Result<(), ConfigError> {
+        self.policy.set_parameter(value)
     }
 
     /// Moves the policy's memory between action dimensions when the joints
@@ -591,19 +600,41 @@ where
         Q16::from_wide(sum / TILINGS as i64)
     }
 
-    /// ε-greedy choice among the policy's candidates. Does not change the
-    /// agent; [`commit`](Self::commit) applies the choice.
+    /// The next action by the policy's way of exploring
+    /// ([`Policy::exploration`]): ε-greedy among its candidates (ε-PADA:
+    /// the greedy choice among all actions, the exploratory draw within Δ
+    /// of the previous one), or, for the noise explorations, the greedy
+    /// action moved by the policy's noise while learning. Testing is always
+    /// greedy. Changes nothing but the noise process;
+    /// [`commit`](Self::commit) applies the choice.
     fn decide<R: RngCore + ?Sized>(
-        &self,
+        &mut self,
         obs: &[f32],
         rng: &mut R,
     ) -> (Decision, [u32; TILINGS]) {
         let code = self.code(obs);
-        let candidates = self.policy.candidates();
-        let space = self.policy.learner_space();
-        let explore = self.mode == Mode::Learning && (rng.next_u32() as u64) < self.epsilon;
-        let levels = if explore { candidates.random(rng) } else { self.greedy(&code, &candidates, space, rng) };
-        let action = space.encode(&levels);
+        let learning = self.mode == Mode::Learning;
+        let (levels, explore) = match self.policy.exploration() {
+            Exploration::EpsilonGreedy | Exploration::EpsilonLocal => {
+                let explore = learning && (rng.next_u32() as u64) < self.epsilon;
+                let levels = if explore {
+                    self.policy.explore_candidates().random(rng)
+                } else {
+                    self.greedy(&code, &self.policy.candidates(), self.policy.learner_space(), rng)
+                };
+                (levels, explore)
+            }
+            Exploration::Noise => {
+                let greedy = self.greedy(&code, &self.policy.candidates(), self.policy.learner_space(), rng);
+                if learning {
+                    let moved = self.policy.perturb(&greedy, rng);
+                    (moved, moved != greedy)
+                } else {
+                    (greedy, false)
+                }
+            }
+        };
+        let action = self.policy.learner_space().encode(&levels);
         let features = self.coder.features(&code, action);
         let q = self.q_of(&features);
         (Decision { action, levels, output: [0.0; MAX_ACTION_DIMS], explored: explore, q }, features)
@@ -713,7 +744,13 @@ where
     /// The SARSA(λ) update for the pair `current` that earned `reward`;
     /// `q_next` is `Q(s', a')`, or `None` at an absorbing end. A table that
     /// rounds stochastically gets one dither from `rng` per weight write.
+    ///
+    /// The reward learned from is the plant's less the policy's penalty for
+    /// the action that earned it ([`Policy::penalty`]: the action-change
+    /// penalty, 0 for the other kinds); the caller's returns stay the
+    /// plant's.
     fn update<R: RngCore + ?Sized>(&mut self, current: &Current<TILINGS>, reward: f32, q_next: Option<Q16>, rng: &mut R) {
+        let reward = reward - self.policy.penalty();
         let q = self.q_of(&current.features);
         let mut delta = Q16::from_f32(reward).0 as i64 - q.0 as i64;
         if let Some(qn) = q_next {

@@ -66,6 +66,17 @@ fn raw_to_damage(raw: u64) -> f64 {
     raw as f64 / DAMAGE_SCALE
 }
 
+/// Damage J of `raw` accumulator units (Q16.48, [`DAMAGE_FRAC_BITS`]).
+pub fn damage_of_raw(raw: u64) -> f64 {
+    raw_to_damage(raw)
+}
+
+/// Accumulator units (Q16.48, rounded to nearest, saturating) of a damage
+/// `damage ≥ 0`.
+pub fn raw_of_damage(damage: f64) -> u64 {
+    damage_to_raw(damage)
+}
+
 /// Why a fatigue parameter or update was refused. A refused update changes
 /// nothing.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -300,6 +311,12 @@ impl FatigueModel {
         let t_e = t_m + libm::sqrt(t_m * (t_m + self.two_theta_k));
         // Eqs. 4–7.
         self.two_over_teeth * libm::pow(self.ratio_per_nm * t_e, self.neg_inv_d)
+    }
+
+    /// [`damage`](Self::damage) in accumulator units (Q16.48), as a
+    /// re-engagement at `t_m` adds it to the counter.
+    pub fn damage_raw(&self, t_m: f64) -> u64 {
+        damage_to_raw(self.damage(t_m))
     }
 }
 

@@ -11,7 +11,12 @@
 //! - [`action_tiles`]: optional generalisation over actions (their values
 //!   tile-coded, as the paper's LEO learner does);
 //! - [`policy`]: the six action policies of Section V (SARSA, low-pass,
-//!   Markov low-pass, integrator, Markov integrator, PADA) as one concept;
+//!   Markov low-pass, integrator, Markov integrator, PADA) and four gentler
+//!   explorations (ε-PADA, Ornstein–Uhlenbeck and pink noise on the action
+//!   levels, an action-change penalty) as one concept;
+//! - [`exploration`]: the noise processes of those explorations;
+//! - [`governor`]: the wear governor, which moves PADA's Δ or the low-pass
+//!   filter's α while learning to hold a stated MTBF;
 //! - [`trace`]: bounded eligibility traces;
 //! - [`agent`]: SARSA(λ) with ε-greedy selection over the policy's candidates;
 //! - [`fatigue`]: backlash re-engagements → damage J → predicted MTBF
@@ -48,8 +53,10 @@ pub mod checkpoint;
 pub mod crc;
 pub mod dynamixel;
 pub mod error;
+pub mod exploration;
 pub mod fatigue;
 pub mod fixed;
+pub mod governor;
 pub mod policy;
 pub mod profile;
 pub mod rng;

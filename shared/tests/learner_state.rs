@@ -19,6 +19,7 @@ use pada_core::checkpoint::*;
 use pada_core::error::ConfigError;
 use pada_core::fatigue::{FatigueCounter, FatigueError, GearboxParams, JointFatigueState};
 use pada_core::fixed::Q16;
+use pada_core::governor::{GovernorState, Restricts};
 use pada_core::policy::{PolicyKind, PolicyState};
 use pada_core::rng::{Pcg32, RngState};
 use pada_core::tile_coding::{Layout, StateDim};
@@ -107,6 +108,8 @@ struct Learner {
     rng: Pcg32,
     /// The caller's counters: episodes started, and three that only ride along.
     user: [u32; 4],
+    /// A governor's state, carried as a checkpoint carries it.
+    governor: Option<GovernorState>,
     /// Grid position while an episode runs.
     pos: Option<(f32, f32)>,
 }
@@ -123,7 +126,7 @@ fn new_learner(policy: PolicyKind, seed: u64) -> Learner {
     let mut rng = Pcg32::seed_from_u64(seed);
     agent.reset_weights(&mut rng);
     let fatigue = FatigueCounter::new(GearboxParams::TABLE_I, 0.05, Some(WINDOW)).unwrap();
-    Learner { agent, fatigue, rng, user: [0; 4], pos: None }
+    Learner { agent, fatigue, rng, user: [0; 4], governor: None, pos: None }
 }
 
 impl Learner {
@@ -171,6 +174,7 @@ impl Learner {
             joints: heapless::Vec::from_slice(&self.fatigue.state()).unwrap(),
             user: self.user,
             wear: FlashWear::default(),
+            governor: self.governor,
         }
     }
 
@@ -188,6 +192,7 @@ impl Learner {
         self.fatigue.restore(&s.joints).map_err(fatigue_param)?;
         self.rng = Pcg32::from_state(s.rng).map_err(|e| e.param)?;
         self.user = s.user;
+        self.governor = s.governor;
         self.pos = None;
         Ok(())
     }
@@ -330,6 +335,10 @@ fn policy_state() -> impl Strategy<Value = PolicyState> {
         Just(PolicyKind::Sarsa),
         (0.0f32..3.0).prop_map(|delta| PolicyKind::Pada { delta }),
         (0.001f32..=1.0).prop_map(|alpha| PolicyKind::LowPass { alpha }),
+        (0.0f32..1.0).prop_map(|delta| PolicyKind::EpsilonPada { delta }),
+        (0.01f32..=1.0, 0.01f32..=4.0).prop_map(|(theta, sigma)| PolicyKind::OrnsteinUhlenbeck { theta, sigma }),
+        (0.01f32..=4.0).prop_map(|sigma| PolicyKind::PinkNoise { sigma }),
+        (0.01f32..=100.0).prop_map(|weight| PolicyKind::ActionPenalty { weight }),
     ];
     (kind, any::<bool>(), [0u8..3, 0u8..3], [-1.0f32..=1.0, -1.0f32..=1.0]).prop_map(|(kind, sw, prev, out)| {
         PolicyState {
@@ -367,6 +376,38 @@ fn agent_state() -> impl Strategy<Value = AgentState> {
         })
 }
 
+/// Any governor state the record can hold (the ranges that depend on the
+/// running governor are the restorer's to check).
+fn governor_state() -> impl Strategy<Value = Option<GovernorState>> {
+    proptest::option::of(
+        (
+            any::<u32>(),
+            any::<bool>(),
+            any::<[u8; 4]>(),
+            any::<(u32, u32, u64, u64)>(),
+            (any::<u32>(), any::<i64>()),
+            any::<[[u64; 12]; 4]>(),
+        )
+            .prop_map(|(budget_bits, alpha, [rung, cursor, filled, in_bucket], (calm_steps, moves, steps, over), (since_move, headroom_at_move), buckets)| {
+                GovernorState {
+                    budget_bits,
+                    restricts: if alpha { Restricts::Alpha } else { Restricts::Delta },
+                    rung,
+                    cursor,
+                    filled,
+                    in_bucket,
+                    calm_steps,
+                    since_move,
+                    headroom_at_move,
+                    moves,
+                    steps,
+                    over_budget_steps: over,
+                    buckets,
+                }
+            }),
+    )
+}
+
 fn learner_state() -> impl Strategy<Value = LearnerState> {
     (agent_state(), any::<u64>(), any::<u64>(), any::<[u32; 4]>(), 0u64..5000, [0u32..1_000_000, 0u32..1_000_000], any::<u64>())
         .prop_flat_map(|(agent, state, inc, user, steps, erases, operating_s)| {
@@ -376,14 +417,16 @@ fn learner_state() -> impl Strategy<Value = LearnerState> {
                 Just(user),
                 [joint_state(steps), joint_state(steps), joint_state(steps)],
                 Just(FlashWear { erases, operating_s }),
+                governor_state(),
             )
         })
-        .prop_map(|(agent, rng, user, joints, wear)| LearnerState {
+        .prop_map(|(agent, rng, user, joints, wear, governor)| LearnerState {
             agent,
             rng,
             joints: heapless::Vec::from_slice(&joints).unwrap(),
             user,
             wear,
+            governor,
         })
 }
 
@@ -540,16 +583,18 @@ fn write_raw(store: &mut Store, slot: u8, version: u16, generation: u32, record:
 #[test]
 fn records_that_cannot_be_decoded_are_refused_by_name() {
     let good = trained(PolicyKind::Pada { delta: 0.5 }, 3, 300).state().to_bytes();
-    let cases: [(usize, u8, &str); 9] = [
-        (0, 1, "state.version"),   // record version 1 (before the flash wear)
+    let cases: [(usize, u8, &str); 11] = [
+        (0, 2, "state.version"),   // record version 2 (before the governor)
         (2, 2, "mode"),            // mode 2
-        (3, 6, "policy.kind"),     // kind 6
+        (3, 10, "policy.kind"),    // kind 10
         (8, 2, "policy.switched"), // switched 2
         (9, 9, "joints"),          // 9 joints
         (14, 1, "state.reserved"),
-        (77, 1, "state.reserved"),
+        (77, 1, "policy.parameter2"), // a second parameter for PADA
         (112 + 3, 1, "fatigue.reserved"),
         (112 + 3 * 48 + 8, 1, "fatigue"), // an unused entry not 0
+        (512, 2, "governor"),             // governor flag 2
+        (700, 1, "governor"),             // governor bytes without a governor
     ];
     for (offset, value, field) in cases {
         let mut record = good;
@@ -564,6 +609,30 @@ fn records_that_cannot_be_decoded_are_refused_by_name() {
         assert_eq!(load(&store, HASH, &mut st, &mut out), Ok(LoadOutcome::InvalidState), "{field}");
         assert_eq!(st, LearnerState::default());
         assert!(out.iter().all(|w| *w == Q16(5)));
+    }
+    // A governor's block: its restriction code and reserved bytes.
+    let mut governed = trained(PolicyKind::Pada { delta: 0.5 }, 3, 300).state();
+    governed.governor = Some(GovernorState {
+        budget_bits: 2600.0f32.to_bits(),
+        restricts: Restricts::Delta,
+        rung: 1,
+        cursor: 3,
+        filled: 3,
+        in_bucket: 7,
+        calm_steps: 2,
+        since_move: 4,
+        headroom_at_move: -3,
+        moves: 5,
+        steps: 307,
+        over_budget_steps: 0,
+        buckets: [[1 << 30; 12], [0; 12], [0; 12], [0; 12]],
+    });
+    let bytes = governed.to_bytes();
+    assert_eq!(LearnerState::from_bytes(&bytes).unwrap(), governed);
+    for (offset, value, field) in [(513, 2, "governor.restricts"), (518, 1, "governor.reserved"), (1000, 1, "governor.reserved")] {
+        let mut record = bytes;
+        record[offset] = value;
+        assert_eq!(LearnerState::from_bytes(&record).map(|_| ()).unwrap_err().param, field, "byte {offset}");
     }
     // SARSA has no parameter: one stored is not silently dropped.
     let mut record = good;

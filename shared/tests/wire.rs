@@ -6,6 +6,7 @@ use heapless::{String, Vec as HVec};
 use pada_core::checkpoint::{LoadOutcome, Saved};
 use pada_core::dynamixel::ErrorFlags;
 use pada_core::policy::{PolicyKind, PolicyName};
+use pada_core::governor::{GovernorStatus, Restricts};
 use pada_core::safety::{FaultCause, Rejection, State};
 use pada_core::wire::*;
 use proptest::prelude::*;
@@ -111,8 +112,47 @@ fn all_to_host() -> Vec<ToHost> {
         ToHost::Ack(Ack { seq: 41 }),
         ToHost::Checkpoint(CheckpointReport::Saved(Saved { generation: 3, slot: 0, erases: u32::MAX })),
         ToHost::Checkpoint(CheckpointReport::SaveFailed),
-        ToHost::Policy(PolicyReport { step: 7, built: PolicyKind::Pada { delta: 0.5 }, switched_to_sarsa: true }),
-        ToHost::Policy(PolicyReport { step: u32::MAX, built: PolicyKind::LowPass { alpha: 0.834 }, switched_to_sarsa: false }),
+        ToHost::Policy(PolicyReport { step: 7, built: PolicyKind::Pada { delta: 0.5 }, switched_to_sarsa: true, governor: None }),
+        ToHost::Policy(PolicyReport {
+            step: u32::MAX,
+            built: PolicyKind::LowPass { alpha: 0.834 },
+            switched_to_sarsa: false,
+            governor: None,
+        }),
+        ToHost::Policy(PolicyReport {
+            step: 1234,
+            built: PolicyKind::Pada { delta: 1.0 / 3.0 },
+            switched_to_sarsa: false,
+            governor: Some(GovernorStatus {
+                budget_s: 2600.0,
+                restricts: Restricts::Delta,
+                parameter: 1.0 / 3.0,
+                rung: 1,
+                rungs: 6,
+                window_steps: 1134,
+                damage_rate: 3.1e-4,
+                window_mtbf_s: 3225.8,
+                moves: 17,
+                over_budget_steps: 0,
+            }),
+        }),
+        ToHost::Policy(PolicyReport {
+            step: 9,
+            built: PolicyKind::LowPass { alpha: 0.1 },
+            switched_to_sarsa: false,
+            governor: Some(GovernorStatus {
+                budget_s: 1.0e10,
+                restricts: Restricts::Alpha,
+                parameter: 0.1,
+                rung: 0,
+                rungs: 7,
+                window_steps: 0,
+                damage_rate: 0.0,
+                window_mtbf_s: f32::INFINITY,
+                moves: 0,
+                over_budget_steps: u32::MAX,
+            }),
+        }),
         ToHost::Checkpoint(CheckpointReport::TooLarge { needed: 8_389_136, capacity: 131_072 }),
     ];
     for o in [
@@ -169,6 +209,12 @@ fn all_to_chip() -> Vec<ToChip> {
         ToChip::SetPolicy(PolicyKind::Integrator { delta: 0.1 }),
         ToChip::SetPolicy(PolicyKind::MarkovIntegrator { delta: 0.1 }),
         ToChip::SetPolicy(PolicyKind::Pada { delta: 0.25 }),
+        ToChip::SetPolicy(PolicyKind::EpsilonPada { delta: 0.25 }),
+        ToChip::SetPolicy(PolicyKind::OrnsteinUhlenbeck { theta: 0.15, sigma: 0.3 }),
+        ToChip::SetPolicy(PolicyKind::PinkNoise { sigma: 0.5 }),
+        ToChip::SetPolicy(PolicyKind::ActionPenalty { weight: 2.0 }),
+        ToChip::SetMtbfBudget(Some(2600.0)),
+        ToChip::SetMtbfBudget(None),
         ToChip::SwitchToSarsa,
         ToChip::SetEpsilon(0.05),
         ToChip::SaveCheckpoint,
@@ -222,11 +268,13 @@ fn the_protocol_version_changes_with_the_layout() {
     // A change of any message's layout changes this fingerprint: then bump
     // PROTOCOL_VERSION and put the new pair here (with the docs that name
     // the version: docs/sil.md, firmware/README.md, README.md).
-    assert_eq!((PROTOCOL_VERSION, layout_fingerprint()), (5, EXPECTED_FINGERPRINT), "{:#010x}", layout_fingerprint());
+    assert_eq!((PROTOCOL_VERSION, layout_fingerprint()), (6, EXPECTED_FINGERPRINT), "{:#010x}", layout_fingerprint());
 }
 
-/// [`layout_fingerprint`] of protocol 5 (`Step::footstep`).
-const EXPECTED_FINGERPRINT: u32 = 0x2441_7eb5;
+/// [`layout_fingerprint`] of protocol 6 (the gentle explorations in
+/// `PolicyKind`, the governor in `PolicyReport`, `SetMtbfBudget`; 5 added
+/// `Step::footstep`).
+const EXPECTED_FINGERPRINT: u32 = 0x9109_396b;
 
 #[test]
 fn every_chip_message_round_trips() {
@@ -444,11 +492,11 @@ fn set_policy_carries_the_policy_kind_as_its_code_and_parameter() {
     // The wire's PolicySpec is PolicyKind itself; its bytes are the
     // policy's code (the checkpoint's too) and then α or Δ.
     for name in PolicyName::ALL {
-        let kind = name.with_parameter(0.25);
+        let kind = name.with_parameters([0.25, 0.75]);
         let bytes = body(&ToChip::SetPolicy(kind));
         let mut expected = vec![4, name.code()];
-        if name != PolicyName::Sarsa {
-            expected.extend_from_slice(&0.25f32.to_le_bytes());
+        for (i, _) in name.parameter_names().iter().enumerate() {
+            expected.extend_from_slice(&[0.25f32, 0.75][i].to_le_bytes());
         }
         assert_eq!(bytes, expected, "{name}");
         assert_eq!(pada_core::policy::kind_code(&kind), name.code());

@@ -125,9 +125,9 @@ fn the_firmware_in_qemu_replays_bit_for_bit_on_the_host_and_its_link_is_clean() 
         .collect();
     // At boot (SARSA), then after the run's SetPolicy.
     assert_eq!(policies.len(), 2, "{policies:?}");
-    assert_eq!(PolicyKind::from(policies[0].built), PolicyKind::Sarsa);
+    assert_eq!(policies[0].built, PolicyKind::Sarsa);
     let last = policies.last().expect("the firmware sent a Policy frame");
-    assert_eq!(PolicyKind::from(last.built), policy, "{policies:?}");
+    assert_eq!(last.built, policy, "{policies:?}");
     assert!(!last.switched_to_sarsa);
     let profile = Board::F405.profile(Robot::Pendulum33);
     let seed = trial_seed(SEED, 0);

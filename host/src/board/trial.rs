@@ -31,6 +31,7 @@
 //! period at or after `--switch-at` rather than at the exact step.
 
 use super::protocol::{EpisodeOutcome, RunProtocol};
+use crate::experiment::governed::GovernorStats;
 use crate::experiment::metrics::{end_performance, rise_time};
 use crate::experiment::runner::RunConfig;
 use crate::experiment::TrialResult;
@@ -187,8 +188,15 @@ fn run<R: RobotAdapter, W: WeightStore>(
     // (a fresh learner from the seed) and starts the first test run.
     let mut ctl = Controller::<W, R>::new(profile, PolicyKind::Sarsa, table, seed).map_err(|e| anyhow!("{e}"))?;
     for cmd in RunProtocol::start(cfg.policy) {
+        let starts = matches!(cmd, ToChip::Start(_));
+        if let (true, Some(budget)) = (starts, cfg.mtbf_budget_s) {
+            // As the host would: the wire command, after the policy and
+            // before the first run (torque off).
+            command(&mut ctl, ToChip::SetMtbfBudget(Some(budget)))?;
+        }
         command(&mut ctl, cmd).map_err(|e| anyhow!("--algo {:?} on board {}: {e}", cfg.policy, profile.board.name()))?;
     }
+    let mut governed = GovernorStats::default();
     let mut protocol = RunProtocol::new(cfg.seconds, spec.period_us);
     let mut episodes = Vec::new();
 
@@ -252,6 +260,11 @@ fn run<R: RobotAdapter, W: WeightStore>(
         k += 1;
         rig.advance_to(k * period_us);
         if learning_action {
+            // The parameter this action was chosen with (the period's own
+            // move, if any, applies to the next decision).
+            if let Some(g) = ctl.governor() {
+                governed.record(g);
+            }
             let mut com = [0.0f32; COUNTED];
             let mut sim = [0.0f32; COUNTED];
             let mut est = [0.0f32; COUNTED];
@@ -299,6 +312,7 @@ fn run<R: RobotAdapter, W: WeightStore>(
         rise_time_s: rise_time(&times, &returns).unwrap_or(f64::NAN),
         mtbf_s: paper.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
         window_reengagements: paper.joints().iter().filter_map(|j| j.window_reengagements()).sum(),
+        run_mtbf_s: paper.robot_mtbf_s(),
         physical_mtbf_s: simulated.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
         physical_window_reengagements: simulated.joints().iter().filter_map(|j| j.window_reengagements()).sum(),
         learning_steps,
@@ -310,6 +324,13 @@ fn run<R: RobotAdapter, W: WeightStore>(
         end_speed_m_s: walked.map(|w| w / tail.iter().map(|p| p.duration_s).sum::<f64>()),
         saturations: stats.saturations,
         trace_drops: stats.trace_drops,
+        governor: ctl.governor().map(|g| {
+            governed.finish(
+                g,
+                paper.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
+                simulated.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
+            )
+        }),
         curve,
     };
     Ok(BoardTrial {

@@ -27,6 +27,7 @@ pub fn run(args: DemoArgs) -> Result<(), CliError> {
         .map(|policy| RunConfig {
             policy,
             switch_at_s: None,
+            mtbf_budget_s: None,
             seconds,
             trials: args.trials,
             seed: args.trial.seed,

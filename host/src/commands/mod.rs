@@ -6,6 +6,7 @@ pub mod leo;
 pub mod mtbf;
 pub mod paper;
 pub mod paper_leo;
+pub mod paper_wear;
 pub mod render;
 pub mod run;
 pub mod sil;

@@ -18,9 +18,15 @@ use crate::timing::RunTiming;
 
 /// Runs `pada paper`.
 pub fn run(args: PaperArgs) -> Result<(), CliError> {
+    if args.task.is_some() && args.experiment != PaperExperiment::Wear {
+        return Err(crate::error::usage(
+            "--task applies only to `pada paper wear` (pendulum or leo)",
+        ));
+    }
     match args.experiment {
         PaperExperiment::Pendulum => pendulum_cmd(args),
         PaperExperiment::Leo => super::paper_leo::run(args),
+        PaperExperiment::Wear => super::paper_wear::run(args),
     }
 }
 

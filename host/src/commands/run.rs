@@ -5,7 +5,7 @@ use crate::console::outln;
 use crate::cli::{check_seconds, set_threads, RunArgs};
 use crate::display::{fmt_estimate, fmt_mtbf};
 use crate::error::{usage, CliError};
-use crate::experiment::algo::{label, parameter_of, policy_kind, Algo};
+use crate::experiment::algo::{label, parameter_of, policy_kind_of, Algo, PolicyFlags};
 use crate::board::trial::table_len;
 use crate::board::{robot_of_task, run_board};
 use crate::experiment::task::{Task, TaskSpec};
@@ -71,7 +71,7 @@ fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
         };
         profile = profile.with_hashed_table(log2, format);
     }
-    let policy = policy_kind(args.algo, args.alpha, args.delta).map_err(|e| usage(e.0))?;
+    let policy = policy_of(&args)?;
     // The task as the runner describes it, with the board's table: the
     // summary's keys and parameters are `pada run`'s.
     let task_spec = match robot {
@@ -110,7 +110,7 @@ fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
     if args.json {
         outln!("{}", summary.to_json())?;
     } else {
-        print_summary(&summary.run, &label(&policy))?;
+        print_summary(&summary.run, &run_label(&policy, cfg.mtbf_budget_s))?;
         outln!(
             "  board                {}: {} {} weights ({} KiB, {}-bit) in {}",
             board.name(),
@@ -125,13 +125,51 @@ fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
     Ok(())
 }
 
+/// The run's label: the policy, or the governed policy and its budget.
+fn run_label(policy: &pada_core::policy::PolicyKind, budget_s: Option<f32>) -> String {
+    crate::paper::wear::WearResult::label_of(policy, budget_s)
+}
+
+/// The policy of the flags, checked.
+fn policy_of(args: &RunArgs) -> Result<pada_core::policy::PolicyKind, CliError> {
+    let flags = PolicyFlags { alpha: args.alpha, delta: args.delta, theta: args.theta, sigma: args.sigma, weight: args.weight };
+    if args.mtbf_budget.is_some() {
+        if !matches!(args.algo, Algo::Pada | Algo::LowPass) {
+            return Err(usage(format!(
+                "--mtbf-budget applies only to pada and lowpass (the governor moves their delta or alpha), not to {}",
+                args.algo
+            )));
+        }
+        for (flag, given) in [("--delta", args.delta.is_some()), ("--alpha", args.alpha.is_some())] {
+            if given {
+                return Err(usage(format!(
+                    "{flag} and --mtbf-budget exclude each other: the governor chooses the {} while learning",
+                    &flag[2..]
+                )));
+            }
+        }
+    }
+    policy_kind_of(args.algo, &flags).map_err(|e| usage(e.0))
+}
+
 /// The run's configuration from the flags, checked.
 fn run_config(args: &RunArgs, spec: &TaskSpec, policy: pada_core::policy::PolicyKind) -> Result<RunConfig, CliError> {
     let seconds = check_seconds("--seconds", args.seconds.unwrap_or(spec.default_seconds))?;
+    if let Some(b) = args.mtbf_budget {
+        let max = pada_core::governor::MAX_BUDGET_S;
+        if !(b.is_finite() && b > 0.0 && b <= max) {
+            return Err(usage(format!("--mtbf-budget {b} is out of range: valid is 0 < budget <= {max:e} s")));
+        }
+        if args.switch_at.is_some() {
+            return Err(usage(
+                "--switch-at and --mtbf-budget exclude each other: the governor keeps the restriction for the whole run",
+            ));
+        }
+    }
     if let Some(s) = args.switch_at {
-        if !matches!(args.algo, Algo::LowPass | Algo::Pada) {
+        if args.algo == Algo::Sarsa || !args.algo.can_switch() {
             return Err(usage(format!(
-                "--switch-at applies only to lowpass and pada (Section VIII), not to {}",
+                "--switch-at applies only to lowpass, pada, epsilon-pada, ou, pink and action-penalty (Section VIII), not to {}",
                 args.algo
             )));
         }
@@ -144,6 +182,7 @@ fn run_config(args: &RunArgs, spec: &TaskSpec, policy: pada_core::policy::Policy
     Ok(RunConfig {
         policy,
         switch_at_s: args.switch_at,
+        mtbf_budget_s: args.mtbf_budget,
         seconds,
         trials: args.trials.unwrap_or(spec.default_trials),
         seed: args.trial.seed,
@@ -158,7 +197,7 @@ impl TaskVisitor for RunVisitor {
     fn visit<T: Task>(self, task: &T) -> Self::Output {
         let args = self.0;
         let spec = task.spec();
-        let policy = policy_kind(args.algo, args.alpha, args.delta).map_err(|e| usage(e.0))?;
+        let policy = policy_of(&args)?;
         let cfg = run_config(&args, spec, policy)?;
         let out_path = args
             .out
@@ -249,7 +288,7 @@ impl TaskVisitor for RunVisitor {
         if args.json {
             outln!("{}", summary.to_json())?;
         } else {
-            print_summary(&summary, &label(&policy))?;
+            print_summary(&summary, &run_label(&policy, cfg.mtbf_budget_s))?;
             outln!("wrote {}", out.path().display())?;
         }
         Ok(())
@@ -293,9 +332,25 @@ pub fn print_summary(s: &RunSummary, label: &str) -> Result<(), CliError> {
         fmt_mtbf(s.mtbf_s.mean, s.mtbf_s.ci95)
     )?;
     outln!(
+        "  MTBF (whole run)     {} (the paper's, over all learning actions)",
+        fmt_mtbf(s.run_mtbf_s.mean, s.run_mtbf_s.ci95)
+    )?;
+    outln!(
         "  physical MTBF        {} (from the simulated gear torques)",
         fmt_mtbf(s.physical_mtbf_s.mean, s.physical_mtbf_s.ci95)
     )?;
+    if let Some(g) = &s.governor {
+        outln!(
+            "  wear governor        budget {} s: held in {:.0} % of trials (physical MTBF: {:.0} %); mean {} {}, at the floor {:.0} % of the time, {:.0} moves per trial",
+            g.budget_s,
+            100.0 * g.held_fraction,
+            100.0 * g.physical_held_fraction,
+            if s.algo.takes_alpha() { "α" } else { "Δ" },
+            fmt_estimate(g.mean_parameter.mean, g.mean_parameter.ci95, 3, ""),
+            100.0 * g.floor_fraction.mean,
+            g.moves.mean
+        )?;
+    }
     if let (Some(w), Some(v)) = (&s.end_walked_m, &s.end_speed_m_s) {
         outln!(
             "  walked (last 10%)    {}",

@@ -11,12 +11,14 @@
 //! | [`tasks`] | the tasks the command line knows, by name |
 //! | [`algo`] | the six algorithms of Section V by their command-line names |
 //! | [`agent_setup`] | the host's agent for a task and a policy |
+//! | [`governed`] | the wear governor in a trial (`--mtbf-budget`) |
 //! | [`trial`] | one trial: learning with periodic greedy test runs |
 //! | [`runner`] | trials and configurations in parallel |
 //! | [`metrics`] | end performance and rise time (Section VI) |
 
 pub mod agent_setup;
 pub mod algo;
+pub mod governed;
 pub mod metrics;
 pub mod runner;
 pub mod task;

@@ -16,6 +16,10 @@ pub struct RunConfig {
     /// Learning time after which PADA or the low-pass filter switches back
     /// to SARSA(λ) (Section VIII) \[s\], if any.
     pub switch_at_s: Option<f64>,
+    /// The wear governor's budget \[s\]: the predicted MTBF over the last
+    /// 1200 learning actions it holds by moving PADA's Δ or the low-pass
+    /// filter's α ([`pada_core::governor`]); `None` for a fixed Δ or α.
+    pub mtbf_budget_s: Option<f32>,
     /// Learning time per trial \[s of simulated time\].
     pub seconds: f64,
     /// Number of trials.

@@ -132,6 +132,12 @@ pub struct TaskSpec {
     /// `pada_core::robot` (`None` for the simulated pendulum, which has no
     /// board).
     pub profile: Option<LearnerProfile>,
+    /// The largest gearbox torque one learning action can command, as
+    /// [`Plant::commanded_torques`] takes it \[N·m\]: the torque law at the
+    /// motor's largest level. Its re-engagement is the most damage one
+    /// action can do, the wear governor's reserve
+    /// ([`pada_core::governor`]).
+    pub worst_torque_nm: f32,
 }
 
 impl WeightTable {
@@ -174,6 +180,7 @@ impl TaskSpec {
             gearboxes: robot.gearboxes as usize,
             footstep_remap: robot.footstep_remap,
             profile: Some(profile),
+            worst_torque_nm: robot.worst_commanded_torque(),
         }
     }
 }

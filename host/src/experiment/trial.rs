@@ -15,6 +15,7 @@
 //!   ([`Plant::gearbox_torques`]).
 
 use super::agent_setup::{build_agent, HostAgent};
+use super::governed::{damage_raws, GovernorTrial, TrialGovernor};
 use super::metrics::{end_performance, rise_time};
 use super::runner::RunConfig;
 use crate::experiment::task::{Plant, Task, TaskSpec};
@@ -63,6 +64,10 @@ pub struct TrialResult {
     /// Backlash re-engagements within those actions (all gearboxes), the
     /// paper's definition.
     pub window_reengagements: u64,
+    /// Predicted MTBF over all learning actions of the trial \[s\], the
+    /// paper's torques: how the learner wears the gearbox once it knows
+    /// more (the window's MTBF is its first minute).
+    pub run_mtbf_s: f64,
     /// Predicted MTBF from the first 1200 learning actions \[s\], from the
     /// simulated gear torques.
     pub physical_mtbf_s: f64,
@@ -88,6 +93,8 @@ pub struct TrialResult {
     pub saturations: u32,
     /// Trace entries dropped for capacity (should be 0).
     pub trace_drops: u32,
+    /// What the wear governor did, when one ran (`--mtbf-budget`).
+    pub governor: Option<GovernorTrial>,
     /// The learning curve.
     #[serde(skip)]
     pub curve: Vec<TestPoint>,
@@ -144,6 +151,14 @@ pub fn run_trial_observed<T: Task>(
     )
     .map_err(|e| anyhow!("{e}"))?;
     let physical = fatigue.clone();
+    let governor = match cfg.mtbf_budget_s {
+        Some(budget) => {
+            let g = TrialGovernor::new(spec, &cfg.policy, budget)?;
+            agent.set_policy_parameter(g.parameter()).map_err(|e| anyhow!("{e}"))?;
+            Some(g)
+        }
+        None => None,
+    };
     let mut t = Trial {
         spec,
         agent,
@@ -163,6 +178,7 @@ pub fn run_trial_observed<T: Task>(
         observer,
         calls: 0,
         reported_episodes: 0,
+        governor,
     };
 
     let budget = (cfg.seconds / spec.control_period_s).round() as u64;
@@ -187,13 +203,16 @@ pub fn run_trial_observed<T: Task>(
     let end_walked_m = walked.map(|w| w / k as f64);
     let end_speed_m_s = walked.map(|w| w / tail.iter().map(|p| p.duration_s).sum::<f64>());
     let switched = cfg.switch_at_s.is_some() && t.switch_step.is_none();
+    let mtbf_s = t.fatigue.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY);
+    let physical_mtbf_s = t.physical.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY);
     let result = TrialResult {
         trial,
         seed: trial_seed(cfg.seed, trial),
         end_performance: end_performance(&returns).unwrap_or(f64::NAN),
         rise_time_s: rise_time(&times, &returns).unwrap_or(f64::NAN),
-        mtbf_s: t.fatigue.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
-        physical_mtbf_s: t.physical.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
+        mtbf_s,
+        physical_mtbf_s,
+        run_mtbf_s: t.fatigue.robot_mtbf_s(),
         physical_window_reengagements: t
             .physical
             .joints()
@@ -215,6 +234,7 @@ pub fn run_trial_observed<T: Task>(
         end_speed_m_s,
         saturations: stats.saturations,
         trace_drops: stats.trace_drops,
+        governor: t.governor.as_ref().map(|g| g.finish(mtbf_s, physical_mtbf_s)),
         curve: t.curve,
     };
     Ok((result, t.agent, switched))
@@ -243,6 +263,8 @@ struct Trial<'a, 'o, P: Plant> {
     calls: u32,
     /// Episodes reported so far (the `episode` of telemetry).
     reported_episodes: u32,
+    /// The wear governor, with `--mtbf-budget`.
+    governor: Option<TrialGovernor>,
 }
 
 impl<P: Plant> Trial<'_, '_, P> {
@@ -326,6 +348,10 @@ impl<P: Plant> Trial<'_, '_, P> {
             weights_checksum: self.agent.weights_checksum(),
         }));
         self.reported_episodes = self.reported_episodes.wrapping_add(1);
+        // While a governor runs, its damage rate after every episode.
+        if self.governor.is_some() {
+            self.report_policy();
+        }
     }
 
     /// A greedy test run, recorded on the curve; returns its steps.
@@ -365,8 +391,9 @@ impl<P: Plant> Trial<'_, '_, P> {
         let policy = self.agent.policy();
         observer(ToHost::Policy(wire::PolicyReport {
             step: self.calls,
-            built: policy.built_kind().into(),
+            built: policy.built_kind(),
             switched_to_sarsa: policy.switched(),
+            governor: self.governor.as_ref().map(|g| g.governor().status()),
         }));
     }
 
@@ -397,9 +424,16 @@ impl<P: Plant> Trial<'_, '_, P> {
                 self.agent.remap_memory(&map);
             }
             if learning {
+                let before = damage_raws(&self.fatigue);
                 self.fatigue
                     .update(&self.plant.commanded_torques(command))
                     .map_err(|e| anyhow!("{e}"))?;
+                // The governor moves Δ or α for the next decision.
+                let moved = self.governor.as_mut().and_then(|g| g.observe(&before, &self.fatigue));
+                if let Some(parameter) = moved {
+                    self.agent.set_policy_parameter(parameter).map_err(|e| anyhow!("{e}"))?;
+                    self.report_policy();
+                }
                 self.physical
                     .update(&self.plant.gearbox_torques(command))
                     .map_err(|e| anyhow!("{e}"))?;

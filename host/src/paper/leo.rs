@@ -99,6 +99,7 @@ fn run_configs_of(o: &LeoOptions) -> Vec<RunConfig> {
         .map(|c| RunConfig {
             policy: c.policy,
             switch_at_s: c.switch.then_some(o.seconds / 2.0),
+            mtbf_budget_s: None,
             seconds: o.seconds,
             trials: o.trials,
             seed: o.seed,

@@ -1,6 +1,7 @@
 //! Reproducing the paper: its published numbers ([`numbers`]), the
 //! objective of Section VI ([`objective`]), the pendulum experiments of
-//! Section VII ([`pendulum`]) and their report ([`report`]).
+//! Section VII ([`pendulum`]) and their report ([`report`]), and learning
+//! on a wear budget ([`wear`], `pada paper wear`).
 
 pub mod figure_data;
 pub mod leo;
@@ -8,3 +9,4 @@ pub mod numbers;
 pub mod objective;
 pub mod pendulum;
 pub mod report;
+pub mod wear;

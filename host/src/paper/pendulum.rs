@@ -140,6 +140,7 @@ pub fn expected_steps(o: &PendulumOptions) -> u64 {
         let cfg = RunConfig {
             policy: PolicyKind::Sarsa,
             switch_at_s: None,
+            mtbf_budget_s: None,
             seconds,
             trials,
             seed: 0,
@@ -168,6 +169,7 @@ pub fn experiment(o: &PendulumOptions, command: String) -> Experiment {
     let cfg = |policy, trials, seconds| RunConfig {
         policy,
         switch_at_s: None,
+        mtbf_budget_s: None,
         seconds,
         trials,
         seed: o.seed,

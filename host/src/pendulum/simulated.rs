@@ -196,6 +196,8 @@ impl SimulatedPendulumTask {
             gearboxes: 1,
             footstep_remap: None,
             profile: None,
+            // The action is the gearbox torque.
+            worst_torque_nm: limit,
             params: SarsaParams { init: WeightInit::Uniform { min: 0.0, max: 1.0 }, ..SarsaParams::default() },
             test_interval: 10,
             default_seconds: 3000.0,

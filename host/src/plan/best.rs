@@ -106,6 +106,7 @@ mod tests {
                 RunConfig {
                     policy: PolicyKind::Sarsa,
                     switch_at_s: None,
+                    mtbf_budget_s: None,
                     seconds: 60.0,
                     trials: 5,
                     seed: 1,
@@ -128,6 +129,8 @@ mod tests {
                     mtbf_s: 1.0,
                     window_reengagements: 0,
                     physical_mtbf_s: 2.0,
+                    run_mtbf_s: 2.5,
+                    governor: None,
                     physical_window_reengagements: 0,
                     learning_steps: 0,
                     test_steps: 0,

@@ -51,7 +51,7 @@ pub fn scan(dir: &Path, plan: &Plan) -> Scan {
             what,
         };
         match result::read(dir, plan, spec.index) {
-            ResultState::Verified(r) => results.push(Some(r)),
+            ResultState::Verified(r) => results.push(Some(*r)),
             ResultState::Missing => {
                 results.push(None);
                 problems.push(problem("missing".into()));

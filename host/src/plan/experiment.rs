@@ -3,7 +3,7 @@
 //! time, trials, seed). The local runner, the plan and the merge all start
 //! from the same [`Experiment`], so they agree on what trial `i` is.
 
-use crate::experiment::algo::{label, parameter_of, policy_kind, Algo};
+use crate::experiment::algo::{label, parameter_of, policy_kind_of, Algo, PolicyFlags};
 use crate::experiment::tasks::TaskName;
 use crate::experiment::RunConfig;
 use crate::seed::trial_seed;
@@ -21,6 +21,8 @@ pub enum ExperimentKind {
     PaperPendulum,
     /// `pada paper leo`: Section VIII.
     PaperLeo,
+    /// `pada paper wear`: every strategy and the wear governor.
+    PaperWear,
 }
 
 impl ExperimentKind {
@@ -36,6 +38,7 @@ impl ExperimentKind {
             ExperimentKind::Run => "pada run",
             ExperimentKind::PaperPendulum => "pada paper pendulum",
             ExperimentKind::PaperLeo => "pada paper leo",
+            ExperimentKind::PaperWear => "pada paper wear",
         }
     }
 }
@@ -51,8 +54,15 @@ pub struct Configuration {
     pub task: String,
     /// The algorithm's command-line name (Section V).
     pub algo: String,
-    /// α (Eq. 8) or Δ (Eq. 9), if the algorithm takes one.
+    /// α (Eq. 8) or Δ (Eq. 9), if the algorithm takes one (OU's θ, pink
+    /// noise's σ, the penalty's weight for the gentle explorations).
     pub parameter: Option<f32>,
+    /// The second parameter, for the algorithms that take two (OU's σ).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub parameter2: Option<f32>,
+    /// The wear governor's MTBF budget \[s\], if one runs (`--mtbf-budget`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mtbf_budget_s: Option<f32>,
     /// Learning time of the switch back to SARSA(λ) \[s\] (Section VIII).
     #[serde(with = "super::exact::opt_f64")]
     pub switch_at_s: Option<f64>,
@@ -76,14 +86,19 @@ impl Configuration {
             .switch_at_s
             .map(|s| format!(", switch at {s} s"))
             .unwrap_or_default();
+        let budget = cfg
+            .mtbf_budget_s
+            .map(|b| format!(", MTBF budget {b} s"))
+            .unwrap_or_default();
+        let algo = crate::experiment::algo::algo_of(&cfg.policy);
         Configuration {
             index,
-            label: format!("{task} {}{switch}", label(&cfg.policy)),
+            label: format!("{task} {}{switch}{budget}", label(&cfg.policy)),
             task: task.to_string(),
-            algo: crate::experiment::algo::algo_of(&cfg.policy)
-                .name()
-                .to_string(),
+            algo: algo.name().to_string(),
             parameter: parameter_of(&cfg.policy),
+            parameter2: (algo.parameter_names().len() > 1).then(|| cfg.policy.parameters()[1]),
+            mtbf_budget_s: cfg.mtbf_budget_s,
             switch_at_s: cfg.switch_at_s,
             seconds: cfg.seconds,
             seed: cfg.seed,
@@ -112,15 +127,25 @@ impl Configuration {
                 self.algo
             )
         })?;
-        let (alpha, delta) = match (algo.takes_alpha(), algo.takes_delta()) {
-            (true, _) => (self.parameter, None),
-            (_, true) => (None, self.parameter),
-            _ if self.parameter.is_some() => {
-                bail!("configuration {}: {algo} takes no parameter", self.index)
+        let names = algo.parameter_names();
+        let given = [self.parameter, self.parameter2];
+        if given.iter().skip(names.len()).any(Option::is_some) {
+            match names.len() {
+                0 => bail!("configuration {}: {algo} takes no parameter", self.index),
+                n => bail!("configuration {}: {algo} takes only {n} parameter(s) ({})", self.index, names.join(", ")),
             }
-            _ => (None, None),
-        };
-        let policy = policy_kind(algo, alpha, delta)
+        }
+        let mut flags = PolicyFlags::default();
+        for (name, value) in names.iter().zip(given) {
+            match *name {
+                "alpha" => flags.alpha = value,
+                "delta" => flags.delta = value,
+                "theta" => flags.theta = value,
+                "sigma" => flags.sigma = value,
+                _ => flags.weight = value,
+            }
+        }
+        let policy = policy_kind_of(algo, &flags)
             .map_err(|e| anyhow!("configuration {}: {e}", self.index))?;
         if self.board.is_some() {
             bail!(
@@ -132,6 +157,7 @@ impl Configuration {
         Ok(RunConfig {
             policy,
             switch_at_s: self.switch_at_s,
+            mtbf_budget_s: self.mtbf_budget_s,
             seconds: self.seconds,
             trials: self.trials,
             seed: self.seed,
@@ -208,6 +234,7 @@ mod tests {
             let cfg = RunConfig {
                 policy,
                 switch_at_s: Some(7333.0),
+                mtbf_budget_s: None,
                 seconds: 14_666.0,
                 trials: 15,
                 seed: u64::MAX,
@@ -226,6 +253,7 @@ mod tests {
         let cfg = |trials| RunConfig {
             policy: PolicyKind::Sarsa,
             switch_at_s: None,
+            mtbf_budget_s: None,
             seconds: 60.0,
             trials,
             seed: 1,
@@ -262,6 +290,7 @@ mod tests {
         let cfg = RunConfig {
             policy: PolicyKind::Sarsa,
             switch_at_s: None,
+            mtbf_budget_s: None,
             seconds: 60.0,
             trials: 1,
             seed: 1,

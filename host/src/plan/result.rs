@@ -59,7 +59,7 @@ pub struct StoredResult {
 #[derive(Debug, Clone, PartialEq)]
 pub enum ResultState {
     /// A result of this plan's trial whose checksum matches.
-    Verified(StoredResult),
+    Verified(Box<StoredResult>),
     /// No file.
     Missing,
     /// A file that is not this trial's intact result, and why.
@@ -91,6 +91,13 @@ struct StoredTrial {
     #[serde(with = "super::exact::f64")]
     physical_mtbf_s: f64,
     physical_window_reengagements: u64,
+    /// The paper's MTBF over all learning actions (absent in results
+    /// written before the wear governor: NaN, unknown).
+    #[serde(default = "nan", with = "super::exact::f64")]
+    run_mtbf_s: f64,
+    /// The wear governor's record, when one ran.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    governor: Option<crate::experiment::governed::GovernorTrial>,
     learning_steps: u64,
     test_steps: u64,
     learning_falls: u64,
@@ -103,6 +110,10 @@ struct StoredTrial {
     saturations: u32,
     trace_drops: u32,
     curve: Vec<StoredPoint>,
+}
+
+fn nan() -> f64 {
+    f64::NAN
 }
 
 /// [`TestPoint`] with exact floats.
@@ -131,6 +142,8 @@ impl From<&TrialResult> for StoredTrial {
             window_reengagements: r.window_reengagements,
             physical_mtbf_s: r.physical_mtbf_s,
             physical_window_reengagements: r.physical_window_reengagements,
+            run_mtbf_s: r.run_mtbf_s,
+            governor: r.governor.clone(),
             learning_steps: r.learning_steps,
             test_steps: r.test_steps,
             learning_falls: r.learning_falls,
@@ -167,6 +180,8 @@ impl From<StoredTrial> for TrialResult {
             window_reengagements: r.window_reengagements,
             physical_mtbf_s: r.physical_mtbf_s,
             physical_window_reengagements: r.physical_window_reengagements,
+            run_mtbf_s: r.run_mtbf_s,
+            governor: r.governor.clone(),
             learning_steps: r.learning_steps,
             test_steps: r.test_steps,
             learning_falls: r.learning_falls,
@@ -270,7 +285,7 @@ pub fn read(dir: &Path, plan: &Plan, index: u32) -> ResultState {
         Err(e) => return ResultState::Corrupt(format!("cannot read {} ({e})", path.display())),
     };
     match verify(&bytes, plan, index) {
-        Ok(r) => ResultState::Verified(r),
+        Ok(r) => ResultState::Verified(Box::new(r)),
         Err(why) => ResultState::Corrupt(format!("{}: {why}", path.display())),
     }
 }
@@ -348,6 +363,7 @@ mod tests {
                 RunConfig {
                     policy: PolicyKind::Pada { delta: 1.0 / 6.0 },
                     switch_at_s: None,
+                    mtbf_budget_s: None,
                     seconds: 60.0,
                     trials: 2,
                     seed: 9,
@@ -367,6 +383,8 @@ mod tests {
             mtbf_s: f64::INFINITY,
             window_reengagements: 349,
             physical_mtbf_s: 1.0e-300,
+            run_mtbf_s: f64::INFINITY,
+            governor: Some(crate::experiment::governed::GovernorTrial { budget_s: 2600.0, held: true, physical_held: false, final_parameter: 0.834, mean_parameter: 0.1 + 0.2, floor_fraction: 1.0 / 3.0, moves: 7, over_budget_steps: 2 }),
             physical_window_reengagements: 7,
             learning_steps: 1800,
             test_steps: 77,

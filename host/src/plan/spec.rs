@@ -155,6 +155,7 @@ mod tests {
                 RunConfig {
                     policy: PolicyKind::Pada { delta: 0.5 },
                     switch_at_s: None,
+                    mtbf_budget_s: None,
                     seconds: 60.0,
                     trials: 3,
                     seed,

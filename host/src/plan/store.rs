@@ -283,6 +283,7 @@ mod tests {
                 RunConfig {
                     policy: PolicyKind::LowPass { alpha: 0.834 },
                     switch_at_s: Some(30.0),
+                    mtbf_budget_s: None,
                     seconds: 60.0,
                     trials: 3,
                     seed,

@@ -24,6 +24,10 @@ pub fn color(algo: Algo) -> RGBColor {
         Algo::Integrator => RGBColor(214, 39, 40),
         Algo::MarkovIntegrator => RGBColor(255, 127, 14),
         Algo::Pada => RGBColor(44, 160, 44),
+        Algo::EpsilonPada => RGBColor(188, 189, 34),
+        Algo::OrnsteinUhlenbeck => RGBColor(148, 103, 189),
+        Algo::PinkNoise => RGBColor(227, 119, 194),
+        Algo::ActionPenalty => RGBColor(140, 86, 75),
     }
 }
 
@@ -51,7 +55,7 @@ const SWEPT: [Algo; 5] = [
     Algo::Pada,
 ];
 
-fn finite_ci(e: &Estimate) -> f64 {
+pub(crate) fn finite_ci(e: &Estimate) -> f64 {
     if e.ci95.is_finite() {
         e.ci95
     } else {
@@ -60,7 +64,7 @@ fn finite_ci(e: &Estimate) -> f64 {
 }
 
 /// A log range covering `values` with some room.
-fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
+pub(crate) fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
     let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
     for v in values.filter(|v| v.is_finite() && *v > 0.0) {
         lo = lo.min(v);
@@ -73,7 +77,7 @@ fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
 }
 
 /// A linear range covering `values` with 6% room.
-fn lin_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
+pub(crate) fn lin_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for v in values.filter(|v| v.is_finite()) {
         lo = lo.min(v);

@@ -3,6 +3,7 @@
 //! embedded in the binary, so no system font is needed.
 
 pub mod figures;
+pub mod wear;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;

@@ -12,7 +12,6 @@ use super::series::Decimated;
 use crate::capture::{Latest, MessageCounts};
 use crate::experiment::metrics::{end_performance, rise_time};
 use pada_core::fatigue::PAPER_WINDOW_STEPS;
-use pada_core::policy::PolicyKind;
 use pada_core::wire::{
     Decoded, Hello, LinkStats, PolicyReport, RunMode, StepKind, ToHost, MAX_JOINTS,
 };
@@ -119,11 +118,13 @@ pub struct FatigueView {
 /// The policy in force.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PolicyView {
-    /// The policy the learner was built with (`sarsa`, `lowpass`, …, `pada`).
+    /// The policy the learner was built with (`sarsa`, `lowpass`, …, `pada`,
+    /// `epsilon-pada`, `ou`, `pink`, `action-penalty`).
     pub built: &'static str,
-    /// Its parameter's name: `alpha` (Eq. 8) or `delta` (Eq. 9).
+    /// Its first parameter's name: `alpha` (Eq. 8), `delta` (Eq. 9),
+    /// `theta`, `sigma` or `weight`.
     pub parameter_name: Option<&'static str>,
-    /// Its α or Δ.
+    /// Its α, Δ, θ, σ or weight.
     pub parameter: Option<f32>,
     /// Switched back to plain SARSA(λ) (Section VIII).
     pub switched_to_sarsa: bool,
@@ -131,35 +132,39 @@ pub struct PolicyView {
     pub step: u32,
     /// One line for the page, e.g. `pada Δ=0.5`.
     pub label: String,
+    /// The wear governor, when one runs: budget, Δ or α in force, damage
+    /// rate and MTBF over its window.
+    pub governor: Option<pada_core::governor::GovernorStatus>,
 }
 
 impl PolicyView {
     /// The view of a `Policy` report.
     pub fn of(report: &PolicyReport) -> PolicyView {
-        let kind = PolicyKind::from(report.built);
-        let (parameter_name, parameter, symbol) = match kind {
-            PolicyKind::Sarsa => (None, None, ""),
-            PolicyKind::LowPass { alpha } | PolicyKind::MarkovLowPass { alpha } => {
-                (Some("alpha"), Some(alpha), "α")
-            }
-            PolicyKind::Integrator { delta }
-            | PolicyKind::MarkovIntegrator { delta }
-            | PolicyKind::Pada { delta } => (Some("delta"), Some(delta), "Δ"),
-        };
-        let mut label = match parameter {
-            Some(p) => format!("{} {symbol}={p}", kind.name()),
-            None => kind.name().to_string(),
-        };
+        let kind = report.built;
+        let name = pada_core::policy::PolicyName::of(&kind);
+        let mut label = crate::experiment::algo::label(&kind);
+        if let Some(g) = &report.governor {
+            label += &format!(
+                " (wear governor: budget {:.0} s, rung {}/{}, damage rate {:.3e} per s, window MTBF {:.0} s over {} actions)",
+                g.budget_s,
+                g.rung + 1,
+                g.rungs,
+                g.damage_rate,
+                g.window_mtbf_s,
+                g.window_steps
+            );
+        }
         if report.switched_to_sarsa {
             label = format!("sarsa (switched from {label} at step {})", report.step);
         }
         PolicyView {
             built: kind.name(),
-            parameter_name,
-            parameter,
+            parameter_name: name.parameter_names().first().copied(),
+            parameter: kind.parameter(),
             switched_to_sarsa: report.switched_to_sarsa,
             step: report.step,
             label,
+            governor: report.governor,
         }
     }
 }
@@ -637,6 +642,7 @@ mod tests {
                 step: 7,
                 built: pada_core::policy::PolicyKind::Pada { delta: 0.5 },
                 switched_to_sarsa: true,
+                governor: None,
             }),
         };
         feed(

@@ -8,15 +8,18 @@ use crate::agent::{AgentState, AgentStats, Mode};
 use crate::error::ConfigError;
 use crate::fatigue::JointFatigueState;
 use crate::fixed::Q16;
-use crate::policy::{kind_code, kind_from_code, kind_parameter, PolicyKind, PolicyState};
+use crate::governor::{GovernorState, Restricts, GOVERNED_JOINTS, WINDOW_BUCKETS};
+use crate::policy::{kind_code, kind_from_code, kind_parameter, kind_second_parameter, PolicyKind, PolicyState};
 use crate::rng::RngState;
 use heapless::Vec;
 
 /// Version of the learner-state record this code writes and reads (2: the
-/// flash wear at offset 496).
-pub const STATE_VERSION: u16 = 2;
+/// flash wear at offset 496; 3: the policy's second parameter at offset
+/// 76, the policy codes of the gentle explorations, and the wear
+/// governor's state from offset 512).
+pub const STATE_VERSION: u16 = 3;
 /// Bytes of the learner-state record (a multiple of 4).
-pub const STATE_LEN: usize = 512;
+pub const STATE_LEN: usize = 1024;
 /// Fatigue joints the state record has room for.
 pub const MAX_JOINTS: usize = 8;
 /// Counters the state record keeps for the caller ([`LearnerState::user`]).
@@ -41,7 +44,7 @@ pub(super) mod at {
     pub const EPISODES: usize = 64;
     pub const SATURATIONS: usize = 68;
     pub const TRACE_DROPS: usize = 72;
-    pub const RESERVED_B: usize = 76;
+    pub const PARAMETER_2: usize = 76;
     pub const RNG_STATE: usize = 80;
     pub const RNG_INCREMENT: usize = 88;
     pub const USER: usize = 96;
@@ -50,10 +53,28 @@ pub(super) mod at {
     pub const JOINT_LEN: usize = 48;
     pub const ERASES: usize = 496;
     pub const OPERATING_S: usize = 504;
+    /// The governor's block ([`super::super::governor`]).
+    pub const GOVERNOR: usize = 512;
+    pub const GOV_RESTRICTS: usize = 513;
+    pub const GOV_RUNG: usize = 514;
+    pub const GOV_CURSOR: usize = 515;
+    pub const GOV_FILLED: usize = 516;
+    pub const GOV_IN_BUCKET: usize = 517;
+    pub const GOV_RESERVED_A: usize = 518;
+    pub const GOV_BUDGET: usize = 520;
+    pub const GOV_CALM: usize = 524;
+    pub const GOV_MOVES: usize = 528;
+    pub const GOV_SINCE_MOVE: usize = 532;
+    pub const GOV_STEPS: usize = 536;
+    pub const GOV_OVER: usize = 544;
+    pub const GOV_BUCKETS: usize = 552;
+    pub const GOV_HEADROOM_AT_MOVE: usize = GOV_BUCKETS + 8 * super::GOVERNED_JOINTS * super::WINDOW_BUCKETS;
+    pub const GOV_END: usize = GOV_HEADROOM_AT_MOVE + 8;
 }
 
 const _: () = assert!(at::FATIGUE + MAX_JOINTS * at::JOINT_LEN == at::ERASES);
-const _: () = assert!(at::OPERATING_S + 8 == STATE_LEN);
+const _: () = assert!(at::OPERATING_S + 8 == at::GOVERNOR);
+const _: () = assert!(at::GOV_END == 944 && at::GOV_END <= STATE_LEN);
 // The record has four action dimensions: previous levels and outputs.
 const _: () = assert!(MAX_ACTION_DIMS == 4 && at::PREVIOUS + MAX_ACTION_DIMS <= at::RESERVED_A);
 const _: () = assert!(at::OUTPUT + 4 * MAX_ACTION_DIMS == at::EPSILON);
@@ -82,6 +103,9 @@ pub struct LearnerState {
     /// store's, this field's, whichever is higher, plus its own erase);
     /// the caller supplies the operating time.
     pub wear: FlashWear,
+    /// The wear governor's state, when one runs
+    /// ([`crate::governor::Governor::state`]).
+    pub governor: Option<GovernorState>,
 }
 
 impl Default for LearnerState {
@@ -105,6 +129,7 @@ impl Default for LearnerState {
             joints: Vec::new(),
             user: [0; USER_COUNTERS],
             wear: FlashWear::default(),
+            governor: None,
         }
     }
 }
@@ -164,6 +189,7 @@ impl LearnerState {
         put(&mut b, at::EPISODES, &a.stats.episodes.to_le_bytes());
         put(&mut b, at::SATURATIONS, &a.stats.saturations.to_le_bytes());
         put(&mut b, at::TRACE_DROPS, &a.stats.trace_drops.to_le_bytes());
+        put(&mut b, at::PARAMETER_2, &kind_second_parameter(&p.kind).to_le_bytes());
         put(&mut b, at::RNG_STATE, &self.rng.state.to_le_bytes());
         put(&mut b, at::RNG_INCREMENT, &self.rng.increment.to_le_bytes());
         for (i, u) in self.user.iter().enumerate() {
@@ -179,6 +205,26 @@ impl LearnerState {
             put(&mut b, o + 32, &f.window_reengagements.to_le_bytes());
             put(&mut b, o + 40, &f.window_damage_raw.to_le_bytes());
         }
+        if let Some(g) = &self.governor {
+            b[at::GOVERNOR] = 1;
+            b[at::GOV_RESTRICTS] = g.restricts.code();
+            b[at::GOV_RUNG] = g.rung;
+            b[at::GOV_CURSOR] = g.cursor;
+            b[at::GOV_FILLED] = g.filled;
+            b[at::GOV_IN_BUCKET] = g.in_bucket;
+            put(&mut b, at::GOV_BUDGET, &g.budget_bits.to_le_bytes());
+            put(&mut b, at::GOV_CALM, &g.calm_steps.to_le_bytes());
+            put(&mut b, at::GOV_MOVES, &g.moves.to_le_bytes());
+            put(&mut b, at::GOV_SINCE_MOVE, &g.since_move.to_le_bytes());
+            put(&mut b, at::GOV_HEADROOM_AT_MOVE, &g.headroom_at_move.to_le_bytes());
+            put(&mut b, at::GOV_STEPS, &g.steps.to_le_bytes());
+            put(&mut b, at::GOV_OVER, &g.over_budget_steps.to_le_bytes());
+            for (j, row) in g.buckets.iter().enumerate() {
+                for (k, v) in row.iter().enumerate() {
+                    put(&mut b, at::GOV_BUCKETS + 8 * (j * WINDOW_BUCKETS + k), &v.to_le_bytes());
+                }
+            }
+        }
         b
     }
 
@@ -190,7 +236,7 @@ impl LearnerState {
         let r = Record(bytes);
         let version = r.u16(at::VERSION);
         if version != STATE_VERSION {
-            return Err(ConfigError::new("state.version", version as f32, "2"));
+            return Err(ConfigError::new("state.version", version as f32, "3"));
         }
         let mode = match r.u8(at::MODE) {
             0 => Mode::Learning,
@@ -198,13 +244,16 @@ impl LearnerState {
             m => return Err(ConfigError::new("mode", m as f32, "0 (learning) or 1 (testing)")),
         };
         let code = r.u8(at::KIND);
-        let kind = kind_from_code(code, r.f32(at::PARAMETER)).ok_or(ConfigError::new(
+        let kind = kind_from_code(code, [r.f32(at::PARAMETER), r.f32(at::PARAMETER_2)]).ok_or(ConfigError::new(
             "policy.kind",
             code as f32,
-            "0 sarsa, 1 lowpass, 2 markov-lowpass, 3 integrator, 4 markov-integrator, 5 pada",
+            "0 sarsa, 1 lowpass, 2 markov-lowpass, 3 integrator, 4 markov-integrator, 5 pada, 6 epsilon-pada, 7 ou, 8 pink, 9 action-penalty",
         ))?;
         if kind == PolicyKind::Sarsa && r.u32(at::PARAMETER) != 0 {
             return Err(ConfigError::new("policy.parameter", r.f32(at::PARAMETER), "0 for sarsa"));
+        }
+        if !matches!(kind, PolicyKind::OrnsteinUhlenbeck { .. }) && r.u32(at::PARAMETER_2) != 0 {
+            return Err(ConfigError::new("policy.parameter2", r.f32(at::PARAMETER_2), "0 unless the policy is ou"));
         }
         let switched = match r.u8(at::SWITCHED) {
             0 => false,
@@ -215,7 +264,7 @@ impl LearnerState {
         if joints > MAX_JOINTS {
             return Err(ConfigError::new("joints", joints as f32, "0 ..= 8 fatigue joints"));
         }
-        if !r.zero(at::RESERVED_A, 2) || !r.zero(at::RESERVED_B, 4) {
+        if !r.zero(at::RESERVED_A, 2) {
             return Err(ConfigError::new("state.reserved", 0.0, "reserved bytes 0"));
         }
         let mut previous = [0u8; MAX_ACTION_DIMS];
@@ -263,9 +312,53 @@ impl LearnerState {
             rng: RngState { state: r.u64(at::RNG_STATE), increment: r.u64(at::RNG_INCREMENT) },
             joints: fatigue,
             user: core::array::from_fn(|i| r.u32(at::USER + 4 * i)),
-            wear: wear_of(bytes),
+            wear: wear_of(&bytes[..WEAR_END]),
+            governor: governor_of(&r)?,
         })
     }
+}
+
+/// The governor's block of a record: `None` when its flag is 0 (then every
+/// byte of it is 0).
+fn governor_of(r: &Record<'_>) -> Result<Option<GovernorState>, ConfigError> {
+    match r.u8(at::GOVERNOR) {
+        0 => {
+            return if r.zero(at::GOVERNOR, STATE_LEN - at::GOVERNOR) {
+                Ok(None)
+            } else {
+                Err(ConfigError::new("governor", 0.0, "all bytes 0 without a governor"))
+            }
+        }
+        1 => {}
+        g => return Err(ConfigError::new("governor", g as f32, "0 (none) or 1")),
+    }
+    let code = r.u8(at::GOV_RESTRICTS);
+    let restricts = Restricts::from_code(code)
+        .ok_or(ConfigError::new("governor.restricts", code as f32, "0 (pada delta) or 1 (lowpass alpha)"))?;
+    if !r.zero(at::GOV_RESERVED_A, 2) || !r.zero(at::GOV_END, STATE_LEN - at::GOV_END) {
+        return Err(ConfigError::new("governor.reserved", 0.0, "reserved bytes 0"));
+    }
+    let mut buckets = [[0u64; WINDOW_BUCKETS]; GOVERNED_JOINTS];
+    for (j, row) in buckets.iter_mut().enumerate() {
+        for (k, v) in row.iter_mut().enumerate() {
+            *v = r.u64(at::GOV_BUCKETS + 8 * (j * WINDOW_BUCKETS + k));
+        }
+    }
+    Ok(Some(GovernorState {
+        budget_bits: r.u32(at::GOV_BUDGET),
+        restricts,
+        rung: r.u8(at::GOV_RUNG),
+        cursor: r.u8(at::GOV_CURSOR),
+        filled: r.u8(at::GOV_FILLED),
+        in_bucket: r.u8(at::GOV_IN_BUCKET),
+        calm_steps: r.u32(at::GOV_CALM),
+        since_move: r.u32(at::GOV_SINCE_MOVE),
+        moves: r.u32(at::GOV_MOVES),
+        steps: r.u64(at::GOV_STEPS),
+        over_budget_steps: r.u64(at::GOV_OVER),
+        headroom_at_move: r.u64(at::GOV_HEADROOM_AT_MOVE) as i64,
+        buckets,
+    }))
 }
 
 /// Writes `wear` into its place in a record.
@@ -276,8 +369,14 @@ pub(super) fn put_wear(b: &mut [u8; STATE_LEN], wear: &FlashWear) {
     put(b, at::OPERATING_S, &wear.operating_s.to_le_bytes());
 }
 
-/// The wear a record holds (every value is meaningful: counts and seconds).
-pub(super) fn wear_of(bytes: &[u8; STATE_LEN]) -> FlashWear {
-    let r = Record(bytes);
-    FlashWear { erases: [r.u32(at::ERASES), r.u32(at::ERASES + 4)], operating_s: r.u64(at::OPERATING_S) }
+/// Where the flash wear ends in a record of version 2 or later: the bytes
+/// a reader needs to find the wear of any such record.
+pub(super) const WEAR_END: usize = at::OPERATING_S + 8;
+
+/// The wear the first [`WEAR_END`] bytes of a record hold (every value is
+/// meaningful: counts and seconds).
+pub(super) fn wear_of(bytes: &[u8]) -> FlashWear {
+    let u32_at = |i: usize| u32::from_le_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
+    let u64_at = |i: usize| (u32_at(i) as u64) | ((u32_at(i + 4) as u64) << 32);
+    FlashWear { erases: [u32_at(at::ERASES), u32_at(at::ERASES + 4)], operating_s: u64_at(at::OPERATING_S) }
 }

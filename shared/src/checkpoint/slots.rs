@@ -1,7 +1,7 @@
 //! The two alternating slots: the header, checking a slot, finding the
 //! newest valid checkpoint, saving into the other slot, loading.
 
-use super::record::{put_wear, wear_of, LearnerState, STATE_LEN};
+use super::record::{put_wear, wear_of, LearnerState, STATE_LEN, WEAR_END};
 use super::store::CheckpointStore;
 use super::wear::{FlashWear, WearBudget, WearRefusal};
 use crate::crc::{crc32, CRC32};
@@ -290,11 +290,13 @@ fn wear_in<S: CheckpointStore>(store: &S, best: Newest) -> Result<FlashWear, S::
     let Some((slot, header)) = best else {
         return Ok(FlashWear::default());
     };
-    if header.state_len as usize != STATE_LEN {
+    // Records of version 2 (512 bytes) and 3 keep the wear at the same
+    // offsets; a version-1 record (496 bytes) has none.
+    if (header.state_len as usize) < WEAR_END {
         let g = header.generation;
         return Ok(FlashWear { erases: [g - g / 2, g / 2], operating_s: 0 });
     }
-    let mut record = [0u8; STATE_LEN];
+    let mut record = [0u8; WEAR_END];
     store.read(slot, HEADER_LEN, &mut record)?;
     Ok(wear_of(&record))
 }

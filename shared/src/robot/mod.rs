@@ -177,6 +177,21 @@ impl RobotSpec {
         ActionSpace::repeated(dim, self.motor_dims as usize)
     }
 
+    /// The largest gearbox torque one learning action can command \[N·m\]:
+    /// the paper's torque law ([`Robot::commanded_gear_torque`]) at the level
+    /// of largest magnitude. Its re-engagement is the most damage one action
+    /// can do (the wear governor's reserve, [`crate::governor`]).
+    pub fn worst_commanded_torque(&self) -> f32 {
+        let Ok(motor) = self.motor() else { return 0.0 };
+        let mut worst = 0.0f32;
+        for i in 0..motor.dims() {
+            for &v in motor.dim(i).values() {
+                worst = worst.max(self.robot.commanded_gear_torque(v).abs());
+            }
+        }
+        worst
+    }
+
     /// Whether an agent with `policy` on a table of `table_len` weights laid
     /// out as `layout` builds, without building it (the firmware checks a
     /// new policy before it hands its only table to the new agent): the

@@ -3,6 +3,7 @@
 //! [`crate::wire::frame`]; nothing here knows about bytes.
 
 use crate::checkpoint::{LoadOutcome, Saved};
+use crate::governor::GovernorStatus;
 use crate::policy::PolicyKind;
 use crate::safety::{FaultCause, Rejection, State};
 use heapless::{String, Vec};
@@ -15,8 +16,10 @@ pub use crate::safety::RunMode;
 /// `Saved` the erase count, `NackReason::FlashWear`; `SetPolicy` carries
 /// [`PolicyKind`] itself, in the same bytes as before; 4: the
 /// [`ToHost::Policy`] report and [`CheckpointReport::TooLarge`], appended
-/// last).
-pub const PROTOCOL_VERSION: u16 = 5;
+/// last; 5: `Step::footstep`; 6: the gentle explorations appended to
+/// [`PolicyKind`], the wear governor's status in [`PolicyReport`] and
+/// [`ToChip::SetMtbfBudget`]).
+pub const PROTOCOL_VERSION: u16 = 6;
 /// State dimensions a [`Step`] carries.
 pub const MAX_STATE_DIMS: usize = 16;
 /// Action dimensions (motor outputs) a [`Step`] carries.
@@ -328,9 +331,11 @@ pub struct Nack {
 }
 
 /// The action policy in force: sent after every [`Hello`] and whenever it
-/// changes (`SetPolicy`, `SwitchToSarsa`, a loaded checkpoint, the host
-/// runner's switch at `--switch-at`), so a viewer that joins knows what
-/// the learner restricts.
+/// changes (`SetPolicy`, `SwitchToSarsa`, `SetMtbfBudget`, a loaded
+/// checkpoint, the host runner's switch at `--switch-at`, every move of the
+/// wear governor), and at the end of every episode while a governor runs,
+/// so a viewer that joins knows what the learner restricts and how fast
+/// the gearboxes wear.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct PolicyReport {
@@ -342,6 +347,10 @@ pub struct PolicyReport {
     /// Whether PADA or the low-pass filter has switched back to plain
     /// SARSA(λ) (Section VIII); then `built` is what it explored with.
     pub switched_to_sarsa: bool,
+    /// The wear governor, when one runs: its budget, the Δ or α in force
+    /// (also `built`'s), and the damage rate and MTBF over its window
+    /// ([`crate::governor`]).
+    pub governor: Option<GovernorStatus>,
 }
 
 // ---------------------------------------------------------------------------
@@ -381,12 +390,19 @@ pub enum ToChip {
     },
     /// Leave Fault for Idle.
     ClearFault,
+    /// Learn within a gearbox life (protocol 5): a wear governor keeps the
+    /// predicted MTBF over the last 1200 learning actions at or above this
+    /// many seconds by moving PADA's Δ or the low-pass filter's α
+    /// ([`crate::governor`]), starting at its floor; `None` stops it (the
+    /// parameter stays where it is). Only with torque off, for a `pada` or
+    /// `lowpass` learner, `0 < seconds <= 1e10`.
+    SetMtbfBudget(Option<f32>),
 }
 
-/// The six policies of Section V with their parameter, as sent on the wire:
-/// the learning core's own [`PolicyKind`] (one definition, not a copy). Its
-/// postcard encoding is the policy's variant index ([`PolicyName::code`])
-/// then, except for SARSA, its α or Δ as an `f32`.
+/// The policies with their parameters, as sent on the wire: the learning
+/// core's own [`PolicyKind`] (one definition, not a copy). Its postcard
+/// encoding is the policy's variant index ([`PolicyName::code`]) then,
+/// except for SARSA, its parameters as `f32`s (OU: θ then σ).
 ///
 /// [`PolicyName::code`]: crate::policy::PolicyName::code
 pub type PolicySpec = PolicyKind;

@@ -21,18 +21,19 @@
 //! | [`ToHost::Weights`] | chip → host | [`WeightsChunk`] | in answer to `ReadWeights` |
 //! | [`ToHost::Ack`] | chip → host | [`Ack`] | a command was carried out |
 //! | [`ToHost::Nack`] | chip → host | [`Nack`] | a command was refused |
-//! | [`ToHost::Policy`] | chip → host | [`PolicyReport`] | after `Hello`, and whenever the policy or its α/Δ changes |
+//! | [`ToHost::Policy`] | chip → host | [`PolicyReport`] | after `Hello`, whenever the policy or its α/Δ changes, and after every episode while a wear governor runs |
 //! | [`ToChip::Ping`] | host → chip | — | answered by `Hello` |
 //! | [`ToChip::Start`] | host → chip | [`RunMode`] | learn or test, torque on |
 //! | [`ToChip::Stop`] | host → chip | — | to Idle, torque off |
 //! | [`ToChip::Pause`] | host → chip | — | to Paused, torque off |
-//! | [`ToChip::SetPolicy`] | host → chip | [`PolicySpec`] | one of the six policies and its α/Δ |
+//! | [`ToChip::SetPolicy`] | host → chip | [`PolicySpec`] | one of the policies and its parameters |
 //! | [`ToChip::SwitchToSarsa`] | host → chip | — | end of the exploration phase (Section VIII) |
 //! | [`ToChip::SetEpsilon`] | host → chip | `f32` | exploration rate |
 //! | [`ToChip::SaveCheckpoint`] | host → chip | — | weights and learner state to flash |
 //! | [`ToChip::LoadCheckpoint`] | host → chip | — | weights and learner state from flash |
 //! | [`ToChip::ReadWeights`] | host → chip | offset `u32`, count `u32` | answered by `Weights` chunks |
 //! | [`ToChip::ClearFault`] | host → chip | — | Fault → Idle |
+//! | [`ToChip::SetMtbfBudget`] | host → chip | `Option<f32>` | start (or stop) the wear governor with this MTBF budget \[s\] |
 //!
 //! Every command is answered by exactly one `Ack` or `Nack` carrying the
 //! command frame's sequence number, after any data it asks for (`Hello`,

@@ -1,15 +1,21 @@
-//! The six action policies of Section V as one concept.
+//! The action policies as one concept: Section V's six and the four gentle
+//! explorations of issue 15 ([`kind`]).
 //!
 //! A [`Policy`] sits between the learner and the motor. It decides
-//! 1. which actions the learner may choose from ([`Policy::candidates`]):
-//!    all of them, or for PADA only those within Δ of the previous one
-//!    (Eq. 9);
+//! 1. which actions the learner may choose from ([`Policy::candidates`] for
+//!    the greedy choice, [`Policy::explore_candidates`] for an exploratory
+//!    draw): all of them, or for PADA only those within Δ of the previous
+//!    one (Eq. 9), for ε-PADA only the exploratory draws;
 //! 2. what the learner's action means for the motor ([`Policy::apply`]):
 //!    the level itself, a low-pass filtered level (Eq. 8) or an increment of
 //!    an integrated command;
 //! 3. whether the state is extended by the policy's memory
 //!    ([`Policy::extension`]): the Markov variants append the previous
-//!    filtered or integrated output so the learner's state stays Markov.
+//!    filtered or integrated output so the learner's state stays Markov;
+//! 4. for the noise explorations (`ou`, `pink`), how the greedy level is
+//!    moved ([`Policy::perturb`], [`crate::exploration`]); for the
+//!    action-change penalty, what the last action costs in the reward
+//!    ([`Policy::penalty`]).
 //!
 //! | kind | learner chooses | applied output | state extended |
 //! |---|---|---|---|
@@ -19,6 +25,10 @@
 //! | [`PolicyKind::Integrator`] | −Δ, 0, +Δ | `clip(prev + inc)` | no |
 //! | [`PolicyKind::MarkovIntegrator`] | −Δ, 0, +Δ | as integrator | by `prev` |
 //! | [`PolicyKind::Pada`] | levels within Δ of the previous (Eq. 9) | the level | no |
+//! | [`PolicyKind::EpsilonPada`] | greedy: any level; explore: within Δ | the level | no |
+//! | [`PolicyKind::OrnsteinUhlenbeck`] | the greedy level moved by OU noise | the level | no |
+//! | [`PolicyKind::PinkNoise`] | the greedy level moved by pink noise | the level | no |
+//! | [`PolicyKind::ActionPenalty`] | any level (reward less the change penalty) | the level | no |
 //!
 //! Δ is relative to the size of each action range (`max − min`), as in
 //! Section V: on the pendulum's {−1.5, 0, 1.5} Nm, Δ = 0.5 is a step of
@@ -30,324 +40,35 @@
 //! first action; starting from rest keeps Eq. 9 true across episode
 //! boundaries, which is what the gearbox sees.
 //!
-//! PADA and the low-pass filter can be switched back to plain SARSA
-//! (Section VIII) without changing the learner's action set or state.
+//! Every policy that chooses motor levels on the plain state can be
+//! switched back to plain SARSA (Section VIII) without changing the
+//! learner's action set or state; PADA's Δ and the filters' α can be moved
+//! while learning ([`Policy::set_parameter`], the wear governor
+//! [`crate::governor`]).
 
-use crate::action_space::{ActionDim, ActionSpace, Levels, Output, MAX_ACTION_DIMS, MAX_LEVELS};
-use crate::error::{check_range, ConfigError, StepError};
-use crate::tile_coding::StateDim;
-use rand_core::RngCore;
+mod candidates;
+mod kind;
 
-/// The six policies of Section V by name, without their parameter: the one
-/// list that the policy kind ([`PolicyKind`]), the checkpoint's policy code
-/// ([`PolicyName::code`]), the wire's `SetPolicy` (which carries a
-/// [`PolicyKind`]) and the host's `--algo` names all derive from.
-///
-/// The discriminant is the checkpoint code and the variant index on the
-/// wire, so the order is a stored format: append, never reorder.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-#[derive(serde::Serialize, serde::Deserialize)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[repr(u8)]
-pub enum PolicyName {
-    /// SARSA(λ): the chosen level is applied.
-    #[serde(rename = "sarsa")]
-    Sarsa = 0,
-    /// Low-pass filtered actions (Eq. 8).
-    #[serde(rename = "lowpass")]
-    LowPass = 1,
-    /// Low-pass filter with the previous output in the state.
-    #[serde(rename = "markov-lowpass")]
-    MarkovLowPass = 2,
-    /// Integrating controller: the learner chooses −Δ, 0 or +Δ.
-    #[serde(rename = "integrator")]
-    Integrator = 3,
-    /// Integrating controller with the integrated command in the state.
-    #[serde(rename = "markov-integrator")]
-    MarkovIntegrator = 4,
-    /// Previous-action-dependent actions (Eq. 9).
-    #[serde(rename = "pada")]
-    Pada = 5,
-}
-
-impl PolicyName {
-    /// Every policy, in the paper's order (which is the code order).
-    pub const ALL: [PolicyName; 6] = [
-        PolicyName::Sarsa,
-        PolicyName::LowPass,
-        PolicyName::MarkovLowPass,
-        PolicyName::Integrator,
-        PolicyName::MarkovIntegrator,
-        PolicyName::Pada,
-    ];
-
-    /// The name of `kind`.
-    pub const fn of(kind: &PolicyKind) -> PolicyName {
-        match kind {
-            PolicyKind::Sarsa => PolicyName::Sarsa,
-            PolicyKind::LowPass { .. } => PolicyName::LowPass,
-            PolicyKind::MarkovLowPass { .. } => PolicyName::MarkovLowPass,
-            PolicyKind::Integrator { .. } => PolicyName::Integrator,
-            PolicyKind::MarkovIntegrator { .. } => PolicyName::MarkovIntegrator,
-            PolicyKind::Pada { .. } => PolicyName::Pada,
-        }
-    }
-
-    /// The kind of this name with `parameter` as its α or Δ (ignored for
-    /// SARSA); the parameter is not checked here ([`PolicyKind::validate`]).
-    pub const fn with_parameter(self, parameter: f32) -> PolicyKind {
-        match self {
-            PolicyName::Sarsa => PolicyKind::Sarsa,
-            PolicyName::LowPass => PolicyKind::LowPass { alpha: parameter },
-            PolicyName::MarkovLowPass => PolicyKind::MarkovLowPass { alpha: parameter },
-            PolicyName::Integrator => PolicyKind::Integrator { delta: parameter },
-            PolicyName::MarkovIntegrator => PolicyKind::MarkovIntegrator { delta: parameter },
-            PolicyName::Pada => PolicyKind::Pada { delta: parameter },
-        }
-    }
-
-    /// The number that stands for the policy in a checkpoint (0 sarsa, 1
-    /// lowpass, 2 markov-lowpass, 3 integrator, 4 markov-integrator, 5 pada).
-    pub const fn code(self) -> u8 {
-        self as u8
-    }
-
-    /// The policy of a [`code`](Self::code); `None` for an unknown code.
-    pub fn from_code(code: u8) -> Option<PolicyName> {
-        PolicyName::ALL.get(code as usize).copied()
-    }
-
-    /// The name as the command line spells it.
-    pub const fn name(self) -> &'static str {
-        match self {
-            PolicyName::Sarsa => "sarsa",
-            PolicyName::LowPass => "lowpass",
-            PolicyName::MarkovLowPass => "markov-lowpass",
-            PolicyName::Integrator => "integrator",
-            PolicyName::MarkovIntegrator => "markov-integrator",
-            PolicyName::Pada => "pada",
-        }
-    }
-
-    /// The policy of a command-line name.
-    pub fn from_name(name: &str) -> Option<PolicyName> {
-        PolicyName::ALL.into_iter().find(|n| n.name() == name)
-    }
-
-    /// The name used in the paper's figures.
-    pub const fn title(self) -> &'static str {
-        match self {
-            PolicyName::Sarsa => "SARSA(λ)",
-            PolicyName::LowPass => "low-pass filter",
-            PolicyName::MarkovLowPass => "Markov low-pass filter",
-            PolicyName::Integrator => "integrating controller",
-            PolicyName::MarkovIntegrator => "Markov integrating controller",
-            PolicyName::Pada => "PADA",
-        }
-    }
-
-    /// Whether the policy takes α (the low-pass filters, Eq. 8).
-    pub const fn takes_alpha(self) -> bool {
-        matches!(self, PolicyName::LowPass | PolicyName::MarkovLowPass)
-    }
-
-    /// Whether the policy takes Δ (the integrators and PADA).
-    pub const fn takes_delta(self) -> bool {
-        matches!(self, PolicyName::Integrator | PolicyName::MarkovIntegrator | PolicyName::Pada)
-    }
-
-    /// Whether a learner of this policy can run as (or switch back to)
-    /// plain SARSA(λ) without changing its actions or state (Section VIII):
-    /// SARSA itself, PADA and the low-pass filter.
-    pub const fn can_switch(self) -> bool {
-        matches!(self, PolicyName::Sarsa | PolicyName::LowPass | PolicyName::Pada)
-    }
-}
-
-impl core::fmt::Display for PolicyName {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-/// Which of the six policies of Section V, with its parameter. Its variants
-/// are [`PolicyName`]'s in the same order, so its postcard encoding (the
-/// variant index, then the `f32` parameter if any) is what the wire's
-/// `SetPolicy` carries.
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[derive(serde::Serialize, serde::Deserialize)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum PolicyKind {
-    /// Plain SARSA(λ): the chosen level is applied.
-    Sarsa,
-    /// First-order low-pass filter on the applied output (Eq. 8), `0 < alpha ≤ 1`.
-    LowPass {
-        /// Filter coefficient α of Eq. 8 (1 = no filtering).
-        alpha: f32,
-    },
-    /// Low-pass filter with the previous filtered output in the state.
-    MarkovLowPass {
-        /// Filter coefficient α of Eq. 8.
-        alpha: f32,
-    },
-    /// The learner chooses −Δ, 0 or +Δ on an integrated command.
-    Integrator {
-        /// Increment relative to the action range, `0 < delta ≤ 1`.
-        delta: f32,
-    },
-    /// Integrating controller with the integrated command in the state.
-    MarkovIntegrator {
-        /// Increment relative to the action range, `0 < delta ≤ 1`.
-        delta: f32,
-    },
-    /// Previous-action-dependent actions (Eq. 9): the next level is within Δ
-    /// of the previous one, for greedy choice and exploration alike.
-    Pada {
-        /// Reach relative to the action range, `delta ≥ 0` (≥ 1 allows all).
-        delta: f32,
-    },
-}
-
-// The variant order of the two enums is one format (checkpoint code, wire
-// variant index): keep them in step.
-const _: () = {
-    let kinds = [
-        PolicyKind::Sarsa,
-        PolicyKind::LowPass { alpha: 0.0 },
-        PolicyKind::MarkovLowPass { alpha: 0.0 },
-        PolicyKind::Integrator { delta: 0.0 },
-        PolicyKind::MarkovIntegrator { delta: 0.0 },
-        PolicyKind::Pada { delta: 0.0 },
-    ];
-    let mut i = 0;
-    while i < kinds.len() {
-        assert!(PolicyName::of(&kinds[i]) as usize == i);
-        i += 1;
-    }
+pub use candidates::{uniform_below, Candidates};
+pub use kind::{
+    kind_code, kind_from_code, kind_parameter, kind_second_parameter, Exploration, PolicyKind, PolicyName,
+    POLICY_COUNT,
 };
 
-impl PolicyKind {
-    /// The policy's name as the command line spells it.
-    pub fn name(&self) -> &'static str {
-        PolicyName::of(self).name()
-    }
-
-    /// Its parameter (α of the low-pass filters, Δ of the others); `None`
-    /// for SARSA.
-    pub fn parameter(&self) -> Option<f32> {
-        match *self {
-            PolicyKind::Sarsa => None,
-            PolicyKind::LowPass { alpha } | PolicyKind::MarkovLowPass { alpha } => Some(alpha),
-            PolicyKind::Integrator { delta } | PolicyKind::MarkovIntegrator { delta } | PolicyKind::Pada { delta } => {
-                Some(delta)
-            }
-        }
-    }
-
-    /// Checks the parameter's range.
-    pub fn validate(&self) -> Result<(), ConfigError> {
-        match *self {
-            PolicyKind::Sarsa => Ok(()),
-            PolicyKind::LowPass { alpha } | PolicyKind::MarkovLowPass { alpha } => {
-                if alpha.is_finite() && alpha > 0.0 && alpha <= 1.0 {
-                    Ok(())
-                } else {
-                    Err(ConfigError::new("lowpass alpha", alpha, "0 < alpha <= 1"))
-                }
-            }
-            PolicyKind::Integrator { delta } | PolicyKind::MarkovIntegrator { delta } => {
-                if delta.is_finite() && delta > 0.0 && delta <= 1.0 {
-                    Ok(())
-                } else {
-                    Err(ConfigError::new("delta", delta, "0 < delta <= 1 (relative to the action range)"))
-                }
-            }
-            PolicyKind::Pada { delta } => {
-                check_range("delta", delta, 0.0, f32::MAX, "delta >= 0 (relative to the action range)")
-            }
-        }
-    }
-
-    fn is_integrator(&self) -> bool {
-        matches!(self, PolicyKind::Integrator { .. } | PolicyKind::MarkovIntegrator { .. })
-    }
-
-    fn is_markov(&self) -> bool {
-        matches!(self, PolicyKind::MarkovLowPass { .. } | PolicyKind::MarkovIntegrator { .. })
-    }
-}
-
-/// The set of level combinations the learner may choose from: per dimension
-/// a contiguous range of levels `lo..=hi` (all levels, or PADA's
-/// neighbourhood, Eq. 9). The joint candidates are the product of the
-/// ranges.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Candidates {
-    /// Lowest allowed level per dimension.
-    pub lo: Levels,
-    /// Highest allowed level per dimension.
-    pub hi: Levels,
-    /// Number of dimensions in use.
-    pub dims: u8,
-}
-
-impl Candidates {
-    /// Number of joint candidates.
-    pub fn count(&self) -> u32 {
-        (0..self.dims as usize).map(|i| (self.hi[i] - self.lo[i]) as u32 + 1).product()
-    }
-
-    /// Whether `levels` is a candidate.
-    pub fn contains(&self, levels: &Levels) -> bool {
-        (0..self.dims as usize).all(|i| levels[i] >= self.lo[i] && levels[i] <= self.hi[i])
-    }
-
-    /// A uniformly random candidate: the product set is uniform when each
-    /// dimension is drawn uniformly and independently.
-    pub fn random<R: RngCore + ?Sized>(&self, rng: &mut R) -> Levels {
-        let mut levels = [0u8; MAX_ACTION_DIMS];
-        for i in 0..self.dims as usize {
-            let n = (self.hi[i] - self.lo[i]) as u32 + 1;
-            levels[i] = self.lo[i] + uniform_below(rng, n) as u8;
-        }
-        levels
-    }
-
-    /// Visits every candidate once, first dimension fastest.
-    pub fn for_each(&self, mut visit: impl FnMut(&Levels)) {
-        let d = self.dims as usize;
-        let mut l = self.lo;
-        loop {
-            visit(&l);
-            // Odometer increment.
-            let mut i = 0;
-            loop {
-                if i == d {
-                    return;
-                }
-                if l[i] < self.hi[i] {
-                    l[i] += 1;
-                    break;
-                }
-                l[i] = self.lo[i];
-                i += 1;
-            }
-        }
-    }
-}
-
-/// A uniform integer in `0..n` (`n ≥ 1`) by Lemire's multiply-shift: one
-/// `u32` per draw, no division, bias below 2⁻³² · n.
-pub fn uniform_below<R: RngCore + ?Sized>(rng: &mut R, n: u32) -> u32 {
-    ((rng.next_u32() as u64 * n as u64) >> 32) as u32
-}
+use crate::action_space::{ActionDim, ActionSpace, Levels, Output, MAX_ACTION_DIMS, MAX_LEVELS};
+use crate::error::{ConfigError, StepError};
+use crate::exploration::Noise;
+use crate::tile_coding::StateDim;
+use kind::family;
+use rand_core::RngCore;
 
 /// A policy's state as plain data ([`Policy::state`], [`Policy::restore`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct PolicyState {
-    /// The kind the policy was built as, with its Δ or α.
+    /// The kind the policy was built as, with its parameters (PADA's Δ and
+    /// the filters' α as last set, [`Policy::set_parameter`]).
     pub kind: PolicyKind,
     /// Whether it was switched back to plain SARSA.
     pub switched: bool,
@@ -359,37 +80,39 @@ pub struct PolicyState {
     pub output: Output,
 }
 
-/// The number that stands for a policy kind in a checkpoint
-/// ([`PolicyName::code`]).
-pub fn kind_code(kind: &PolicyKind) -> u8 {
-    PolicyName::of(kind).code()
+/// PADA's reach per dimension and level: the contiguous levels within Δ.
+type Reach = [[(u8, u8); MAX_LEVELS]; MAX_ACTION_DIMS];
+
+/// The reach of `delta` on `motor`: for each level, the contiguous levels
+/// within Δ·range of it (all of them for `f32::INFINITY`).
+fn reach_of(delta: f32, motor: &ActionSpace) -> Reach {
+    let mut reach = [[(0u8, 0u8); MAX_LEVELS]; MAX_ACTION_DIMS];
+    for i in 0..motor.dims() {
+        let d = motor.dim(i);
+        // A tolerance of 1e-4 of the range absorbs float rounding of
+        // levels computed as min + k·step.
+        let limit = delta * d.range() * (1.0 + 1e-4);
+        for p in 0..d.len() {
+            let vp = d.value(p as u8);
+            let lo = (0..d.len()).find(|&l| (d.value(l as u8) - vp).abs() <= limit).unwrap_or(p);
+            let hi = (0..d.len()).rev().find(|&l| (d.value(l as u8) - vp).abs() <= limit).unwrap_or(p);
+            reach[i][p] = (lo as u8, hi as u8);
+        }
+    }
+    reach
 }
 
-/// Kinds whose learners mean the same by an action and a state: SARSA, PADA
-/// and the low-pass filter choose motor levels on the plain state; each of
-/// the others is a family of its own.
-fn family(kind: &PolicyKind) -> u8 {
-    match kind {
-        PolicyKind::Sarsa | PolicyKind::Pada { .. } | PolicyKind::LowPass { .. } => 0,
-        PolicyKind::MarkovLowPass { .. } => 1,
-        PolicyKind::Integrator { .. } => 2,
-        PolicyKind::MarkovIntegrator { .. } => 3,
+/// The noise process of `kind` (none for the policies without one).
+fn noise_of(kind: &PolicyKind) -> Noise {
+    match *kind {
+        PolicyKind::OrnsteinUhlenbeck { theta, sigma } => Noise::ou(theta, sigma),
+        PolicyKind::PinkNoise { sigma } => Noise::pink(sigma),
+        _ => Noise::None,
     }
 }
 
-/// The parameter of a kind (α or Δ; 0 for SARSA), as a checkpoint stores it.
-pub fn kind_parameter(kind: &PolicyKind) -> f32 {
-    kind.parameter().unwrap_or(0.0)
-}
-
-/// The kind of a [`kind_code`] with its parameter; `None` for an unknown
-/// code. The parameter is not checked here ([`PolicyKind::validate`]).
-pub fn kind_from_code(code: u8, parameter: f32) -> Option<PolicyKind> {
-    PolicyName::from_code(code).map(|n| n.with_parameter(parameter))
-}
-
 /// An action policy with its memory (previous action, filter state or
-/// integrated command).
+/// integrated command, noise).
 #[derive(Debug, Clone)]
 pub struct Policy {
     /// The kind in force (plain SARSA after a switch back).
@@ -398,10 +121,15 @@ pub struct Policy {
     built: PolicyKind,
     motor: ActionSpace,
     learner: ActionSpace,
-    /// PADA's reach per dimension and level: the contiguous levels within Δ.
-    reach: [[(u8, u8); MAX_LEVELS]; MAX_ACTION_DIMS],
+    /// PADA's and ε-PADA's reach per dimension and level.
+    reach: Reach,
     prev: Levels,
     output: Output,
+    /// The noise process of `ou` and `pink`.
+    noise: Noise,
+    /// What the last applied action costs in the reward (the
+    /// action-change penalty; 0 for the other kinds).
+    penalty: f32,
 }
 
 impl Policy {
@@ -419,45 +147,78 @@ impl Policy {
             }
             _ => motor.clone(),
         };
-        let mut reach = [[(0u8, 0u8); MAX_LEVELS]; MAX_ACTION_DIMS];
-        let delta = match kind {
-            PolicyKind::Pada { delta } => delta,
-            _ => f32::INFINITY,
+        let reach = reach_of(kind.reach_delta().unwrap_or(f32::INFINITY), &motor);
+        let mut policy = Policy {
+            kind,
+            built: kind,
+            motor,
+            learner,
+            reach,
+            prev: [0; MAX_ACTION_DIMS],
+            output: [0.0; MAX_ACTION_DIMS],
+            noise: noise_of(&kind),
+            penalty: 0.0,
         };
-        for i in 0..motor.dims() {
-            let d = motor.dim(i);
-            // A tolerance of 1e-4 of the range absorbs float rounding of
-            // levels computed as min + k·step.
-            let limit = delta * d.range() * (1.0 + 1e-4);
-            for p in 0..d.len() {
-                let vp = d.value(p as u8);
-                let lo = (0..d.len()).find(|&l| (d.value(l as u8) - vp).abs() <= limit).unwrap_or(p);
-                let hi = (0..d.len()).rev().find(|&l| (d.value(l as u8) - vp).abs() <= limit).unwrap_or(p);
-                reach[i][p] = (lo as u8, hi as u8);
-            }
-        }
-        let mut policy =
-            Policy { kind, built: kind, motor, learner, reach, prev: [0; MAX_ACTION_DIMS], output: [0.0; MAX_ACTION_DIMS] };
         policy.reset();
         Ok(policy)
     }
 
-    /// The kind in force, with its parameter ([`PolicyKind::Sarsa`] after
+    /// The kind in force, with its parameters ([`PolicyKind::Sarsa`] after
     /// [`switch_to_sarsa`](Self::switch_to_sarsa)).
     pub fn kind(&self) -> PolicyKind {
         self.kind
     }
 
-    /// The kind the policy was built (or restored) as, with its parameter;
-    /// unchanged by a switch back to SARSA.
+    /// The kind the policy was built (or restored) as, with its parameters
+    /// as last set; unchanged by a switch back to SARSA.
     pub fn built_kind(&self) -> PolicyKind {
         self.built
     }
 
-    /// Whether PADA or the low-pass filter was switched back to plain SARSA
-    /// (Section VIII).
+    /// How the policy in force explores.
+    pub fn exploration(&self) -> crate::policy::Exploration {
+        PolicyName::of(&self.kind).exploration()
+    }
+
+    /// Whether the policy was switched back to plain SARSA (Section VIII).
     pub fn switched(&self) -> bool {
         self.kind != self.built
+    }
+
+    /// Moves the policy's first parameter while it learns: PADA's or
+    /// ε-PADA's Δ (the reach is recomputed), a low-pass filter's α (its
+    /// memory stays, so Eq. 8 runs on), OU's θ, pink noise's σ or the
+    /// penalty's weight — never an integrator's Δ, which is the learner's
+    /// action set. The new value gets the kind's own check
+    /// ([`PolicyKind::validate`]); a refused value changes nothing. After a
+    /// switch back to SARSA the built kind's parameter changes and SARSA
+    /// stays in force.
+    pub fn set_parameter(&mut self, value: f32) -> Result<(), ConfigError> {
+        let name = PolicyName::of(&self.built);
+        if name == PolicyName::Sarsa || self.built.is_integrator() {
+            return Err(ConfigError::new(
+                "policy parameter",
+                value,
+                "a policy whose parameter leaves the learner's actions alone (not sarsa or an integrator)",
+            ));
+        }
+        let mut parameters = self.built.parameters();
+        parameters[0] = value;
+        let kind = name.with_parameters(parameters);
+        kind.validate()?;
+        if let Some(delta) = kind.reach_delta() {
+            self.reach = reach_of(delta, &self.motor);
+        }
+        match (&mut self.noise, kind) {
+            (Noise::Ou { theta, .. }, PolicyKind::OrnsteinUhlenbeck { theta: t, .. }) => *theta = t,
+            (Noise::Pink { sigma, .. }, PolicyKind::PinkNoise { sigma: s }) => *sigma = s,
+            _ => {}
+        }
+        if !self.switched() {
+            self.kind = kind;
+        }
+        self.built = kind;
+        Ok(())
     }
 
     /// The policy's state as plain data (for a checkpoint).
@@ -471,14 +232,15 @@ impl Policy {
         self.restored(state).map(|_| ())
     }
 
-    /// Restores a policy state: the kind with its parameter, the switch back
-    /// to SARSA, the previous action and the filter's or integrator's
+    /// Restores a policy state: the kind with its parameters, the switch
+    /// back to SARSA, the previous action and the filter's or integrator's
     /// memory. The kind may differ from the one built when its learner means
-    /// the same by an action and a state: SARSA, PADA and the low-pass
-    /// filter (any Δ or α) stand in for each other, as do Markov low-pass
-    /// filters of any α, and integrators of a Δ that gives the same
-    /// increments; otherwise, or with any field out of range, nothing
-    /// changes.
+    /// the same by an action and a state: every kind that chooses motor
+    /// levels on the plain state (SARSA, PADA, the low-pass filter, ε-PADA,
+    /// the noise explorations, the penalty) stands in for the others, as do
+    /// Markov low-pass filters of any α, and integrators of a Δ that gives
+    /// the same increments; otherwise, or with any field out of range,
+    /// nothing changes.
     pub fn restore(&mut self, state: &PolicyState) -> Result<(), ConfigError> {
         *self = self.restored(state)?;
         Ok(())
@@ -499,17 +261,18 @@ impl Policy {
                 return Err(ConfigError::new(
                     "policy.kind",
                     kind_code(&state.kind) as f32,
-                    "a policy with the running learner's actions and state (sarsa, pada, lowpass alike; the integrators and Markov variants only as configured)",
+                    "a policy with the running learner's actions and state (sarsa, pada, lowpass and the gentle explorations alike; the integrators and Markov variants only as configured)",
                 ));
             }
             p
         };
         if state.switched {
-            if !matches!(state.kind, PolicyKind::Pada { .. } | PolicyKind::LowPass { .. }) {
+            let name = PolicyName::of(&state.kind);
+            if name == PolicyName::Sarsa || !name.can_switch() {
                 return Err(ConfigError::new(
                     "policy.switched",
                     1.0,
-                    "false unless the policy is pada or lowpass (only they switch back to sarsa)",
+                    "false unless the policy can switch back to sarsa (not sarsa itself, the integrators or markov-lowpass)",
                 ));
             }
             p.kind = PolicyKind::Sarsa;
@@ -559,7 +322,8 @@ impl Policy {
         &self.motor
     }
 
-    /// Back to the state of an episode start: the motor at rest.
+    /// Back to the state of an episode start: the motor at rest, the noise
+    /// at its start, no penalty pending.
     pub fn reset(&mut self) {
         self.prev = if self.kind.is_integrator() {
             // The middle increment, 0.
@@ -573,6 +337,8 @@ impl Policy {
             let d = self.motor.dim(i);
             self.output[i] = 0.0f32.clamp(d.min(), d.max());
         }
+        self.noise.reset();
+        self.penalty = 0.0;
     }
 
     /// The learner's previous action (levels of the learner's space).
@@ -585,13 +351,13 @@ impl Policy {
         self.output
     }
 
-    /// The candidates for the next action: PADA's neighbourhood of the
-    /// previous action (Eq. 9), otherwise every action.
-    pub fn candidates(&self) -> Candidates {
+    /// The neighbourhood of the previous action within the reach, or every
+    /// action.
+    fn neighbourhood(&self, local: bool) -> Candidates {
         let dims = self.learner.dims();
         let mut c = Candidates { lo: [0; MAX_ACTION_DIMS], hi: [0; MAX_ACTION_DIMS], dims: dims as u8 };
         for i in 0..dims {
-            if let PolicyKind::Pada { .. } = self.kind {
+            if local {
                 let (lo, hi) = self.reach[i][self.prev[i] as usize];
                 c.lo[i] = lo;
                 c.hi[i] = hi;
@@ -602,23 +368,70 @@ impl Policy {
         c
     }
 
+    /// The candidates of the greedy choice: PADA's neighbourhood of the
+    /// previous action (Eq. 9), otherwise every action.
+    pub fn candidates(&self) -> Candidates {
+        self.neighbourhood(matches!(self.kind, PolicyKind::Pada { .. }))
+    }
+
+    /// The candidates of an exploratory draw: PADA's and ε-PADA's
+    /// neighbourhood of the previous action, otherwise every action.
+    pub fn explore_candidates(&self) -> Candidates {
+        self.neighbourhood(self.kind.reach_delta().is_some())
+    }
+
+    /// The greedy action's levels moved by the noise process (`ou`,
+    /// `pink`): each dimension's value plus the noise times the largest
+    /// distance from 0 to a bound of its range (GRL's scaling), rounded to
+    /// the nearest level (which clips at the ends). Advances the noise; the
+    /// levels are returned unchanged by a policy without noise.
+    pub fn perturb<R: RngCore + ?Sized>(&mut self, greedy: &Levels, rng: &mut R) -> Levels {
+        if matches!(self.noise, Noise::None) || self.exploration() != Exploration::Noise {
+            return *greedy;
+        }
+        let dims = self.learner.dims();
+        let noise = self.noise.sample(dims, rng);
+        let mut levels = *greedy;
+        for i in 0..dims {
+            let d = self.learner.dim(i);
+            let scale = d.min().abs().max(d.max().abs());
+            levels[i] = d.nearest(d.value(greedy[i]) + noise[i] * scale);
+        }
+        levels
+    }
+
+    /// What the last applied action costs the learner's reward: the
+    /// action-change penalty `w·Σᵢ((aᵢ − a⁻ᵢ)/rangeᵢ)²` (a⁻ the output
+    /// before it, at rest at an episode's start), 0 for every other kind.
+    pub fn penalty(&self) -> f32 {
+        self.penalty
+    }
+
     /// Applies the learner's choice and returns the motor output.
     pub fn apply(&mut self, levels: &Levels) -> Output {
         self.prev = *levels;
+        let mut change = 0.0f32;
         for i in 0..self.motor.dims() {
             let chosen = self.learner.dim(i).value(levels[i]);
+            let before = self.output[i];
             self.output[i] = match self.kind {
-                PolicyKind::Sarsa | PolicyKind::Pada { .. } => chosen,
                 // Eq. 8.
                 PolicyKind::LowPass { alpha } | PolicyKind::MarkovLowPass { alpha } => {
-                    alpha * chosen + (1.0 - alpha) * self.output[i]
+                    alpha * chosen + (1.0 - alpha) * before
                 }
                 PolicyKind::Integrator { .. } | PolicyKind::MarkovIntegrator { .. } => {
                     let d = self.motor.dim(i);
-                    (self.output[i] + chosen).clamp(d.min(), d.max())
+                    (before + chosen).clamp(d.min(), d.max())
                 }
+                _ => chosen,
             };
+            let step = (self.output[i] - before) / self.motor.dim(i).range();
+            change += step * step;
         }
+        self.penalty = match self.kind {
+            PolicyKind::ActionPenalty { weight } => weight * change,
+            _ => 0.0,
+        };
         self.output
     }
 
@@ -627,7 +440,8 @@ impl Policy {
     /// dimension `i` takes dimension `map[i]`'s previous action and filter
     /// or integrator output, or, for `None`, starts at rest (the level and
     /// output of 0, as at an episode's start). Unused dimensions are left
-    /// alone; an index out of range counts as `None`.
+    /// alone; an index out of range counts as `None`. (The noise of `ou`
+    /// and `pink` belongs to the action dimension, not the joint, and stays.)
     pub fn remap(&mut self, map: &[Option<u8>; MAX_ACTION_DIMS]) {
         let (prev, output) = (self.prev, self.output);
         let mut rest = self.clone();
@@ -667,16 +481,17 @@ impl Policy {
         &self.output[..self.extension_len()]
     }
 
-    /// Switches PADA or the low-pass filter back to plain SARSA
-    /// (Section VIII); the learner's actions and state stay the same, so the
+    /// Switches a policy that chooses motor levels on the plain state back
+    /// to plain SARSA (Section VIII: PADA, the low-pass filter, the gentle
+    /// explorations); the learner's actions and state stay the same, so the
     /// learned values carry over. Plain SARSA switches to itself.
     pub fn switch_to_sarsa(&mut self) -> Result<(), StepError> {
-        match self.built {
-            PolicyKind::Sarsa | PolicyKind::Pada { .. } | PolicyKind::LowPass { .. } => {
-                self.kind = PolicyKind::Sarsa;
-                Ok(())
-            }
-            _ => Err(StepError::CannotSwitch),
+        if PolicyName::of(&self.built).can_switch() {
+            self.kind = PolicyKind::Sarsa;
+            self.penalty = 0.0;
+            Ok(())
+        } else {
+            Err(StepError::CannotSwitch)
         }
     }
 }
@@ -758,6 +573,102 @@ mod tests {
     }
 
     #[test]
+    fn epsilon_pada_restricts_only_exploration() {
+        let mut p = Policy::new(PolicyKind::EpsilonPada { delta: 1.0 / 6.0 }, leo_motor()).unwrap();
+        p.apply(&[3, 0, 6, 0]);
+        assert_eq!(p.candidates().count(), 343, "the greedy choice is free");
+        let e = p.explore_candidates();
+        assert_eq!(e.count(), 3 * 2 * 2);
+        assert_eq!((e.lo, e.hi), ([2, 0, 5, 0], [4, 1, 6, 0]));
+        // PADA restricts both.
+        let mut q = Policy::new(PolicyKind::Pada { delta: 1.0 / 6.0 }, leo_motor()).unwrap();
+        q.apply(&[3, 0, 6, 0]);
+        assert_eq!(q.candidates(), q.explore_candidates());
+    }
+
+    #[test]
+    fn noise_moves_the_greedy_level_and_clips_at_the_ends() {
+        let mut rng = Pcg32::seed_from_u64(4);
+        let mut p = Policy::new(PolicyKind::OrnsteinUhlenbeck { theta: 0.15, sigma: 0.3 }, leo_motor()).unwrap();
+        let (mut moved, mut steps) = (0, 0);
+        let mut previous = [3u8, 3, 3, 0];
+        let mut flips = 0;
+        for _ in 0..5000 {
+            let l = p.perturb(&[3, 0, 6, 0], &mut rng);
+            assert!(l[..3].iter().all(|&x| x < 7) && l[3] == 0);
+            moved += (l != [3, 0, 6, 0]) as u32;
+            // Correlated noise: consecutive choices of a dimension rarely
+            // jump from one side of the greedy level to the other.
+            flips += ((l[0] as i32 - 3).signum() * (previous[0] as i32 - 3).signum() < 0) as u32;
+            previous = l;
+            steps += 1;
+        }
+        assert!(moved > steps / 2, "{moved} of {steps} moved");
+        assert!(flips < steps / 20, "{flips} sign flips");
+        // A policy without noise returns the greedy levels as they are.
+        let mut s = Policy::new(PolicyKind::Sarsa, leo_motor()).unwrap();
+        assert_eq!(s.perturb(&[1, 2, 3, 0], &mut rng), [1, 2, 3, 0]);
+    }
+
+    #[test]
+    fn the_action_change_penalty_is_its_weight_times_the_squared_relative_change() {
+        let mut p = Policy::new(PolicyKind::ActionPenalty { weight: 2.0 }, pendulum_motor()).unwrap();
+        p.apply(&[2, 0, 0, 0]); // 0 → +1.5 N·m: half the range.
+        assert_eq!(p.penalty(), 2.0 * 0.25);
+        p.apply(&[0, 0, 0, 0]); // +1.5 → −1.5: the full range.
+        assert_eq!(p.penalty(), 2.0);
+        p.apply(&[0, 0, 0, 0]);
+        assert_eq!(p.penalty(), 0.0);
+        p.reset();
+        assert_eq!(p.penalty(), 0.0);
+        let mut s = Policy::new(PolicyKind::Sarsa, pendulum_motor()).unwrap();
+        s.apply(&[2, 0, 0, 0]);
+        assert_eq!(s.penalty(), 0.0, "only the penalty policy has one");
+    }
+
+    #[test]
+    fn set_parameter_moves_delta_and_alpha_and_refuses_the_rest() {
+        let mut p = Policy::new(PolicyKind::Pada { delta: 1.0 / 6.0 }, leo_motor()).unwrap();
+        p.apply(&[3, 3, 3, 0]);
+        assert_eq!(p.candidates().count(), 27);
+        p.set_parameter(2.0 / 6.0).unwrap();
+        assert_eq!(p.candidates().count(), 125);
+        assert_eq!(p.built_kind(), PolicyKind::Pada { delta: 2.0 / 6.0 });
+        assert_eq!(p.state().kind, PolicyKind::Pada { delta: 2.0 / 6.0 }, "a checkpoint keeps the Δ in force");
+        assert_eq!(p.set_parameter(-1.0).unwrap_err().param, "delta");
+        assert_eq!(p.candidates().count(), 125, "a refused value changes nothing");
+        let mut l = Policy::new(PolicyKind::LowPass { alpha: 0.9 }, pendulum_motor()).unwrap();
+        l.apply(&[2, 0, 0, 0]);
+        l.set_parameter(0.5).unwrap();
+        let before = l.output()[0];
+        assert_eq!(l.apply(&[2, 0, 0, 0])[0], 0.5 * 1.5 + 0.5 * before, "Eq. 8 runs on with the new α");
+        for k in [PolicyKind::Sarsa, PolicyKind::Integrator { delta: 0.5 }] {
+            assert_eq!(Policy::new(k, pendulum_motor()).unwrap().set_parameter(0.5).unwrap_err().param, "policy parameter");
+        }
+    }
+
+    #[test]
+    fn the_gentle_explorations_switch_back_to_sarsa() {
+        for k in [
+            PolicyKind::EpsilonPada { delta: 0.2 },
+            PolicyKind::OrnsteinUhlenbeck { theta: 0.2, sigma: 0.2 },
+            PolicyKind::PinkNoise { sigma: 0.3 },
+            PolicyKind::ActionPenalty { weight: 1.0 },
+        ] {
+            let mut p = Policy::new(k, leo_motor()).unwrap();
+            p.switch_to_sarsa().unwrap();
+            assert_eq!(p.kind(), PolicyKind::Sarsa, "{k:?}");
+            assert_eq!(p.exploration(), Exploration::EpsilonGreedy);
+            p.apply(&[6, 0, 3, 0]);
+            assert_eq!(p.penalty(), 0.0);
+            // Their checkpoints restore into a SARSA learner and back.
+            let mut s = Policy::new(PolicyKind::Sarsa, leo_motor()).unwrap();
+            s.restore(&p.state()).unwrap();
+            assert_eq!((s.built_kind(), s.switched()), (k, true));
+        }
+    }
+
+    #[test]
     fn parameters_are_validated() {
         let m = pendulum_motor;
         assert_eq!(Policy::new(PolicyKind::Pada { delta: -0.1 }, m()).unwrap_err().param, "delta");
@@ -765,6 +676,14 @@ mod tests {
         assert_eq!(Policy::new(PolicyKind::LowPass { alpha: 0.0 }, m()).unwrap_err().param, "lowpass alpha");
         assert_eq!(Policy::new(PolicyKind::MarkovLowPass { alpha: 1.5 }, m()).unwrap_err().param, "lowpass alpha");
         assert_eq!(Policy::new(PolicyKind::LowPass { alpha: f32::NAN }, m()).unwrap_err().param, "lowpass alpha");
+        assert_eq!(Policy::new(PolicyKind::EpsilonPada { delta: f32::NAN }, m()).unwrap_err().param, "delta");
+        for (theta, sigma, param) in [(0.0, 0.2, "theta"), (1.5, 0.2, "theta"), (0.2, 0.0, "sigma"), (0.2, 4.5, "sigma")] {
+            let k = PolicyKind::OrnsteinUhlenbeck { theta, sigma };
+            assert_eq!(Policy::new(k, m()).unwrap_err().param, param, "{k:?}");
+        }
+        assert_eq!(Policy::new(PolicyKind::PinkNoise { sigma: f32::INFINITY }, m()).unwrap_err().param, "sigma");
+        assert_eq!(Policy::new(PolicyKind::ActionPenalty { weight: -1.0 }, m()).unwrap_err().param, "weight");
+        assert_eq!(Policy::new(PolicyKind::ActionPenalty { weight: 1e5 }, m()).unwrap_err().param, "weight");
     }
 
     #[test]
