@@ -14,7 +14,7 @@
 //! | 12 | 4 | weight count `n` |
 //! | 16 | 4 | generation (1 for the first save, +1 per save, wrapping: compared in serial-number arithmetic, [`is_newer`]) |
 //! | 20 | 4 | CRC-32 of the payload: the state record and the weights |
-//! | 24 | 2 | length `s` of the learner-state record ([`STATE_LEN`], 512) |
+//! | 24 | 2 | length `s` of the learner-state record ([`STATE_LEN`], 1024) |
 //! | 26 | 2 | bytes `b` per stored weight (4: [`Q16`] as `i32`, 2: 16-bit; [`crate::weights::WeightFormat`]) |
 //! | 28 | 4 | CRC-32 of bytes 0–27 |
 //! | 32 | s | the learner-state record (below) |
