@@ -402,6 +402,10 @@ fn mtbf_budget_errors_name_the_flag_and_the_range() {
         &["run", "--algo", "pada", "--mtbf-budget", "2600", "--switch-at", "10"],
         &["--switch-at", "--mtbf-budget"],
     );
+    // pada sil checks the same flags before it builds or boots anything.
+    assert_bad_input(&["sil", "--algo", "sarsa", "--mtbf-budget", "1e7"], &["--mtbf-budget", "pada and lowpass"]);
+    assert_bad_input(&["sil", "--algo", "pada", "--delta", "0.5", "--mtbf-budget", "1e7"], &["--delta", "--mtbf-budget"]);
+    assert_bad_input(&["sil", "--algo", "pada", "--mtbf-budget", "NaN"], &["--mtbf-budget", "0 < budget <= 1e10"]);
     assert_bad_input(&["paper", "pendulum", "--task", "leo"], &["--task", "pada paper wear"]);
     assert_bad_input(&["paper", "wear", "--task", "moon"], &["moon", "pendulum", "leo"]);
 }

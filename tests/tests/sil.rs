@@ -28,11 +28,12 @@ struct Run {
     faults: Vec<&'static str>,
     forecast: bool,
     compare: bool,
+    mtbf_budget_s: Option<f32>,
 }
 
 impl Run {
     fn pendulum(policy: PolicyKind, seconds: f64) -> Run {
-        Run { board: Board::F405, task: SilTask::Pendulum, policy, seconds, faults: vec![], forecast: true, compare: false }
+        Run { board: Board::F405, task: SilTask::Pendulum, policy, seconds, faults: vec![], forecast: true, compare: false, mtbf_budget_s: None }
     }
 
     fn leo(board: Board, seconds: f64) -> Run {
@@ -44,6 +45,7 @@ impl Run {
             faults: vec![],
             forecast: true,
             compare: false,
+            mtbf_budget_s: None,
         }
     }
 
@@ -55,6 +57,7 @@ impl Run {
             task: self.task,
             board: self.board,
             policy: self.policy,
+            mtbf_budget_s: self.mtbf_budget_s,
             seconds: self.seconds,
             seed: SEED,
             faults: self.faults.iter().map(|f| fault::parse(f).unwrap()).collect(),
@@ -146,6 +149,37 @@ fn the_firmware_in_qemu_replays_bit_for_bit_on_the_host_and_its_link_is_clean() 
     let recs = records(&stream);
     assert!(!replay(&profile, policy, seed + 1, &recs).identical);
     assert!(!replay(&profile, PolicyKind::Sarsa, seed, &recs).identical);
+}
+
+#[test]
+fn a_governed_run_in_qemu_moves_its_delta_and_replays_bit_for_bit() {
+    // `pada sil --algo pada --mtbf-budget B`: the firmware's wear governor
+    // moves Δ while it learns; the replay takes each reported Δ where the
+    // board reported it and must still give the same actions and weights.
+    let dir = tempfile::tempdir().unwrap();
+    let mut run = Run::pendulum(PolicyKind::Pada { delta: 0.5 }, 60.0);
+    // A budget below what the full range gives on the physical pendulum
+    // (≈ 5.6e7 s over 1200 actions, `pada run --board f405 --task
+    // physical-pendulum --algo pada --mtbf-budget 1e7 --seconds 60`): the
+    // governor starts at its floor (Δ = 0.5, one level) and relaxes to the
+    // full range as the budget pays for it, so the run crosses a move.
+    run.mtbf_budget_s = Some(1e7);
+    let s = run.go(dir.path());
+    assert!(s.passed, "{:#?}", check_failures(&s));
+    assert!(s.replay.identical && s.replay.actions_compared >= 1000, "{:?}", s.replay);
+    let stream = std::fs::read(dir.path().join("telemetry.bin")).unwrap();
+    let mut decoder = HostDecoder::new();
+    let deltas: Vec<f32> = decoder
+        .feed(&stream)
+        .filter_map(|f| match f.expect("a clean recording").msg {
+            ToHost::Policy(p) => p.governor.map(|g| g.parameter),
+            _ => None,
+        })
+        .collect();
+    let mut distinct = deltas.clone();
+    distinct.sort_by(f32::total_cmp);
+    distinct.dedup();
+    assert!(distinct.len() >= 2, "the governor never moved Δ: {deltas:?}");
 }
 
 #[test]

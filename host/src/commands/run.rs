@@ -133,21 +133,9 @@ fn run_label(policy: &pada_core::policy::PolicyKind, budget_s: Option<f32>) -> S
 /// The policy of the flags, checked.
 fn policy_of(args: &RunArgs) -> Result<pada_core::policy::PolicyKind, CliError> {
     let flags = PolicyFlags { alpha: args.alpha, delta: args.delta, theta: args.theta, sigma: args.sigma, weight: args.weight };
-    if args.mtbf_budget.is_some() {
-        if !matches!(args.algo, Algo::Pada | Algo::LowPass) {
-            return Err(usage(format!(
-                "--mtbf-budget applies only to pada and lowpass (the governor moves their delta or alpha), not to {}",
-                args.algo
-            )));
-        }
-        for (flag, given) in [("--delta", args.delta.is_some()), ("--alpha", args.alpha.is_some())] {
-            if given {
-                return Err(usage(format!(
-                    "{flag} and --mtbf-budget exclude each other: the governor chooses the {} while learning",
-                    &flag[2..]
-                )));
-            }
-        }
+    if let Some(b) = args.mtbf_budget {
+        crate::experiment::algo::check_mtbf_budget(args.algo, args.alpha.is_some(), args.delta.is_some(), b)
+            .map_err(usage)?;
     }
     policy_kind_of(args.algo, &flags).map_err(|e| usage(e.0))
 }
@@ -155,11 +143,7 @@ fn policy_of(args: &RunArgs) -> Result<pada_core::policy::PolicyKind, CliError> 
 /// The run's configuration from the flags, checked.
 fn run_config(args: &RunArgs, spec: &TaskSpec, policy: pada_core::policy::PolicyKind) -> Result<RunConfig, CliError> {
     let seconds = check_seconds("--seconds", args.seconds.unwrap_or(spec.default_seconds))?;
-    if let Some(b) = args.mtbf_budget {
-        let max = pada_core::governor::MAX_BUDGET_S;
-        if !(b.is_finite() && b > 0.0 && b <= max) {
-            return Err(usage(format!("--mtbf-budget {b} is out of range: valid is 0 < budget <= {max:e} s")));
-        }
+    if args.mtbf_budget.is_some() {
         if args.switch_at.is_some() {
             return Err(usage(
                 "--switch-at and --mtbf-budget exclude each other: the governor keeps the restriction for the whole run",

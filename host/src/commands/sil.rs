@@ -53,6 +53,13 @@ pub struct SilArgs {
     /// default 0.5).
     #[arg(long)]
     pub delta: Option<f32>,
+    /// Learn on a wear budget: the firmware's wear governor (`SetMtbfBudget`,
+    /// sent after the policy and before the first run) moves PADA's Δ or the
+    /// low-pass filter's α to keep the predicted MTBF over the last 1200
+    /// learning actions at or above SECONDS (pada or lowpass; not with
+    /// --delta or --alpha).
+    #[arg(long, value_name = "SECONDS")]
+    pub mtbf_budget: Option<f32>,
     /// Inject a fault on the servo bus (repeatable):
     /// KIND[:at=S][:for=S][:servo=ID][:ms=MS][:bits=NAME] with KIND drop,
     /// corrupt, delay, error-bits or past-limit (docs/sil.md).
@@ -85,6 +92,10 @@ pub struct SilArgs {
 
 /// Runs `pada sil`.
 pub fn run(args: SilArgs) -> Result<(), CliError> {
+    if let Some(b) = args.mtbf_budget {
+        crate::experiment::algo::check_mtbf_budget(args.algo, args.alpha.is_some(), args.delta.is_some(), b)
+            .map_err(usage)?;
+    }
     let policy = policy_kind(args.algo, args.alpha, args.delta).map_err(|e| usage(e.0))?;
     let default_seconds = match args.task {
         SilTask::Pendulum => 600.0,
@@ -132,6 +143,7 @@ pub fn run(args: SilArgs) -> Result<(), CliError> {
         task: args.task,
         board,
         policy,
+        mtbf_budget_s: args.mtbf_budget,
         seconds,
         seed: args.seed,
         faults,

@@ -270,3 +270,28 @@ mod tests {
             .is_err());
     }
 }
+
+/// Checks `--mtbf-budget` against the other flags, for `pada run` and `pada
+/// sil` alike: the governor moves PADA's Δ or the low-pass filter's α, so
+/// it needs one of those policies and excludes choosing the parameter; the
+/// budget lies in `0 < b <= MAX_BUDGET_S` (the wire command's range).
+pub fn check_mtbf_budget(algo: Algo, alpha_given: bool, delta_given: bool, budget: f32) -> Result<(), String> {
+    if !matches!(algo, Algo::Pada | Algo::LowPass) {
+        return Err(format!(
+            "--mtbf-budget applies only to pada and lowpass (the governor moves their delta or alpha), not to {algo}"
+        ));
+    }
+    for (flag, given) in [("--delta", delta_given), ("--alpha", alpha_given)] {
+        if given {
+            return Err(format!(
+                "{flag} and --mtbf-budget exclude each other: the governor chooses the {} while learning",
+                &flag[2..]
+            ));
+        }
+    }
+    let max = pada_core::governor::MAX_BUDGET_S;
+    if !(budget.is_finite() && budget > 0.0 && budget <= max) {
+        return Err(format!("--mtbf-budget {budget} is out of range: valid is 0 < budget <= {max:e} s"));
+    }
+    Ok(())
+}

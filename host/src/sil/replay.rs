@@ -9,7 +9,9 @@
 //! (start, step, absorbing end, time-limit end), with the observation, the
 //! reward and the mode, and whether the policy's memory was mirrored first
 //! (LEO's footsteps), so the replay makes the same calls in the same order. A policy change (`SetPolicy`) starts a fresh learner from the
-//! seed, as on the chip; the replay is given the policy the run used.
+//! seed, as on the chip; the replay is given the policy the run used, and
+//! takes the wear governor's Δ or α from each `Policy` report where the
+//! firmware reported it.
 
 use pada_core::agent::{EpisodeEnd, Mode};
 use pada_core::fixed::Q16;
@@ -27,6 +29,9 @@ pub enum Record {
     Step(Step),
     /// An episode's end.
     Episode(Episode),
+    /// The wear governor's Δ or α, from a `Policy` report: in force from
+    /// the next decision on.
+    Restriction(f32),
 }
 
 /// What the replay found.
@@ -113,6 +118,12 @@ pub fn replay(profile: &LearnerProfile, policy: PolicyKind, seed: u64, records: 
                         report.error = Some(format!("step {}: {e}", s.step));
                         break;
                     }
+                }
+            }
+            Record::Restriction(v) => {
+                if let Err(e) = agent.set_policy_parameter(*v) {
+                    report.error = Some(format!("the governor's parameter {v}: {e}"));
+                    break;
                 }
             }
             Record::Episode(e) => {

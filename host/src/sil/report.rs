@@ -304,7 +304,7 @@ fn first_difference(sil: &[Episode], host: &[Episode]) -> Option<String> {
 fn compare(cfg: &SilConfig, episodes: &[Episode]) -> anyhow::Result<HostComparison> {
     let started = std::time::Instant::now();
     let profile = cfg.profile();
-    let run = |trials| RunConfig { policy: cfg.policy, switch_at_s: None, mtbf_budget_s: None, seconds: cfg.seconds, trials, seed: cfg.seed };
+    let run = |trials| RunConfig { policy: cfg.policy, switch_at_s: None, mtbf_budget_s: cfg.mtbf_budget_s, seconds: cfg.seconds, trials, seed: cfg.seed };
     let none = |_| {};
     match cfg.task {
         SilTask::Leo => {

@@ -98,6 +98,9 @@ pub struct SilConfig {
     pub board: Board,
     /// The policy the run sets (`SetPolicy`) before starting.
     pub policy: PolicyKind,
+    /// The wear governor's budget \[s\] (`SetMtbfBudget`, after the policy
+    /// and before the first run), or none.
+    pub mtbf_budget_s: Option<f32>,
     /// Learning time to reach \[s\].
     pub seconds: f64,
     /// The master seed (`pada run`'s: the board learns with

@@ -264,8 +264,16 @@ impl<'a> Session<'a> {
         self.queue(&ToBoard::Configure { seed: self.cfg.learner_seed() })?;
         self.send_queued()?;
         // A fresh learner with the run's policy, then the first test episode.
-        for (k, cmd) in RunProtocol::start(self.cfg.policy).into_iter().enumerate() {
-            self.command_at(FIRST_COMMAND_US * (k as u64 + 1), cmd);
+        // As `pada run --board`: the budget after the policy, before the
+        // first run (torque off).
+        let mut k = 0;
+        for cmd in RunProtocol::start(self.cfg.policy) {
+            if let (ToChip::Start(_), Some(budget)) = (&cmd, self.cfg.mtbf_budget_s) {
+                k += 1;
+                self.command_at(FIRST_COMMAND_US * k, ToChip::SetMtbfBudget(Some(budget)));
+            }
+            k += 1;
+            self.command_at(FIRST_COMMAND_US * k, cmd);
         }
         Ok(())
     }
@@ -417,6 +425,13 @@ impl<'a> Session<'a> {
                 self.records.push(Record::Episode(e));
                 if let Some(bar) = &self.bar {
                     bar.set_position((self.protocol.learning_time_s() * 1000.0) as u64);
+                }
+            }
+            ToHost::Policy(p) => {
+                // The governor's Δ or α in force from the next decision on
+                // (the firmware reports a move after the period's Step).
+                if let Some(g) = p.governor {
+                    self.records.push(Record::Restriction(g.parameter));
                 }
             }
             ToHost::Fault(f) => {
