@@ -76,7 +76,8 @@ pub(crate) fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f6
     lo / 1.6..hi * 1.6
 }
 
-/// A linear range covering `values` with 6% room.
+/// A linear range covering `values` with 6% room (0..1 when empty; a
+/// flat series gets ±0.1 % of its value, so its axis still has ticks).
 pub(crate) fn lin_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for v in values.filter(|v| v.is_finite()) {
@@ -86,7 +87,7 @@ pub(crate) fn lin_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f6
     if !lo.is_finite() {
         return 0.0..1.0;
     }
-    let pad = ((hi - lo) * 0.06).max(1e-9);
+    let pad = ((hi - lo) * 0.06).max(1e-12_f64.max(hi.abs() * 1e-3));
     lo - pad..hi + pad
 }
 

@@ -11,6 +11,7 @@
 //!   steps where a gearbox re-engaged marked.
 
 use super::state::WatchState;
+use crate::plot::figures::lin_range;
 use crate::plot::{plot_err, Figure, FONT};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -27,20 +28,6 @@ pub fn joint_color(i: usize) -> RGBColor {
         RGBColor(148, 103, 189),
     ];
     C[i % C.len()]
-}
-
-/// A linear range covering `values` with 6 % room (0..1 when empty).
-fn range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for v in values.filter(|v| v.is_finite()) {
-        lo = lo.min(v);
-        hi = hi.max(v);
-    }
-    if !lo.is_finite() {
-        return 0.0..1.0;
-    }
-    let pad = ((hi - lo) * 0.06).max(1e-12_f64.max(hi.abs() * 1e-3));
-    lo - pad..hi + pad
 }
 
 /// A tick label: scientific outside 0.01..10⁴, else at most three
@@ -97,8 +84,8 @@ impl Figure for ReturnsPlot<'_> {
             return empty(root, title, "waiting for the first test run");
         }
         root.fill(&WHITE).map_err(plot_err)?;
-        let x = range(l.curve.iter().map(|p| p.learning_time_s).chain([0.0]));
-        let y = range(l.curve.iter().map(|p| p.test_return));
+        let x = lin_range(l.curve.iter().map(|p| p.learning_time_s).chain([0.0]));
+        let y = lin_range(l.curve.iter().map(|p| p.test_return));
         let mut chart = ChartBuilder::on(root)
             .caption(title, (FONT, 18))
             .margin(8)
@@ -233,7 +220,7 @@ where
         return empty(root, title, "waiting for the first step");
     }
     root.fill(&WHITE).map_err(plot_err)?;
-    let x = range(h.with_last().map(|p| p.time_s));
+    let x = lin_range(h.with_last().map(|p| p.time_s));
     // Counters only grow from 0: the axis starts at 0 exactly.
     let top = h
         .with_last()
@@ -309,8 +296,8 @@ impl Figure for EpisodePlot<'_> {
                 .map(|r| format!(", return {r:.1}"))
                 .unwrap_or_default()
         );
-        let x = range(e.steps.iter().map(|s| s.t_s).chain([0.0]));
-        let y = range(
+        let x = lin_range(e.steps.iter().map(|s| s.t_s).chain([0.0]));
+        let y = lin_range(
             e.steps
                 .iter()
                 .flat_map(|s| s.output.iter().map(|&v| v as f64)),
