@@ -17,6 +17,7 @@
 //! ends the episode as a fall, is counted ([`LeoEnv::blow_ups`]) and never
 //! panics; non-finite action voltages are read as 0 V and flagged.
 
+pub mod compare;
 pub mod constants;
 pub mod gait;
 pub mod model;
@@ -238,6 +239,17 @@ impl LeoEnv {
         self.obs
     }
 
+    /// Every joint's rate through the task's filter after the last step
+    /// (rad/s, [`model::Joint`] order; §3.2).
+    pub fn filtered_rates(&self) -> [f32; NUM_JOINTS] {
+        self.filtered
+    }
+
+    /// The stance leg the next step acts with (§3.3).
+    pub fn stance(&self) -> Leg {
+        self.current_stance()
+    }
+
     /// How the current episode stands.
     pub fn terminal(&self) -> Terminal {
         self.terminal
@@ -347,6 +359,32 @@ impl LeoEnv {
         let (angles, _) = self.model.joint_state();
         let voltages = task::joint_voltages(action_voltages, &angles, stance);
         let invalid_action = action_voltages.iter().any(|v| !v.is_finite());
+        self.step_voltages(voltages, invalid_action)
+    }
+
+    /// One control step (§3.6) with every servo's voltage given (V,
+    /// [`model::Joint`] order) instead of the three learned ones and the
+    /// held joints' P laws: for driving the model open loop with another
+    /// simulator's applied voltages (`pada leo compare`). The task's
+    /// bookkeeping (filters, stance, reward, falls) is the same as
+    /// [`LeoEnv::step`]'s; non-finite voltages are read as 0 V and flagged.
+    pub fn step_joint_voltages(&mut self, voltages: [f32; NUM_JOINTS]) -> StepResult {
+        if self.terminal != Terminal::None {
+            return StepResult {
+                obs: self.obs,
+                reward: 0.0,
+                terminal: self.terminal,
+                info: self.last_info,
+            };
+        }
+        let invalid_action = voltages.iter().any(|v| !v.is_finite());
+        let voltages = voltages.map(|u| if u.is_finite() { u } else { 0.0 });
+        self.step_voltages(voltages, invalid_action)
+    }
+
+    /// The body of a control step once the servos' voltages are known.
+    fn step_voltages(&mut self, voltages: [f32; NUM_JOINTS], invalid_action: bool) -> StepResult {
+        let stance = self.current_stance();
         self.model.set_voltages(voltages);
         let learned = task::learned_joints(stance);
         let torques = match self.model.control_step() {

@@ -41,17 +41,34 @@ pub struct WearPareto {
 }
 
 impl WearPareto {
-    fn panel<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>, physical: bool) -> anyhow::Result<()>
+    fn panel<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        physical: bool,
+    ) -> anyhow::Result<()>
     where
         DB::ErrorType: 'static,
     {
-        let x_of = |p: &WearPoint| if physical { p.physical_mtbf_s.mean } else { p.mtbf_s.mean };
+        let x_of = |p: &WearPoint| {
+            if physical {
+                p.physical_mtbf_s.mean
+            } else {
+                p.mtbf_s.mean
+            }
+        };
         let sarsa = self.sarsa_mtbf_s[physical as usize];
         let x = log_range(self.points.iter().map(x_of).chain([sarsa]));
-        let y = lin_range(
-            self.points.iter().flat_map(|p| [p.end.mean - finite_ci(&p.end), p.end.mean + finite_ci(&p.end)]),
-        );
-        let caption = if physical { "physical MTBF (simulated gear torque)" } else { "the paper's MTBF (commanded torque)" };
+        let y = lin_range(self.points.iter().flat_map(|p| {
+            [
+                p.end.mean - finite_ci(&p.end),
+                p.end.mean + finite_ci(&p.end),
+            ]
+        }));
+        let caption = if physical {
+            "physical MTBF (simulated gear torque)"
+        } else {
+            "the paper's MTBF (commanded torque)"
+        };
         let mut chart = ChartBuilder::on(area)
             .caption(caption, (FONT, 18))
             .margin(10)
@@ -79,12 +96,24 @@ impl WearPareto {
                 RGBColor(120, 120, 120).stroke_width(1),
             ))
             .map_err(plot_err)?;
-        let mut front: Vec<&WearPoint> =
-            self.points.iter().filter(|p| if physical { p.pareto_physical } else { p.pareto }).collect();
+        let mut front: Vec<&WearPoint> = self
+            .points
+            .iter()
+            .filter(|p| {
+                if physical {
+                    p.pareto_physical
+                } else {
+                    p.pareto
+                }
+            })
+            .collect();
         front.sort_by(|a, b| x_of(a).total_cmp(&x_of(b)));
         chart
             .draw_series(LineSeries::new(
-                front.iter().filter(|p| x_of(p).is_finite()).map(|p| (x_of(p), p.end.mean)),
+                front
+                    .iter()
+                    .filter(|p| x_of(p).is_finite())
+                    .map(|p| (x_of(p), p.end.mean)),
                 BLACK.stroke_width(2),
             ))
             .map_err(plot_err)?
@@ -117,9 +146,12 @@ impl WearPareto {
                         .legend(move |(x, y)| TriangleMarker::new((x + 10, y), 6, c.filled()));
                 }
             } else {
-                let s = chart.draw_series(std::iter::once(Circle::new(at, 4, c.filled()))).map_err(plot_err)?;
+                let s = chart
+                    .draw_series(std::iter::once(Circle::new(at, 4, c.filled())))
+                    .map_err(plot_err)?;
                 if first {
-                    s.label(p.algo.name()).legend(move |(x, y)| Circle::new((x + 10, y), 4, c.filled()));
+                    s.label(p.algo.name())
+                        .legend(move |(x, y)| Circle::new((x + 10, y), 4, c.filled()));
                 }
             }
         }
