@@ -11,7 +11,7 @@
 //! |---|---|---|---|
 //! | `f405` | 64 KB CCM + 128 KB SRAM (STM32F405) | exact, 24 960 Q16 weights (CCM, then SRAM) | hashed, see [`Board::profile`] |
 //! | `f429-sdram` | 8 MB SDRAM on the FMC (STM32F429I-DISC1) | exact, in SRAM | hashed, 2^21 Q16 weights (8 MiB) |
-//! | `host` | the heap | exact, as large as the policy needs | hashed, 2^22 Q16 weights (16 MiB) |
+//! | `host` | the heap | exact, as large as the policy needs | hashed, 2^24 Q16 weights (64 MiB) |
 //!
 //! [`config_hash`] covers the profile: a checkpoint saved under one
 //! profile is refused by another.
@@ -93,10 +93,20 @@ impl Board {
                 (Layout::Hashed, TableSize::Weights(1 << 21), WeightFormat::Q16, Memory::Sdram)
             }
             (Board::Host, true) => (Layout::Exact, TableSize::FitExact, WeightFormat::Q16, Memory::Heap),
-            // GRL used 2^24; 2^22 (16 MiB per agent) keeps two parallel
-            // trials small while a 14 666 s trial (4.4·10^5 steps × 16
-            // tilings) touches far fewer tiles than the table has slots.
-            (Board::Host, false) => (Layout::Hashed, TableSize::Weights(1 << 22), WeightFormat::Q16, Memory::Heap),
+            // 2^24 Q16 weights (64 MiB per agent), the size of the
+            // framework's own LEO table (docs/reference/grl.md §3.9).
+            // The framework's table is collision-free (a feature claims a
+            // slot when it is first written, and an unwritten feature
+            // reads its initial weight); a hashed table behaves alike only
+            // while few features share a slot. A 14 666 s trial writes
+            // enough features that 2^22 slots do not: there the greedy
+            // choice over 343 actions reads other features' learned
+            // weights for actions it never tried, and SARSA(λ) never got
+            // past one footstep (learning episodes ≈ 50 steps to the end).
+            // With 2^24 slots its episodes pass 100 steps after
+            // 40 000 learning steps and its test runs walk, as the
+            // framework's do (docs/leo/framework.md).
+            (Board::Host, false) => (Layout::Hashed, TableSize::Weights(1 << 24), WeightFormat::Q16, Memory::Heap),
         };
         LearnerProfile { board: self, robot, layout, size, format, memory }
     }

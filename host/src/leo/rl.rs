@@ -8,7 +8,7 @@
 //! 25 s episodes at 30 Hz — is the robot's one definition,
 //! [`pada_core::robot::leo::SPEC`]; the firmware builds its learner from
 //! the same. The table is the host's learner profile
-//! ([`Board::Host`]: hashed, 2^22 weights, 16 MiB of Q16.16 per agent), or
+//! ([`Board::Host`]: hashed, 2^24 weights, 64 MiB of Q16.16 per agent), or
 //! a board's with `pada run --board`.
 //!
 //! Gearbox torques for the fatigue counter, per physical gearbox (both hips,

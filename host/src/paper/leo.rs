@@ -177,7 +177,7 @@ pub fn run_local(
         .iter()
         .map(|c| c.run_config())
         .collect::<anyhow::Result<Vec<_>>>()?;
-    // Only the best learner so far is kept (16 MiB each), not all of them.
+    // Only the best learner so far is kept (64 MiB each), not all of them.
     let best: std::sync::Mutex<Option<BestTrial>> = std::sync::Mutex::new(None);
     let results = run_configs_keeping(&task, &cfgs, progress, &|f: FinishedTrial| {
         let e = f.result.end_performance;

@@ -61,6 +61,8 @@ impl Figure for ComparisonFigure<'_> {
             });
             let pad = ((hi - lo) * 0.08).max(0.01);
             let y = (lo - pad)..(hi + pad);
+            // Enough decimals that neighbouring ticks differ.
+            let decimals = if y.end - y.start < 0.1 { 3 } else { 2 };
             let mut chart = ChartBuilder::on(panel)
                 .caption(format!("{} [rad]", ANGLE_NAMES[k]), (FONT, 15))
                 .margin(8)
@@ -72,7 +74,7 @@ impl Figure for ComparisonFigure<'_> {
                 .configure_mesh()
                 .x_desc("time [s]")
                 .x_label_formatter(&|v| format!("{v:.2}"))
-                .y_label_formatter(&|v| format!("{v:.2}"))
+                .y_label_formatter(&|v| format!("{v:.decimals$}"))
                 .label_style((FONT, 11))
                 .axis_desc_style((FONT, 12))
                 .draw()
