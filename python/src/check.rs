@@ -35,18 +35,16 @@ pub fn finite_values(name: &str, obj: &Bound<'_, PyAny>, n: usize, what: &str, o
     if let Ok(f) = obj.cast::<PyFloat>() {
         return single(name, f.value(), n, what, out);
     }
-    if let Ok(x) = obj.extract::<f64>() {
-        // An int or a numpy scalar (not iterable as a sequence of numbers).
-        if obj.len().is_err() {
-            return single(name, x, n, what, out);
-        }
-    }
-    let len = obj.len().map_err(|_| {
-        PyValueError::new_err(format!(
-            "{name} must be a sequence of {n} numbers ({what}), got {}",
-            type_name(obj)
-        ))
-    })?;
+    let Ok(len) = obj.len() else {
+        // A number that is not a float (an int, a numpy scalar).
+        let x: f64 = obj.extract().map_err(|_| {
+            PyValueError::new_err(format!(
+                "{name} must be a number or a sequence of {n} numbers ({what}), got {}",
+                type_name(obj)
+            ))
+        })?;
+        return single(name, x, n, what, out);
+    };
     if len != n {
         return Err(PyValueError::new_err(format!(
             "{name} has {len} values, expected {n} ({what})"

@@ -29,6 +29,9 @@ pub struct Fatigue {
     torque_per_volt: Option<f64>,
     window: u32,
     buf: Vec<f64>,
+    /// Bounds the values are clipped to before counting (an action
+    /// space's, as the environment applies them), if any.
+    clip: Option<(Vec<f64>, Vec<f64>)>,
 }
 
 impl Fatigue {
@@ -49,7 +52,7 @@ impl Fatigue {
                     .map_err(|e| PyValueError::new_err(format!("window: {e}")))?,
             );
         }
-        Ok(Fatigue { joints: v, rate_hz, torque_per_volt, window, buf: vec![0.0; n] })
+        Ok(Fatigue { joints: v, rate_hz, torque_per_volt, window, buf: vec![0.0; n], clip: None })
     }
 
     /// The gear torque counted for an input value (a torque, or a voltage
@@ -92,6 +95,11 @@ impl Fatigue {
         let what = if self.torque_per_volt.is_some() { "one voltage per gearbox, V" } else { "one torque per gearbox, N m" };
         let mut buf = std::mem::take(&mut self.buf);
         let r = check::finite_values(name, obj, n, what, &mut buf);
+        if let Some((lo, hi)) = &self.clip {
+            for ((v, l), h) in buf.iter_mut().zip(lo).zip(hi) {
+                *v = v.clamp(*l, *h);
+            }
+        }
         self.buf = buf;
         r
     }
@@ -151,6 +159,39 @@ impl Fatigue {
         for row in values.chunks_exact(n) {
             self.add_checked(row);
         }
+        Ok(())
+    }
+
+    /// Clips every value to `[low, high]` (per gearbox) before counting, as
+    /// an environment clips its actions; `None` turns clipping off.
+    #[pyo3(signature = (low=None, high=None))]
+    fn set_clip(&mut self, low: Option<Vec<f64>>, high: Option<Vec<f64>>) -> PyResult<()> {
+        let n = self.joints.len();
+        self.clip = match (low, high) {
+            (None, None) => None,
+            (Some(l), Some(h)) if l.len() == n && h.len() == n && l.iter().zip(&h).all(|(a, b)| a <= b) => Some((l, h)),
+            _ => {
+                return Err(PyValueError::new_err(format!(
+                    "low, high: valid is two lists of {n} numbers with low <= high, or neither"
+                )))
+            }
+        };
+        Ok(())
+    }
+
+    /// `add(torques)`, then writes `damage`, `mtbf_s` (per gearbox) and
+    /// `robot_mtbf_s` into the dict `info` (what `MtbfWrapper` adds to
+    /// every step's info).
+    fn add_to_info(&mut self, torques: &Bound<'_, PyAny>, info: &Bound<'_, PyDict>) -> PyResult<()> {
+        self.read_step("torques", torques)?;
+        self.add_buffered();
+        let p = self.period_s();
+        let py = info.py();
+        let damage = pyo3::types::PyList::new(py, self.joints.iter().map(|j| j.damage()))?;
+        let mtbf = pyo3::types::PyList::new(py, self.joints.iter().map(|j| j.mtbf_s(p)))?;
+        info.set_item(pyo3::intern!(py, "damage"), damage)?;
+        info.set_item(pyo3::intern!(py, "mtbf_s"), mtbf)?;
+        info.set_item(pyo3::intern!(py, "robot_mtbf_s"), self.robot_mtbf_s())?;
         Ok(())
     }
 
