@@ -146,6 +146,8 @@ class MtbfWrapper(gym.Wrapper):
             self.fatigue.set_clip(self._source.low, self._source.high)
         self._add = self.fatigue.add_to_info
         self._torques = self._source.torques
+        # A 1-D Box of torques goes to the counter as it is (no Python call).
+        self._direct = self._source.box_1d
         self._ep_damage = [0.0] * self._source.joints
         self._ep_start = 0
 
@@ -156,7 +158,7 @@ class MtbfWrapper(gym.Wrapper):
 
     def step(self, action):
         obs, reward, terminated, truncated, info = self.env.step(action)
-        self._add(self._torques(action, obs, info), info)
+        self._add(action if self._direct else self._torques(action, obs, info), info)
         if terminated or truncated:
             self._episode_end(info)
         return obs, reward, terminated, truncated, info

@@ -3,7 +3,7 @@
 
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyFloat;
+use pyo3::types::{PyFloat, PyList, PyTuple};
 
 /// `ValueError("<name> = <value> is out of range: valid is <valid>")`.
 pub fn out_of_range(name: &str, value: impl std::fmt::Display, valid: &str) -> PyErr {
@@ -35,23 +35,58 @@ pub fn finite_values(name: &str, obj: &Bound<'_, PyAny>, n: usize, what: &str, o
     if let Ok(f) = obj.cast::<PyFloat>() {
         return single(name, f.value(), n, what, out);
     }
-    let Ok(len) = obj.len() else {
-        // A number that is not a float (an int, a numpy scalar).
-        let x: f64 = obj.extract().map_err(|_| {
-            PyValueError::new_err(format!(
-                "{name} must be a number or a sequence of {n} numbers ({what}), got {}",
-                type_name(obj)
-            ))
-        })?;
-        return single(name, x, n, what, out);
-    };
+    if let Ok(list) = obj.cast::<PyList>() {
+        return items(name, list.len(), |i| list.get_item(i), n, what, out);
+    }
+    if let Ok(t) = obj.cast::<PyTuple>() {
+        return items(name, t.len(), |i| t.get_item(i), n, what, out);
+    }
+    // A numpy array (or anything with tolist): one call turns it into
+    // Python numbers, far cheaper than iterating the array.
+    if let Ok(listed) = obj.call_method0(pyo3::intern!(obj.py(), "tolist")) {
+        if let Ok(list) = listed.cast::<PyList>() {
+            if list.iter().all(|x| !x.is_instance_of::<PyList>()) {
+                return items(name, list.len(), |i| list.get_item(i), n, what, out);
+            }
+            return Err(PyValueError::new_err(format!(
+                "{name} must be one-dimensional: {n} numbers ({what})"
+            )));
+        }
+        if let Ok(x) = listed.extract::<f64>() {
+            return single(name, x, n, what, out);
+        }
+    }
+    if obj.len().is_ok() {
+        let list = pyo3::types::PyList::new(obj.py(), obj.try_iter()?.collect::<PyResult<Vec<_>>>()?)?;
+        return items(name, list.len(), |i| list.get_item(i), n, what, out);
+    }
+    // A number that is not a float (an int, a numpy scalar).
+    let x: f64 = obj.extract().map_err(|_| {
+        PyValueError::new_err(format!(
+            "{name} must be a number or a sequence of {n} numbers ({what}), got {}",
+            type_name(obj)
+        ))
+    })?;
+    single(name, x, n, what, out)
+}
+
+fn items<'py>(
+    name: &str,
+    len: usize,
+    get: impl Fn(usize) -> PyResult<Bound<'py, PyAny>>,
+    n: usize,
+    what: &str,
+    out: &mut [f64],
+) -> PyResult<()> {
     if len != n {
         return Err(PyValueError::new_err(format!(
             "{name} has {len} values, expected {n} ({what})"
         )));
     }
-    for (i, item) in obj.try_iter()?.enumerate() {
-        let item = item?;
+    let mut tmp = [0.0f64; 64];
+    let tmp = &mut tmp[..n.min(64)];
+    for i in 0..n {
+        let item = get(i)?;
         let v: f64 = item.extract().map_err(|_| {
             PyValueError::new_err(format!(
                 "{name}[{i}] is not a number ({}); expected {n} numbers ({what})",
@@ -63,8 +98,13 @@ pub fn finite_values(name: &str, obj: &Bound<'_, PyAny>, n: usize, what: &str, o
                 "{name}[{i}] = {v} is not finite: valid is a finite number ({what})"
             )));
         }
-        out[i] = v;
+        if i < tmp.len() {
+            tmp[i] = v;
+        } else {
+            out[i] = v;
+        }
     }
+    out[..tmp.len()].copy_from_slice(tmp);
     Ok(())
 }
 
