@@ -33,6 +33,23 @@ fn f32_bytes<'py>(py: Python<'py>, v: impl Iterator<Item = f32>) -> Bound<'py, P
     PyBytes::new(py, &b)
 }
 
+/// One environment's step: its result, its last observation if the
+/// episode ended (then it is reset), and the commanded torques.
+type Stepped = (StepOut, Vec<f32>, Vec<f64>);
+
+fn step_one(e: &mut Core, c: &[f32; MAX_ACTION_DIMS], m: usize, obs_dim: usize) -> Stepped {
+    let s = e.step_command(&c[..m]);
+    let torques = e.commanded_torques();
+    let last = if s.terminal || s.truncated {
+        let last = e.obs.clone();
+        e.reset(None);
+        last
+    } else {
+        vec![f32::NAN; obs_dim]
+    };
+    (s, last, torques)
+}
+
 #[pymethods]
 impl LeoVectorCore {
     #[new]
@@ -88,23 +105,19 @@ impl LeoVectorCore {
             commands.push(c);
         }
         let obs_dim = self.obs_dim;
-        let results: Vec<(StepOut, Vec<f32>, Vec<f64>)> = py.detach(|| {
-            self.envs
-                .par_iter_mut()
-                .zip(commands.par_iter())
-                .map(|(e, c)| {
-                    let s = e.step_command(&c[..m]);
-                    let torques = e.commanded_torques();
-                    let last = if s.terminal || s.truncated {
-                        let last = e.obs.clone();
-                        e.reset(None);
-                        last
-                    } else {
-                        vec![f32::NAN; obs_dim]
-                    };
-                    (s, last, torques)
-                })
-                .collect()
+        // The calling thread steps environment 0 itself while rayon's pool
+        // steps the others: one environment needs no hand-off, n need n − 1.
+        let results: Vec<Stepped> = py.detach(|| {
+            let mut results: Vec<Option<Stepped>> = (0..n).map(|_| None).collect();
+            let (first_env, rest_envs) = self.envs.split_first_mut().expect("n >= 1");
+            let (first_res, rest_res) = results.split_first_mut().expect("n >= 1");
+            rayon::in_place_scope(|s| {
+                for ((e, c), r) in rest_envs.iter_mut().zip(&commands[1..]).zip(rest_res.iter_mut()) {
+                    s.spawn(move |_| *r = Some(step_one(e, c, m, obs_dim)));
+                }
+                *first_res = Some(step_one(first_env, &commands[0], m, obs_dim));
+            });
+            results.into_iter().map(|r| r.expect("every environment stepped")).collect()
         });
         let obs = f32_bytes(py, self.envs.iter().flat_map(|e| e.obs.iter().copied()));
         let last = f32_bytes(py, results.iter().flat_map(|r| r.1.iter().copied()));
