@@ -7,7 +7,9 @@ use pyo3::types::{PyFloat, PyList, PyTuple};
 
 /// `ValueError("<name> = <value> is out of range: valid is <valid>")`.
 pub fn out_of_range(name: &str, value: impl std::fmt::Display, valid: &str) -> PyErr {
-    PyValueError::new_err(format!("{name} = {value} is out of range: valid is {valid}"))
+    PyValueError::new_err(format!(
+        "{name} = {value} is out of range: valid is {valid}"
+    ))
 }
 
 /// A control rate in Hz: finite, `0 < rate_hz <= 1e6` (as `pada mtbf --rate`).
@@ -24,14 +26,24 @@ pub fn count(name: &str, value: i64, lo: i64, hi: i64) -> PyResult<usize> {
     if (lo..=hi).contains(&value) {
         Ok(value as usize)
     } else {
-        Err(out_of_range(name, value, &format!("{lo} <= {name} <= {hi}")))
+        Err(out_of_range(
+            name,
+            value,
+            &format!("{lo} <= {name} <= {hi}"),
+        ))
     }
 }
 
 /// Reads `n` finite numbers from `obj` into `out`: a sequence (list, tuple,
 /// numpy array) of length `n`, or a single number when `n == 1`. Nothing is
 /// written unless all are valid.
-pub fn finite_values(name: &str, obj: &Bound<'_, PyAny>, n: usize, what: &str, out: &mut [f64]) -> PyResult<()> {
+pub fn finite_values(
+    name: &str,
+    obj: &Bound<'_, PyAny>,
+    n: usize,
+    what: &str,
+    out: &mut [f64],
+) -> PyResult<()> {
     if let Ok(f) = obj.cast::<PyFloat>() {
         return single(name, f.value(), n, what, out);
     }
@@ -57,7 +69,8 @@ pub fn finite_values(name: &str, obj: &Bound<'_, PyAny>, n: usize, what: &str, o
         }
     }
     if obj.len().is_ok() {
-        let list = pyo3::types::PyList::new(obj.py(), obj.try_iter()?.collect::<PyResult<Vec<_>>>()?)?;
+        let list =
+            pyo3::types::PyList::new(obj.py(), obj.try_iter()?.collect::<PyResult<Vec<_>>>()?)?;
         return items(name, list.len(), |i| list.get_item(i), n, what, out);
     }
     // A number that is not a float (an int, a numpy scalar).

@@ -6,14 +6,15 @@
 use crate::check;
 use pada::experiment::task::{Plant, Task, TaskSpec};
 use pada::leo::rl::{LeoPlant, LeoTask};
-use pada::pendulum::{PhysicalPendulum, PhysicalPendulumTask, SimulatedPendulum, SimulatedPendulumTask};
+use pada::pendulum::{
+    PhysicalPendulum, PhysicalPendulumTask, SimulatedPendulum, SimulatedPendulumTask,
+};
 use pada_core::action_space::{Levels, MAX_ACTION_DIMS};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use rand_core::SeedableRng;
 use rand_pcg::Pcg64;
-use std::time::Instant;
 
 /// The robots, by the names `pada run --task` uses.
 pub const KINDS: &str = "\"pendulum\", \"physical-pendulum\" or \"leo\"";
@@ -29,14 +30,16 @@ pub enum AnyPlant {
 }
 
 impl AnyPlant {
-    fn get(&mut self) -> &mut dyn Plant {
+    /// The plant.
+    pub fn get(&mut self) -> &mut dyn Plant {
         match self {
             AnyPlant::Pendulum(p) => p,
             AnyPlant::Physical(p) => p,
             AnyPlant::Leo(p) => p.as_mut(),
         }
     }
-    fn get_ref(&self) -> &dyn Plant {
+    /// The plant, shared.
+    pub fn get_ref(&self) -> &dyn Plant {
         match self {
             AnyPlant::Pendulum(p) => p,
             AnyPlant::Physical(p) => p,
@@ -99,7 +102,14 @@ impl Core {
     pub fn new(kind: &str) -> PyResult<Core> {
         let (spec, plant) = make(kind)?;
         let n = spec.state.len();
-        Ok(Core { spec, plant, obs: vec![0.0; n], steps: 0, command: [0.0; MAX_ACTION_DIMS], rng: Pcg64::seed_from_u64(0) })
+        Ok(Core {
+            spec,
+            plant,
+            obs: vec![0.0; n],
+            steps: 0,
+            command: [0.0; MAX_ACTION_DIMS],
+            rng: Pcg64::seed_from_u64(0),
+        })
     }
 
     /// Starts an episode; `seed` reseeds the plant's generator (the
@@ -120,7 +130,11 @@ impl Core {
         self.command[..m].copy_from_slice(&command[..m]);
         let s = self.plant.get().step(&command[..m], &mut self.obs[..n]);
         self.steps += 1;
-        StepOut { reward: s.reward, terminal: s.terminal, truncated: !s.terminal && self.steps >= self.spec.episode_steps }
+        StepOut {
+            reward: s.reward,
+            terminal: s.terminal,
+            truncated: !s.terminal && self.steps >= self.spec.episode_steps,
+        }
     }
 
     /// One control period with the motor's levels.
@@ -154,7 +168,11 @@ impl Core {
         for (i, &a) in action.iter().enumerate().take(m) {
             let n = self.spec.motor.dim(i).len() as i64;
             if !(0..n).contains(&a) {
-                return Err(check::out_of_range(&format!("action[{i}]"), a, &format!("0 <= action[{i}] < {n}")));
+                return Err(check::out_of_range(
+                    &format!("action[{i}]"),
+                    a,
+                    &format!("0 <= action[{i}] < {n}"),
+                ));
             }
             levels[i] = a as u8;
         }
@@ -170,7 +188,11 @@ impl Core {
                 return Err(check::out_of_range(
                     &format!("action[{i}]"),
                     a,
-                    &format!("{} <= action[{i}] <= {} (the motor's range)", d.min(), d.max()),
+                    &format!(
+                        "{} <= action[{i}] <= {} (the motor's range)",
+                        d.min(),
+                        d.max()
+                    ),
                 ));
             }
             c[i] = a as f32;
@@ -196,20 +218,35 @@ fn tuple_of<'py>(py: Python<'py>, v: &[f32]) -> PyResult<Bound<'py, PyTuple>> {
 }
 
 /// Reads `m` action values from a Python object (sequence or number).
-fn read_action<T: for<'a, 'py> FromPyObject<'a, 'py>>(obj: &Bound<'_, PyAny>, m: usize, out: &mut Vec<T>) -> PyResult<()> {
+fn read_action<T: for<'a, 'py> FromPyObject<'a, 'py>>(
+    obj: &Bound<'_, PyAny>,
+    m: usize,
+    out: &mut Vec<T>,
+) -> PyResult<()> {
     out.clear();
     if let Ok(len) = obj.len() {
         if len != m {
-            return Err(PyValueError::new_err(format!("action has {len} values, expected {m} (one per motor dimension)")));
+            return Err(PyValueError::new_err(format!(
+                "action has {len} values, expected {m} (one per motor dimension)"
+            )));
         }
         for item in obj.try_iter()? {
-            out.push(item?.extract::<T>().map_err(|_| PyValueError::new_err("action: every value must be a number"))?);
+            out.push(
+                item?
+                    .extract::<T>()
+                    .map_err(|_| PyValueError::new_err("action: every value must be a number"))?,
+            );
         }
     } else {
         if m != 1 {
-            return Err(PyValueError::new_err(format!("action is one number, expected {m} values (one per motor dimension)")));
+            return Err(PyValueError::new_err(format!(
+                "action is one number, expected {m} values (one per motor dimension)"
+            )));
         }
-        out.push(obj.extract::<T>().map_err(|_| PyValueError::new_err("action must be a number"))?);
+        out.push(
+            obj.extract::<T>()
+                .map_err(|_| PyValueError::new_err("action must be a number"))?,
+        );
     }
     Ok(())
 }
@@ -219,7 +256,12 @@ impl PlantEnv {
     #[new]
     #[pyo3(signature = (robot, continuous=false))]
     fn new(robot: &str, continuous: bool) -> PyResult<Self> {
-        Ok(PlantEnv { core: Core::new(robot)?, continuous, ints: Vec::new(), floats: Vec::new() })
+        Ok(PlantEnv {
+            core: Core::new(robot)?,
+            continuous,
+            ints: Vec::new(),
+            floats: Vec::new(),
+        })
     }
 
     /// The task: `name`, `control_period_s`, `episode_steps`, `gearboxes`,
@@ -234,11 +276,22 @@ impl PlantEnv {
         d.set_item("episode_steps", s.episode_steps)?;
         d.set_item("gearboxes", s.gearboxes)?;
         d.set_item("worst_torque", s.worst_torque_nm as f64)?;
-        let levels: Vec<Vec<f64>> = (0..s.motor.dims()).map(|i| s.motor.dim(i).values().iter().map(|&v| v as f64).collect()).collect();
+        let levels: Vec<Vec<f64>> = (0..s.motor.dims())
+            .map(|i| s.motor.dim(i).values().iter().map(|&v| v as f64).collect())
+            .collect();
         d.set_item("levels", levels)?;
-        d.set_item("state_low", s.state.iter().map(|x| x.min as f64).collect::<Vec<_>>())?;
-        d.set_item("state_high", s.state.iter().map(|x| x.max as f64).collect::<Vec<_>>())?;
-        d.set_item("state_wraps", s.state.iter().map(|x| x.wrap).collect::<Vec<_>>())?;
+        d.set_item(
+            "state_low",
+            s.state.iter().map(|x| x.min as f64).collect::<Vec<_>>(),
+        )?;
+        d.set_item(
+            "state_high",
+            s.state.iter().map(|x| x.max as f64).collect::<Vec<_>>(),
+        )?;
+        d.set_item(
+            "state_wraps",
+            s.state.iter().map(|x| x.wrap).collect::<Vec<_>>(),
+        )?;
         d.set_item("torque_note", s.torque_note)?;
         Ok(d)
     }
@@ -254,7 +307,11 @@ impl PlantEnv {
     /// The action is one level index per motor dimension (a number for one
     /// dimension), or with `continuous` the commands themselves (torque or
     /// voltage, within the motor's range).
-    fn step<'py>(&mut self, py: Python<'py>, action: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyTuple>> {
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        action: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyTuple>> {
         let m = self.core.spec.motor.dims();
         let out = if self.continuous {
             let mut v = std::mem::take(&mut self.floats);
@@ -270,7 +327,19 @@ impl PlantEnv {
             self.core.step_levels(&l)
         };
         let obs = tuple_of(py, &self.core.obs)?;
-        PyTuple::new(py, [obs.into_any(), (out.reward as f64).into_pyobject(py)?.into_any(), pyo3::types::PyBool::new(py, out.terminal).to_owned().into_any(), pyo3::types::PyBool::new(py, out.truncated).to_owned().into_any()])
+        PyTuple::new(
+            py,
+            [
+                obs.into_any(),
+                (out.reward as f64).into_pyobject(py)?.into_any(),
+                pyo3::types::PyBool::new(py, out.terminal)
+                    .to_owned()
+                    .into_any(),
+                pyo3::types::PyBool::new(py, out.truncated)
+                    .to_owned()
+                    .into_any(),
+            ],
+        )
     }
 
     /// The paper's gear torques of the last step, per gearbox \[N m\]
@@ -289,71 +358,4 @@ impl PlantEnv {
     fn walked_distance_m(&self) -> Option<f64> {
         self.core.plant.get_ref().walked_distance_m()
     }
-}
-
-/// `pada run`'s environment without Python: the task's plant driven
-/// through `actions` (level indices, or commands with `continuous`) as the
-/// experiment runner drives it — reset at the start, after an absorbing
-/// state and at the time limit. Returns one `(obs, reward, terminated,
-/// truncated)` per step, for the tests.
-#[pyfunction]
-#[pyo3(signature = (robot, actions, continuous=false, seed=0))]
-pub fn reference_rollout(py: Python<'_>, robot: &str, actions: Vec<Vec<f64>>, continuous: bool, seed: u64) -> PyResult<Vec<(Vec<f64>, f64, bool, bool)>> {
-    let (spec, mut plant) = make(robot)?;
-    let n = spec.state.len();
-    let m = spec.motor.dims();
-    let mut rng = Pcg64::seed_from_u64(seed);
-    let mut obs = vec![0.0f32; n];
-    let mut out = Vec::with_capacity(actions.len());
-    py.detach(|| {
-        plant.get().reset(&mut rng, &mut obs);
-        let mut k = 0u32;
-        for a in &actions {
-            let mut command = [0.0f32; MAX_ACTION_DIMS];
-            if continuous {
-                for i in 0..m {
-                    command[i] = a[i] as f32;
-                }
-            } else {
-                let mut l = Levels::default();
-                for i in 0..m {
-                    l[i] = a[i] as u8;
-                }
-                let o = spec.motor.values(&l);
-                command[..m].copy_from_slice(&o[..m]);
-            }
-            let s = plant.get().step(&command[..m], &mut obs);
-            k += 1;
-            let truncated = !s.terminal && k == spec.episode_steps;
-            out.push((obs.iter().map(|&x| x as f64).collect(), s.reward as f64, s.terminal, truncated));
-            if s.terminal || truncated {
-                plant.get().reset(&mut rng, &mut obs);
-                k = 0;
-            }
-        }
-    });
-    Ok(out)
-}
-
-/// Seconds per control step of `robot` stepped `steps` times in Rust alone
-/// (no Python), with the level indices of `actions` in turn and resets at
-/// episode ends: the benchmark's reference.
-#[pyfunction]
-pub fn bench_rust_steps(py: Python<'_>, robot: &str, actions: Vec<Vec<i64>>, steps: u64) -> PyResult<f64> {
-    let mut core = Core::new(robot)?;
-    if actions.is_empty() {
-        return Err(PyValueError::new_err("actions: valid is at least one action"));
-    }
-    let levels: Vec<Levels> = actions.iter().map(|a| core.levels_of(a)).collect::<PyResult<_>>()?;
-    Ok(py.detach(|| {
-        core.reset(Some(0));
-        let t = Instant::now();
-        for k in 0..steps as usize {
-            let s = core.step_levels(&levels[k % levels.len()]);
-            if s.terminal || s.truncated {
-                core.reset(None);
-            }
-        }
-        t.elapsed().as_secs_f64() / steps.max(1) as f64
-    }))
 }

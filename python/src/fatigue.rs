@@ -36,12 +36,21 @@ pub struct Fatigue {
 
 impl Fatigue {
     /// A counter of `joints` gearboxes; the arguments checked.
-    pub fn build(joints: i64, rate_hz: f64, torque_per_volt: Option<f64>, window: i64) -> PyResult<Fatigue> {
+    pub fn build(
+        joints: i64,
+        rate_hz: f64,
+        torque_per_volt: Option<f64>,
+        window: i64,
+    ) -> PyResult<Fatigue> {
         let n = check::count("joints", joints, 1, MAX_JOINTS)?;
         let rate_hz = check::rate_hz("rate_hz", rate_hz)?;
         if let Some(k) = torque_per_volt {
             if !(k.is_finite() && k > 0.0) {
-                return Err(check::out_of_range("torque_per_volt", k, "0 < torque_per_volt < inf (N m per V)"));
+                return Err(check::out_of_range(
+                    "torque_per_volt",
+                    k,
+                    "0 < torque_per_volt < inf (N m per V)",
+                ));
             }
         }
         let window = check::count("window", window, 1, u32::MAX as i64)? as u32;
@@ -52,7 +61,14 @@ impl Fatigue {
                     .map_err(|e| PyValueError::new_err(format!("window: {e}")))?,
             );
         }
-        Ok(Fatigue { joints: v, rate_hz, torque_per_volt, window, buf: vec![0.0; n], clip: None })
+        Ok(Fatigue {
+            joints: v,
+            rate_hz,
+            torque_per_volt,
+            window,
+            buf: vec![0.0; n],
+            clip: None,
+        })
     }
 
     /// The gear torque counted for an input value (a torque, or a voltage
@@ -86,13 +102,20 @@ impl Fatigue {
     /// Robot MTBF (weakest gearbox) over the whole run.
     pub fn robot_mtbf_s(&self) -> f64 {
         let p = self.period_s();
-        self.joints.iter().map(|j| j.mtbf_s(p)).fold(f64::INFINITY, f64::min)
+        self.joints
+            .iter()
+            .map(|j| j.mtbf_s(p))
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// Reads one step's values from a Python object into the buffer.
     pub fn read_step(&mut self, name: &str, obj: &Bound<'_, PyAny>) -> PyResult<()> {
         let n = self.joints.len();
-        let what = if self.torque_per_volt.is_some() { "one voltage per gearbox, V" } else { "one torque per gearbox, N m" };
+        let what = if self.torque_per_volt.is_some() {
+            "one voltage per gearbox, V"
+        } else {
+            "one torque per gearbox, N m"
+        };
         let mut buf = std::mem::take(&mut self.buf);
         let r = check::finite_values(name, obj, n, what, &mut buf);
         if let Some((lo, hi)) = &self.clip {
@@ -169,7 +192,11 @@ impl Fatigue {
         let n = self.joints.len();
         self.clip = match (low, high) {
             (None, None) => None,
-            (Some(l), Some(h)) if l.len() == n && h.len() == n && l.iter().zip(&h).all(|(a, b)| a <= b) => Some((l, h)),
+            (Some(l), Some(h))
+                if l.len() == n && h.len() == n && l.iter().zip(&h).all(|(a, b)| a <= b) =>
+            {
+                Some((l, h))
+            }
             _ => {
                 return Err(PyValueError::new_err(format!(
                     "low, high: valid is two lists of {n} numbers with low <= high, or neither"
@@ -182,7 +209,11 @@ impl Fatigue {
     /// `add(torques)`, then writes `damage`, `mtbf_s` (per gearbox) and
     /// `robot_mtbf_s` into the dict `info` (what `MtbfWrapper` adds to
     /// every step's info).
-    fn add_to_info(&mut self, torques: &Bound<'_, PyAny>, info: &Bound<'_, PyDict>) -> PyResult<()> {
+    fn add_to_info(
+        &mut self,
+        torques: &Bound<'_, PyAny>,
+        info: &Bound<'_, PyDict>,
+    ) -> PyResult<()> {
         self.read_step("torques", torques)?;
         self.add_buffered();
         let p = self.period_s();
@@ -256,7 +287,10 @@ impl Fatigue {
         d.set_item("steps", self.joints[0].steps())?;
         d.set_item("rate_hz", self.rate_hz)?;
         d.set_item("window_steps", self.window)?;
-        d.set_item("reengagements", r.iter().map(|x| x.reengagements).collect::<Vec<_>>())?;
+        d.set_item(
+            "reengagements",
+            r.iter().map(|x| x.reengagements).collect::<Vec<_>>(),
+        )?;
         d.set_item("damage", r.iter().map(|x| x.damage).collect::<Vec<_>>())?;
         d.set_item("mtbf_s", r.iter().map(|x| x.mtbf_s).collect::<Vec<_>>())?;
         let w = |f: fn(&pada_core::fatigue::WindowReport) -> f64| -> Vec<f64> {
@@ -264,11 +298,19 @@ impl Fatigue {
         };
         d.set_item(
             "window_reengagements",
-            r.iter().map(|x| x.window.map_or(0, |w| w.reengagements)).collect::<Vec<_>>(),
+            r.iter()
+                .map(|x| x.window.map_or(0, |w| w.reengagements))
+                .collect::<Vec<_>>(),
         )?;
         d.set_item("window_damage", w(|w| w.damage))?;
-        let wm: Vec<f64> = r.iter().map(|x| x.window.map_or(f64::INFINITY, |w| w.mtbf_s)).collect();
-        d.set_item("robot_window_mtbf_s", wm.iter().copied().fold(f64::INFINITY, f64::min))?;
+        let wm: Vec<f64> = r
+            .iter()
+            .map(|x| x.window.map_or(f64::INFINITY, |w| w.mtbf_s))
+            .collect();
+        d.set_item(
+            "robot_window_mtbf_s",
+            wm.iter().copied().fold(f64::INFINITY, f64::min),
+        )?;
         d.set_item("window_mtbf_s", wm)?;
         d.set_item("robot_mtbf_s", self.robot_mtbf_s())?;
         Ok(d)

@@ -33,15 +33,30 @@ pub struct WearGovernor {
 impl WearGovernor {
     #[new]
     #[pyo3(signature = (mtbf_budget, rate_hz, *, joints, levels, worst_torque, restricts="delta"))]
-    fn new(mtbf_budget: f64, rate_hz: f64, joints: i64, levels: i64, worst_torque: f64, restricts: &str) -> PyResult<Self> {
+    fn new(
+        mtbf_budget: f64,
+        rate_hz: f64,
+        joints: i64,
+        levels: i64,
+        worst_torque: f64,
+        restricts: &str,
+    ) -> PyResult<Self> {
         if !(mtbf_budget.is_finite() && mtbf_budget > 0.0 && mtbf_budget <= MAX_BUDGET_S as f64) {
-            return Err(check::out_of_range("mtbf_budget", mtbf_budget, "0 < mtbf_budget <= 1e10 (s)"));
+            return Err(check::out_of_range(
+                "mtbf_budget",
+                mtbf_budget,
+                "0 < mtbf_budget <= 1e10 (s)",
+            ));
         }
         let rate_hz = check::rate_hz("rate_hz", rate_hz)?;
         let n = check::count("joints", joints, 1, GOVERNED_JOINTS as i64)?;
         let levels = check::count("levels", levels, 2, 255)?;
         if !(worst_torque.is_finite() && worst_torque > 0.0) {
-            return Err(check::out_of_range("worst_torque", worst_torque, "0 < worst_torque < inf (N m)"));
+            return Err(check::out_of_range(
+                "worst_torque",
+                worst_torque,
+                "0 < worst_torque < inf (N m)",
+            ));
         }
         let kind = match restricts {
             "delta" => PolicyKind::Pada { delta: 1.0 },
@@ -52,8 +67,10 @@ impl WearGovernor {
                 )))
             }
         };
-        let dim = ActionDim::uniform(-1.0, 1.0, levels).map_err(|e| PyValueError::new_err(format!("levels: {e}")))?;
-        let motor = ActionSpace::new(&[dim]).map_err(|e| PyValueError::new_err(format!("levels: {e}")))?;
+        let dim = ActionDim::uniform(-1.0, 1.0, levels)
+            .map_err(|e| PyValueError::new_err(format!("levels: {e}")))?;
+        let motor =
+            ActionSpace::new(&[dim]).map_err(|e| PyValueError::new_err(format!("levels: {e}")))?;
         let config = GovernorConfig {
             budget_s: mtbf_budget as f32,
             period_s: 1.0 / rate_hz,
@@ -61,9 +78,14 @@ impl WearGovernor {
             worst_torque_nm: worst_torque as f32,
             joints: n as u8,
         };
-        let governor = Governor::new(&kind, &motor, &config).map_err(|e| PyValueError::new_err(format!("mtbf_budget: {e}")))?;
+        let governor = Governor::new(&kind, &motor, &config)
+            .map_err(|e| PyValueError::new_err(format!("mtbf_budget: {e}")))?;
         let fatigue = Fatigue::build(n as i64, rate_hz, None, PAPER_WINDOW_STEPS as i64)?;
-        Ok(WearGovernor { governor, fatigue, before: vec![0; n] })
+        Ok(WearGovernor {
+            governor,
+            fatigue,
+            before: vec![0; n],
+        })
     }
 
     /// One action's gear torques (one per gearbox, N m): counts them and

@@ -14,6 +14,7 @@ mod check;
 mod envs;
 mod fatigue;
 mod governor;
+mod reference;
 mod telemetry;
 mod vector;
 
@@ -25,8 +26,8 @@ fn _pada(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<envs::PlantEnv>()?;
     m.add_class::<vector::LeoVectorCore>()?;
     m.add_function(wrap_pyfunction!(telemetry::read_telemetry, m)?)?;
-    m.add_function(wrap_pyfunction!(envs::reference_rollout, m)?)?;
-    m.add_function(wrap_pyfunction!(envs::bench_rust_steps, m)?)?;
+    m.add_function(wrap_pyfunction!(reference::reference_rollout, m)?)?;
+    m.add_function(wrap_pyfunction!(reference::bench_rust_steps, m)?)?;
     m.add(
         "RX28_TORQUE_PER_VOLT",
         pada_core::robot::leo::commanded_gear_torque(1.0) as f64,

@@ -13,14 +13,18 @@ use pyo3::types::PyDict;
 /// side turns them into numpy arrays) and `summary_json`, the link and
 /// message counts as `pada capture --json` writes them.
 #[pyfunction]
-pub fn read_telemetry<'py>(py: Python<'py>, path: std::path::PathBuf) -> PyResult<Bound<'py, PyDict>> {
+pub fn read_telemetry<'py>(
+    py: Python<'py>,
+    path: std::path::PathBuf,
+) -> PyResult<Bound<'py, PyDict>> {
     if path.is_dir() {
         return Err(PyValueError::new_err(format!(
             "path = {} is a directory: valid is a recorded telemetry stream file",
             path.display()
         )));
     }
-    let bytes = std::fs::read(&path).map_err(|e| PyOSError::new_err(format!("path = {}: cannot read: {e}", path.display())))?;
+    let bytes = std::fs::read(&path)
+        .map_err(|e| PyOSError::new_err(format!("path = {}: cannot read: {e}", path.display())))?;
     let (rec, frames) = py.detach(|| {
         let mut rec = Recorder::new(None).expect("no CSV to write");
         let mut frames = Vec::new();
@@ -29,10 +33,31 @@ pub fn read_telemetry<'py>(py: Python<'py>, path: std::path::PathBuf) -> PyResul
         (rec, frames)
     });
     let d = PyDict::new(py);
-    let (mut step, mut time_ms, mut episode, mut mode, mut kind, mut action, mut reward, mut td, mut explored) =
-        (vec![], vec![], vec![], vec![], vec![], vec![], vec![], vec![], vec![]);
-    let (mut state, mut output, mut damage, mut reeng, mut loop_us) = (vec![], vec![], vec![], vec![], vec![]);
-    let (mut e_index, mut e_mode, mut e_return, mut e_length, mut e_checksum) = (vec![], vec![], vec![], vec![], vec![]);
+    let (
+        mut step,
+        mut time_ms,
+        mut episode,
+        mut mode,
+        mut kind,
+        mut action,
+        mut reward,
+        mut td,
+        mut explored,
+    ) = (
+        vec![],
+        vec![],
+        vec![],
+        vec![],
+        vec![],
+        vec![],
+        vec![],
+        vec![],
+        vec![],
+    );
+    let (mut state, mut output, mut damage, mut reeng, mut loop_us) =
+        (vec![], vec![], vec![], vec![], vec![]);
+    let (mut e_index, mut e_mode, mut e_return, mut e_length, mut e_checksum) =
+        (vec![], vec![], vec![], vec![], vec![]);
     for f in &frames {
         match &f.msg {
             ToHost::Step(s) => {

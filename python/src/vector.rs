@@ -26,7 +26,14 @@ pub struct LeoVectorCore {
 
 /// What `step` returns: observations, rewards, ends, last observations of
 /// ended episodes, commanded torques (all flat, env-major).
-type StepBytes<'py> = (Bound<'py, PyBytes>, Vec<f64>, Vec<bool>, Vec<bool>, Bound<'py, PyBytes>, Bound<'py, PyBytes>);
+type StepBytes<'py> = (
+    Bound<'py, PyBytes>,
+    Vec<f64>,
+    Vec<bool>,
+    Vec<bool>,
+    Bound<'py, PyBytes>,
+    Bound<'py, PyBytes>,
+);
 
 fn f32_bytes<'py>(py: Python<'py>, v: impl Iterator<Item = f32>) -> Bound<'py, PyBytes> {
     let b: Vec<u8> = v.flat_map(|x| x.to_ne_bytes()).collect();
@@ -56,11 +63,22 @@ impl LeoVectorCore {
     #[pyo3(signature = (n, robot="leo", continuous=false))]
     fn new(py: Python<'_>, n: i64, robot: &str, continuous: bool) -> PyResult<Self> {
         let n = check::count("n", n, 1, MAX_ENVS)?;
-        let envs = py.detach(|| (0..n).into_par_iter().map(|_| Core::new(robot)).collect::<PyResult<Vec<_>>>())?;
+        let envs = py.detach(|| {
+            (0..n)
+                .into_par_iter()
+                .map(|_| Core::new(robot))
+                .collect::<PyResult<Vec<_>>>()
+        })?;
         let obs_dim = envs[0].spec.state.len();
         let act_dim = envs[0].spec.motor.dims();
         let gearboxes = envs[0].spec.gearboxes;
-        Ok(LeoVectorCore { envs, continuous, obs_dim, act_dim, gearboxes })
+        Ok(LeoVectorCore {
+            envs,
+            continuous,
+            obs_dim,
+            act_dim,
+            gearboxes,
+        })
     }
 
     /// Resets every environment (environment i with `seed + i` when a seed
@@ -92,7 +110,11 @@ impl LeoVectorCore {
                 let mut ints = [0i64; MAX_ACTION_DIMS];
                 for (i, &x) in a.iter().enumerate() {
                     if x.fract() != 0.0 || !x.is_finite() {
-                        return Err(check::out_of_range(&format!("actions[{i}]"), x, "an integer level index"));
+                        return Err(check::out_of_range(
+                            &format!("actions[{i}]"),
+                            x,
+                            "an integer level index",
+                        ));
                     }
                     ints[i] = x as i64;
                 }
@@ -112,16 +134,26 @@ impl LeoVectorCore {
             let (first_env, rest_envs) = self.envs.split_first_mut().expect("n >= 1");
             let (first_res, rest_res) = results.split_first_mut().expect("n >= 1");
             rayon::in_place_scope(|s| {
-                for ((e, c), r) in rest_envs.iter_mut().zip(&commands[1..]).zip(rest_res.iter_mut()) {
+                for ((e, c), r) in rest_envs
+                    .iter_mut()
+                    .zip(&commands[1..])
+                    .zip(rest_res.iter_mut())
+                {
                     s.spawn(move |_| *r = Some(step_one(e, c, m, obs_dim)));
                 }
                 *first_res = Some(step_one(first_env, &commands[0], m, obs_dim));
             });
-            results.into_iter().map(|r| r.expect("every environment stepped")).collect()
+            results
+                .into_iter()
+                .map(|r| r.expect("every environment stepped"))
+                .collect()
         });
         let obs = f32_bytes(py, self.envs.iter().flat_map(|e| e.obs.iter().copied()));
         let last = f32_bytes(py, results.iter().flat_map(|r| r.1.iter().copied()));
-        let torques: Vec<u8> = results.iter().flat_map(|r| r.2.iter().flat_map(|x| x.to_ne_bytes())).collect();
+        let torques: Vec<u8> = results
+            .iter()
+            .flat_map(|r| r.2.iter().flat_map(|x| x.to_ne_bytes()))
+            .collect();
         Ok((
             obs,
             results.iter().map(|r| r.0.reward as f64).collect(),
