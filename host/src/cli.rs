@@ -146,7 +146,7 @@ pub struct RunArgs {
     /// Seed and threads.
     #[command(flatten)]
     pub trial: TrialOptions,
-    /// Plans, merges and Slurm (issue 14).
+    /// Plans, merges and Slurm.
     #[command(flatten)]
     pub cluster: crate::plan::mode::ClusterOptions,
 }
@@ -241,7 +241,7 @@ pub struct PaperArgs {
     /// Seed and threads.
     #[command(flatten)]
     pub trial: TrialOptions,
-    /// Plans, merges and Slurm (issue 14).
+    /// Plans, merges and Slurm.
     #[command(flatten)]
     pub cluster: crate::plan::mode::ClusterOptions,
 }

@@ -24,7 +24,7 @@ use crate::trace::TraceKind;
 use crate::weights::{WeightFormat, WeightStore};
 
 /// Tilings of every board's tile coder: the paper's reference
-/// configuration (GRL, grl-facts §4 and §5).
+/// configuration (GRL, docs/reference/grl.md §4 and §5).
 pub const TILINGS: usize = 16;
 /// Capacity of every board's eligibility trace, in (state, action) entries:
 /// LEO's γλ = 0.9962 · 0.8582 keeps 30 entries above 0.01, the paper's

@@ -9,7 +9,7 @@
 //! **Offsets.** Tiling `j` shifts dimension `i` by `b_ij = j·(2i + 1)`
 //! sub-tiles (modulo `T`), the odd displacement vector (1, 3, 5, …)
 //! recommended by Sutton & Barto and used by the paper's reference
-//! implementation (GRL, `../shared/reference/grl-facts.md` §5.1). The tile
+//! implementation (GRL, `docs/reference/grl.md` §5.1). The tile
 //! that contains `q_i` in tiling `j` starts at
 //! `c_ij = q_i − ((q_i − b_ij) mod T)` (non-negative modulo).
 //! A wrapping dimension (an angle) has a whole number `n` of tiles per

@@ -1,7 +1,7 @@
 //! Bounded eligibility traces.
 //!
 //! As in the paper's reference implementation
-//! (`../shared/reference/grl-facts.md` §5.3–5.4), a trace is a queue of the
+//! (`docs/reference/grl.md` §5.3–5.4), a trace is a queue of the
 //! feature sets of recent (state, action) pairs, newest last. The k-th most
 //! recent entry (k = 0 for the current one) has eligibility `(γλ)^k`; the
 //! queue keeps only entries whose eligibility is at least a threshold, which

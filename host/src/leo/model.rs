@@ -1,5 +1,5 @@
 //! LEO as a rapier3d world, built in one function from the named constants
-//! of [`super::constants`] (`grl-facts.md` §1), and its physics step.
+//! of [`super::constants`] (`docs/reference/grl.md` §1), and its physics step.
 //!
 //! # How the reference model maps onto rapier
 //!
@@ -440,7 +440,7 @@ impl ModelOptions {
     }
 }
 
-/// What went wrong when the simulation blew up (issue 4, "Bad input").
+/// What went wrong when the simulation blew up (bad input).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum BlowUp {
     /// A coordinate or velocity is NaN or infinite.
@@ -616,7 +616,7 @@ impl LeoModel {
         }
 
         // The planar root joint: a fixed anchor at the world origin, the
-        // torso free in x, z and pitch (issue 4: planar motion locked
+        // torso free in x, z and pitch (planar motion locked
         // explicitly).
         let anchor = world.bodies.insert(RigidBodyBuilder::fixed());
         let planar = if options.fixed_torso {
