@@ -267,7 +267,7 @@ fn layout_fingerprint() -> u32 {
 fn the_protocol_version_changes_with_the_layout() {
     // A change of any message's layout changes this fingerprint: then bump
     // PROTOCOL_VERSION and put the new pair here (with the docs that name
-    // the version: docs/sil.md, firmware/README.md, README.md).
+    // the version: docs/sil.md, docs/core.md, firmware/README.md).
     assert_eq!((PROTOCOL_VERSION, layout_fingerprint()), (6, EXPECTED_FINGERPRINT), "{:#010x}", layout_fingerprint());
 }
 
