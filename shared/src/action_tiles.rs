@@ -26,7 +26,7 @@
 use crate::action_space::{ActionSpace, Levels, MAX_ACTION_DIMS, MAX_LEVELS};
 use crate::error::ConfigError;
 use crate::fixed::floor_i32;
-use crate::tile_coding::tile_start;
+use crate::tiling::tile_start;
 
 /// Most action-tile combinations in one tiling (the product over action
 /// dimensions of the tiles their levels fall into). Bounds the table the

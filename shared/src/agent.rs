@@ -489,7 +489,7 @@ where
             .write_f32(self.params.gamma)
             .write_f32(self.params.lambda)
             .write_f32(self.params.trace_threshold)
-            .write_u32(crate::profile::trace_kind_code(self.params.trace_kind));
+            .write_u32(self.params.trace_kind.code());
     }
 
     /// The action policy.

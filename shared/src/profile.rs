@@ -20,7 +20,6 @@ use crate::agent::Agent;
 use crate::checkpoint::ConfigHasher;
 use crate::robot::Robot;
 use crate::tile_coding::Layout;
-use crate::trace::TraceKind;
 use crate::weights::{WeightFormat, WeightStore};
 
 /// Tilings of every board's tile coder: the paper's reference
@@ -232,28 +231,13 @@ pub fn config_hash<W: WeightStore, const TILINGS_: usize, const TRACE_: usize>(
     h.write_u32(CONFIG_HASH_VERSION)
         .write_str(profile.robot.name())
         .write_str(profile.board.name())
-        .write_u32(layout_code(profile.layout))
+        .write_u32(profile.layout.code())
         .write_u32(agent.weights().len() as u32)
         .write_u32(agent.weights().format().code());
     agent.write_config(&mut h);
     h.finish()
 }
 
-/// A stable number of a layout.
-pub const fn layout_code(layout: Layout) -> u32 {
-    match layout {
-        Layout::Hashed => 1,
-        Layout::Exact => 2,
-    }
-}
-
-/// A stable number of a trace kind.
-pub const fn trace_kind_code(kind: TraceKind) -> u32 {
-    match kind {
-        TraceKind::Replacing => 1,
-        TraceKind::Accumulating => 2,
-    }
-}
 
 #[cfg(test)]
 mod tests {

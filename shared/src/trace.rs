@@ -34,6 +34,16 @@ pub enum TraceKind {
     Accumulating,
 }
 
+impl TraceKind {
+    /// A stable number of the kind, for the configuration hash.
+    pub const fn code(self) -> u32 {
+        match self {
+            TraceKind::Replacing => 1,
+            TraceKind::Accumulating => 2,
+        }
+    }
+}
+
 /// A bounded trace of up to `CAP` feature sets of `TILINGS` indices each.
 #[derive(Debug, Clone)]
 pub struct Trace<const TILINGS: usize, const CAP: usize> {
