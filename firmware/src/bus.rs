@@ -511,7 +511,7 @@ pub(crate) mod tests {
 
     #[test]
     fn stray_packets_before_the_reply_are_discarded_and_counted() {
-        // Issue 16, defect 6: a valid packet from another servo, one from
+        // Regression: a valid packet from another servo, one from
         // the asked servo with the wrong length, and a spurious header with
         // a large LENGTH come before the real reply.
         let mut bus = ServoBus::new(FakeBus::with_servos(&[1]), BusConfig::default());

@@ -80,7 +80,7 @@ impl RobotConfig {
 const PENDULUM_JOINTS: [Joint; 1] = [Joint { id: 1, zero: 512, sign: 1 }];
 
 /// LEO's servos in [`LeoJoint`] order (shoulder, hip L/R, knee L/R, ankle
-/// L/R), with the IDs of GRL's raw order (grl-facts §3.1: shoulder 1,
+/// L/R), with the IDs of GRL's raw order (docs/reference/grl.md §3.1: shoulder 1,
 /// hip R 2, hip L 3, knee R 4, knee L 5, ankle R 6, ankle L 7). `zero` is
 /// the raw position at joint angle 0 and `sign` maps the servo's direction
 /// to GRL's joint sign (§1.2, §1.5): **calibrate both on your robot**;
@@ -95,7 +95,7 @@ const LEO_JOINTS: [Joint; NUM_JOINTS] = [
     Joint { id: 6, zero: 512, sign: 1 },
 ];
 
-/// Margin outside LEO's joint stops (grl-facts §1.5) before a soft-limit
+/// Margin outside LEO's joint stops (docs/reference/grl.md §1.5) before a soft-limit
 /// fault \[rad\]: the stops are soft springs, a joint that passes them by
 /// this much is being driven into them.
 const STOP_MARGIN: f32 = 0.15;
@@ -139,7 +139,7 @@ pub const fn hardware(robot: Robot) -> RobotConfig {
             soft_limits: &LEO_LIMITS,
             // The boom's encoder; the torso angle is minus its angle (§3.1).
             encoder: EncoderConfig { counts_per_rev: 4096, sign: 1 },
-            // LEO_SUPPLY_VOLTAGE (grl-facts §2.2).
+            // LEO_SUPPLY_VOLTAGE (docs/reference/grl.md §2.2).
             supply_nominal_v: pada_core::rx28::LEO_SUPPLY_VOLTAGE,
         },
     }

@@ -1252,7 +1252,7 @@ mod tests {
 
     #[test]
     fn replaying_the_reported_steps_on_a_host_agent_gives_the_same_actions() {
-        // What issue 6 does with the firmware's telemetry, in miniature: a
+        // What `pada sil` does with the firmware's telemetry, in miniature: a
         // pendulum that moves with the commands, the Step records replayed
         // through a plain agent with the same seed.
         let seed = 11;

@@ -2,7 +2,7 @@
 //! peripherals.
 //!
 //! The real board (`src/board/`) implements these with embassy-stm32
-//! drivers; the emulated board of issue 6 implements them with a few PAC
+//! drivers; the emulated board (QEMU, `pada sil`) implements them with a few PAC
 //! register accesses and a lock-step clock; the host tests implement them
 //! with byte buffers. Everything above them is the same code.
 
@@ -40,7 +40,7 @@ pub trait BusPort {
 /// axis, and LEO's foot contacts: the sensors that are not on the servo bus.
 ///
 /// On the real board the encoder is a timer in encoder mode and the contacts
-/// are GPIO inputs; on the emulated board (issue 6) they are a device on the
+/// are GPIO inputs; on the emulated board (QEMU) they are a device on the
 /// emulated bus. Hence `async`.
 pub trait Sensors {
     /// The encoder's counter (it wraps; [`crate::encoder::Unwrapper`]

@@ -2,7 +2,7 @@
 //!
 //! Everything the firmware decides lives here, in plain `no_std` Rust that
 //! touches no peripheral, so that the host runs its tests
-//! (`cargo xtask firmware-test`) and the emulated board of issue 6 runs the
+//! (`cargo xtask firmware-test`) and the emulated board (QEMU) runs the
 //! very same code. The binary (`src/main.rs`, `src/board/`) only moves bytes
 //! and reads counters:
 //!

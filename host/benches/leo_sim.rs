@@ -1,4 +1,4 @@
-//! LEO simulation speed (issue 4, "Performance"): simulated seconds per
+//! LEO simulation speed: simulated seconds per
 //! wall-clock second on one core, with the default physics settings.
 //!
 //! `leo_sim/random_actions`: one iteration is one simulated second (30

@@ -464,7 +464,7 @@ mod tests {
 
     #[test]
     fn the_end_of_the_input_counts_a_cut_off_frame() {
-        // Issue 16, defect 1.
+        // Regression: a frame cut off by the end of the input was not counted.
         let bytes = frames(&[hello(), episode(0, RunMode::Learning, -1.0)]);
         let mut rec = Recorder::new(None).unwrap();
         let mut out = Vec::new();

@@ -21,6 +21,7 @@ pub mod plan;
 pub mod plot;
 pub mod progress;
 pub mod rig;
+pub mod robots;
 pub mod seed;
 pub mod sil;
 pub mod stats;

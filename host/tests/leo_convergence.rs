@@ -1,4 +1,4 @@
-//! Issue 13: a converged LEO model. The passive fall does not depend on
+//! A converged LEO model. The passive fall does not depend on
 //! the step, dry friction holds a joint whose load stays below it at any
 //! step, and the stance foot does not slide on the floor.
 //!
@@ -19,7 +19,7 @@ fn model(f: impl FnOnce(&mut ModelOptions)) -> LeoModel {
 /// Halving the physics step changes the passive fall (0 V on the learned
 /// joints, the held joints on) by less than 5 % in time and by less than
 /// 0.02 rad in torso angle at every control step until the fall (the
-/// issue's definition of converged). Measured at the default 4 × 1
+/// definition of converged). Measured at the default 4 × 1
 /// against 8 × 1: both fall at step 24 (0.800 s); |φ| = 1 is reached at
 /// 0.7705 s and 0.7727 s (−0.3 %); the torso angles differ by 0.0066 rad
 /// at most.

@@ -1,4 +1,4 @@
-//! Sanity checks of the LEO model (issue 4), against `grl-facts.md` §1–3.
+//! Sanity checks of the LEO model, against `docs/reference/grl.md` §1–3.
 //!
 //! Each test states its bound; the measured values at the default settings
 //! are recorded in `host/src/leo/README.md`.
@@ -111,7 +111,7 @@ fn initial_pose_has_the_left_foot_on_the_floor() {
     assert!((o[0] + 0.10).abs() < 0.02, "phi {}", o[0]);
 }
 
-/// Issue 4: planar motion is locked explicitly, not by symmetry. With
+/// Planar motion is locked explicitly, not by symmetry. With
 /// random actions and a sideways push on the torso (5 N along y plus a
 /// 0.5 N m torque about x and z), every body stays in y = 0 and rotates
 /// only about y.
@@ -219,7 +219,7 @@ fn servo_response_over_one_control_period() {
     );
 }
 
-/// Issue 4: a passive robot (0 V: back-EMF braking, dry friction) falls
+/// A passive robot (0 V: back-EMF braking, dry friction) falls
 /// and comes to rest without gaining energy.
 ///
 /// Bounds: the mechanical energy never exceeds its starting value by more
@@ -242,7 +242,7 @@ fn passive_robot_falls_and_comes_to_rest() {
     assert!(s.torso_pitch.abs() > 1.0, "torso pitch {}", s.torso_pitch);
 }
 
-/// Issue 4: with contacts and friction off, total energy drifts less than
+/// With contacts and friction off, total energy drifts less than
 /// a stated bound over 10 s.
 ///
 /// Setting: torso welded in the starting pose, gravity on, no floor, no
@@ -429,7 +429,7 @@ fn reset_is_exact() {
     }
 }
 
-/// Issue 4 "Bad input": a blown-up simulation ends the episode as a fall,
+/// Bad input: a blown-up simulation ends the episode as a fall,
 /// is counted, keeps the observation finite and never panics; the next
 /// reset starts cleanly. Non-finite actions are read as 0 V and flagged.
 #[test]

@@ -2,7 +2,7 @@
 //! device (`> /dev/full`) or a pipe whose reader has gone (`| true`). Every
 //! command must then exit non-zero with one line on stderr naming the
 //! problem, never panic (exit 101). Also `pada capture`'s exit code on a
-//! read error and on a directory (issue 16, defects 2 and 3).
+//! read error and on a directory.
 
 use std::fs::File;
 use std::path::Path;
@@ -145,7 +145,7 @@ fn a_read_error_ends_the_capture_with_its_summary_and_exit_code_1() {
 
 #[test]
 fn a_stream_cut_off_at_the_end_reports_the_loss() {
-    // Issue 16, defect 1: trailing bytes without a delimiter were never
+    // Regression: trailing bytes without a delimiter were never
     // counted, so a 10 MB file without a zero byte reported a clean link.
     let dir = tempfile::tempdir().unwrap();
     let noise = dir.path().join("noise.bin");

@@ -5,7 +5,7 @@
 //! joints). The agent works on joint action indices: the index of the level
 //! combination `(l_0, …, l_(k−1))` is `Σ l_i · Π_(m<i) n_m`, the first
 //! dimension varying fastest (as GRL's uniform discretiser,
-//! `../shared/reference/grl-facts.md` §3.4).
+//! `docs/reference/grl.md` §3.4).
 
 use crate::error::ConfigError;
 use heapless::Vec;

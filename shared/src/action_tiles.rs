@@ -1,7 +1,7 @@
 //! Generalisation over actions: the action's voltages tile-coded like state
 //! dimensions, so that neighbouring levels share weights.
 //!
-//! The paper's LEO learner (GRL, `../shared/reference/grl-facts.md` §3.9:
+//! The paper's LEO learner (GRL, `docs/reference/grl.md` §3.9:
 //! `generalizeActions` true, action tile width 6.67 V over the 7 levels of
 //! [−10.7, 10.7] V) codes the 3 actions as three more tile-coded dimensions.
 //! A level two steps away (7.13 V) then shares tiles with its neighbour in
@@ -26,7 +26,7 @@
 use crate::action_space::{ActionSpace, Levels, MAX_ACTION_DIMS, MAX_LEVELS};
 use crate::error::ConfigError;
 use crate::fixed::floor_i32;
-use crate::tile_coding::tile_start;
+use crate::tiling::tile_start;
 
 /// Most action-tile combinations in one tiling (the product over action
 /// dimensions of the tiles their levels fall into). Bounds the table the

@@ -1,6 +1,6 @@
 //! SARSA(λ) with tile coding, ε-greedy selection over the policy's
 //! candidates, and bounded traces (Section III; reference semantics in
-//! `../shared/reference/grl-facts.md` §5).
+//! `docs/reference/grl.md` §5).
 //!
 //! - `Q(s, a)` is the **mean** of the `TILINGS` active weights, and an update
 //!   moves every active weight by `α·δ·e`, so that `Q` itself moves by `α·δ`
@@ -489,7 +489,7 @@ where
             .write_f32(self.params.gamma)
             .write_f32(self.params.lambda)
             .write_f32(self.params.trace_threshold)
-            .write_u32(crate::profile::trace_kind_code(self.params.trace_kind));
+            .write_u32(self.params.trace_kind.code());
     }
 
     /// The action policy.

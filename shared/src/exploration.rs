@@ -1,6 +1,6 @@
 //! Temporally correlated exploration noise on the action levels: the
 //! Ornstein–Uhlenbeck process of GRL's OU samplers
-//! (`../shared/reference/grl-facts.md` §6.6) and pink (1/f) noise after
+//! (`docs/reference/grl.md` §6.6) and pink (1/f) noise after
 //! Eberhard et al. (ICLR 2023), for the `ou` and `pink` policies
 //! ([`crate::policy::PolicyKind`]).
 //!

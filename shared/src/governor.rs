@@ -29,7 +29,7 @@
 //! action can add before the governor can react) plus the spread of the
 //! window's count of re-engagements — a count of independent events varies
 //! about its mean by its square root, and `z` is the normal quantile that
-//! is exceeded in 10 % of windows, the target of holding the budget
+//! is exceeded in 10 % of windows, the target of holding the budget
 //! in at least 90 % of trials. After every learning action:
 //!
 //! - headroom below `d` — the next worst re-engagement would break the
@@ -101,7 +101,7 @@ pub const LOWPASS_LADDER: [f32; 7] = [0.1, 0.25, 0.5, 0.7, 0.834, 0.9, 1.0];
 /// The standard normal quantile exceeded with probability 0.1: the
 /// reserve covers the window's count of re-engagements up to it, so a
 /// governor running at its allowance breaks the budget in about one window
-/// in ten (the target: held in at least 90 % of trials).
+/// in ten (the target: held in at least 90 % of trials).
 pub const HOLD_QUANTILE: f64 = 1.2816;
 /// Largest budget \[s\]: about 300 years, well above any gearbox's
 /// predicted life in the paper (10⁸ s on the physical pendulum); keeps the

@@ -64,6 +64,7 @@ pub mod robot;
 pub mod rx28;
 pub mod safety;
 pub mod tile_coding;
+mod tiling;
 pub mod trace;
 pub mod weights;
 pub mod wire;

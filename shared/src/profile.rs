@@ -20,11 +20,10 @@ use crate::agent::Agent;
 use crate::checkpoint::ConfigHasher;
 use crate::robot::Robot;
 use crate::tile_coding::Layout;
-use crate::trace::TraceKind;
 use crate::weights::{WeightFormat, WeightStore};
 
 /// Tilings of every board's tile coder: the paper's reference
-/// configuration (GRL, grl-facts §4 and §5).
+/// configuration (GRL, docs/reference/grl.md §4 and §5).
 pub const TILINGS: usize = 16;
 /// Capacity of every board's eligibility trace, in (state, action) entries:
 /// LEO's γλ = 0.9962 · 0.8582 keeps 30 entries above 0.01, the paper's
@@ -242,28 +241,13 @@ pub fn config_hash<W: WeightStore, const TILINGS_: usize, const TRACE_: usize>(
     h.write_u32(CONFIG_HASH_VERSION)
         .write_str(profile.robot.name())
         .write_str(profile.board.name())
-        .write_u32(layout_code(profile.layout))
+        .write_u32(profile.layout.code())
         .write_u32(agent.weights().len() as u32)
         .write_u32(agent.weights().format().code());
     agent.write_config(&mut h);
     h.finish()
 }
 
-/// A stable number of a layout.
-pub const fn layout_code(layout: Layout) -> u32 {
-    match layout {
-        Layout::Hashed => 1,
-        Layout::Exact => 2,
-    }
-}
-
-/// A stable number of a trace kind.
-pub const fn trace_kind_code(kind: TraceKind) -> u32 {
-    match kind {
-        TraceKind::Replacing => 1,
-        TraceKind::Accumulating => 2,
-    }
-}
 
 #[cfg(test)]
 mod tests {

@@ -1,5 +1,5 @@
 //! The Dynamixel RX-28 servo as a voltage-driven DC motor behind a gearbox
-//! (`grl-facts.md` §2.1–2.3, the model GRL simulates LEO with).
+//! (`docs/reference/grl.md` §2.1–2.3, the model GRL simulates LEO with).
 //!
 //! Per sub-step, with commanded voltage `U` and joint rate `q̇` (§2.1):
 //!

@@ -9,7 +9,7 @@
 //! **Offsets.** Tiling `j` shifts dimension `i` by `b_ij = j·(2i + 1)`
 //! sub-tiles (modulo `T`), the odd displacement vector (1, 3, 5, …)
 //! recommended by Sutton & Barto and used by the paper's reference
-//! implementation (GRL, `../shared/reference/grl-facts.md` §5.1). The tile
+//! implementation (GRL, `docs/reference/grl.md` §5.1). The tile
 //! that contains `q_i` in tiling `j` starts at
 //! `c_ij = q_i − ((q_i − b_ij) mod T)` (non-negative modulo).
 //! A wrapping dimension (an angle) has a whole number `n` of tiles per
@@ -32,6 +32,7 @@
 
 use crate::action_space::ActionSpace;
 use crate::action_tiles::ActionTiles;
+pub(crate) use crate::tiling::tile_start;
 use crate::error::ConfigError;
 use crate::fixed::floor_i32;
 use heapless::Vec;
@@ -119,6 +120,16 @@ pub enum Layout {
     Hashed,
     /// One weight per (tiling, tile, action); the table must hold them all.
     Exact,
+}
+
+impl Layout {
+    /// A stable number of the layout, for the configuration hash.
+    pub const fn code(self) -> u32 {
+        match self {
+            Layout::Hashed => 1,
+            Layout::Exact => 2,
+        }
+    }
 }
 
 /// A dimension prepared for integer coding.
@@ -280,7 +291,7 @@ impl<const TILINGS: usize> TileCoder<TILINGS> {
     /// tiles) and the action tiling if any.
     pub fn write_config(&self, h: &mut crate::checkpoint::ConfigHasher) {
         h.write_u32(TILINGS as u32)
-            .write_u32(crate::profile::layout_code(self.layout))
+            .write_u32(self.layout.code())
             .write_u32(self.table_size)
             .write_u32(self.actions)
             .write_u32(self.dims.len() as u32);
@@ -403,20 +414,6 @@ impl<const TILINGS: usize> TileCoder<TILINGS> {
             *slot = self.feature(code, j, action);
         }
         f
-    }
-}
-
-/// Start (in sub-tiles) of the tile of tiling `j` that holds `q` along
-/// dimension `i`: `c = q − ((q − b) mod T)` with `b = j·(2i + 1)`, wrapped
-/// modulo `period` when the dimension wraps.
-#[inline]
-pub(crate) fn tile_start(q: i32, j: i32, i: i32, t: i32, period: i32) -> i32 {
-    let b = j * (2 * i + 1);
-    let c = q - (q - b).rem_euclid(t);
-    if period > 0 {
-        c.rem_euclid(period)
-    } else {
-        c
     }
 }
 

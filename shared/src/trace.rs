@@ -1,7 +1,7 @@
 //! Bounded eligibility traces.
 //!
 //! As in the paper's reference implementation
-//! (`../shared/reference/grl-facts.md` §5.3–5.4), a trace is a queue of the
+//! (`docs/reference/grl.md` §5.3–5.4), a trace is a queue of the
 //! feature sets of recent (state, action) pairs, newest last. The k-th most
 //! recent entry (k = 0 for the current one) has eligibility `(γλ)^k`; the
 //! queue keeps only entries whose eligibility is at least a threshold, which
@@ -32,6 +32,16 @@ pub enum TraceKind {
     Replacing,
     /// Eligibilities add up.
     Accumulating,
+}
+
+impl TraceKind {
+    /// A stable number of the kind, for the configuration hash.
+    pub const fn code(self) -> u32 {
+        match self {
+            TraceKind::Replacing => 1,
+            TraceKind::Accumulating => 2,
+        }
+    }
 }
 
 /// A bounded trace of up to `CAP` feature sets of `TILINGS` indices each.

@@ -1,5 +1,5 @@
 //! The agent with generalisation over actions (LEO's 3 × 7 voltages with
-//! 6.67 V action tiles, grl-facts §3.9): the fast greedy choice agrees with
+//! 6.67 V action tiles, docs/reference/grl.md §3.9): the fast greedy choice agrees with
 //! evaluating every action, and learning one voltage teaches its neighbours.
 
 use pada_core::action_space::{ActionDim, ActionSpace};

@@ -248,7 +248,7 @@ fn header_claiming_more_weights_than_fit_is_corrupt() {
 
 #[test]
 fn saving_goes_on_past_the_largest_generation() {
-    // Regression (issue 16, defect 4): the generation saturated at u32::MAX
+    // Regression: the generation saturated at u32::MAX
     // and, with a strict `>`, every later save was lost and loading
     // returned the older slot. Start just below the wrap by writing a
     // checkpoint of generation u32::MAX - 2 by hand.
@@ -272,7 +272,7 @@ fn saving_goes_on_past_the_largest_generation() {
 
 #[test]
 fn a_never_written_store_smaller_than_a_header_is_empty() {
-    // Regression (issue 16, defect 9): it loaded as Corrupt.
+    // Regression: it loaded as Corrupt.
     let tiny = RamStore::<{ HEADER_LEN - 1 }>::new();
     let mut st = LearnerState::default();
     let mut out = vec![Q16(5); N];

@@ -245,7 +245,7 @@ fn a_status_packet_from_the_broadcast_id_is_refused() {
 
 #[test]
 fn writes_without_data_are_refused_by_encoder_and_parser_alike() {
-    // Regression (issue 16, defect 7): WRITE and REG_WRITE with no data
+    // Regression: WRITE and REG_WRITE with no data
     // encoded, and the emulator's parser then refused them as BadParams.
     let mut buf = [0u8; 16];
     for code in [0x03u8, 0x04] {
@@ -265,7 +265,7 @@ fn writes_without_data_are_refused_by_encoder_and_parser_alike() {
 
 #[test]
 fn only_the_expected_reply_is_accepted_and_a_spurious_header_holds_nothing_back() {
-    // Regression (issue 16, defect 6): garbage that formed a header with a
+    // Regression: garbage that formed a header with a
     // valid checksum was accepted, and a spurious header with a large
     // LENGTH held back the real reply behind it.
     let reply = Status::new(3, ErrorFlags::NONE, &[1, 2, 3, 4, 5, 6, 7, 8]).unwrap();

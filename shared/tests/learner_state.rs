@@ -1,4 +1,4 @@
-//! Saved learning (issue 5): the learner's state — agent counters, ε, mode,
+//! Saved learning: the learner's state — agent counters, ε, mode,
 //! policy, fatigue counters, generator, user counters — saved with the
 //! weights and restored, so that a board that resets continues where it was.
 //!

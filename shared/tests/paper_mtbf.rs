@@ -10,8 +10,8 @@
 //!   η·G·k/R), |V| uniform over {3.57, 7.13, 10.7} V;
 //! - MTBF = 1200 · T / (514 · mean damage per re-engagement).
 //!
-//! The issue that asked for this definition quotes 250–770 s for the stall
-//! torques one may take, against the paper's 362 s for SARSA(λ).
+//! The three stall torques one may take give 250–770 s, against the
+//! paper's 362 s for SARSA(λ).
 
 use pada_core::fatigue::{FatigueCounter, FatigueModel, GearboxParams, PAPER_WINDOW_STEPS};
 use pada_core::robot::leo::{commanded_gear_torque, ACTION_VOLTAGE_LIMIT, CONTROL_PERIOD_US};

@@ -267,7 +267,7 @@ fn layout_fingerprint() -> u32 {
 fn the_protocol_version_changes_with_the_layout() {
     // A change of any message's layout changes this fingerprint: then bump
     // PROTOCOL_VERSION and put the new pair here (with the docs that name
-    // the version: docs/sil.md, firmware/README.md, README.md).
+    // the version: docs/sil.md, docs/core.md, firmware/README.md).
     assert_eq!((PROTOCOL_VERSION, layout_fingerprint()), (6, EXPECTED_FINGERPRINT), "{:#010x}", layout_fingerprint());
 }
 
@@ -520,7 +520,7 @@ fn cobs_small(raw: &[u8]) -> Vec<u8> {
 
 #[test]
 fn the_end_of_the_input_counts_a_cut_off_frame() {
-    // Regression (issue 16, defect 1): a frame cut off by the end of the
+    // Regression: a frame cut off by the end of the
     // stream, or bytes without a delimiter, were never counted as lost.
     let whole = frame_of(&ToHost::Ack(Ack { seq: 5 }), 0);
     let mut dec = HostDecoder::new();
@@ -544,7 +544,7 @@ fn the_end_of_the_input_counts_a_cut_off_frame() {
 
 #[test]
 fn a_non_canonical_body_is_refused() {
-    // Regression (issue 16, defect 5): an overlong varint with a valid CRC
+    // Regression: an overlong varint with a valid CRC
     // decoded as if canonical. Ack { seq: 5 } with seq 300 written
     // canonically (AC 02), then with the 5 padded to two bytes (85 00),
     // then with the sequence number padded to three (AC 82 00).
@@ -589,7 +589,7 @@ fn a_non_canonical_body_is_refused() {
 
 #[test]
 fn a_large_sequence_jump_is_a_resync_not_billions_missed() {
-    // Regression (issue 16, defect 8): a forward jump counted up to 2^31 - 1
+    // Regression: a forward jump counted up to 2^31 - 1
     // missing frames.
     let mut dec = HostDecoder::new();
     let ack = ToHost::Ack(Ack { seq: 0 });

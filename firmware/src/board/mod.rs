@@ -21,7 +21,7 @@
 //! 1 Mbps divides exactly (USARTDIV 5.25); USART2 on APB1 (42 MHz) gives
 //! 921 600 baud at −0.9 %, well inside a UART's tolerance. USART1 and
 //! USART2 are also the two serial ports QEMU's `netduinoplus2` connects
-//! first (issue 6). TIM2 is embassy's time base (32-bit), TIM3 counts the
+//! first. TIM2 is embassy's time base (32-bit), TIM3 counts the
 //! encoder. On the Discovery, PA9 carries the USB VBUS sense and PA0 the
 //! user button, so its servo bus and encoder move to port B.
 //!

@@ -19,9 +19,9 @@
 pub mod protocol;
 pub mod trial;
 
-use crate::experiment::runner::RunConfig;
+use crate::experiment::RunConfig;
 use crate::experiment::TrialResult;
-use pada_core::profile::{Board, LearnerProfile, Memory};
+use pada_core::profile::{LearnerProfile, Memory};
 use pada_core::robot::Robot;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -77,41 +77,13 @@ impl ProfileReport {
     }
 }
 
-/// A board on the command line (`--board`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum BoardName {
-    /// STM32F405/F407: 128 KB SRAM + 64 KB CCM.
-    F405,
-    /// STM32F429I-DISC1: 8 MB SDRAM on the FMC.
-    #[value(name = "f429-sdram")]
-    F429Sdram,
-    /// The host's own learner (tables on the heap).
-    Host,
-}
-
-impl BoardName {
-    /// The board.
-    pub fn board(self) -> Board {
-        match self {
-            BoardName::F405 => Board::F405,
-            BoardName::F429Sdram => Board::F429Sdram,
-            BoardName::Host => Board::Host,
-        }
-    }
-}
-
 /// The robot of a `--task` that has a board, or why not.
 pub fn robot_of_task(task: crate::experiment::tasks::TaskName) -> Result<Robot, String> {
-    use crate::experiment::tasks::TaskName;
-    match task {
-        TaskName::PhysicalPendulum => Ok(Robot::Pendulum33),
-        TaskName::Leo => Ok(Robot::Leo),
-        TaskName::Pendulum => Err(
-            "--board runs a robot that has a board: --task physical-pendulum or --task leo, not pendulum \
-             (the simulated pendulum of Section VII is a simulation only)"
-                .to_string(),
-        ),
-    }
+    task.robot().ok_or_else(|| {
+        "--board runs a robot that has a board: --task physical-pendulum or --task leo, not pendulum \
+         (the simulated pendulum of Section VII is a simulation only)"
+            .to_string()
+    })
 }
 
 /// Runs the trials of `cfg` with `profile`'s learner, in parallel;

@@ -33,11 +33,9 @@
 use super::protocol::{EpisodeOutcome, RunProtocol};
 use crate::experiment::governed::GovernorStats;
 use crate::experiment::metrics::{end_performance, rise_time};
-use crate::experiment::runner::RunConfig;
+use crate::experiment::RunConfig;
 use crate::experiment::TrialResult;
-use crate::leo::model::ModelOptions;
-use crate::pendulum::PhysicalPendulumParams;
-use crate::rig::{LeoRig, PendulumRig, Rig};
+use crate::rig::Rig;
 use crate::seed::trial_seed;
 use anyhow::{anyhow, bail};
 use pada_core::fatigue::{FatigueCounter, GearboxParams, PAPER_WINDOW_STEPS};
@@ -118,10 +116,7 @@ pub fn table_len(profile: &LearnerProfile, policy: PolicyKind) -> anyhow::Result
 /// model with an operator who stops it between episodes, or the rapier3d
 /// LEO.
 pub fn standard_rig(robot: Robot) -> anyhow::Result<Box<dyn Rig>> {
-    Ok(match robot {
-        Robot::Leo => Box::new(LeoRig::new(ModelOptions::default())?),
-        _ => Box::new(PendulumRig::with_operator(PhysicalPendulumParams::default())),
-    })
+    crate::robots::board_rig(robot)
 }
 
 /// Trial `trial` of `cfg` with `profile`'s learner against its robot's

@@ -2,7 +2,7 @@
 //! the simulated pendulum of Section VII, next to the paper's numbers.
 
 use crate::console::outln;
-use crate::cli::{check_seconds, set_threads, DemoArgs};
+use crate::commands::options::{check_seconds, set_threads};
 use crate::display::{fmt_estimate, fmt_mtbf};
 use crate::error::CliError;
 use crate::experiment::task::Task;
@@ -14,6 +14,29 @@ use crate::progress::steps_bar;
 use crate::summary::{run_files, RunSummary};
 use pada_core::policy::PolicyKind;
 use std::time::Instant;
+use crate::commands::options::TrialOptions;
+use std::path::PathBuf;
+use clap::Args;
+
+/// `pada demo`.
+#[derive(Debug, Clone, Args)]
+pub struct DemoArgs {
+    /// Trials per algorithm.
+    #[arg(long, value_name = "N", default_value_t = 29, value_parser = clap::value_parser!(u32).range(1..=10000))]
+    pub trials: u32,
+    /// Learning time per trial [s].
+    #[arg(long, value_name = "S", default_value_t = 3000.0)]
+    pub seconds: f64,
+    /// Also write both runs' summaries and curves under this directory.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Print both summaries as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Seed and threads.
+    #[command(flatten)]
+    pub trial: TrialOptions,
+}
 
 /// Runs `pada demo`.
 pub fn run(args: DemoArgs) -> Result<(), CliError> {

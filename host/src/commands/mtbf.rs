@@ -3,11 +3,30 @@
 //! MTBF, over the first N steps (the paper's window) and the whole log.
 
 use crate::console::outln;
-use crate::cli::MtbfArgs;
 use crate::error::{usage, CliError};
 use crate::torque_log;
 use pada_core::fatigue::{FatigueReport, GearboxParams, JointFatigue};
 use serde::Serialize;
+use std::path::PathBuf;
+use clap::Args;
+
+/// `pada mtbf`.
+#[derive(Debug, Clone, Args)]
+pub struct MtbfArgs {
+    /// CSV torque log [N·m], one column per joint, one row per control
+    /// step; an optional header row names the joints.
+    #[arg(long, value_name = "FILE.csv")]
+    pub torques: PathBuf,
+    /// Control rate of the log [Hz].
+    #[arg(long, value_name = "HZ", default_value_t = 20.0)]
+    pub rate: f64,
+    /// MTBF window: the first N steps (the paper's 1200 actions).
+    #[arg(long, value_name = "N", default_value_t = 1200, value_parser = clap::value_parser!(u32).range(1..))]
+    pub window: u32,
+    /// Print the result as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
 
 /// One joint's figures.
 #[derive(Debug, Clone, Serialize)]

@@ -2,7 +2,8 @@
 //! the figures — in one directory.
 
 use crate::console::outln;
-use crate::cli::{check_seconds, set_threads, PaperArgs, PaperExperiment};
+use crate::commands::options::{check_seconds, set_threads};
+pub use crate::commands::paper_args::{PaperArgs, PaperExperiment, WearTask};
 use crate::error::CliError;
 use crate::experiment::algo::{algo_of, parameter_of};
 use crate::output::OutDir;
@@ -15,6 +16,7 @@ use crate::plot::figures::{LearningCurves, Measure, MtbfSweep, PerformanceVsMtbf
 use crate::plot::save;
 use crate::progress::steps_bar;
 use crate::timing::RunTiming;
+
 
 /// Runs `pada paper`.
 pub fn run(args: PaperArgs) -> Result<(), CliError> {

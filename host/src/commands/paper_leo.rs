@@ -3,7 +3,8 @@
 //! performance against MTBF.
 
 use crate::console::outln;
-use crate::cli::{check_seconds, set_threads, PaperArgs};
+use crate::commands::options::{check_seconds, set_threads};
+use crate::commands::paper_args::PaperArgs;
 use crate::display::{fmt_estimate, fmt_mtbf};
 use crate::error::CliError;
 use crate::experiment::algo::label;

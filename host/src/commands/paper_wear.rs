@@ -2,7 +2,8 @@
 //! the wear governor at three budgets ([`crate::paper::wear`]); report.md,
 //! the Pareto figure against both MTBFs, learning curves and the data.
 
-use crate::cli::{check_seconds, set_threads, PaperArgs, WearTask};
+use crate::commands::options::{check_seconds, set_threads};
+use crate::commands::paper_args::{PaperArgs, WearTask};
 use crate::console::outln;
 use crate::error::CliError;
 use crate::experiment::algo::Algo;

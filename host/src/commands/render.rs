@@ -3,13 +3,34 @@
 //! `pada run --task leo --save-weights FILE`.
 
 use crate::console::outln;
-use crate::cli::RenderArgs;
 use crate::error::{usage, CliError};
 use crate::experiment::task::Task;
 use crate::experiment::tasks::TaskName;
 use crate::leo::gait::{gait_files, gait_title, record_agent, Frame};
 use crate::leo::rl::LeoTask;
 use crate::output::OutDir;
+use std::path::PathBuf;
+use clap::Args;
+
+/// `pada render`.
+#[derive(Debug, Clone, Args)]
+pub struct RenderArgs {
+    /// The task (only leo can be drawn).
+    #[arg(long, value_enum, default_value_t = TaskName::Leo)]
+    pub task: TaskName,
+    /// Weights saved by `pada run --save-weights`.
+    #[arg(long, value_name = "FILE")]
+    pub policy: PathBuf,
+    /// Output directory for gait.svg, gait.png and gait.csv.
+    #[arg(long, value_name = "DIR", default_value = "pada-out/render-leo")]
+    pub out: PathBuf,
+    /// Seconds of the greedy episode to draw.
+    #[arg(long, value_name = "S", default_value_t = 6.0)]
+    pub seconds: f64,
+    /// Frames in the strip.
+    #[arg(long, value_name = "N", default_value_t = 12, value_parser = clap::value_parser!(u32).range(1..=200))]
+    pub frames: u32,
+}
 
 /// Runs the greedy policy of the weights file for up to `seconds` and
 /// records every control step.

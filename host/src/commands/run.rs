@@ -2,7 +2,7 @@
 //! `summary.json`, `trials.csv` and per-trial learning curves.
 
 use crate::console::outln;
-use crate::cli::{check_seconds, set_threads, RunArgs};
+use crate::commands::options::{check_seconds, set_threads};
 use crate::display::{fmt_estimate, fmt_mtbf};
 use crate::error::{usage, CliError};
 use crate::experiment::algo::{label, parameter_of, policy_kind_of, Algo, PolicyFlags};
@@ -10,11 +10,8 @@ use crate::board::trial::table_len;
 use crate::board::{robot_of_task, run_board};
 use crate::experiment::task::{Task, TaskSpec};
 use crate::experiment::tasks::{visit_task, TaskVisitor};
-use crate::leo::rl::{leo_params, LeoTask};
-use crate::pendulum::{PhysicalPendulumParams, PhysicalPendulumTask};
 use crate::summary::{board_files, BoardSummary};
 use pada_core::profile::{Board, TILINGS};
-use pada_core::robot::Robot;
 use pada_core::tile_coding::Layout;
 use pada_core::weights::WeightFormat;
 use crate::experiment::{build_agent, run_trials, run_trials_observed, RunConfig, TrialResult};
@@ -27,11 +24,99 @@ use crate::telemetry::{parse_target, TelemetrySink};
 use pada_core::wire::{self, ToHost};
 use std::path::PathBuf;
 use std::time::Instant;
+use crate::commands::options::TrialOptions;
+use crate::experiment::tasks::TaskName;
+use clap::Args;
+
+/// `pada run`.
+#[derive(Debug, Clone, Args)]
+pub struct RunArgs {
+    /// The task.
+    #[arg(long, value_enum, default_value_t = TaskName::Pendulum)]
+    pub task: TaskName,
+    /// The algorithm (Section V, and the gentle explorations epsilon-pada,
+    /// ou, pink, action-penalty).
+    #[arg(long, value_parser = crate::experiment::algo::algo_parser())]
+    pub algo: Algo,
+    /// Low-pass α of Eq. 8, 0 < α ≤ 1 (lowpass, markov-lowpass; default 0.834).
+    #[arg(long)]
+    pub alpha: Option<f32>,
+    /// Δ relative to the action range, 0 < Δ ≤ 1 (integrator,
+    /// markov-integrator, pada, epsilon-pada; default 0.5).
+    #[arg(long)]
+    pub delta: Option<f32>,
+    /// OU's mean reversion per step, 0 < θ ≤ 1 (ou; default 0.15).
+    #[arg(long)]
+    pub theta: Option<f32>,
+    /// Noise scale, 0 < σ ≤ 4, in units of the largest distance from 0 to a
+    /// bound of the action range (ou, default 0.2; pink, default 0.38).
+    #[arg(long)]
+    pub sigma: Option<f32>,
+    /// The action-change penalty per squared full-range change,
+    /// 0 < w ≤ 10000 (action-penalty; default 1).
+    #[arg(long)]
+    pub weight: Option<f32>,
+    /// Learn on a wear budget: a governor moves PADA's Δ or the low-pass
+    /// filter's α while learning so that the predicted MTBF over the last
+    /// 1200 learning actions stays at or above this [s] (pada, lowpass;
+    /// 0 < budget <= 1e10; instead of --delta or --alpha).
+    #[arg(long, value_name = "SECONDS")]
+    pub mtbf_budget: Option<f32>,
+    /// Switch back to SARSA(λ) after this much learning time [s]
+    /// (lowpass, pada and the gentle explorations; Section VIII).
+    #[arg(long, value_name = "SECONDS")]
+    pub switch_at: Option<f64>,
+    /// Trials (default: the paper's count for the task, 29 or 28).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=10000))]
+    pub trials: Option<u32>,
+    /// Learning time per trial [s of simulated time] (default: the task's).
+    #[arg(long, value_name = "S")]
+    pub seconds: Option<f64>,
+    /// Output directory for summary.json, trials.csv and the learning
+    /// curves (default: pada-out/run-<task>-<algo>).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Print the summary as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Stream trial 0 as the firmware's telemetry frames to FILE or to
+    /// tcp:HOST:PORT (loopback only); `pada capture --file` reads them.
+    #[arg(long, value_name = "FILE|tcp:HOST:PORT")]
+    pub telemetry: Option<String>,
+    /// Save the first trial's learned weights to this file (versioned, with
+    /// a checksum; read by `pada render`).
+    #[arg(long, value_name = "FILE")]
+    pub save_weights: Option<PathBuf>,
+    /// Run a board's own learner instead of the host's: the firmware's
+    /// controller built for the host, with the board's learner profile
+    /// (table layout, size, weight format), its sensors (servo counts,
+    /// differenced rates, the encoder) and its episode logic, against the
+    /// task's plant (physical-pendulum or leo). What it learns is what the
+    /// board will learn.
+    #[arg(long, value_name = "NAME", value_parser = crate::robots::board_parser())]
+    pub board: Option<pada_core::profile::Board>,
+    /// With --board: a hashed table of 2^N weights instead of the board's
+    /// (placed in CCM, then SRAM on an F405), to see what a board would
+    /// learn with more or less memory. The firmware builds only the boards'
+    /// own profiles.
+    #[arg(long, value_name = "N", requires = "board", value_parser = clap::value_parser!(u32).range(8..=26))]
+    pub table_log2: Option<u32>,
+    /// With --board: store weights in 16 or 32 bits (16: stochastic
+    /// rounding, the robot's range; see pada_core::weights).
+    #[arg(long, value_name = "BITS", requires = "board", value_parser = ["16", "32"])]
+    pub weight_bits: Option<String>,
+    /// Seed and threads.
+    #[command(flatten)]
+    pub trial: TrialOptions,
+    /// Plans, merges and Slurm.
+    #[command(flatten)]
+    pub cluster: crate::plan::mode::ClusterOptions,
+}
 
 /// Runs `pada run`.
 pub fn run(args: RunArgs) -> Result<(), CliError> {
     if let Some(board) = args.board {
-        return run_on_board(args, board.board());
+        return run_on_board(args, board);
     }
     visit_task(args.task, RunVisitor(args))
 }
@@ -74,10 +159,7 @@ fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
     let policy = policy_of(&args)?;
     // The task as the runner describes it, with the board's table: the
     // summary's keys and parameters are `pada run`'s.
-    let task_spec = match robot {
-        Robot::Leo => LeoTask::with_profile(profile, leo_params()).spec().clone(),
-        _ => PhysicalPendulumTask::with_profile(PhysicalPendulumParams::default(), profile).spec().clone(),
-    };
+    let task_spec = crate::robots::board_task_spec(robot, profile);
     let weights = table_len(&profile, policy).map_err(|e| usage(format!("{e}")))?;
     if let Err(e) = robot.spec().check::<TILINGS>(policy, profile.layout, weights) {
         return Err(usage(format!(

@@ -2,11 +2,10 @@
 //! plant (docs/sil.md).
 
 use crate::console::{errln, outln};
-use crate::cli::check_seconds;
+use crate::commands::options::check_seconds;
 use crate::error::{usage, CliError};
 use crate::experiment::algo::{label, policy_kind, Algo};
 use crate::output::OutDir;
-use crate::board::BoardName;
 use crate::sil::{self, fault, SilConfig, SilSummary, SilTask};
 use anyhow::{anyhow, Context};
 use clap::Args;
@@ -16,9 +15,10 @@ use std::time::Duration;
 /// `pada sil`.
 #[derive(Debug, Clone, Args)]
 pub struct SilArgs {
-    /// The robot: the physical pendulum (against its model), or LEO
-    /// (against the rapier3d LEO, with an operator who sets it up between
-    /// episodes).
+    /// The robot: the physical pendulum (`pendulum`, the robot
+    /// `physical-pendulum` of `pada run --task`; not `pada run --task
+    /// pendulum`, the simulated one) against its model, or LEO (against the
+    /// rapier3d LEO, with an operator who sets it up between episodes).
     #[arg(long, value_enum, default_value_t = SilTask::Pendulum)]
     pub task: SilTask,
     /// The board learner profile the image is built for, and so the
@@ -26,8 +26,8 @@ pub struct SilArgs {
     /// f429-sdram (QEMU's mps2-an386, whose PSRAM holds LEO's 8 MiB table
     /// as the F429I-DISC1's SDRAM would). Default: f405 for the pendulum,
     /// f429-sdram for LEO.
-    #[arg(long, value_enum)]
-    pub board: Option<BoardName>,
+    #[arg(long, value_parser = crate::robots::board_parser())]
+    pub board: Option<pada_core::profile::Board>,
     /// Master seed, as `pada run`'s: the board learns with trial 0's seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -102,7 +102,7 @@ pub fn run(args: SilArgs) -> Result<(), CliError> {
         SilTask::Leo => 60.0,
     };
     let seconds = check_seconds("--seconds", args.seconds.unwrap_or(default_seconds))?;
-    let board = args.board.map(BoardName::board).unwrap_or(args.task.default_board());
+    let board = args.board.unwrap_or(args.task.default_board());
     if sil::machine(board).is_none() {
         return Err(usage(format!(
             "--board {}: no emulated board; valid are f405 (netduinoplus2) and f429-sdram (mps2-an386)",

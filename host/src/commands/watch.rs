@@ -332,10 +332,12 @@ mod tests {
 
     #[test]
     fn the_page_is_served_on_loopback_unless_told_otherwise() {
-        let cli = crate::cli::Cli::try_parse_from(["pada", "watch", "--file", "x.bin"]).unwrap();
-        let crate::cli::Command::Watch(args) = cli.command else {
-            panic!("not watch");
-        };
+        #[derive(Parser)]
+        struct Watch {
+            #[command(flatten)]
+            args: WatchArgs,
+        }
+        let args = Watch::try_parse_from(["watch", "--file", "x.bin"]).unwrap().args;
         assert!(parse_serve(&args.serve).unwrap().ip().is_loopback());
         assert!(parse_listen("tcp:[::1]:9000").is_ok());
         assert!(parse_listen("tcp:localhost:9000").is_ok());

@@ -10,6 +10,7 @@
 //! | [`task`] | what the runner needs from a task: its description and plants |
 //! | [`tasks`] | the tasks the command line knows, by name |
 //! | [`algo`] | the six algorithms of Section V by their command-line names |
+//! | [`config`] | what a run is: algorithm, parameter, trials, seed ([`RunConfig`]) |
 //! | [`agent_setup`] | the host's agent for a task and a policy |
 //! | [`governed`] | the wear governor in a trial (`--mtbf-budget`) |
 //! | [`trial`] | one trial: learning with periodic greedy test runs |
@@ -18,6 +19,7 @@
 
 pub mod agent_setup;
 pub mod algo;
+pub mod config;
 pub mod governed;
 pub mod metrics;
 pub mod runner;
@@ -27,9 +29,8 @@ pub mod trial;
 
 pub use agent_setup::{build_agent, HostAgent, TILINGS, TRACE};
 pub use metrics::{end_performance, rise_time};
-pub use runner::{
-    run_configs, run_configs_keeping, run_trials, run_trials_observed, FinishedTrial, RunConfig,
-};
+pub use config::RunConfig;
+pub use runner::{run_configs, run_configs_keeping, run_trials, run_trials_observed, FinishedTrial};
 pub use trial::{
     run_trial, run_trial_keep, run_trial_observed, TestPoint, TrialObserver, TrialResult,
 };

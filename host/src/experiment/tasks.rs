@@ -1,31 +1,13 @@
-//! The tasks the command line knows, by name. A new task (LEO) adds a
-//! variant here and an arm in [`visit_task`]; everything else is generic.
+//! The tasks the command line knows, by name. A new task adds a variant
+//! to [`TaskName`] (in the registry, [`crate::robots`]) and an arm in
+//! [`visit_task`]; everything else is generic.
 
 use crate::experiment::task::Task;
 use crate::leo::rl::LeoTask;
 use crate::pendulum::{PhysicalPendulumTask, SimulatedPendulumTask};
-use std::fmt;
 
-/// A task name on the command line.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum TaskName {
-    /// The simulated inverted pendulum of Section VII.
-    Pendulum,
-    /// The model of the physical pendulum of the paper's experiment.
-    PhysicalPendulum,
-    /// The LEO biped walking (Section VIII).
-    Leo,
-}
-
-impl fmt::Display for TaskName {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            TaskName::Pendulum => "pendulum",
-            TaskName::PhysicalPendulum => "physical-pendulum",
-            TaskName::Leo => "leo",
-        })
-    }
-}
+/// A task name on the command line (the registry's, [`crate::robots`]).
+pub use crate::robots::TaskName;
 
 /// Something done with a task of any type (a generic closure).
 pub trait TaskVisitor {

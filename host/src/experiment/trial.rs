@@ -17,7 +17,7 @@
 use super::agent_setup::{build_agent, HostAgent};
 use super::governed::{damage_raws, GovernorTrial, TrialGovernor};
 use super::metrics::{end_performance, rise_time};
-use super::runner::RunConfig;
+use super::config::RunConfig;
 use crate::experiment::task::{Plant, Task, TaskSpec};
 use crate::seed::{trial_rng, trial_seed};
 use anyhow::anyhow;

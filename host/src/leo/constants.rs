@@ -2,7 +2,7 @@
 //! shared with the firmware, come from `pada_core::robot::leo` (re-exported
 //! below).
 //!
-//! Each constant names the section of `shared/reference/grl-facts.md` it
+//! Each constant names the section of `docs/reference/grl.md` it
 //! comes from (a clean-room restatement of GRL's `leoconfig.xml`,
 //! `leolearnwalking-sarsa-tc.xml` and `LeoBhWalkSym.cpp`). The few numbers
 //! that are choices of this simulator, not facts of the reference (rapier's
@@ -212,7 +212,7 @@ pub const INIT_LEFT_FOOT_POINT: [f32; 2] = [-0.0405, -0.013];
 pub const INIT_RANDOMIZATION: f32 = 0.0872639;
 
 // ---------------------------------------------------------------------------
-// Blow-up guards (issue 4 "Bad input"): not from the reference.
+// Blow-up guards (bad input): not from the reference.
 // ---------------------------------------------------------------------------
 
 /// A body further than this from the start (m) means the simulation blew up.
@@ -242,7 +242,7 @@ pub const SOLVER_ITERATIONS: usize = 1;
 ///
 /// The reference's rubber pair is a soft spring (K = 2.5e4 N/m, D = 250
 /// N s/m, §1.7: ≈ 0.4 mm under LEO's weight; ≈ 25 Hz and ζ ≈ 0.8 for the
-/// ≈ 1 kg LEO puts on one foot), and until issue 13 this setting matched
+/// ≈ 1 kg LEO puts on one foot), and in the earlier, unconverged model this setting matched
 /// it. But rapier's softness is not a spring: it acts in a biased solver
 /// pass, a second pass then removes all approach velocity, and so the
 /// penetration builds up at a rate set by the step (after 0.2 s of

@@ -1,4 +1,4 @@
-//! LEO (issue 4): the Delft biped in rapier3d, its RX-28 servos and the
+//! LEO: the Delft biped in rapier3d, its RX-28 servos and the
 //! walking task of Section VIII of the paper, behind one small interface:
 //!
 //! ```text
@@ -7,7 +7,7 @@
 //! env.step([U_hip,st, U_hip,sw, U_knee,sw]) -> StepResult
 //! ```
 //!
-//! All facts come from `shared/reference/grl-facts.md` (sections cited in
+//! All facts come from `docs/reference/grl.md` (sections cited in
 //! [`constants`]): [`model`] builds the rapier world (§1) with the servo
 //! model of [`pada_core::rx28`] (§2); the walking task's rules (§3) are the
 //! robot's one definition, [`pada_core::robot::leo`] (here as [`task`]). The step size and solver settings, and the measurements

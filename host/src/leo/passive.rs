@@ -1,4 +1,4 @@
-//! The passive rollout (issue 13): LEO from its reference start (§1.8)
+//! The passive rollout: LEO from its reference start (§1.8)
 //! with 0 V on the three learned joints (stance hip, swing hip, swing
 //! knee) and the auto-actuated joints on (shoulder, stance knee and ankles
 //! under their P controllers, §3.5), one record per control step, until it
@@ -16,7 +16,7 @@ use super::task::ACTION_DIM;
 use super::{LeoConfig, LeoEnv, LeoError, Terminal};
 
 /// The seven joint angles of one record (rad, ODE's q = θ_parent − θ_child,
-/// `grl-facts.md` §1.2).
+/// `docs/reference/grl.md` §1.2).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct JointAngles {
     /// Torso → arm.

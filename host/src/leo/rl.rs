@@ -58,7 +58,7 @@ impl LeoTask {
     pub fn with_profile(profile: LearnerProfile, params: SarsaParams) -> Self {
         let mut spec = TaskSpec::of_robot(
             profile,
-            "LEO walking (Section VIII; rapier3d model of grl-facts §1-3, 30 Hz, 3 joints x 7 voltages)",
+            "LEO walking (Section VIII; rapier3d model of docs/reference/grl.md §1-3, 30 Hz, 3 joints x 7 voltages)",
             "per gearbox (hips, knees): mtbf_s from the commanded voltage's RX-28 stall torque (0.167 N m/V, the paper's linear law); physical_mtbf_s from the rapier3d model's mean gear torque over the control step",
         );
         spec.params = params;

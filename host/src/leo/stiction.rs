@@ -1,4 +1,4 @@
-//! Dry friction of a servo joint as stick and slip (`grl-facts.md` §1.5:
+//! Dry friction of a servo joint as stick and slip (`docs/reference/grl.md` §1.5:
 //! the RX-28's 0.2 N m), in a form an implicit integrator solves at any
 //! step size.
 //!

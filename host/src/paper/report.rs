@@ -261,7 +261,7 @@ pub fn render(r: &PendulumResults, command: &str) -> String {
     let _ = writeln!(s, "## The physical pendulum (Fig. 6)\n");
     let _ = writeln!(
         s,
-        "The model of grl-facts §4 stands in for the real pendulum. Gearbox torque = voltage × K/R = 5.642·10⁻³ N·m/V \
+        "The model of docs/reference/grl.md §4 stands in for the real pendulum. Gearbox torque = voltage × K/R = 5.642·10⁻³ N·m/V \
          (the motor's stall torque per volt; the paper assumes a linear voltage-to-torque relation and LEO's \
          gearbox of Table I).\n"
     );

@@ -6,7 +6,7 @@
 //!
 //! The sweep is data ([`sweep`]): a list of [`WearEntry`]s per task, made
 //! into a plan [`Experiment`] so that `--plan`, `--merge` and `--slurm`
-//! (issue 14) run it as they run `pada paper pendulum`.
+//! run it as they run `pada paper pendulum`.
 
 use crate::experiment::algo::{algo_of, label, Algo, PolicyFlags};
 use crate::experiment::task::{Task, TaskSpec};
@@ -30,7 +30,7 @@ pub const PENDULUM_SARSA_MTBF_S: f32 = 1297.0;
 /// 892 ± 123 s; the window is the first 1200 learning actions, 40 s, so
 /// a minute of learning measures it).
 pub const LEO_SARSA_MTBF_S: f32 = 892.0;
-/// The budgets as multiples of SARSA(λ)'s MTBF: the issue's 2× (the
+/// The budgets as multiples of SARSA(λ)'s MTBF: the target's 2× (the
 /// paper's gentle learners double the MTBF), one easier, one harder.
 pub const BUDGET_MULTIPLES: [f32; 3] = [1.5, 2.0, 3.0];
 
@@ -400,7 +400,7 @@ fn dominance(s: &mut String, r: &WearResults, physical: bool) {
     let _ = writeln!(s);
 }
 
-/// The issue's targets: the governor at 2× SARSA's MTBF against the best
+/// The targets: the governor at 2× SARSA's MTBF against the best
 /// fixed Δ (and α), and the hold.
 fn targets(s: &mut String, r: &WearResults) {
     let _ = writeln!(s, "## The governor's targets\n");

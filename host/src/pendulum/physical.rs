@@ -1,7 +1,7 @@
 //! A model of the physical inverted pendulum of the paper's experiment
 //! (Section VII, "Inverted pendulum experiment"), standing in for the real
 //! setup. Constants, timing, observation and reward are those of the
-//! paper's reference framework (GRL, `../shared/reference/grl-facts.md` §4):
+//! paper's reference framework (GRL, `docs/reference/grl.md` §4):
 //!
 //! `J·θ̈ = m·g·l·sin θ − b·θ̇ − (K²/R)·θ̇ + (K/R)·u`, θ = 0 upright, with
 //! J = 1.91·10⁻⁴ kg·m², m = 0.055 kg, l = 0.042 m, b = 3·10⁻⁶ N·m·s/rad,
@@ -28,7 +28,7 @@ use pada_core::robot::Robot;
 use rand_core::RngCore;
 use std::f64::consts::PI;
 
-/// Constants of the physical pendulum's model (grl-facts §4).
+/// Constants of the physical pendulum's model (docs/reference/grl.md §4).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PhysicalPendulumParams {
     /// Moment of inertia \[kg·m²\].

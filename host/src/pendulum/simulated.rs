@@ -153,9 +153,9 @@ impl Plant for SimulatedPendulum {
 }
 
 /// Tile width of the angle: 20 tiles per turn (0.314 rad), the resolution of
-/// the paper's reference pendulum configuration (GRL, grl-facts §4).
+/// the paper's reference pendulum configuration (GRL, docs/reference/grl.md §4).
 pub const ANGLE_TILES: u32 = 20;
-/// Tile width of the angular velocity \[rad/s\]: π, as in GRL (grl-facts §4).
+/// Tile width of the angular velocity \[rad/s\]: π, as in GRL (docs/reference/grl.md §4).
 pub const VELOCITY_TILE_RAD_S: f32 = std::f32::consts::PI;
 /// Velocity range ±8π rad/s: above the fastest speed of a swing-up with
 /// ±1.5 N·m (about 19 rad/s through the bottom); faster states are clamped.

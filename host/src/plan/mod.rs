@@ -1,4 +1,4 @@
-//! Experiments as plans of independent trials (issue 14), so that a
+//! Experiments as plans of independent trials, so that a
 //! cluster runs them: one trial per Slurm array task (or Kubernetes indexed
 //! job, or GNU parallel job), results written atomically with checksums,
 //! and a merge that reports exactly what the local run reports.

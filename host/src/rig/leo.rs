@@ -224,7 +224,7 @@ impl Rig for LeoRig {
     }
 
     fn describe(&self) -> String {
-        "LEO in rapier3d (grl-facts §1-2): 7 RX-28s, the boom's 4096-count encoder, 4 foot switches, set upright by an operator between episodes".into()
+        "LEO in rapier3d (docs/reference/grl.md §1-2): 7 RX-28s, the boom's 4096-count encoder, 4 foot switches, set upright by an operator between episodes".into()
     }
 
     fn episode_ended(&mut self, _t_us: u64) {

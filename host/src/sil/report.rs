@@ -33,7 +33,7 @@ use serde::Serialize;
 
 /// Learning time from which a run is expected to have learned \[s\].
 pub const LEARNING_CHECK_S: f64 = 300.0;
-/// Learning time from which LEO is expected to walk \[s\]: the issue's
+/// Learning time from which LEO is expected to walk \[s\]: the
 /// 3600 s run.
 pub const WALKING_CHECK_S: f64 = 3600.0;
 /// How far LEO must walk per test run over the last 10 % of them \[m\].

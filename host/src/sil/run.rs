@@ -14,64 +14,14 @@ use super::fault::FaultSpec;
 use super::qemu::{Emulator, QemuSetup};
 use super::report::SilSummary;
 use super::session::Session;
-use crate::leo::model::ModelOptions;
-use crate::pendulum::PhysicalPendulumParams;
-use crate::rig::{LeoRig, PendulumRig, Rig};
 use anyhow::{anyhow, Context};
 use pada_core::policy::PolicyKind;
 use pada_core::profile::{Board, LearnerProfile};
-use pada_firmware::config::Robot;
-use serde::Serialize;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-/// The robots `pada sil` runs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
-#[serde(rename_all = "kebab-case")]
-pub enum SilTask {
-    /// The physical pendulum at 33 Hz (robot `physical-pendulum`) against
-    /// the host's model of it.
-    Pendulum,
-    /// LEO (firmware robot `leo`) against the rapier3d LEO.
-    Leo,
-}
-
-impl SilTask {
-    /// The firmware's robot.
-    pub fn robot(self) -> Robot {
-        match self {
-            SilTask::Pendulum => Robot::Pendulum33,
-            SilTask::Leo => Robot::Leo,
-        }
-    }
-
-    /// The name on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            SilTask::Pendulum => "pendulum",
-            SilTask::Leo => "leo",
-        }
-    }
-
-    /// The board each robot is built for when `--board` is not given: the
-    /// F405 for the pendulum, the F429I-DISC1 with its SDRAM for LEO.
-    pub fn default_board(self) -> Board {
-        match self {
-            SilTask::Pendulum => Board::F405,
-            SilTask::Leo => Board::F429Sdram,
-        }
-    }
-
-    /// The robot behind the bus: the physical pendulum's model, swinging
-    /// freely between episodes as on the real rig; or the rapier3d LEO with
-    /// its operator.
-    pub fn rig(self) -> anyhow::Result<Box<dyn Rig>> {
-        Ok(match self {
-            SilTask::Pendulum => Box::new(PendulumRig::new(PhysicalPendulumParams::default())),
-            SilTask::Leo => Box::new(LeoRig::new(ModelOptions::default())?),
-        })
-    }
-}
+/// The robots `pada sil` runs (the registry's, [`crate::robots`]).
+pub use crate::robots::SilTask;
 
 /// The QEMU machine that emulates `board`: netduinoplus2 (an STM32F405)
 /// for `f405`, mps2-an386 (a Cortex-M4F with 16 MB of PSRAM standing in

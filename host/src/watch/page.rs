@@ -8,7 +8,7 @@ use super::state::WatchState;
 use crate::plot::to_svg;
 use std::fmt::Write as _;
 
-/// The page refreshes its live part this often \[ms\] (the issue asks for
+/// The page refreshes its live part this often \[ms\] (the target is
 /// at least once a second).
 pub const REFRESH_MS: u32 = 1000;
 

@@ -31,51 +31,14 @@
 //! cover header, state and weights: a flipped bit anywhere makes the slot
 //! invalid.
 //!
-//! # Learner-state record (record version [`STATE_VERSION`], 2)
+//! # Learner-state record
 //!
-//! Offsets from the record's start (slot offset 32). Every reserved byte is
-//! written 0 and must read 0.
-//!
-//! | offset | size | field |
-//! |---|---|---|
-//! | 0 | 2 | record version ([`STATE_VERSION`]) |
-//! | 2 | 1 | mode: 0 learning, 1 testing ([`Mode`]) |
-//! | 3 | 1 | policy kind built: 0 sarsa, 1 lowpass, 2 markov-lowpass, 3 integrator, 4 markov-integrator, 5 pada ([`kind_code`]) |
-//! | 4 | 4 | its parameter, `f32`: α of the low-pass filters, Δ of the others, 0 for SARSA |
-//! | 8 | 1 | switched back to SARSA: 0 no, 1 yes |
-//! | 9 | 1 | fatigue joints in use `j`, 0–[`MAX_JOINTS`] |
-//! | 10 | 4 | previous action: level per action dimension, 4 × `u8` (0 unused) |
-//! | 14 | 2 | reserved |
-//! | 16 | 16 | previous output (filter/integrator memory), 4 × `f32` (0 unused) |
-//! | 32 | 4 | ε, `f32` |
-//! | 36 | 4 | last TD error, raw [`Q16`] as `i32` |
-//! | 40 | 8 | agent steps (decisions), `u64` |
-//! | 48 | 8 | SARSA updates, `u64` |
-//! | 56 | 8 | exploratory decisions, `u64` |
-//! | 64 | 4 | episodes started, `u32` |
-//! | 68 | 4 | weight saturations, `u32` |
-//! | 72 | 4 | trace drops, `u32` |
-//! | 76 | 4 | reserved |
-//! | 80 | 8 | generator state ([`RngState::state`]), `u64` |
-//! | 88 | 8 | generator increment ([`RngState::increment`], odd), `u64` |
-//! | 96 | 16 | user counters, 4 × `u32` ([`USER_COUNTERS`], the caller's) |
-//! | 112 | 48 × 8 | fatigue per joint ([`JointFatigueState`]), [`MAX_JOINTS`] entries, the first `j` in use, the others all 0 |
-//!
-//! | 496 | 8 | erases of slot 0's and slot 1's sector, 2 × `u32` ([`FlashWear`], written by [`save`]) |
-//! | 504 | 8 | operating seconds when saved, `u64` ([`FlashWear::operating_s`]) |
-//!
-//! Each fatigue entry: +0 last sign (`i8`: −1, 0, +1), +1 seven reserved
-//! bytes, +8 steps, +16 re-engagements, +24 damage (Q16.48), +32 window
-//! re-engagements, +40 window damage (Q16.48), each a `u64`.
-//!
-//! The record holds what a learner carries between episodes
-//! ([`AgentState`]), not the eligibility trace: restoring ends the episode
-//! (see [`crate::agent::Agent::restore_state`]). Decoding
-//! ([`LearnerState::from_bytes`]) checks only what the bytes can mean
-//! (version, enum codes, flags, reserved zeros); the ranges that depend on
-//! the running learner are the restorer's to check
-//! ([`crate::agent::Agent::check_state`],
-//! [`crate::fatigue::FatigueCounter::check_state`], [`RngState::check`]).
+//! The 1024-byte record ([`STATE_LEN`], version [`STATE_VERSION`], 3) at
+//! slot offset 32 holds what a learner carries between episodes: the agent's
+//! counters, ε, mode and policy, the generator, each joint's fatigue
+//! counters, the caller's counters, the flash wear and the wear governor's
+//! state. Its layout is documented once, next to its offsets, in
+//! [`record`]; a test checks that table against the offsets the code uses.
 //!
 //! # Why a torn write is harmless
 //!
@@ -93,8 +56,10 @@
 //! [`load`] writes the caller's state and weights only when the outcome is
 //! [`LoadOutcome::Loaded`]. A format-1 slot (weights only) is refused as
 //! [`LoadOutcome::UnsupportedVersion`] `{ found: 1 }`, never loaded without
-//! its state; a record of version 1 (496 bytes, before the flash wear) is
-//! refused as [`LoadOutcome::InvalidState`].
+//! its state; a record of version 1 (496 bytes, before the flash wear) or
+//! 2 (512 bytes, before the governor) is refused as
+//! [`LoadOutcome::InvalidState`], but the wear of a version-2 record is
+//! still read ([`stored_wear`]), so re-flashing keeps the erase counts.
 //!
 //! The newer of two valid slots is the one whose generation is ahead in
 //! serial-number arithmetic ([`is_newer`]), so saving goes on past
@@ -120,13 +85,6 @@
 //! frames.
 //!
 //! [`Q16`]: crate::fixed::Q16
-//! [`Mode`]: crate::agent::Mode
-//! [`kind_code`]: crate::policy::kind_code
-//! [`AgentState`]: crate::agent::AgentState
-//! [`JointFatigueState`]: crate::fatigue::JointFatigueState
-//! [`RngState::check`]: crate::rng::RngState::check
-//! [`RngState::increment`]: crate::rng::RngState::increment
-//! [`RngState::state`]: crate::rng::RngState::state
 
 pub mod record;
 pub mod slots;

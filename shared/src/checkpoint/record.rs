@@ -1,6 +1,80 @@
 //! The learner-state record: everything a learner saves besides its
-//! weights, as a fixed-size little-endian record (layout in the module
-//! documentation of [`crate::checkpoint`]).
+//! weights, as a fixed-size little-endian record of [`STATE_LEN`] bytes at
+//! slot offset 32 ([`crate::checkpoint`] has the slot around it).
+//!
+//! # Layout (record version [`STATE_VERSION`], 3)
+//!
+//! Offsets from the record's start; the third column names the offset's
+//! constant in this file, and a test checks every row against it (offset,
+//! and offset + size = the next row's offset). Every reserved byte is
+//! written 0 and must read 0.
+//!
+//! | offset | size | `at::` | field |
+//! |---|---|---|---|
+//! | 0 | 2 | `VERSION` | record version ([`STATE_VERSION`], `u16`) |
+//! | 2 | 1 | `MODE` | mode: 0 learning, 1 testing ([`Mode`]) |
+//! | 3 | 1 | `KIND` | policy kind built ([`kind_code`]): 0 sarsa, 1 lowpass, 2 markov-lowpass, 3 integrator, 4 markov-integrator, 5 pada, 6 epsilon-pada, 7 ou, 8 pink, 9 action-penalty |
+//! | 4 | 4 | `PARAMETER` | its first parameter, `f32`: α of the low-pass filters, Δ of the integrators and the PADAs, θ of ou, σ of pink, the weight of action-penalty, 0 for sarsa |
+//! | 8 | 1 | `SWITCHED` | switched back to SARSA: 0 no, 1 yes |
+//! | 9 | 1 | `JOINTS` | fatigue joints in use `j`, 0–[`MAX_JOINTS`] |
+//! | 10 | 4 | `PREVIOUS` | previous action: level per action dimension, 4 × `u8` (0 unused) |
+//! | 14 | 2 | `RESERVED_A` | reserved |
+//! | 16 | 4 × 4 | `OUTPUT` | previous output (filter/integrator memory), 4 × `f32` (0 unused) |
+//! | 32 | 4 | `EPSILON` | ε, `f32` |
+//! | 36 | 4 | `TD_ERROR` | last TD error, raw [`Q16`] as `i32` |
+//! | 40 | 8 | `STEPS` | agent steps (decisions), `u64` |
+//! | 48 | 8 | `UPDATES` | SARSA updates, `u64` |
+//! | 56 | 8 | `EXPLORATIONS` | exploratory decisions, `u64` |
+//! | 64 | 4 | `EPISODES` | episodes started, `u32` |
+//! | 68 | 4 | `SATURATIONS` | weight saturations, `u32` |
+//! | 72 | 4 | `TRACE_DROPS` | trace drops, `u32` |
+//! | 76 | 4 | `PARAMETER_2` | the policy's second parameter, `f32`: σ of ou, 0 for the others |
+//! | 80 | 8 | `RNG_STATE` | generator state ([`RngState::state`]), `u64` |
+//! | 88 | 8 | `RNG_INCREMENT` | generator increment ([`RngState::increment`], odd), `u64` |
+//! | 96 | 4 × 4 | `USER` | user counters, 4 × `u32` ([`USER_COUNTERS`], the caller's) |
+//! | 112 | 8 × 48 | `FATIGUE` | fatigue per joint ([`JointFatigueState`]), [`MAX_JOINTS`] entries of `JOINT_LEN` = 48 bytes, the first `j` in use, the others all 0 |
+//! | 496 | 2 × 4 | `ERASES` | erases of slot 0's and slot 1's sector, 2 × `u32` ([`FlashWear`], written by [`super::save`]) |
+//! | 504 | 8 | `OPERATING_S` | operating seconds when saved, `u64` ([`FlashWear::operating_s`]) |
+//! | 512 | 1 | `GOVERNOR` | wear governor: 0 none (then every byte from here on is 0), 1 one runs |
+//! | 513 | 1 | `GOV_RESTRICTS` | what it moves: 0 PADA's Δ, 1 the low-pass α ([`Restricts`]) |
+//! | 514 | 1 | `GOV_RUNG` | the rung in force, 0 the floor |
+//! | 515 | 1 | `GOV_CURSOR` | the window bucket being filled |
+//! | 516 | 1 | `GOV_FILLED` | full buckets before it |
+//! | 517 | 1 | `GOV_IN_BUCKET` | actions in the bucket being filled |
+//! | 518 | 2 | `GOV_RESERVED_A` | reserved |
+//! | 520 | 4 | `GOV_BUDGET` | the budget \[s\], `f32` |
+//! | 524 | 4 | `GOV_CALM` | calm actions (since the last move or the headroom last below the reserve), `u32` |
+//! | 528 | 4 | `GOV_MOVES` | moves so far, `u32` |
+//! | 532 | 4 | `GOV_SINCE_MOVE` | actions since the last move, `u32` |
+//! | 536 | 8 | `GOV_STEPS` | learning actions observed, `u64` |
+//! | 544 | 8 | `GOV_OVER` | actions after which the window was over budget, `u64` |
+//! | 552 | 4 × 12 × 8 | `GOV_BUCKETS` | damage per governed gearbox and bucket, Q16.48, [`GOVERNED_JOINTS`] × [`WINDOW_BUCKETS`] × `u64`, gearbox-major |
+//! | 936 | 8 | `GOV_HEADROOM_AT_MOVE` | the headroom right after the last move, Q16.48 as `i64` |
+//! | 944 | 80 | `GOV_END` | reserved, up to [`STATE_LEN`] = 1024 |
+//!
+//! Each fatigue entry: +0 last sign (`i8`: −1, 0, +1), +1 seven reserved
+//! bytes, +8 steps, +16 re-engagements, +24 damage (Q16.48), +32 window
+//! re-engagements, +40 window damage (Q16.48), each a `u64`.
+//!
+//! Records of version 1 (496 bytes, before the flash wear) and 2 (512
+//! bytes, before the governor) are refused; the flash wear sits at the
+//! same offsets in versions 2 and 3, so a version-2 record's wear is still
+//! read ([`WEAR_END`]).
+//!
+//! The record holds what a learner carries between episodes
+//! ([`AgentState`]), not the eligibility trace: restoring ends the episode
+//! (see [`crate::agent::Agent::restore_state`]). Decoding
+//! ([`LearnerState::from_bytes`]) checks only what the bytes can mean
+//! (version, enum codes, flags, reserved zeros); the ranges that depend on
+//! the running learner are the restorer's to check
+//! ([`crate::agent::Agent::check_state`],
+//! [`crate::fatigue::FatigueCounter::check_state`], [`RngState::check`]).
+//!
+//! [`Q16`]: crate::fixed::Q16
+//! [`Mode`]: crate::agent::Mode
+//! [`RngState::check`]: crate::rng::RngState::check
+//! [`RngState::increment`]: crate::rng::RngState::increment
+//! [`RngState::state`]: crate::rng::RngState::state
 
 use super::wear::FlashWear;
 use crate::action_space::MAX_ACTION_DIMS;
@@ -13,10 +87,9 @@ use crate::policy::{kind_code, kind_from_code, kind_parameter, kind_second_param
 use crate::rng::RngState;
 use heapless::Vec;
 
-/// Version of the learner-state record this code writes and reads (2: the
-/// flash wear at offset 496; 3: the policy's second parameter at offset
-/// 76, the policy codes of the gentle explorations, and the wear
-/// governor's state from offset 512).
+/// Version of the learner-state record this code writes and reads (2 added
+/// the flash wear at offset 496; 3 the policy's second parameter at offset
+/// 76, the policy codes 6–9 and the wear governor's block from offset 512).
 pub const STATE_VERSION: u16 = 3;
 /// Bytes of the learner-state record (a multiple of 4).
 pub const STATE_LEN: usize = 1024;
@@ -25,7 +98,7 @@ pub const MAX_JOINTS: usize = 8;
 /// Counters the state record keeps for the caller ([`LearnerState::user`]).
 pub const USER_COUNTERS: usize = 4;
 
-/// Offsets in the state record (see the module documentation).
+/// Offsets in the state record (the table of the module documentation).
 pub(super) mod at {
     pub const VERSION: usize = 0;
     pub const MODE: usize = 2;
@@ -379,4 +452,91 @@ pub(super) fn wear_of(bytes: &[u8]) -> FlashWear {
     let u32_at = |i: usize| u32::from_le_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
     let u64_at = |i: usize| (u32_at(i) as u64) | ((u32_at(i + 4) as u64) << 32);
     FlashWear { erases: [u32_at(at::ERASES), u32_at(at::ERASES + 4)], operating_s: u64_at(at::OPERATING_S) }
+}
+
+#[cfg(test)]
+mod layout_doc {
+    use super::at;
+
+    /// Every offset constant of [`at`] with its value, in record order.
+    const OFFSETS: &[(&str, usize)] = &[
+        ("VERSION", at::VERSION),
+        ("MODE", at::MODE),
+        ("KIND", at::KIND),
+        ("PARAMETER", at::PARAMETER),
+        ("SWITCHED", at::SWITCHED),
+        ("JOINTS", at::JOINTS),
+        ("PREVIOUS", at::PREVIOUS),
+        ("RESERVED_A", at::RESERVED_A),
+        ("OUTPUT", at::OUTPUT),
+        ("EPSILON", at::EPSILON),
+        ("TD_ERROR", at::TD_ERROR),
+        ("STEPS", at::STEPS),
+        ("UPDATES", at::UPDATES),
+        ("EXPLORATIONS", at::EXPLORATIONS),
+        ("EPISODES", at::EPISODES),
+        ("SATURATIONS", at::SATURATIONS),
+        ("TRACE_DROPS", at::TRACE_DROPS),
+        ("PARAMETER_2", at::PARAMETER_2),
+        ("RNG_STATE", at::RNG_STATE),
+        ("RNG_INCREMENT", at::RNG_INCREMENT),
+        ("USER", at::USER),
+        ("FATIGUE", at::FATIGUE),
+        ("ERASES", at::ERASES),
+        ("OPERATING_S", at::OPERATING_S),
+        ("GOVERNOR", at::GOVERNOR),
+        ("GOV_RESTRICTS", at::GOV_RESTRICTS),
+        ("GOV_RUNG", at::GOV_RUNG),
+        ("GOV_CURSOR", at::GOV_CURSOR),
+        ("GOV_FILLED", at::GOV_FILLED),
+        ("GOV_IN_BUCKET", at::GOV_IN_BUCKET),
+        ("GOV_RESERVED_A", at::GOV_RESERVED_A),
+        ("GOV_BUDGET", at::GOV_BUDGET),
+        ("GOV_CALM", at::GOV_CALM),
+        ("GOV_MOVES", at::GOV_MOVES),
+        ("GOV_SINCE_MOVE", at::GOV_SINCE_MOVE),
+        ("GOV_STEPS", at::GOV_STEPS),
+        ("GOV_OVER", at::GOV_OVER),
+        ("GOV_BUCKETS", at::GOV_BUCKETS),
+        ("GOV_HEADROOM_AT_MOVE", at::GOV_HEADROOM_AT_MOVE),
+        ("GOV_END", at::GOV_END),
+    ];
+
+    /// A size cell: a number or a product such as `4 × 12 × 8`.
+    fn size(cell: &str) -> usize {
+        cell.split('×').map(|f| f.trim().parse::<usize>().expect("a size")).product()
+    }
+
+    #[test]
+    fn the_documented_layout_is_the_codes_layout() {
+        let source = include_str!("record.rs");
+        // The rows of the module documentation's table: offset, size, name.
+        let mut rows = [("", 0usize, 0usize); 64];
+        let mut n = 0;
+        for line in source.lines() {
+            let Some(row) = line.strip_prefix("//! | ") else { continue };
+            let mut cells = row.split(" | ");
+            let (Some(offset), Some(len), Some(name)) = (cells.next(), cells.next(), cells.next()) else { continue };
+            let Ok(offset) = offset.trim().parse::<usize>() else { continue };
+            rows[n] = (name.trim().trim_matches('`'), offset, size(len));
+            n += 1;
+        }
+        let rows = &rows[..n];
+        assert_eq!(rows.len(), OFFSETS.len(), "one documented row per offset constant");
+        for (i, (&(name, offset, len), &(code_name, code_offset))) in rows.iter().zip(OFFSETS).enumerate() {
+            assert_eq!(name, code_name, "row {i} names another offset than the code's");
+            assert_eq!(offset, code_offset, "{name}: documented at {offset}, the code has {code_offset}");
+            let next = rows.get(i + 1).map_or(super::STATE_LEN, |r| r.1);
+            assert_eq!(offset + len, next, "{name}: offset + size does not reach the next field");
+        }
+        // Every offset constant of `at` is in OFFSETS (JOINT_LEN is a length).
+        let consts = source
+            .lines()
+            .skip_while(|l| !l.starts_with("pub(super) mod at {"))
+            .take_while(|l| *l != "}")
+            .filter(|l| l.trim_start().starts_with("pub const ") && !l.contains("JOINT_LEN"))
+            .count();
+        assert_eq!(consts, OFFSETS.len(), "an offset of `at` is missing from the test's list");
+        assert_eq!(at::FATIGUE + super::MAX_JOINTS * at::JOINT_LEN, at::ERASES);
+    }
 }

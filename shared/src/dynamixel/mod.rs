@@ -5,7 +5,7 @@
 //! duplex, driver-enable pin, timeouts and retries).
 //!
 //! Both directions are here, because the host's software-in-the-loop run
-//! emulates RX-28 servos (issue 6): the firmware encodes instruction packets
+//! emulates RX-28 servos: the firmware encodes instruction packets
 //! and decodes status packets ([`StatusDecoder`]); the bus emulator decodes
 //! instruction packets ([`InstructionDecoder`]) and encodes status packets
 //! ([`StatusPacket::encode`]).

@@ -4,11 +4,11 @@
 //! names all derive from.
 //!
 //! The first six are Section V's; the four after them are the gentler
-//! exploration of issue 15, each scored by the same fatigue counter:
+//! explorations, each scored by the same fatigue counter:
 //!
 //! | name | parameters | what it restricts |
 //! |---|---|---|
-//! | `epsilon-pada` | Δ | only the exploratory draws, to within Δ of the previous action (GRL's `sampler/epsilon_pada`, `../shared/reference/grl-facts.md` §6.3); the greedy choice is free |
+//! | `epsilon-pada` | Δ | only the exploratory draws, to within Δ of the previous action (GRL's `sampler/epsilon_pada`, `docs/reference/grl.md` §6.3); the greedy choice is free |
 //! | `ou` | θ, σ | no ε-greedy: the greedy level plus Ornstein–Uhlenbeck noise `n ← n − θ·n + σ·N(0, 1)`, re-discretised (GRL's OU sampler, §6.6) |
 //! | `pink` | σ | the same with pink (1/f) noise of unit variance scaled by σ (after Eberhard et al., ICLR 2023) |
 //! | `action-penalty` | w | nothing: ε-greedy SARSA(λ) learns from `r − w·Σᵢ((aᵢ − a⁻ᵢ)/rangeᵢ)²`, the reward-shaping baseline (legged_gym's `action_rate`) |

@@ -1,4 +1,4 @@
-//! GRL's rate filter (grl-facts §3.2): a first-order Butterworth low-pass
+//! GRL's rate filter (docs/reference/grl.md §3.2): a first-order Butterworth low-pass
 //! discretised with Tustin's method without pre-warping,
 //! `T_c = 2π·f_c/f_s`, `b0 = b1 = T_c/(T_c + 2)`, `a1 = (T_c − 2)/(T_c + 2)`,
 //! `y[n] = b0·(x[n] + x[n−1]) − a1·y[n−1]`, cleared at every episode start.

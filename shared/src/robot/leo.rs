@@ -1,5 +1,5 @@
 //! LEO, the Delft biped on its boom, walking (Section VIII), defined once:
-//! the facts of `grl-facts.md` §1.3–1.8 the task needs and the walking task
+//! the facts of `docs/reference/grl.md` §1.3–1.8 the task needs and the walking task
 //! of §3. The rapier3d simulation (`host/src/leo/`) produces these
 //! quantities from physics; the firmware (`firmware/src/leo.rs`) from servo
 //! positions, the boom's encoder and the foot switches. Both then apply the
@@ -32,7 +32,7 @@ use crate::trace::TraceKind;
 use core::f32::consts::{FRAC_PI_2, PI};
 
 // ---------------------------------------------------------------------------
-// The robot (grl-facts §1)
+// The robot (docs/reference/grl.md §1)
 // ---------------------------------------------------------------------------
 
 /// The seven servo joints (§1.5), in this order everywhere: the
@@ -153,7 +153,7 @@ pub const THIGH_LENGTH: f32 = 0.116;
 pub const SHANK_LENGTH: f32 = 0.1045;
 
 // ---------------------------------------------------------------------------
-// The walking task (grl-facts §2.2, §3)
+// The walking task (docs/reference/grl.md §2.2, §3)
 // ---------------------------------------------------------------------------
 
 /// Control period: 30 Hz (§1.1, §3.6) \[µs\].
@@ -264,7 +264,7 @@ pub const SPEC: RobotSpec = RobotSpec {
 /// So the policy's memory moves with the joints — stance hip ← swing hip,
 /// swing hip ← stance hip, swing knee at rest (0 V) — as GRL's LEO
 /// action sampler mirrors PADA's previous action at touchdown and sets the
-/// auto-actuated knee's entry to 0 (grl-facts §6.2). Without it a physical
+/// auto-actuated knee's entry to 0 (docs/reference/grl.md §6.2). Without it a physical
 /// hip's voltage could jump by the whole range at every footstep.
 pub const FOOTSTEP_REMAP: [Option<u8>; crate::action_space::MAX_ACTION_DIMS] = [Some(1), Some(0), None, None];
 
@@ -656,7 +656,7 @@ mod tests {
 
     #[test]
     fn the_gear_torque_estimate_is_the_rx28_model() {
-        // Stall torque at 10.6919 V ≈ 2.3803 N·m before η (grl-facts §2.1).
+        // Stall torque at 10.6919 V ≈ 2.3803 N·m before η (docs/reference/grl.md §2.1).
         let stall = estimated_gear_torque(10.6919, 0.0);
         assert!((stall - 0.75 * 2.3803).abs() < 1e-3, "{stall}");
         // Back-EMF can reverse the torque's sign (braking).

@@ -1,5 +1,5 @@
 //! The physical inverted pendulum of Section VII, defined once (constants,
-//! timing, observation, reward as GRL's, grl-facts §4). The host's model
+//! timing, observation, reward as GRL's, docs/reference/grl.md §4). The host's model
 //! (`host/src/pendulum/physical.rs`) integrates its dynamics; the firmware
 //! (`firmware/src/pendulum.rs`) reads it through an encoder on the axis and
 //! drives its motor. Both apply these rules.
@@ -19,17 +19,17 @@ use crate::tile_coding::StateDim;
 use crate::trace::TraceKind;
 use core::f32::consts::PI;
 
-/// Motor torque constant K \[N·m/A\] (grl-facts §4).
+/// Motor torque constant K \[N·m/A\] (docs/reference/grl.md §4).
 pub const TORQUE_CONSTANT: f64 = 0.0536;
-/// Motor resistance R \[Ω\] (grl-facts §4).
+/// Motor resistance R \[Ω\] (docs/reference/grl.md §4).
 pub const RESISTANCE: f64 = 9.5;
-/// The motor's voltage limit \[V\] (grl-facts §4).
+/// The motor's voltage limit \[V\] (docs/reference/grl.md §4).
 pub const VOLTAGE_LIMIT: f64 = 3.0;
-/// Episode length \[µs\]: 3 s (grl-facts §4).
+/// Episode length \[µs\]: 3 s (docs/reference/grl.md §4).
 pub const EPISODE_US: u32 = 3_000_000;
 
 /// The tile coder's view (GRL's resolution \[0.31415 rad, 3.1415 rad/s\]
-/// and velocity bounds ±12π, grl-facts §4): 20 angle tiles per turn,
+/// and velocity bounds ±12π, docs/reference/grl.md §4): 20 angle tiles per turn,
 /// velocity tiles π rad/s wide.
 pub const STATE: [StateDim; 2] = [
     StateDim { min: -PI, max: PI, tile_width: 2.0 * PI / 20.0, wrap: true },

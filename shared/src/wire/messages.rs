@@ -390,7 +390,7 @@ pub enum ToChip {
     },
     /// Leave Fault for Idle.
     ClearFault,
-    /// Learn within a gearbox life (protocol 5): a wear governor keeps the
+    /// Learn within a gearbox life (protocol 6): a wear governor keeps the
     /// predicted MTBF over the last 1200 learning actions at or above this
     /// many seconds by moving PADA's Δ or the low-pass filter's α
     /// ([`crate::governor`]), starting at its floor; `None` stops it (the
