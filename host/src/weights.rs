@@ -34,7 +34,7 @@ pub struct WeightsHeader {
     pub switched: bool,
     /// Tilings.
     pub tilings: usize,
-    /// Weight table layout and size, e.g. `hashed 2^22` (with the action
+    /// Weight table layout and size, e.g. `hashed 2^24` (with the action
     /// tile widths when actions are tile-coded).
     pub table: String,
     /// Number of weights.

@@ -89,7 +89,7 @@ impl LeoModel {
         }
 
         // The planar root joint: a fixed anchor at the world origin, the
-        // torso free in x, z and pitch (issue 4: planar motion locked
+        // torso free in x, z and pitch (planar motion locked
         // explicitly).
         let anchor = world.bodies.insert(RigidBodyBuilder::fixed());
         let planar = if options.fixed_torso {

@@ -1,5 +1,5 @@
 //! LEO as a rapier3d world, built in one function from the named constants
-//! of [`super::constants`] (`grl-facts.md` §1), and its physics step.
+//! of [`super::constants`] (`docs/reference/grl.md` §1), and its physics step.
 //!
 //! # How the reference model maps onto rapier
 //!

@@ -119,7 +119,7 @@ impl ModelOptions {
     }
 }
 
-/// What went wrong when the simulation blew up (issue 4, "Bad input").
+/// What went wrong when the simulation blew up (bad input).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum BlowUp {
     /// A coordinate or velocity is NaN or infinite.
