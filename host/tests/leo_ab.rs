@@ -50,7 +50,11 @@ fn references() -> Vec<(String, Reference)> {
         out.push((name, reference));
     }
     out.sort_by(|a, b| a.0.cmp(&b.0));
-    assert_eq!(out.len(), 9, "the nine references of docs/reference/leo-ab.md");
+    assert_eq!(
+        out.len(),
+        9,
+        "the nine references of docs/reference/leo-ab.md"
+    );
     out
 }
 
@@ -120,9 +124,12 @@ fn the_first_touchdown_of_every_reference_happens_in_pada_within_one_step() {
             continue;
         };
         seen += 1;
-        let d = first
-            .difference
-            .unwrap_or_else(|| panic!("{name}: no touchdown of the {} foot near step {}", first.foot, first.reference_step));
+        let d = first.difference.unwrap_or_else(|| {
+            panic!(
+                "{name}: no touchdown of the {} foot near step {}",
+                first.foot, first.reference_step
+            )
+        });
         assert!(
             d.abs() <= 1,
             "{name}: the {} foot touches down at step {} in pada, {} in the reference",
