@@ -159,6 +159,20 @@ fn spin() -> ! {
     loop {
         // SAFETY: see `record`.
         unsafe { core::ptr::write_volatile(&raw mut (*r).alive_count, machine::counter()) };
+        // Between readings, a register-only loop of 2 × 5000 instructions
+        // (10 µs of emulated time): under -icount every peripheral access
+        // ends a translation block, and a loop of nothing but readings
+        // would emulate a hundred times slower.
+        // SAFETY: a register-only countdown loop.
+        unsafe {
+            core::arch::asm!(
+                "2:",
+                "subs {n}, {n}, #1",
+                "bne 2b",
+                n = inout(reg) 5000u32 => _,
+                options(nomem, nostack),
+            );
+        }
     }
 }
 
