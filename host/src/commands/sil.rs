@@ -66,7 +66,7 @@ pub struct SilArgs {
     #[arg(long, value_name = "SPEC")]
     pub fault: Vec<String>,
     /// A power cut, repeatable: `at=SECONDS` (emulated time),
-    /// `random:N[:seed=K]` (N cuts at seeded random instants, about a third
+    /// `random:N[:in-save=M][:seed=K]` (N cuts at seeded random instants, M of them (default a third)
     /// inside a checkpoint save) or `during-save:K` (inside the K-th save).
     /// QEMU is killed (SIGKILL), the checkpoint file kept as it is, and the
     /// same image boots on it; the run goes on from the last completed save.

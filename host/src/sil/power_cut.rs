@@ -3,7 +3,8 @@
 //!
 //! ```text
 //! --power-cut at=SECONDS               a cut at that emulated time
-//! --power-cut random:N[:seed=K]        N cuts at seeded random instants, about a third inside a save
+//! --power-cut random:N[:in-save=M][:seed=K]
+//!                                      N cuts at seeded random instants, M (default round(N/3)) inside saves
 //! --power-cut during-save:K            a cut inside the K-th checkpoint save (1 = the first)
 //! --fault hang:at=SECONDS              the control loop stops feeding the watchdog (mps2-an386)
 //! ```
@@ -46,6 +47,8 @@ pub enum CutSpec {
     Random {
         /// How many.
         n: u32,
+        /// How many of them inside saves (default: a third).
+        in_save: Option<u32>,
         /// The seed.
         seed: u64,
     },
@@ -55,7 +58,7 @@ pub enum CutSpec {
 
 /// Parses a `--power-cut` value.
 pub fn parse(spec: &str) -> Result<CutSpec, String> {
-    let bad = || format!("--power-cut {spec}: expected at=SECONDS, random:N[:seed=K] or during-save:K");
+    let bad = || format!("--power-cut {spec}: expected at=SECONDS, random:N[:in-save=M][:seed=K] or during-save:K");
     if let Some(t) = spec.strip_prefix("at=") {
         let t: f64 = t.parse().map_err(|_| bad())?;
         if !(t.is_finite() && t >= 0.0) {
@@ -76,11 +79,19 @@ pub fn parse(spec: &str) -> Result<CutSpec, String> {
         if !(1..=10_000).contains(&n) {
             return Err(format!("--power-cut {spec}: N must be 1..=10000"));
         }
-        let mut seed = 1;
+        let (mut seed, mut in_save) = (1, None);
         for p in parts {
-            seed = p.strip_prefix("seed=").ok_or_else(bad)?.parse().map_err(|_| bad())?;
+            if let Some(m) = p.strip_prefix("in-save=") {
+                let m: u32 = m.parse().map_err(|_| bad())?;
+                if m > n {
+                    return Err(format!("--power-cut {spec}: in-save={m} is more than the {n} cuts"));
+                }
+                in_save = Some(m);
+            } else {
+                seed = p.strip_prefix("seed=").ok_or_else(bad)?.parse().map_err(|_| bad())?;
+            }
         }
-        return Ok(CutSpec::Random { n, seed });
+        return Ok(CutSpec::Random { n, in_save, seed });
     }
     Err(bad())
 }
@@ -121,11 +132,12 @@ impl CutPlan {
             match *spec {
                 CutSpec::At(t) => plan.at_us.push((t * 1e6).round() as u64),
                 CutSpec::DuringSave(k) => plan.in_save.push((k, save_bytes / 2)),
-                CutSpec::Random { n, seed } => {
+                CutSpec::Random { n, in_save, seed } => {
                     let mut rng = Pcg32::seed_from_u64(seed);
                     let mut uniform = move || rng.next_u32() as f64 / (u32::MAX as f64 + 1.0);
                     let attempts = (seconds / save_every_s).floor() as u32;
-                    let n_save = if fits { ((n as f64 / 3.0).round() as u32).min(attempts) } else { 0 };
+                    let third = (n as f64 / 3.0).round() as u32;
+                    let n_save = if fits { in_save.unwrap_or(third).min(attempts) } else { 0 };
                     // Distinct attempts: a partial Fisher-Yates over 1..=attempts.
                     let mut pool: Vec<u32> = (1..=attempts).collect();
                     for i in 0..n_save as usize {
@@ -143,7 +155,12 @@ impl CutPlan {
         plan.at_us.sort_unstable();
         plan.learning.sort_by(|a, b| a.0.total_cmp(&b.0));
         plan.in_save.sort_unstable();
-        plan.in_save.dedup_by_key(|c| c.0);
+        // Two cuts asked for the same save: the second takes the next one.
+        for i in 1..plan.in_save.len() {
+            if plan.in_save[i].0 <= plan.in_save[i - 1].0 {
+                plan.in_save[i].0 = plan.in_save[i - 1].0 + 1;
+            }
+        }
         plan
     }
 
@@ -279,10 +296,11 @@ mod tests {
     #[test]
     fn specs_parse_and_bad_ones_say_why() {
         assert_eq!(parse("at=12.5"), Ok(CutSpec::At(12.5)));
-        assert_eq!(parse("random:30"), Ok(CutSpec::Random { n: 30, seed: 1 }));
-        assert_eq!(parse("random:30:seed=7"), Ok(CutSpec::Random { n: 30, seed: 7 }));
+        assert_eq!(parse("random:30"), Ok(CutSpec::Random { n: 30, in_save: None, seed: 1 }));
+        assert_eq!(parse("random:30:seed=7"), Ok(CutSpec::Random { n: 30, in_save: None, seed: 7 }));
+        assert_eq!(parse("random:30:in-save=5:seed=7"), Ok(CutSpec::Random { n: 30, in_save: Some(5), seed: 7 }));
         assert_eq!(parse("during-save:3"), Ok(CutSpec::DuringSave(3)));
-        for bad in ["at=-1", "random:0", "during-save:0", "now", "random:3:salt=1"] {
+        for bad in ["at=-1", "random:0", "during-save:0", "now", "random:3:salt=1", "random:3:in-save=4"] {
             assert!(parse(bad).is_err(), "{bad}");
         }
         assert_eq!(parse_hang("hang:at=20"), Some(Ok(20.0)));
@@ -293,7 +311,7 @@ mod tests {
 
     #[test]
     fn a_random_plan_puts_a_third_inside_distinct_saves_and_is_seeded() {
-        let specs = [CutSpec::Random { n: 30, seed: 3 }];
+        let specs = [CutSpec::Random { n: 30, in_save: None, seed: 3 }];
         let p = CutPlan::new(&specs, 600.0, 20.0, 100_368, 131_072);
         assert_eq!(p.len(), 30);
         assert_eq!(p.in_save.len(), 10);
@@ -302,7 +320,9 @@ mod tests {
         let again = CutPlan::new(&specs, 600.0, 20.0, 100_368, 131_072);
         assert_eq!((p.learning.clone(), p.in_save.clone()), (again.learning, again.in_save));
         // A checkpoint that no slot holds is never written: every cut timed.
-        let leo = CutPlan::new(&[CutSpec::Random { n: 5, seed: 1 }], 60.0, 20.0, 8_389_136, 131_072);
+        let leo = CutPlan::new(&[CutSpec::Random { n: 5, in_save: None, seed: 1 }], 60.0, 20.0, 8_389_136, 131_072);
+        let five = CutPlan::new(&[CutSpec::Random { n: 30, in_save: Some(5), seed: 1 }], 600.0, 20.0, 100_368, 131_072);
+        assert_eq!((five.learning.len(), five.in_save.len()), (25, 5));
         assert_eq!((leo.learning.len(), leo.in_save.len()), (5, 0));
     }
 }
