@@ -22,6 +22,7 @@ pub mod plot;
 pub mod progress;
 pub mod rig;
 pub mod seed;
+pub mod serial_link;
 pub mod sil;
 pub mod stats;
 pub mod console;

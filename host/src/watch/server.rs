@@ -38,6 +38,8 @@ pub struct Shared {
     pub requests: AtomicU64,
     /// Set when decoding ended in a failure (a read error, the CSV).
     pub failed: std::sync::atomic::AtomicBool,
+    /// Times the serial port went away (and was waited for).
+    pub disconnects: std::sync::atomic::AtomicU32,
     /// The last rendering of `/live`, reused within the same second.
     live_cache: Mutex<Option<(LiveKey, Arc<String>)>>,
 }
@@ -53,6 +55,7 @@ impl Shared {
             last_data_ms: AtomicU64::new(0),
             requests: AtomicU64::new(0),
             failed: std::sync::atomic::AtomicBool::new(false),
+            disconnects: std::sync::atomic::AtomicU32::new(0),
             live_cache: Mutex::new(None),
         }
     }
