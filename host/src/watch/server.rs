@@ -103,6 +103,8 @@ pub struct ApiState<'a> {
     pub no_data_for_s: Option<f64>,
     /// Whether the page shows the stream as stalled.
     pub stalled: bool,
+    /// Times the serial port went away (and was waited for).
+    pub disconnects: u32,
 }
 
 impl<'a> ApiState<'a> {
@@ -114,6 +116,7 @@ impl<'a> ApiState<'a> {
             wall_s: clock.wall_s,
             no_data_for_s: clock.since_data_s,
             stalled: state.ended.is_none() && silent >= STALL_AFTER_S,
+            disconnects: 0,
         }
     }
 }
@@ -212,7 +215,9 @@ pub fn handle(rq: Request, shared: &Shared) {
         }
         "/api/state" => {
             let state = shared.snapshot();
-            match serde_json::to_vec(&ApiState::new(&state, shared.clock())) {
+            let mut api = ApiState::new(&state, shared.clock());
+            api.disconnects = shared.disconnects.load(std::sync::atomic::Ordering::SeqCst);
+            match serde_json::to_vec(&api) {
                 Ok(body) => respond(rq, 200, "application/json", body),
                 Err(e) => error(rq, 500, &e.to_string()),
             }
