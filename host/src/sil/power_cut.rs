@@ -22,7 +22,8 @@
 //! learning time (`--seconds`; a cut comes at the first moment the learning
 //! done so far, lost learning included, passes its instant, plus a uniform
 //! 0–5 s of emulated time, so cuts land in learning and test episodes and
-//! between them alike) and `round(N / 3)` of them inside saves: distinct
+//! between them alike; one overtaken by another cut comes 1 s after the
+//! next boot) and `round(N / 3)` of them inside saves: distinct
 //! save attempts among the first `seconds / save interval`, each at a
 //! uniform byte of the save. With a checkpoint larger than a slot (LEO on
 //! `f429-sdram`) every save is refused before flash is touched, so all N

@@ -64,6 +64,9 @@ struct Power {
     next_learning: usize,
     /// A timed cut decided on, at this instant \[µs\].
     due_us: Option<u64>,
+    /// Timed cuts decided on but overtaken by another reboot: each comes
+    /// 1 s after the next boot settles.
+    deferred: u32,
     /// Learning done so far, lost learning included \[s\].
     learning_done_s: f64,
     /// The in-save cut armed for the next `SaveCheckpoint` sent.
@@ -163,6 +166,7 @@ impl<'a> Session<'a> {
             next_at: 0,
             next_learning: 0,
             due_us: None,
+            deferred: 0,
             learning_done_s: 0.0,
             arm_next_save: None,
             armed: None,
@@ -424,7 +428,9 @@ impl<'a> Session<'a> {
             None => self.power.initial.clone(),
         };
         self.power.last_attempt_learning_s = self.protocol.learning_time_s();
-        self.power.due_us = None;
+        if self.power.due_us.take().is_some() {
+            self.power.deferred += 1;
+        }
         self.power.armed = None;
         self.commands.clear();
         self.replies.clear();
@@ -487,7 +493,10 @@ impl<'a> Session<'a> {
             return None;
         }
         if p.due_us.is_none() {
-            if let Some(&t) = p.plan.at_us.get(p.next_at) {
+            if p.deferred > 0 {
+                p.deferred -= 1;
+                p.due_us = Some(self.now_us + 1_000_000);
+            } else if let Some(&t) = p.plan.at_us.get(p.next_at) {
                 p.next_at += 1;
                 p.due_us = Some(t.max(self.now_us));
             } else if let Some(&(instant, delay)) = p.plan.learning.get(p.next_learning) {
@@ -500,17 +509,18 @@ impl<'a> Session<'a> {
         p.due_us.filter(|&t| t <= next)
     }
 
-    /// After a learning episode: a save when the next learning episode
-    /// could take the learning since the last save past the interval
-    /// (torque off for it: `Pause`, `SaveCheckpoint`, `Start`), not before
-    /// the board's own test episode.
+    /// After a learning episode: a save when the next two learning
+    /// episodes could take the learning since the last save past the
+    /// interval (two: the board's own test episode may come first, and no
+    /// save is made before it, so the next chance may be one episode later;
+    /// torque off for it: `Pause`, `SaveCheckpoint`, `Start`).
     fn maybe_save(&mut self, at_us: u64) {
         let Some(every) = self.cfg.save_every_s else { return };
         let spec = self.cfg.task.robot().spec();
         let max_episode_s = spec.episode_steps as f64 * spec.period_us as f64 * 1e-6;
         let since = self.protocol.learning_time_s() - self.power.last_attempt_learning_s;
         let test_next = spec.test_interval > 0 && self.protocol.learning_episodes() % spec.test_interval == 0;
-        if since <= 0.0 || since + max_episode_s <= every || test_next {
+        if since <= 0.0 || since + 2.0 * max_episode_s <= every || test_next {
             return;
         }
         self.power.last_attempt_learning_s = self.protocol.learning_time_s();
