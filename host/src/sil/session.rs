@@ -608,6 +608,7 @@ impl<'a> Session<'a> {
             bail!("the board waits for nothing and nothing is scheduled: it would sleep forever");
         }
         if let Some(t) = self.cut_due(next) {
+            self.power.due_us = None;
             self.power_cut(t.max(self.now_us), None)?;
             return Ok(false);
         }
