@@ -73,7 +73,7 @@ use heapless::{String, Vec};
 use serde::{Deserialize, Serialize};
 
 /// Version of the clock protocol; the board sends it in [`FromBoard::Boot`].
-pub const CLOCK_PROTOCOL: u16 = 2;
+pub const CLOCK_PROTOCOL: u16 = 3;
 
 /// Instructions of the calibration loop of [`FromBoard::Boot`].
 pub const CALIBRATION_INSTRUCTIONS: u32 = 20_000;
@@ -120,6 +120,18 @@ pub enum FromBoard {
         /// Instructions per count of the board's instruction counter (its
         /// timer's period in nanoseconds under `-icount shift=0`).
         resolution: u16,
+        /// The watchdog's period \[ms\] (0: the machine models none, as
+        /// QEMU's netduinoplus2).
+        watchdog_ms: u32,
+        /// Why the board booted.
+        reset: ResetCause,
+    },
+    /// The board stopped at the power cut the host armed
+    /// ([`ToBoard::CutInSave`]), inside a checkpoint save, with the flash
+    /// file as the cut leaves it; the host kills QEMU now.
+    PowerCut {
+        /// The board's clock \[µs\].
+        now_us: u64,
     },
     /// Bytes the board wrote at `at_us`.
     Output {
@@ -154,7 +166,21 @@ pub enum ToBoard {
         /// The seed of the learner's generator (a real board uses
         /// `crate::config::DEFAULT_SEED`).
         seed: u64,
+        /// The board's clock at boot \[µs\]: the host's time, so a board
+        /// booted again (after a power cut or a watchdog reset) goes on on
+        /// the plant's clock.
+        now_us: u64,
     },
+    /// Power-cut injection: the next bytes the board writes to its
+    /// checkpoint file (erases included) are cut after `after_bytes`, and
+    /// the board stops there ([`FromBoard::PowerCut`]).
+    CutInSave {
+        /// Bytes written before the cut.
+        after_bytes: u32,
+    },
+    /// Hang injection: the control loop stops at its next period (it spins
+    /// without feeding the watchdog).
+    Hang,
     /// Bytes arriving at the next [`ToBoard::Advance`]'s instant.
     Input {
         /// The stream.
@@ -184,6 +210,23 @@ pub enum ToBoard {
         /// scheduled): the board advances on its own only before it \[µs\]
         /// ([`NEVER`] if none).
         horizon_us: u64,
+    },
+}
+
+/// Why an emulated board booted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ResetCause {
+    /// Power on: a fresh emulator (the first boot, or after a power cut).
+    PowerOn,
+    /// The watchdog reset the chip (mps2-an386's CMSDK watchdog).
+    Watchdog {
+        /// The board's clock at the watchdog's last feed \[µs\].
+        fed_at_us: u64,
+        /// The board's clock when the control loop hung \[µs\].
+        hung_at_us: u64,
+        /// Emulated nanoseconds from the last feed to the reset, as the
+        /// hung loop measured them on the instruction counter.
+        since_feed_ns: u64,
     },
 }
 
@@ -263,7 +306,10 @@ mod tests {
                 machine: String::try_from("mps2-an386-xxxxx").unwrap(),
                 calibration: u32::MAX,
                 resolution: u16::MAX,
+                watchdog_ms: u32::MAX,
+                reset: ResetCause::Watchdog { fed_at_us: u64::MAX, hung_at_us: u64::MAX, since_feed_ns: u64::MAX },
             },
+            FromBoard::PowerCut { now_us: u64::MAX },
             FromBoard::Output {
                 channel: Channel::Telemetry,
                 at_us: u64::MAX,
@@ -273,7 +319,9 @@ mod tests {
             FromBoard::Idle { now_us: u64::MAX - 1, until_us: NEVER, instructions: u64::MAX },
         ]);
         round_trip(&[
-            ToBoard::Configure { seed: u64::MAX },
+            ToBoard::Configure { seed: u64::MAX, now_us: u64::MAX },
+            ToBoard::CutInSave { after_bytes: u32::MAX },
+            ToBoard::Hang,
             ToBoard::Input { channel: Channel::Bus, bytes: Vec::from_slice(&full(CHUNK_LEN)).unwrap() },
             ToBoard::Forecast {
                 request_at_us: u64::MAX,

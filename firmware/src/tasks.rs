@@ -256,6 +256,8 @@ pub async fn control(mut cl: ControlLoop) -> ! {
 
     loop {
         ticker.next().await;
+        // The emulated boards' `--fault hang` (nothing on a real board).
+        crate::board::injected_hang();
         let t0 = cl.cycles.cycles();
         period = period.wrapping_add(1);
 

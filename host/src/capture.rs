@@ -164,6 +164,16 @@ impl Recorder {
         }
     }
 
+    /// The sender restarted on purpose (a board booted again after a
+    /// power cut or a reset): its sequence numbers start over, so the next
+    /// frame is not a gap; a frame cut short by the restart counts as lost.
+    /// Returns whether there was one.
+    pub fn restarted(&mut self) -> bool {
+        let cut = self.decoder.finish().is_some();
+        self.decoder.resync_seq();
+        cut
+    }
+
     /// Link counters: frames, bytes, every kind of loss.
     pub fn stats(&self) -> LinkStats {
         self.decoder.stats()

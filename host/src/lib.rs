@@ -23,6 +23,7 @@ pub mod progress;
 pub mod rig;
 pub mod robots;
 pub mod seed;
+pub mod serial_link;
 pub mod sil;
 pub mod stats;
 pub mod console;

@@ -162,9 +162,13 @@ fn capture_from_a_pseudo_terminal_resynchronises_counts_every_loss_and_keeps_goi
         std::thread::sleep(Duration::from_millis(40));
     }
     let fed_in = started.elapsed();
-    // Let it drain, then hang up: the port goes away, the capture ends.
+    // Let it drain, then hang up: the port goes away, and the capture
+    // waits for it to come back (counting the disconnect) until Ctrl-C.
     std::thread::sleep(Duration::from_millis(500));
     drop(m);
+    std::thread::sleep(Duration::from_millis(500));
+    let pid = rustix::process::Pid::from_child(&child);
+    rustix::process::kill_process(pid, rustix::process::Signal::INT).expect("SIGINT");
     let out = child.wait_with_output().unwrap();
     let lines = lines.join().unwrap();
     assert!(
@@ -175,7 +179,9 @@ fn capture_from_a_pseudo_terminal_resynchronises_counts_every_loss_and_keeps_goi
     );
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     check_summary(&json, &want);
-    assert!(json["ended"].as_str().unwrap().contains("port"), "{json:#}");
+    assert_eq!(json["ended"], "interrupted", "{json:#}");
+    assert_eq!(json["disconnects"], 1, "{json:#}");
+    assert!(lines.iter().any(|l| l.contains("waiting for it to come back")), "{lines:?}");
     // A live status line every second while bytes came in, and a last one.
     let status: Vec<&String> = lines.iter().filter(|l| l.starts_with("frames ")).collect();
     assert!(
@@ -252,4 +258,111 @@ fn capture_rejects_bad_input_with_exit_code_2() {
             "{args:?}: {err}"
         );
     }
+}
+
+/// A pseudo-terminal behind a fixed path (a symlink, as udev's
+/// `/dev/serial/by-id/…` names a USB adapter): closing its master is
+/// pulling the adapter; a new pty behind the same link is plugging it in.
+struct Adapter {
+    link: std::path::PathBuf,
+    master: Option<std::fs::File>,
+}
+
+impl Adapter {
+    fn plug(&mut self) {
+        let (master, slave) = pty();
+        {
+            let fd = std::fs::OpenOptions::new().read(true).write(true).open(&slave).unwrap();
+            let mut t = rustix::termios::tcgetattr(&fd).unwrap();
+            t.make_raw();
+            rustix::termios::tcsetattr(&fd, rustix::termios::OptionalActions::Now, &t).unwrap();
+        }
+        let tmp = self.link.with_extension("new");
+        let _ = std::fs::remove_file(&tmp);
+        std::os::unix::fs::symlink(&slave, &tmp).unwrap();
+        std::fs::rename(&tmp, &self.link).unwrap();
+        self.master = Some(std::fs::File::from(master));
+    }
+
+    fn pull(&mut self) {
+        self.master = None;
+        let _ = std::fs::remove_file(&self.link);
+    }
+}
+
+#[test]
+fn capture_survives_ten_disconnects_of_its_port_and_records_every_frame_sent_while_connected() {
+    let stream = recording();
+    let bounds = frames(&stream);
+    let dir = tempfile::tempdir().unwrap();
+    let mut adapter = Adapter { link: dir.path().join("ttyUSB-pada"), master: None };
+    adapter.plug();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_pada"))
+        .args(["capture", "--baud", "921600", "--json", "--port"])
+        .arg(&adapter.link)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let stderr = child.stderr.take().unwrap();
+    let (tx, rx) = std::sync::mpsc::channel::<String>();
+    let lines = std::thread::spawn(move || {
+        let mut all = Vec::new();
+        for l in BufReader::new(stderr).lines().map_while(Result::ok) {
+            let _ = tx.send(l.clone());
+            all.push(l);
+        }
+        all
+    });
+    // Waits for a stderr line containing `what`.
+    let wait_for = |what: &str| {
+        let deadline = Instant::now() + Duration::from_secs(20);
+        while Instant::now() < deadline {
+            if let Ok(l) = rx.recv_timeout(Duration::from_millis(100)) {
+                if l.contains(what) {
+                    return;
+                }
+            }
+        }
+        panic!("no line with {what:?} within 20 s");
+    };
+    std::thread::sleep(Duration::from_millis(500));
+    // Eleven connected stretches, each a slice of whole frames; ten
+    // disconnects between them.
+    let per = bounds.len() / 11;
+    let mut sent = 0u64;
+    for k in 0..11 {
+        let (a, b) = (bounds[k * per].0, bounds[if k == 10 { bounds.len() - 1 } else { (k + 1) * per - 1 }].1);
+        let m = adapter.master.as_mut().unwrap();
+        for chunk in stream[a..b].chunks(512) {
+            m.write_all(chunk).unwrap();
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        sent += HostDecoder::new().feed(&stream[a..b]).filter(|f| f.is_ok()).count() as u64;
+        // Let the capture read it all before the cable goes.
+        std::thread::sleep(Duration::from_millis(400));
+        if k < 10 {
+            adapter.pull();
+            wait_for("waiting for it to come back");
+            std::thread::sleep(Duration::from_millis(300));
+            adapter.plug();
+            wait_for("is back");
+        }
+    }
+    std::thread::sleep(Duration::from_millis(300));
+    let pid = rustix::process::Pid::from_child(&child);
+    rustix::process::kill_process(pid, rustix::process::Signal::INT).expect("SIGINT");
+    let out = child.wait_with_output().unwrap();
+    let lines = lines.join().unwrap();
+    assert!(out.status.success(), "exit {:?}; stderr:\n{}", out.status, lines.join("\n"));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // Ctrl-C still gives the summary; every frame sent while connected was
+    // recorded, each disconnect counted, and nothing else lost.
+    assert_eq!(json["ended"], "interrupted", "{json:#}");
+    assert_eq!(json["disconnects"], 10, "{json:#}");
+    assert_eq!(json["link"]["frames"], sent, "{json:#}");
+    assert_eq!(json["bad_frames"], 0, "{json:#}");
+    // Each stretch starts where the last ended: no frame was sent while
+    // unplugged, so there is no gap either.
+    assert_eq!(json["link"]["seq_gaps"], 0, "{json:#}");
 }

@@ -504,3 +504,53 @@ fn a_csv_that_cannot_be_written_ends_the_watch_with_an_error() {
         "{err}"
     );
 }
+
+#[test]
+fn watch_waits_for_its_port_to_come_back_and_counts_each_disconnect() {
+    // A pty behind a symlink (as udev names a USB adapter): closing the
+    // master pulls the adapter, a new pty behind the link plugs it in.
+    use pada_core::wire::HostDecoder;
+    use rustix::pty::{grantpt, openpt, ptsname, unlockpt, OpenptFlags};
+    let dir = tempfile::tempdir().unwrap();
+    let (bin, _) = recorded_run(dir.path());
+    let bytes = std::fs::read(&bin).unwrap();
+    let capture = capture_json(&bin, None);
+    let link = dir.path().join("ttyUSB-pada");
+    let plug = || {
+        let master = openpt(OpenptFlags::RDWR | OpenptFlags::NOCTTY | OpenptFlags::CLOEXEC).expect("openpt");
+        grantpt(&master).unwrap();
+        unlockpt(&master).unwrap();
+        let slave = ptsname(&master, Vec::new()).unwrap().into_string().unwrap();
+        let fd = std::fs::OpenOptions::new().read(true).write(true).open(&slave).unwrap();
+        let mut t = rustix::termios::tcgetattr(&fd).unwrap();
+        t.make_raw();
+        rustix::termios::tcsetattr(&fd, rustix::termios::OptionalActions::Now, &t).unwrap();
+        let tmp = link.with_extension("new");
+        let _ = std::fs::remove_file(&tmp);
+        std::os::unix::fs::symlink(&slave, &tmp).unwrap();
+        std::fs::rename(&tmp, &link).unwrap();
+        std::fs::File::from(master)
+    };
+    // Split the stream at frame boundaries into three stretches.
+    let ends: Vec<usize> = bytes.iter().enumerate().filter(|(_, b)| **b == 0).map(|(i, _)| i + 1).collect();
+    let cuts = [0, ends[ends.len() / 3], ends[2 * ends.len() / 3], bytes.len()];
+    let mut m = plug();
+    let w = Watch::start(&["--port", link.to_str().unwrap()]);
+    std::thread::sleep(Duration::from_millis(300));
+    for k in 0..3 {
+        m.write_all(&bytes[cuts[k]..cuts[k + 1]]).unwrap();
+        if k < 2 {
+            let upto = HostDecoder::new().feed(&bytes[..cuts[k + 1]]).filter(|f| f.is_ok()).count() as u64;
+            w.wait_for(60, "the stretch", |s| s["link"]["frames"].as_u64() == Some(upto));
+            drop(m);
+            let _ = std::fs::remove_file(&link);
+            w.wait_for(20, "the disconnect", |s| s["disconnects"].as_u64() == Some(k as u64 + 1));
+            m = plug();
+        }
+    }
+    let want = capture["link"]["frames"].as_u64().unwrap();
+    let s = w.wait_for(60, "every frame", |s| s["link"]["frames"].as_u64() == Some(want));
+    assert_eq!(s["disconnects"], 2);
+    assert_eq!(s["link"], capture["link"]);
+    drop(m);
+}

@@ -247,6 +247,11 @@ impl io::CycleCounter for Cycles {
     }
 }
 
+/// The emulated boards' hang injection (`pada sil --fault hang`): nothing
+/// on a real board.
+#[inline(always)]
+pub fn injected_hang() {}
+
 /// The independent watchdog. Started with a prescaler that reaches
 /// [`WATCHDOG_FLASH_US`], then run at [`WATCHDOG_US`]; [`extend`] switches
 /// between the two by the reload register alone.

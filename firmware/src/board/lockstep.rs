@@ -20,7 +20,7 @@
 //! | cycle counter: lock-step time × the real chip's clock + instructions executed (`-icount`) | DWT CYCCNT | QEMU has no DWT; instructions stand in for cycles |
 //! | checkpoints in a file on the host, in slots of one flash sector | flash sectors | QEMU's flash is read-only |
 //! | the learner's seed from the host ([`ToBoard::Configure`]) | `DEFAULT_SEED` | a run chooses its seed, as `pada run --seed` does |
-//! | no watchdog | IWDG | nothing can hang the lock-step clock unnoticed: the host times out |
+//! | mps2-an386: the CMSDK watchdog (`cmsdk_watchdog.rs`); netduinoplus2: none (QEMU models none) | IWDG | a hung loop spins, and QEMU's clock counts its instructions |
 //! | defmt and panics over semihosting, exit code 1 on a panic | RTT, probe-rs | no debug probe |
 //!
 //! Forecasts ([`pada_firmware::sil`], "Forecasts"): a bus request that is
@@ -463,6 +463,8 @@ fn wait_for_advance(inbox: &mut Inbox) {
                 return;
             }
             ToBoard::Configure { .. } => defmt::warn!("lock-step clock: Configure after boot ignored"),
+            ToBoard::CutInSave { after_bytes } => super::injection::arm_cut(after_bytes),
+            ToBoard::Hang => super::injection::request_hang(),
         }
     }
 }
@@ -599,13 +601,13 @@ pub struct Board {
     pub sensors: BoardSensors,
     /// The checkpoint slots (a file on the host).
     pub flash: FlashStore,
-    /// No watchdog.
+    /// The machine's watchdog (none on netduinoplus2).
     pub watchdog: Watchdog,
     /// Lock-step time plus instructions.
     pub cycles: Cycles,
     /// No LED.
     pub led: Led,
-    /// Never: there is no watchdog to reset the emulated chip.
+    /// The watchdog reset the chip (mps2-an386; never on netduinoplus2).
     pub watchdog_reset: bool,
     /// The table's memory: internal SRAM and CCM, or the mps2's PSRAM,
     /// which QEMU models from reset.
@@ -618,6 +620,8 @@ impl Board {
     /// Counter, clock link, the Boot message and the host's configuration.
     /// Call once.
     pub fn init() -> Board {
+        // Before anything writes RAM the record lives in.
+        let reset = super::watchdog::reset_cause();
         machine::start_counter();
         let (to_host, from_host) = match (semi::open(CLOCK_OUT, semi::WRITE), semi::open(CLOCK_IN, semi::READ)) {
             (Some(a), Some(b)) => (a, b),
@@ -635,6 +639,8 @@ impl Board {
             machine: heapless::String::try_from(machine::MACHINE).unwrap_or_default(),
             calibration,
             resolution: machine::INSTRUCTIONS_PER_COUNT as u16,
+            watchdog_ms: super::watchdog::PERIOD_MS,
+            reset,
         };
         link(|l| {
             l.to_host = to_host;
@@ -644,7 +650,13 @@ impl Board {
         });
         let mut inbox = Inbox { decoder: FrameDecoder::new(), pending: Deque::new() };
         let seed = match link(|l| l.receive(&mut inbox.decoder, &mut inbox.pending)) {
-            ToBoard::Configure { seed } => seed,
+            ToBoard::Configure { seed, now_us } => {
+                link(|l| {
+                    l.now_us = now_us;
+                    l.horizon_us = now_us;
+                });
+                seed
+            }
             _ => {
                 defmt::error!("lock-step clock: the host did not answer Boot with Configure");
                 exit_failure()
@@ -659,10 +671,10 @@ impl Board {
             telemetry_rx: TelemetryRx(()),
             sensors: BoardSensors { bus: ServoBus::new(ServoPort(()), BusConfig::default()), contacts: 0 },
             flash: FlashStore::open(),
-            watchdog: Watchdog(()),
+            watchdog: Watchdog::new(),
             cycles: Cycles(()),
             led: Led(()),
-            watchdog_reset: false,
+            watchdog_reset: matches!(reset, sil::ResetCause::Watchdog { .. }),
             table_memory: Ok(TableMemory::ready()),
             seed,
         }
@@ -757,16 +769,41 @@ impl io::CycleCounter for Cycles {
     }
 }
 
-/// No watchdog on the emulated board (the host notices a hang).
-pub struct Watchdog(());
+pub use super::watchdog::Watchdog;
 
-impl Watchdog {
-    /// Nothing to start.
-    pub fn start(&mut self) {}
-    /// Nothing to feed.
-    pub fn feed(&mut self) {}
-    /// Nothing to extend.
-    pub fn extend(&mut self, _long: bool) {}
+/// The board's clock \[µs\].
+pub(super) fn lockstep_now_us() -> u64 {
+    link(|l| l.now_us)
+}
+
+/// The armed power cut is here (`injection.rs`): report everything, say
+/// so, and wait for the host to kill the emulator.
+fn power_cut_now() -> ! {
+    let from_host = link(|l| {
+        l.report_output();
+        let cut = FromBoard::PowerCut { now_us: l.now_us };
+        l.queue(&cut);
+        l.flush_writes();
+        l.from_host
+    });
+    let mut buf = [0u8; 64];
+    // The host ends QEMU on reading PowerCut; whatever comes meanwhile is
+    // dropped, as the power is off.
+    while semi::read_some(from_host, &mut buf) > 0 {}
+    exit_failure()
+}
+
+/// Writes `data` at `pos` of the checkpoint file, up to an armed power cut.
+fn flash_put(h: usize, pos: usize, data: &[u8]) -> bool {
+    match super::injection::before_cut(data.len()) {
+        Ok(_) => semi::seek(h, pos) && semi::write(h, data),
+        Err(n) => {
+            if n > 0 {
+                let _ = semi::seek(h, pos) && semi::write(h, &data[..n]);
+            }
+            power_cut_now()
+        }
+    }
 }
 
 /// No LED.
@@ -845,23 +882,20 @@ impl CheckpointStore for FlashStore {
 
     fn erase(&mut self, slot: u8) -> Result<(), FlashError> {
         let (h, pos) = self.at(slot, 0, SLOT_LEN)?;
-        if !semi::seek(h, pos) {
-            return Err(FlashError::Host);
-        }
-        let mut left = SLOT_LEN;
-        while left > 0 {
-            let n = left.min(ERASED.len());
-            if !semi::write(h, &ERASED[..n]) {
+        let mut done = 0;
+        while done < SLOT_LEN {
+            let n = (SLOT_LEN - done).min(ERASED.len());
+            if !flash_put(h, pos + done, &ERASED[..n]) {
                 return Err(FlashError::Host);
             }
-            left -= n;
+            done += n;
         }
         Ok(())
     }
 
     fn write(&mut self, slot: u8, offset: usize, data: &[u8]) -> Result<(), FlashError> {
         let (h, pos) = self.at(slot, offset, data.len())?;
-        (semi::seek(h, pos) && semi::write(h, data)).then_some(()).ok_or(FlashError::Host)
+        flash_put(h, pos, data).then_some(()).ok_or(FlashError::Host)
     }
 }
 

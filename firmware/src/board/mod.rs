@@ -108,6 +108,20 @@ use qemu as machine;
 mod mps2;
 #[cfg(feature = "mps2")]
 use mps2 as machine;
+// The emulated boards' watchdog: mps2-an386's CMSDK watchdog; none on
+// netduinoplus2, which models none. And the host's fault injection.
+#[cfg(feature = "mps2")]
+mod cmsdk_watchdog;
+#[cfg(feature = "mps2")]
+use cmsdk_watchdog as watchdog;
+#[cfg(feature = "qemu")]
+mod no_watchdog;
+#[cfg(feature = "qemu")]
+use no_watchdog as watchdog;
+#[cfg(emulated)]
+mod injection;
+#[cfg(emulated)]
+pub use injection::injected_hang;
 
 /// Proof that the memory the weight table lives in works: only the board
 /// layer makes one, after it started that memory (the F429's SDRAM, which

@@ -1,8 +1,12 @@
 //! `pada capture`: telemetry from a board's serial port or a recorded
 //! stream, decoded, recorded as CSV, with a live one-line status.
 //!
-//! Nothing stops a capture but the end of its input (end of file, the port
-//! going away), Ctrl-C, or `--seconds`: a bad frame is counted and the
+//! Nothing stops a capture but the end of its input (end of file), Ctrl-C,
+//! or `--seconds`. A serial port that goes away (an adapter pulled, a pty
+//! closed) is waited for and opened again at the same path
+//! (`crate::serial_link`): each disconnect is counted (`disconnects`), the
+//! frame it cut short counts as lost, and what the board sent meanwhile
+//! shows as a sequence gap. Otherwise a bad frame is counted and the
 //! decoder picks up at the next frame. At the end of the input a frame cut
 //! off is counted as lost too (a capture stopped by Ctrl-C or `--seconds`
 //! cut it itself, so it is not). A read error ends the capture with its
@@ -10,6 +14,7 @@
 
 use crate::console::{errln, outln};
 use crate::capture::Recorder;
+use crate::serial_link::LinkEvent;
 use crate::error::{usage, CliError};
 use anyhow::Context;
 use clap::Args;
@@ -62,10 +67,12 @@ pub struct CaptureSummary {
     pub messages: crate::capture::MessageCounts,
     /// The latest values (episodes, returns, fatigue, fault).
     pub latest: crate::capture::Latest,
+    /// Times the serial port went away (and was waited for).
+    pub disconnects: u32,
 }
 
 enum Source {
-    Port(Box<dyn serialport::SerialPort>),
+    Port(crate::serial_link::SerialLink),
     Reader(Box<dyn Read + Send>),
 }
 
@@ -86,9 +93,7 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
     }
     let (mut source, name) = match (&args.port, &args.file) {
         (Some(port), _) => {
-            let p = serialport::new(port.to_string_lossy(), args.baud)
-                .timeout(Duration::from_millis(100))
-                .open()
+            let p = crate::serial_link::SerialLink::open(port, args.baud)
                 .map_err(|e| usage(format!("--port {}: cannot open: {e}", port.display())))?;
             (Source::Port(p), port.display().to_string())
         }
@@ -146,15 +151,20 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
         }
         let n = match &mut source {
             Source::Port(p) => match p.read(&mut buf) {
-                Ok(0) => break ("the port closed".to_string(), true, false),
-                Ok(n) => n,
-                Err(e)
-                    if e.kind() == std::io::ErrorKind::TimedOut
-                        || e.kind() == std::io::ErrorKind::Interrupted =>
-                {
+                LinkEvent::Data(n) => n,
+                LinkEvent::Nothing => 0,
+                LinkEvent::Lost(why) => {
+                    errln!("capture: {name}: {why}; waiting for it to come back (disconnect {})", p.disconnects());
+                    // A frame in progress can never complete.
+                    rec.finish(started.elapsed().as_secs_f64())
+                        .context("cannot write the CSV")
+                        .map_err(CliError::Runtime)?;
                     0
                 }
-                Err(e) => break (format!("the port went away ({e})"), true, false),
+                LinkEvent::Back => {
+                    errln!("capture: {name} is back");
+                    0
+                }
             },
             Source::Reader(r) => match r.read(&mut buf) {
                 Ok(0) => break ("end of file".to_string(), true, false),
@@ -187,7 +197,12 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
         .map_err(CliError::Runtime)?;
     status(&rec, tty, true);
     let link = rec.stats();
+    let disconnects = match &source {
+        Source::Port(p) => p.disconnects(),
+        Source::Reader(_) => 0,
+    };
     let summary = CaptureSummary {
+        disconnects,
         source: name,
         ended,
         wall_s: started.elapsed().as_secs_f64(),
@@ -203,13 +218,14 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
         )?;
     } else {
         errln!(
-            "capture of {} ended ({}): {} frames, {} lost, {} sequence gaps ({} frames missing)",
+            "capture of {} ended ({}): {} frames, {} lost, {} sequence gaps ({} frames missing), {} disconnects",
             summary.source,
             summary.ended,
             link.frames,
             summary.bad_frames,
             link.seq_gaps,
-            link.frames_missed
+            link.frames_missed,
+            summary.disconnects
         );
     }
     if read_error {

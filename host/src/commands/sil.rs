@@ -65,6 +65,18 @@ pub struct SilArgs {
     /// corrupt, delay, error-bits or past-limit (docs/sil.md).
     #[arg(long, value_name = "SPEC")]
     pub fault: Vec<String>,
+    /// A power cut, repeatable: `at=SECONDS` (emulated time),
+    /// `random:N[:in-save=M][:seed=K]` (N cuts at seeded random instants, M of them (default a third)
+    /// inside a checkpoint save) or `during-save:K` (inside the K-th save).
+    /// QEMU is killed (SIGKILL), the checkpoint file kept as it is, and the
+    /// same image boots on it; the run goes on from the last completed save.
+    #[arg(long, value_name = "SPEC")]
+    pub power_cut: Vec<String>,
+    /// Save a checkpoint every S seconds of learning (`Pause`,
+    /// `SaveCheckpoint`, `Start` between learning episodes); default 20 with
+    /// `--power-cut` or `--fault hang`, else none.
+    #[arg(long, value_name = "S")]
+    pub checkpoint_every: Option<f64>,
     /// The firmware ELF built for the emulated board (default: build it
     /// with `cargo xtask qemu --board B --robot R` in this repository).
     #[arg(long, value_name = "FILE")]
@@ -109,12 +121,36 @@ pub fn run(args: SilArgs) -> Result<(), CliError> {
             board.name()
         )));
     }
-    let faults = args
-        .fault
+    let mut hangs_s = Vec::new();
+    let mut bus_faults = Vec::new();
+    for f in &args.fault {
+        match sil::power_cut::parse_hang(f) {
+            Some(t) => hangs_s.push(t.map_err(usage)?),
+            None => bus_faults.push(fault::parse(f).map_err(usage)?),
+        }
+    }
+    let faults = bus_faults;
+    if !hangs_s.is_empty() && board == pada_core::profile::Board::F405 {
+        return Err(usage(
+            "--fault hang: QEMU's netduinoplus2 (the f405 board's emulation) models no watchdog; \
+             test the hang on mps2-an386 (--board f429-sdram), whose CMSDK watchdog the firmware arms"
+                .to_string(),
+        ));
+    }
+    let power_cuts = args
+        .power_cut
         .iter()
-        .map(|f| fault::parse(f))
+        .map(|c| sil::power_cut::parse(c))
         .collect::<Result<Vec<_>, _>>()
         .map_err(usage)?;
+    if let Some(s) = args.checkpoint_every {
+        if !(s.is_finite() && s >= 1.0) {
+            return Err(usage(format!("--checkpoint-every {s}: at least 1 s of learning")));
+        }
+    }
+    let save_every_s = args
+        .checkpoint_every
+        .or((!power_cuts.is_empty() || !hangs_s.is_empty()).then_some(20.0));
     sil::bus::check_faults(args.task.robot(), &faults).map_err(usage)?;
     if !(1..=3600).contains(&args.hang_timeout) {
         return Err(usage(format!(
@@ -147,6 +183,9 @@ pub fn run(args: SilArgs) -> Result<(), CliError> {
         seconds,
         seed: args.seed,
         faults,
+        power_cuts,
+        hangs_s,
+        save_every_s,
         forecast: !args.no_forecast,
         compare: !args.no_compare,
         out_dir: out_path.clone(),

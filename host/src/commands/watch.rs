@@ -76,6 +76,8 @@ pub struct WatchSummary {
     pub url: String,
     /// HTTP requests answered.
     pub requests: u64,
+    /// Times the serial port went away (and was waited for).
+    pub disconnects: u32,
 }
 
 /// Parses `tcp:HOST:PORT` on the loopback interface.
@@ -235,6 +237,7 @@ pub fn run(args: WatchArgs) -> Result<(), CliError> {
         latest: rec.latest().clone(),
         url,
         requests: shared.requests.load(Ordering::Relaxed),
+        disconnects: shared.disconnects.load(Ordering::SeqCst),
     };
     drop(rec);
     if args.json {
@@ -247,13 +250,14 @@ pub fn run(args: WatchArgs) -> Result<(), CliError> {
             .map_err(CliError::Runtime)?;
     } else {
         eprintln!(
-            "watch of {} ended ({}): {} frames, {} lost, {} sequence gaps ({} frames missing); {} requests served",
+            "watch of {} ended ({}): {} frames, {} lost, {} sequence gaps ({} frames missing), {} disconnects; {} requests served",
             summary.source,
             summary.ended,
             link.frames,
             summary.bad_frames,
             link.seq_gaps,
             link.frames_missed,
+            summary.disconnects,
             summary.requests
         );
     }
@@ -270,9 +274,7 @@ pub fn run(args: WatchArgs) -> Result<(), CliError> {
 /// Opens the source named by `--port`, `--file` or `--listen`.
 fn open(args: &WatchArgs) -> Result<(Source, String), CliError> {
     if let Some(port) = &args.port {
-        let p = serialport::new(port.to_string_lossy(), args.baud)
-            .timeout(Duration::from_millis(100))
-            .open()
+        let p = crate::serial_link::SerialLink::open(port, args.baud)
             .map_err(|e| usage(format!("--port {}: cannot open: {e}", port.display())))?;
         return Ok((Source::Port(p), port.display().to_string()));
     }

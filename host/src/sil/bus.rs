@@ -202,6 +202,8 @@ pub struct BusEmulator {
     traces: Vec<FaultTrace>,
     stats: BusStats,
     supply_v: f64,
+    /// Watching for every servo's torque off from this instant (a reset).
+    off_watch: Option<(u64, Option<u64>)>,
 }
 
 impl BusEmulator {
@@ -223,7 +225,31 @@ impl BusEmulator {
             traces,
             stats: BusStats::default(),
             supply_v: rig.supply_v(),
+            off_watch: None,
         })
+    }
+
+    /// A power cut at `t_us`: every servo loses its supply and comes back
+    /// with its factory control table (torque off, Moving Speed 0); the
+    /// joints go limp.
+    pub fn power_off(&mut self, t_us: u64, rig: &mut dyn Rig) {
+        for s in &mut self.servos {
+            *s = Servo::new(s.id, s.joint);
+            rig.drive(t_us, s.id, false, 0.0);
+        }
+    }
+
+    /// From `t_us` on (a reset), notes the first instant every servo has
+    /// torque off ([`all_off_since`](Self::all_off_since)).
+    pub fn watch_torque_off(&mut self, t_us: u64) {
+        let now = self.servos.iter().all(|s| !s.torque()).then_some(t_us);
+        self.off_watch = Some((t_us, now));
+    }
+
+    /// The first instant every servo had torque off since the last
+    /// [`watch_torque_off`](Self::watch_torque_off).
+    pub fn all_off_since(&self) -> Option<u64> {
+        self.off_watch.and_then(|w| w.1)
     }
 
     /// Counters so far.
@@ -436,6 +462,11 @@ impl BusEmulator {
         rig.drive(t, s.id, s.torque(), s.volts(self.supply_v));
         let all_off = self.servos.iter().all(|s| !s.torque());
         let all_on = self.servos.iter().all(Servo::torque);
+        if let Some((from, None)) = self.off_watch {
+            if all_off && t >= from {
+                self.off_watch = Some((from, Some(t)));
+            }
+        }
         for (f, trace) in self.faults.iter().zip(self.traces.iter_mut()) {
             let Some(onset) = trace.onset_us else { continue };
             if all_off && trace.torque_off_us.is_none() && t >= onset {

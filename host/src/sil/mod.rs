@@ -14,7 +14,9 @@
 //!   bus, with `--fault` injection ([`fault`]);
 //! - the robot behind the bus: a [`crate::rig::Rig`] (the physical
 //!   pendulum's model, or the rapier3d LEO with its operator);
-//! - [`qemu`]: starting QEMU and its channel;
+//! - [`qemu`]: starting QEMU and its channel (and cutting its power);
+//! - [`power_cut`]: `--power-cut` and `--fault hang`: the plan, and what
+//!   each reboot found;
 //! - [`session`]: the lock-step loop; [`forecast`]: the answers it sends
 //!   ahead, so a period's bus traffic takes one exchange;
 //! - [`run`]: what to run and setting it up;
@@ -30,6 +32,7 @@
 pub mod bus;
 pub mod fault;
 pub mod forecast;
+pub mod power_cut;
 pub mod qemu;
 pub mod replay;
 pub mod report;

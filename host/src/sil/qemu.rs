@@ -42,6 +42,7 @@ pub struct QemuSetup {
 
 /// The running emulator and its channel.
 pub struct Emulator {
+    setup: QemuSetup,
     child: Child,
     /// The temporary directory of the FIFOs and the checkpoint file.
     dir: tempfile::TempDir,
@@ -105,30 +106,75 @@ impl Emulator {
         let from_board = rw(&from_path).context("cannot open the clock FIFO")?;
         let to_board = rw(&to_path).context("cannot open the clock FIFO")?;
 
-        let stdout = File::create(&setup.defmt_log)
-            .with_context(|| format!("cannot create {}", setup.defmt_log.display()))?;
-        let stderr = File::create(&setup.qemu_log)
-            .with_context(|| format!("cannot create {}", setup.qemu_log.display()))?;
-        let elf = std::fs::canonicalize(&setup.elf)
-            .with_context(|| format!("{}", setup.elf.display()))?;
-        let child = Command::new(&setup.qemu)
-            .args(qemu_args(setup.machine))
-            .arg("-kernel")
-            .arg(&elf)
-            .current_dir(dir.path())
-            .stdin(Stdio::null())
-            .stdout(stdout)
-            .stderr(stderr)
-            .spawn()
-            .map_err(|e| {
-                anyhow!(
-                    "cannot start {} ({e}); install QEMU 10 (DESIGN.md: qemu-system-arm from bookworm-backports) or pass --qemu",
-                    setup.qemu.display()
-                )
-            })?;
-        Ok(Emulator { child, dir, to_board, from_board })
+        let child = spawn(setup, dir.path(), false)?;
+        Ok(Emulator { setup: setup.clone(), child, dir, to_board, from_board })
     }
 
+    /// A power cut: kills QEMU at once (SIGKILL), leaving the checkpoint
+    /// file in the run directory as it is, drops whatever either side had
+    /// not read from the FIFOs, and boots the same image again in the same
+    /// directory (its logs appended).
+    pub fn power_cycle(&mut self) -> anyhow::Result<()> {
+        // `Child::kill` is SIGKILL on Unix.
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+        drain(&mut self.from_board)?;
+        drain(&mut self.to_board)?;
+        self.child = spawn(&self.setup, self.dir.path(), true)?;
+        Ok(())
+    }
+}
+
+/// Reads and drops everything a FIFO holds now.
+fn drain(f: &mut File) -> anyhow::Result<()> {
+    let mut buf = [0u8; 4096];
+    loop {
+        let mut fds = [PollFd::new(&*f, PollFlags::IN)];
+        match poll(&mut fds, Some(&Timespec { tv_sec: 0, tv_nsec: 0 })) {
+            Ok(0) => return Ok(()),
+            Ok(_) => {
+                if f.read(&mut buf).context("draining a FIFO")? == 0 {
+                    return Ok(());
+                }
+            }
+            Err(rustix::io::Errno::INTR) => {}
+            Err(e) => return Err(e).context("draining a FIFO"),
+        }
+    }
+}
+
+/// Starts QEMU on `setup`'s image in `dir`; `append`: add to the logs.
+fn spawn(setup: &QemuSetup, dir: &Path, append: bool) -> anyhow::Result<Child> {
+    let open = |p: &Path| {
+        std::fs::OpenOptions::new()
+            .create(true)
+            .write(true)
+            .append(append)
+            .truncate(!append)
+            .open(p)
+            .with_context(|| format!("cannot create {}", p.display()))
+    };
+    let stdout = open(&setup.defmt_log)?;
+    let stderr = open(&setup.qemu_log)?;
+    let elf = std::fs::canonicalize(&setup.elf).with_context(|| format!("{}", setup.elf.display()))?;
+    Command::new(&setup.qemu)
+        .args(qemu_args(setup.machine))
+        .arg("-kernel")
+        .arg(&elf)
+        .current_dir(dir)
+        .stdin(Stdio::null())
+        .stdout(stdout)
+        .stderr(stderr)
+        .spawn()
+        .map_err(|e| {
+            anyhow!(
+                "cannot start {} ({e}); install QEMU 10 (DESIGN.md: qemu-system-arm from bookworm-backports) or pass --qemu",
+                setup.qemu.display()
+            )
+        })
+}
+
+impl Emulator {
     /// The run's temporary directory (the board's working directory).
     pub fn dir(&self) -> &Path {
         self.dir.path()

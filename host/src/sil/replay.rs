@@ -32,6 +32,13 @@ pub enum Record {
     /// The wear governor's Δ or α, from a `Policy` report: in force from
     /// the next decision on.
     Restriction(f32),
+    /// A checkpoint save completed (`Checkpoint(Saved)`): what a later boot
+    /// must load.
+    Saved,
+    /// The board booted again (after a power cut or a watchdog reset): its
+    /// learner is the last completed save's, or a fresh one from the seed
+    /// if there was none.
+    Boot,
 }
 
 /// What the replay found.
@@ -55,6 +62,8 @@ pub struct ReplayReport {
     pub final_checksum_firmware: Option<u32>,
     /// The replay's checksum at the same point.
     pub final_checksum_replay: Option<u32>,
+    /// Boots after the first, each replayed from the last completed save.
+    pub boots: u64,
     /// Every action and every checksum identical.
     pub identical: bool,
 }
@@ -78,8 +87,22 @@ pub fn replay(profile: &LearnerProfile, policy: PolicyKind, seed: u64, records: 
     };
     let mut rng = Pcg32::seed_from_u64(seed);
     agent.reset_weights(&mut rng);
+    // What a boot without a checkpoint starts from (the run sends
+    // `SetPolicy` again: a fresh learner from the seed), and the last save.
+    let mut saved = (agent.state(), agent.weights().clone(), rng.clone());
     for record in records {
         match record {
+            Record::Saved => saved = (agent.state(), agent.weights().clone(), rng.clone()),
+            Record::Boot => {
+                report.boots += 1;
+                let (state, weights, generator) = &saved;
+                if let Err(e) = agent.restore_state(state) {
+                    report.error = Some(format!("boot {}: the saved state does not restore: {e}", report.boots));
+                    break;
+                }
+                agent.weights_mut().copy_from_slice(weights);
+                rng = generator.clone();
+            }
             Record::Step(s) => {
                 report.steps += 1;
                 if s.footstep {

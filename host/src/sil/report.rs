@@ -232,6 +232,9 @@ pub struct SilSummary {
     pub faults: Vec<FaultResult>,
     /// Faults the firmware reported that no injection explains.
     pub unexpected_faults: Vec<String>,
+    /// Power cuts, checkpoint saves and hangs (`--power-cut`, `--fault
+    /// hang`).
+    pub power: super::power_cut::PowerReport,
     /// The checks; the run passes when all hold.
     pub checks: Vec<Check>,
     /// All checks hold.
@@ -274,6 +277,8 @@ pub struct Facts<'a> {
     pub latest: Latest,
     /// The `--telemetry` forwarder.
     pub sink: Option<crate::telemetry::TelemetrySink>,
+    /// Power cuts, saves and hangs.
+    pub power: super::power_cut::PowerReport,
 }
 
 /// Mean distance walked per test run over the last 10 % (at least one) of
@@ -533,6 +538,10 @@ pub fn summarize(cfg: &SilConfig, facts: Facts<'_>) -> SilSummary {
             ),
         });
     }
+    let mut power = facts.power;
+    let fits = super::power_cut::checkpoint_bytes(profile.weights().unwrap_or(0), profile.format.bytes())
+        <= pada_firmware::sil::CHECKPOINT_SLOT_LEN;
+    checks.extend(super::power_cut::checks(&mut power, period_ms, facts.emulated_s, fits));
     if let Some(sink) = facts.sink {
         let (ok, detail) = match sink.finish() {
             Ok(t) => (true, format!("{} bytes to {}", t.bytes, t.target)),
@@ -586,6 +595,7 @@ pub fn summarize(cfg: &SilConfig, facts: Facts<'_>) -> SilSummary {
         host,
         faults,
         unexpected_faults,
+        power,
         checks,
         passed,
     }

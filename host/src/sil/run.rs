@@ -11,6 +11,7 @@
 
 use super::bus::BusEmulator;
 use super::fault::FaultSpec;
+use super::power_cut::CutSpec;
 use super::qemu::{Emulator, QemuSetup};
 use super::report::SilSummary;
 use super::session::Session;
@@ -58,6 +59,12 @@ pub struct SilConfig {
     pub seed: u64,
     /// Faults to inject.
     pub faults: Vec<FaultSpec>,
+    /// Power cuts (`--power-cut`).
+    pub power_cuts: Vec<CutSpec>,
+    /// Hangs of the control loop (`--fault hang:at=S`) \[s\].
+    pub hangs_s: Vec<f64>,
+    /// Learning time between checkpoint saves \[s\] (none: no saves).
+    pub save_every_s: Option<f64>,
     /// Forecast the bus's answers (fewer exchanges, the same run).
     pub forecast: bool,
     /// Also run the firmware's controller on the host to compare with (the

@@ -38,6 +38,8 @@ pub struct Shared {
     pub requests: AtomicU64,
     /// Set when decoding ended in a failure (a read error, the CSV).
     pub failed: std::sync::atomic::AtomicBool,
+    /// Times the serial port went away (and was waited for).
+    pub disconnects: std::sync::atomic::AtomicU32,
     /// The last rendering of `/live`, reused within the same second.
     live_cache: Mutex<Option<(LiveKey, Arc<String>)>>,
 }
@@ -53,6 +55,7 @@ impl Shared {
             last_data_ms: AtomicU64::new(0),
             requests: AtomicU64::new(0),
             failed: std::sync::atomic::AtomicBool::new(false),
+            disconnects: std::sync::atomic::AtomicU32::new(0),
             live_cache: Mutex::new(None),
         }
     }
@@ -100,6 +103,8 @@ pub struct ApiState<'a> {
     pub no_data_for_s: Option<f64>,
     /// Whether the page shows the stream as stalled.
     pub stalled: bool,
+    /// Times the serial port went away (and was waited for).
+    pub disconnects: u32,
 }
 
 impl<'a> ApiState<'a> {
@@ -111,6 +116,7 @@ impl<'a> ApiState<'a> {
             wall_s: clock.wall_s,
             no_data_for_s: clock.since_data_s,
             stalled: state.ended.is_none() && silent >= STALL_AFTER_S,
+            disconnects: 0,
         }
     }
 }
@@ -209,7 +215,9 @@ pub fn handle(rq: Request, shared: &Shared) {
         }
         "/api/state" => {
             let state = shared.snapshot();
-            match serde_json::to_vec(&ApiState::new(&state, shared.clock())) {
+            let mut api = ApiState::new(&state, shared.clock());
+            api.disconnects = shared.disconnects.load(std::sync::atomic::Ordering::SeqCst);
+            match serde_json::to_vec(&api) {
                 Ok(body) => respond(rq, 200, "application/json", body),
                 Err(e) => error(rq, 500, &e.to_string()),
             }

@@ -6,6 +6,7 @@
 
 use super::server::Shared;
 use crate::capture::Recorder;
+use crate::serial_link::LinkEvent;
 use std::io::Read;
 use std::net::{SocketAddr, TcpListener, TcpStream};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -17,8 +18,9 @@ const POLL: Duration = Duration::from_millis(100);
 
 /// An open source.
 pub enum Source {
-    /// A serial port (reads time out every [`POLL`]).
-    Port(Box<dyn serialport::SerialPort>),
+    /// A serial port (reads time out every [`POLL`]); reopened when it
+    /// goes away and comes back (`crate::serial_link`).
+    Port(crate::serial_link::SerialLink),
     /// A file or standard input.
     Reader(Box<dyn Read + Send>),
     /// A listener waiting for its one sender.
@@ -75,17 +77,22 @@ pub fn decode(
         }
         let n = match &mut source {
             Source::Port(p) => match p.read(&mut buf) {
-                Ok(0) => return ended("the port closed"),
-                Ok(n) => n,
-                Err(e)
-                    if matches!(
-                        e.kind(),
-                        std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted
-                    ) =>
-                {
+                LinkEvent::Data(n) => n,
+                LinkEvent::Nothing => 0,
+                LinkEvent::Lost(why) => {
+                    shared.disconnects.store(p.disconnects(), Ordering::SeqCst);
+                    eprintln!("watch: {why}; waiting for the port to come back (disconnect {})", p.disconnects());
+                    // A frame in progress can never complete: lost.
+                    let mut rec = recorder.lock().unwrap_or_else(|e| e.into_inner());
+                    if let Err(e) = rec.finish(shared.started.elapsed().as_secs_f64()) {
+                        return failed(format!("cannot write the CSV ({e})"));
+                    }
                     0
                 }
-                Err(e) => return ended(format!("the port went away ({e})")),
+                LinkEvent::Back => {
+                    eprintln!("watch: the port is back");
+                    0
+                }
             },
             Source::Reader(r) => match r.read(&mut buf) {
                 Ok(0) => return ended("end of file"),

@@ -1,0 +1,407 @@
+//! Power cuts and hangs in the loop (`pada sil --power-cut`, `--fault
+//! hang`): what to cut and when, and what each reboot found.
+//!
+//! ```text
+//! --power-cut at=SECONDS               a cut at that emulated time
+//! --power-cut random:N[:in-save=M][:seed=K]
+//!                                      N cuts at seeded random instants, M (default round(N/3)) inside saves
+//! --power-cut during-save:K            a cut inside the K-th checkpoint save (1 = the first)
+//! --fault hang:at=SECONDS              the control loop stops feeding the watchdog (mps2-an386)
+//! ```
+//!
+//! A cut kills QEMU at once (SIGKILL) and keeps the checkpoint file as it is
+//! at that instant; the same image boots on it after [`OFF_US`] with the
+//! servos powered off meanwhile (the robot falls limp; the operator sets it
+//! back, `Rig::episode_ended`). A cut inside a save is armed on the board
+//! ([`pada_firmware::sil::ToBoard::CutInSave`]): the checkpoint file takes
+//! the save's first `after_bytes` bytes (its erase and writes, in order)
+//! and the board stops there, so the cut lands at an exact byte between the
+//! erase's first and the header's last.
+//!
+//! Random instants: `random:N` draws its timed cuts uniformly over the
+//! learning time (`--seconds`; a cut comes at the first moment the learning
+//! done so far, lost learning included, passes its instant, plus a uniform
+//! 0–5 s of emulated time, so cuts land in learning and test episodes and
+//! between them alike; one overtaken by another cut comes 1 s after the
+//! next boot) and `round(N / 3)` of them inside saves: distinct
+//! save attempts among the first `seconds / save interval`, each at a
+//! uniform byte of the save. With a checkpoint larger than a slot (LEO on
+//! `f429-sdram`) every save is refused before flash is touched, so all N
+//! are timed.
+
+use pada_core::checkpoint::slot_len;
+use rand_core::{RngCore, SeedableRng};
+use rand_pcg::Pcg32;
+use serde::Serialize;
+
+/// How long the power stays off at a cut \[µs\] of emulated time.
+pub const OFF_US: u64 = 2_000_000;
+/// The random extra delay after a random cut's learning instant \[µs\].
+const RANDOM_DELAY_US: u64 = 5_000_000;
+
+/// One `--power-cut` option.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CutSpec {
+    /// A cut at this emulated time \[s\].
+    At(f64),
+    /// N cuts at seeded random instants.
+    Random {
+        /// How many.
+        n: u32,
+        /// How many of them inside saves (default: a third).
+        in_save: Option<u32>,
+        /// The seed.
+        seed: u64,
+    },
+    /// A cut inside the K-th save attempt (1-based).
+    DuringSave(u32),
+}
+
+/// Parses a `--power-cut` value.
+pub fn parse(spec: &str) -> Result<CutSpec, String> {
+    let bad = || format!("--power-cut {spec}: expected at=SECONDS, random:N[:in-save=M][:seed=K] or during-save:K");
+    if let Some(t) = spec.strip_prefix("at=") {
+        let t: f64 = t.parse().map_err(|_| bad())?;
+        if !(t.is_finite() && t >= 0.0) {
+            return Err(format!("--power-cut {spec}: the time must be at least 0 s"));
+        }
+        return Ok(CutSpec::At(t));
+    }
+    if let Some(k) = spec.strip_prefix("during-save:") {
+        let k: u32 = k.parse().map_err(|_| bad())?;
+        if k == 0 {
+            return Err(format!("--power-cut {spec}: saves count from 1"));
+        }
+        return Ok(CutSpec::DuringSave(k));
+    }
+    if let Some(rest) = spec.strip_prefix("random:") {
+        let mut parts = rest.split(':');
+        let n: u32 = parts.next().ok_or_else(bad)?.parse().map_err(|_| bad())?;
+        if !(1..=10_000).contains(&n) {
+            return Err(format!("--power-cut {spec}: N must be 1..=10000"));
+        }
+        let (mut seed, mut in_save) = (1, None);
+        for p in parts {
+            if let Some(m) = p.strip_prefix("in-save=") {
+                let m: u32 = m.parse().map_err(|_| bad())?;
+                if m > n {
+                    return Err(format!("--power-cut {spec}: in-save={m} is more than the {n} cuts"));
+                }
+                in_save = Some(m);
+            } else {
+                seed = p.strip_prefix("seed=").ok_or_else(bad)?.parse().map_err(|_| bad())?;
+            }
+        }
+        return Ok(CutSpec::Random { n, in_save, seed });
+    }
+    Err(bad())
+}
+
+/// Parses `hang[:at=SECONDS]` (default at 10 s); `None` if `spec` is
+/// another fault.
+pub fn parse_hang(spec: &str) -> Option<Result<f64, String>> {
+    let rest = spec.strip_prefix("hang")?;
+    if rest.is_empty() {
+        return Some(Ok(10.0));
+    }
+    let t = rest.strip_prefix(":at=").and_then(|t| t.parse::<f64>().ok()).filter(|t| t.is_finite() && *t >= 0.0);
+    Some(t.ok_or_else(|| format!("--fault {spec}: expected hang[:at=SECONDS]")))
+}
+
+/// The cuts of a run, resolved.
+#[derive(Debug, Clone, Default)]
+pub struct CutPlan {
+    /// Cuts at emulated times \[µs\], sorted.
+    pub at_us: Vec<u64>,
+    /// Cuts when the learning done passes an instant \[s\], then a delay
+    /// \[µs\]; sorted by instant.
+    pub learning: Vec<(f64, u64)>,
+    /// Cuts inside saves: (save attempt, 1-based; bytes of the save written
+    /// before the cut), sorted by attempt.
+    pub in_save: Vec<(u32, u32)>,
+}
+
+impl CutPlan {
+    /// Resolves `specs` for a run of `seconds` saving every `save_every_s`
+    /// of learning a checkpoint of `checkpoint_bytes` into slots of
+    /// `slot_bytes` (a larger one is never written: its cuts are timed).
+    pub fn new(specs: &[CutSpec], seconds: f64, save_every_s: f64, checkpoint_bytes: usize, slot_bytes: usize) -> CutPlan {
+        let mut plan = CutPlan::default();
+        let fits = checkpoint_bytes <= slot_bytes;
+        let save_bytes = (slot_bytes + checkpoint_bytes) as u32;
+        for spec in specs {
+            match *spec {
+                CutSpec::At(t) => plan.at_us.push((t * 1e6).round() as u64),
+                CutSpec::DuringSave(k) => plan.in_save.push((k, save_bytes / 2)),
+                CutSpec::Random { n, in_save, seed } => {
+                    let mut rng = Pcg32::seed_from_u64(seed);
+                    let mut uniform = move || rng.next_u32() as f64 / (u32::MAX as f64 + 1.0);
+                    let attempts = (seconds / save_every_s).floor() as u32;
+                    let third = (n as f64 / 3.0).round() as u32;
+                    let n_save = if fits { in_save.unwrap_or(third).min(attempts) } else { 0 };
+                    // Distinct attempts: a partial Fisher-Yates over 1..=attempts.
+                    let mut pool: Vec<u32> = (1..=attempts).collect();
+                    for i in 0..n_save as usize {
+                        let last = pool.len() - 1;
+                        let j = i + (uniform() * (pool.len() - i) as f64) as usize;
+                        pool.swap(i, j.min(last));
+                        plan.in_save.push((pool[i], (uniform() * save_bytes as f64) as u32));
+                    }
+                    for _ in n_save..n {
+                        plan.learning.push((uniform() * seconds, (uniform() * RANDOM_DELAY_US as f64) as u64));
+                    }
+                }
+            }
+        }
+        plan.at_us.sort_unstable();
+        plan.learning.sort_by(|a, b| a.0.total_cmp(&b.0));
+        plan.in_save.sort_unstable();
+        // Two cuts asked for the same save: the second takes the next one.
+        for i in 1..plan.in_save.len() {
+            if plan.in_save[i].0 <= plan.in_save[i - 1].0 {
+                plan.in_save[i].0 = plan.in_save[i - 1].0 + 1;
+            }
+        }
+        plan
+    }
+
+    /// Cuts planned.
+    pub fn len(&self) -> usize {
+        self.at_us.len() + self.learning.len() + self.in_save.len()
+    }
+
+    /// No cut planned.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// Bytes a checkpoint of `weights` weights of `bytes` each takes in a slot.
+pub fn checkpoint_bytes(weights: usize, bytes: usize) -> usize {
+    slot_len(weights, bytes)
+}
+
+/// One power cut and the boot after it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CutRecord {
+    /// When \[s\] of emulated time.
+    pub at_s: f64,
+    /// Inside a save (its attempt number, and the bytes written before the
+    /// cut).
+    pub in_save: Option<(u32, u32)>,
+    /// The generation of the last save completed before the cut (none: no
+    /// save yet, or none fits).
+    pub last_save: Option<u32>,
+    /// Learning time since that save, lost \[s\].
+    pub learning_lost_s: f64,
+    /// What the next boot loaded: a generation, `None` for no checkpoint;
+    /// filled at its `Checkpoint` report (or its first step).
+    pub loaded: Option<Option<u32>>,
+    /// The boot refused a checkpoint (`CheckpointIgnored`): lost or corrupt.
+    pub refused: Option<String>,
+}
+
+impl CutRecord {
+    /// The boot loaded exactly the last completed save (or, with none,
+    /// found no checkpoint).
+    pub fn loaded_last_save(&self) -> bool {
+        self.refused.is_none() && self.loaded == Some(self.last_save)
+    }
+}
+
+/// One injected hang and the watchdog reset that ended it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct HangRecord {
+    /// When the host asked for it \[s\].
+    pub asked_s: f64,
+    /// When the control loop hung (its next period) \[s\].
+    pub hung_s: Option<f64>,
+    /// Emulated time from the watchdog's last feed to the reset \[ms\].
+    pub reset_after_feed_ms: Option<f64>,
+    /// The watchdog's period \[ms\].
+    pub watchdog_ms: u32,
+    /// When the chip reset \[s\].
+    pub reset_s: Option<f64>,
+    /// When every servo had torque off after the reset \[s\].
+    pub torque_off_s: Option<f64>,
+    /// From the reset to every servo's torque off \[ms\].
+    pub torque_off_ms: Option<f64>,
+    /// The reset cause the firmware reported.
+    pub cause: Option<String>,
+    /// The generation the boot loaded (`Some(None)`: no checkpoint).
+    pub loaded: Option<Option<u32>>,
+    /// The generation of the last save before the hang.
+    pub last_save: Option<u32>,
+    /// Learning episodes completed after the reset.
+    pub episodes_after: u32,
+}
+
+impl HangRecord {
+    /// Ended by the watchdog within its period, torque off within one
+    /// control period, cause reported, the last save loaded, learning on.
+    pub fn ok(&self, period_ms: f64) -> bool {
+        self.reset_after_feed_ms.is_some_and(|t| t <= self.watchdog_ms as f64)
+            && self.torque_off_ms.is_some_and(|t| t <= period_ms)
+            && self.cause.is_some()
+            && self.loaded == Some(self.last_save)
+            && self.episodes_after > 0
+    }
+}
+
+/// Everything about the run's power cuts, saves and hangs.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct PowerReport {
+    /// Learning time between saves \[s\] (none: no saves).
+    pub save_every_s: Option<f64>,
+    /// Save attempts (`SaveCheckpoint` sent).
+    pub save_attempts: u32,
+    /// Saves completed (`Checkpoint(Saved)`).
+    pub saves: u32,
+    /// Saves refused: the checkpoint is larger than a slot.
+    pub saves_too_large: u32,
+    /// Other failed saves (wear budget, store).
+    pub saves_failed: u32,
+    /// The more worn sector's erases, from the last `Saved`.
+    pub max_erases: u32,
+    /// Erases the ten-year budget allows after the board's operating time.
+    pub erases_allowed: f64,
+    /// Cuts planned.
+    pub cuts_planned: usize,
+    /// Every cut and its boot.
+    pub cuts: Vec<CutRecord>,
+    /// Every hang.
+    pub hangs: Vec<HangRecord>,
+}
+
+impl PowerReport {
+    /// Cuts inside a save.
+    pub fn cuts_in_save(&self) -> usize {
+        self.cuts.iter().filter(|c| c.in_save.is_some()).count()
+    }
+
+    /// Boots that loaded the last completed save.
+    pub fn boots_ok(&self) -> usize {
+        self.cuts.iter().filter(|c| c.loaded_last_save()).count()
+    }
+
+    /// The most learning one cut lost \[s\].
+    pub fn max_learning_lost_s(&self) -> f64 {
+        self.cuts.iter().map(|c| c.learning_lost_s).fold(0.0, f64::max)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn specs_parse_and_bad_ones_say_why() {
+        assert_eq!(parse("at=12.5"), Ok(CutSpec::At(12.5)));
+        assert_eq!(parse("random:30"), Ok(CutSpec::Random { n: 30, in_save: None, seed: 1 }));
+        assert_eq!(parse("random:30:seed=7"), Ok(CutSpec::Random { n: 30, in_save: None, seed: 7 }));
+        assert_eq!(parse("random:30:in-save=5:seed=7"), Ok(CutSpec::Random { n: 30, in_save: Some(5), seed: 7 }));
+        assert_eq!(parse("during-save:3"), Ok(CutSpec::DuringSave(3)));
+        for bad in ["at=-1", "random:0", "during-save:0", "now", "random:3:salt=1", "random:3:in-save=4"] {
+            assert!(parse(bad).is_err(), "{bad}");
+        }
+        assert_eq!(parse_hang("hang:at=20"), Some(Ok(20.0)));
+        assert_eq!(parse_hang("hang"), Some(Ok(10.0)));
+        assert!(parse_hang("hang:when=2").unwrap().is_err());
+        assert_eq!(parse_hang("drop:at=2"), None);
+    }
+
+    #[test]
+    fn a_random_plan_puts_a_third_inside_distinct_saves_and_is_seeded() {
+        let specs = [CutSpec::Random { n: 30, in_save: None, seed: 3 }];
+        let p = CutPlan::new(&specs, 600.0, 20.0, 100_368, 131_072);
+        assert_eq!(p.len(), 30);
+        assert_eq!(p.in_save.len(), 10);
+        assert!(p.in_save.iter().all(|&(k, b)| (1..=30).contains(&k) && b < 131_072 + 100_368));
+        assert!(p.learning.iter().all(|&(t, d)| (0.0..600.0).contains(&t) && d < RANDOM_DELAY_US));
+        let again = CutPlan::new(&specs, 600.0, 20.0, 100_368, 131_072);
+        assert_eq!((p.learning.clone(), p.in_save.clone()), (again.learning, again.in_save));
+        // A checkpoint that no slot holds is never written: every cut timed.
+        let leo = CutPlan::new(&[CutSpec::Random { n: 5, in_save: None, seed: 1 }], 60.0, 20.0, 8_389_136, 131_072);
+        let five = CutPlan::new(&[CutSpec::Random { n: 30, in_save: Some(5), seed: 1 }], 600.0, 20.0, 100_368, 131_072);
+        assert_eq!((five.learning.len(), five.in_save.len()), (25, 5));
+        assert_eq!((leo.learning.len(), leo.in_save.len()), (5, 0));
+    }
+}
+
+/// The checks of a run's cuts, saves and hangs (none without them).
+pub fn checks(p: &mut PowerReport, period_ms: f64, emulated_s: f64, checkpoint_fits: bool) -> Vec<super::report::Check> {
+    use super::report::Check;
+    let mut checks = Vec::new();
+    p.erases_allowed = pada_core::checkpoint::WearBudget::STM32F4.allowed(emulated_s as u64) as f64;
+    let lost: Vec<f64> = p.cuts.iter().map(|c| c.learning_lost_s).collect();
+    let mean_lost = if lost.is_empty() { 0.0 } else { lost.iter().sum::<f64>() / lost.len() as f64 };
+    if p.cuts_planned > 0 {
+        let refused = p.cuts.iter().filter(|c| c.refused.is_some()).count();
+        checks.push(Check {
+            name: "power cuts: every planned cut made, every boot loaded the last completed save",
+            ok: p.cuts.len() == p.cuts_planned && p.boots_ok() == p.cuts.len(),
+            detail: format!(
+                "{} of {} cuts made ({} inside a save); {} of {} boots loaded the last completed save; {} refused a checkpoint (lost or corrupt){}",
+                p.cuts.len(),
+                p.cuts_planned,
+                p.cuts_in_save(),
+                p.boots_ok(),
+                p.cuts.len(),
+                refused,
+                p.cuts
+                    .iter()
+                    .find(|c| !c.loaded_last_save())
+                    .map(|c| format!("; first bad boot after the cut at {:.3} s: last save {:?}, loaded {:?}, refused {:?}", c.at_s, c.last_save, c.loaded, c.refused))
+                    .unwrap_or_default()
+            ),
+        });
+        match (checkpoint_fits, p.save_every_s) {
+            (true, Some(every)) => checks.push(Check {
+                name: "power cuts: learning lost per cut at most one save interval",
+                ok: p.max_learning_lost_s() <= every + 1e-9,
+                detail: format!("mean {mean_lost:.2} s, max {:.2} s of learning lost per cut; saves every {every} s", p.max_learning_lost_s()),
+            }),
+            (false, _) => checks.push(Check {
+                name: "power cuts: no checkpoint fits a slot, so every save is refused and a cut costs all learning since the boot",
+                ok: p.saves == 0 && p.saves_too_large == p.save_attempts && p.cuts.iter().all(|c| c.loaded == Some(None)),
+                detail: format!(
+                    "{} save attempts, {} refused as too large, {} saved; learning lost per cut: mean {mean_lost:.2} s, max {:.2} s",
+                    p.save_attempts,
+                    p.saves_too_large,
+                    p.saves,
+                    p.max_learning_lost_s()
+                ),
+            }),
+            (true, None) => {}
+        }
+    }
+    if p.saves > 0 {
+        checks.push(Check {
+            name: "flash: erases within the ten-year wear budget, no save failed",
+            ok: (p.max_erases as f64) <= p.erases_allowed && p.saves_failed == 0,
+            detail: format!(
+                "{} saves of {} attempts; the more worn sector erased {} times, {} allowed after {:.0} s of operation; {} failed",
+                p.saves, p.save_attempts, p.max_erases, p.erases_allowed, emulated_s, p.saves_failed
+            ),
+        });
+    }
+    for h in &p.hangs {
+        checks.push(Check {
+            name: "hang: reset by the watchdog within its period, torque off on every servo within one control period, cause reported, last save loaded, learning resumed",
+            ok: h.ok(period_ms),
+            detail: format!(
+                "asked at {:.3} s, hung {}, reset {} after the last feed (period {} ms), torque off {} after the reset (period {period_ms} ms), cause {}, loaded {:?} (last save {:?}), {} learning episodes after",
+                h.asked_s,
+                h.hung_s.map(|t| format!("{t:.3} s")).unwrap_or("never".into()),
+                h.reset_after_feed_ms.map(|t| format!("{t:.3} ms")).unwrap_or("never".into()),
+                h.watchdog_ms,
+                h.torque_off_ms.map(|t| format!("{t:.3} ms")).unwrap_or("never".into()),
+                h.cause.as_deref().unwrap_or("none"),
+                h.loaded,
+                h.last_save,
+                h.episodes_after
+            ),
+        });
+    }
+    checks
+}

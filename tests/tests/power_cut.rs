@@ -1,0 +1,162 @@
+//! Power cuts, hangs and the watchdog in the loop (`pada sil --power-cut`,
+//! `--fault hang`): the real firmware image in QEMU is killed (SIGKILL)
+//! while it learns — at random instants and inside checkpoint saves —,
+//! booted again on the same checkpoint file, and must load exactly the last
+//! save it completed; a hung control loop on mps2-an386 must be ended by
+//! the CMSDK watchdog within its period. None is skipped when QEMU is
+//! missing.
+
+mod common;
+
+use pada::seed::trial_seed;
+use pada::sil::power_cut::{self, CutSpec};
+use pada::sil::replay::{replay, Record};
+use pada::sil::{run, SilConfig, SilSummary, SilTask};
+use pada_core::policy::PolicyKind;
+use pada_core::profile::Board;
+use pada_core::wire::{CheckpointReport, HostDecoder, ToHost};
+use pada_firmware::config::Robot;
+use std::path::Path;
+use std::time::Duration;
+
+fn config(board: Board, task: SilTask, policy: PolicyKind, seconds: f64, out: &Path) -> SilConfig {
+    common::require_qemu();
+    SilConfig {
+        qemu: "qemu-system-arm".into(),
+        elf: common::image(board.name(), task.name()),
+        task,
+        board,
+        policy,
+        mtbf_budget_s: None,
+        seconds,
+        seed: 1,
+        faults: vec![],
+        power_cuts: vec![],
+        hangs_s: vec![],
+        save_every_s: Some(10.0),
+        forecast: true,
+        compare: false,
+        out_dir: out.to_path_buf(),
+        hang_timeout: Duration::from_secs(120),
+        progress: false,
+        telemetry: None,
+    }
+}
+
+fn go(cfg: &SilConfig) -> SilSummary {
+    run(cfg).unwrap_or_else(|e| panic!("SIL run failed: {e:#}"))
+}
+
+fn failures(s: &SilSummary) -> Vec<String> {
+    s.checks.iter().filter(|c| !c.ok).map(|c| format!("{}: {}", c.name, c.detail)).collect()
+}
+
+/// The replay's records from a recorded stream; with `boots`, a `Saved` at
+/// every completed save and a `Boot` at every `Hello` after the first (a
+/// board announces itself at every boot).
+fn records(stream: &[u8], boots: bool) -> Vec<Record> {
+    let mut out = Vec::new();
+    let mut hellos = 0;
+    for frame in HostDecoder::new().feed(stream) {
+        match frame.expect("a clean recording").msg {
+            ToHost::Step(s) => out.push(Record::Step(s)),
+            ToHost::Episode(e) => out.push(Record::Episode(e)),
+            ToHost::Checkpoint(CheckpointReport::Saved(_)) if boots => out.push(Record::Saved),
+            ToHost::Hello(_) if boots => {
+                hellos += 1;
+                if hellos > 1 {
+                    out.push(Record::Boot);
+                }
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
+#[test]
+fn power_cuts_at_random_and_inside_saves_each_boot_loads_the_last_completed_save() {
+    let dir = tempfile::tempdir().unwrap();
+    let policy = PolicyKind::Pada { delta: 0.5 };
+    let mut cfg = config(Board::F405, SilTask::Pendulum, policy, 60.0, dir.path());
+    cfg.power_cuts = vec![
+        CutSpec::Random { n: 6, in_save: Some(2), seed: 5 },
+        CutSpec::DuringSave(5),
+        CutSpec::At(30.0),
+    ];
+    let s = go(&cfg);
+    assert!(s.passed, "{:#?}", failures(&s));
+    let p = &s.power;
+    assert_eq!((p.cuts_planned, p.cuts.len()), (8, 8), "{p:#?}");
+    assert_eq!(p.cuts_in_save(), 3, "{p:#?}");
+    // Every boot loaded exactly the last save completed before its cut
+    // (none refused, none older), and at least one had a save to load.
+    assert_eq!(p.boots_ok(), 8, "{p:#?}");
+    assert!(p.cuts.iter().any(|c| c.last_save.is_some() && c.loaded == Some(c.last_save)), "{p:#?}");
+    assert!(p.cuts.iter().all(|c| c.refused.is_none()));
+    // No more learning lost than one save interval.
+    assert!(p.max_learning_lost_s() <= 10.0, "{p:#?}");
+    // The replay restarted from the last save at every boot, and still
+    // matched bit for bit.
+    assert_eq!(s.replay.boots, 8);
+    assert!(s.replay.identical, "{:?}", s.replay);
+
+    // From the recorded stream alone: the same, with the boots marked by
+    // their Hello; a replay that ignores the boots (the learner going on
+    // as if never cut) does not match, so the check has teeth.
+    let stream = std::fs::read(dir.path().join("telemetry.bin")).unwrap();
+    let profile = Board::F405.profile(Robot::Pendulum33);
+    let seed = trial_seed(1, 0);
+    let with = replay(&profile, policy, seed, &records(&stream, true));
+    assert!(with.identical && with.boots == 8, "{with:?}");
+    let without = replay(&profile, policy, seed, &records(&stream, false));
+    assert!(!without.identical, "{without:?}");
+}
+
+#[test]
+fn a_hung_control_loop_on_mps2_is_reset_by_the_watchdog_within_its_period() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut cfg = config(Board::F429Sdram, SilTask::Pendulum, PolicyKind::Sarsa, 40.0, dir.path());
+    // One hang before the first save (the board starts afresh), two after.
+    cfg.hangs_s = vec![20.0, 110.0, 170.0];
+    let s = go(&cfg);
+    assert!(s.passed, "{:#?}", failures(&s));
+    assert_eq!(s.power.hangs.len(), 3);
+    for h in &s.power.hangs {
+        assert_eq!(h.watchdog_ms, 250);
+        let after = h.reset_after_feed_ms.unwrap();
+        assert!(after > 240.0 && after <= 250.0, "{h:?}");
+        assert!(h.torque_off_ms.unwrap() <= 30.0, "{h:?}");
+        assert_eq!(h.cause.as_deref(), Some("watchdog-reset"));
+        assert_eq!(h.loaded, Some(h.last_save), "{h:?}");
+        assert!(h.episodes_after > 0);
+    }
+    assert!(s.power.hangs.iter().any(|h| h.last_save.is_some()), "{:#?}", s.power.hangs);
+    assert_eq!(s.replay.boots, 3);
+    assert!(s.unexpected_faults.is_empty(), "{:?}", s.unexpected_faults);
+}
+
+#[test]
+fn leo_on_f429_refuses_every_save_so_a_cut_costs_all_learning_since_boot() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut cfg = config(Board::F429Sdram, SilTask::Leo, PolicyKind::Pada { delta: 0.1667 }, 20.0, dir.path());
+    cfg.power_cuts = vec![CutSpec::Random { n: 2, in_save: None, seed: 1 }];
+    cfg.save_every_s = Some(5.0);
+    let s = go(&cfg);
+    assert!(s.passed, "{:#?}", failures(&s));
+    let p = &s.power;
+    assert_eq!(p.cuts.len(), 2);
+    assert_eq!(p.saves, 0);
+    assert!(p.save_attempts > 0 && p.saves_too_large == p.save_attempts, "{p:#?}");
+    // Nothing to load: each boot starts a fresh learner from the seed, and
+    // the cut lost everything learned since the last boot.
+    assert!(p.cuts.iter().all(|c| c.loaded == Some(None) && c.last_save.is_none()), "{p:#?}");
+    assert!(p.cuts.iter().any(|c| c.learning_lost_s > 0.0), "{p:#?}");
+    assert!(s.replay.identical && s.replay.boots == 2, "{:?}", s.replay);
+}
+
+#[test]
+fn the_plan_and_the_hang_spec_parse() {
+    assert_eq!(power_cut::parse("random:30:in-save=5:seed=9"), Ok(CutSpec::Random { n: 30, in_save: Some(5), seed: 9 }));
+    assert_eq!(power_cut::parse_hang("hang:at=12"), Some(Ok(12.0)));
+}
