@@ -347,13 +347,8 @@ impl LeoEnv {
     /// After the episode ended, returns the final observation again with
     /// reward 0 and the same terminal, without simulating.
     pub fn step(&mut self, action_voltages: [f32; ACTION_DIM]) -> StepResult {
-        if self.terminal != Terminal::None {
-            return StepResult {
-                obs: self.obs,
-                reward: 0.0,
-                terminal: self.terminal,
-                info: self.last_info,
-            };
+        if let Some(ended) = self.ended() {
+            return ended;
         }
         let stance = self.current_stance();
         let (angles, _) = self.model.joint_state();
@@ -369,17 +364,23 @@ impl LeoEnv {
     /// bookkeeping (filters, stance, reward, falls) is the same as
     /// [`LeoEnv::step`]'s; non-finite voltages are read as 0 V and flagged.
     pub fn step_joint_voltages(&mut self, voltages: [f32; NUM_JOINTS]) -> StepResult {
-        if self.terminal != Terminal::None {
-            return StepResult {
-                obs: self.obs,
-                reward: 0.0,
-                terminal: self.terminal,
-                info: self.last_info,
-            };
+        if let Some(ended) = self.ended() {
+            return ended;
         }
         let invalid_action = voltages.iter().any(|v| !v.is_finite());
         let voltages = voltages.map(|u| if u.is_finite() { u } else { 0.0 });
         self.step_voltages(voltages, invalid_action)
+    }
+
+    /// After the episode ended: the final observation again with reward 0
+    /// and the same terminal, without simulating.
+    fn ended(&self) -> Option<StepResult> {
+        (self.terminal != Terminal::None).then_some(StepResult {
+            obs: self.obs,
+            reward: 0.0,
+            terminal: self.terminal,
+            info: self.last_info,
+        })
     }
 
     /// The body of a control step once the servos' voltages are known.
