@@ -30,6 +30,7 @@
 //! them is `pada_firmware::sil`.
 
 pub mod bus;
+pub mod check;
 pub mod fault;
 pub mod forecast;
 pub mod power_cut;

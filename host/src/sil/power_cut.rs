@@ -329,8 +329,8 @@ mod tests {
 }
 
 /// The checks of a run's cuts, saves and hangs (none without them).
-pub fn checks(p: &mut PowerReport, period_ms: f64, emulated_s: f64, checkpoint_fits: bool) -> Vec<super::report::Check> {
-    use super::report::Check;
+pub fn checks(p: &mut PowerReport, period_ms: f64, emulated_s: f64, checkpoint_fits: bool) -> Vec<super::check::Check> {
+    use super::check::Check;
     let mut checks = Vec::new();
     p.erases_allowed = pada_core::checkpoint::WearBudget::STM32F4.allowed(emulated_s as u64) as f64;
     let lost: Vec<f64> = p.cuts.iter().map(|c| c.learning_lost_s).collect();

@@ -119,16 +119,7 @@ pub struct FaultResult {
     pub resumed: bool,
 }
 
-/// A pass/fail check of the run.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Check {
-    /// What is checked.
-    pub name: &'static str,
-    /// Whether it holds.
-    pub ok: bool,
-    /// The numbers behind it.
-    pub detail: String,
-}
+pub use super::check::Check;
 
 /// The firmware's controller on the host, against the same plant.
 #[derive(Debug, Clone, PartialEq, Serialize)]
