@@ -148,17 +148,13 @@ fn the_learned_drive_gives_the_learned_joints_the_references_voltages() {
     // long as both simulators stand on the same leg, those joints get
     // exactly the reference's voltages (the levels are within ±10.7 V, so
     // nothing is clipped).
-    use pada::leo::model::Joint;
+    use pada::leo::task::{learned_joints, Leg};
     for (name, r) in references() {
         let c = compare(&r, Drive::Learned, ModelOptions::default()).expect("the model builds");
         let mut stance_left = true;
         for (s, rs) in c.steps.iter().zip(&r.steps) {
-            let (st, sw, knee) = if stance_left {
-                (Joint::HipLeft, Joint::HipRight, Joint::KneeRight)
-            } else {
-                (Joint::HipRight, Joint::HipLeft, Joint::KneeLeft)
-            };
-            for j in [st, sw, knee] {
+            let stance = if stance_left { Leg::Left } else { Leg::Right };
+            for j in learned_joints(stance) {
                 assert_eq!(
                     s.voltages[j as usize], rs.voltages[j as usize],
                     "{name}: step {}: {:?}",

@@ -11,7 +11,9 @@ use clap::{Args, Subcommand};
 use std::path::PathBuf;
 
 use crate::error::{usage, CliError};
-use crate::leo::compare::{compare as run_comparison, Comparison, Drive, Reference, ANGLE_NAMES};
+use crate::leo::compare::{
+    compare as run_comparison, Comparison, Drive, Reference, ANGLE_NAMES, TOUCHDOWN_MATCH_STEPS,
+};
 use crate::leo::model::ModelOptions;
 use crate::leo::passive::{passive_rollout, PassiveRollout, MAX_PASSIVE_SECONDS};
 
@@ -234,7 +236,7 @@ fn comparison_table(c: &Comparison) -> String {
                 t.foot, t.reference_step
             )),
             _ => s.push_str(&format!(
-                "touchdown {} foot: reference step {}, none in pada within 3 steps\n",
+                "touchdown {} foot: reference step {}, none in pada within {TOUCHDOWN_MATCH_STEPS} steps\n",
                 t.foot, t.reference_step
             )),
         }

@@ -16,7 +16,7 @@ pub mod reference;
 
 use serde::Serialize;
 
-use crate::leo::model::{Joint, ModelOptions, JOINTS, NUM_JOINTS};
+use crate::leo::model::{ModelOptions, NUM_JOINTS};
 use crate::leo::task::Leg;
 use crate::leo::{LeoConfig, LeoEnv, LeoError, Terminal};
 pub use reference::{LeoState, Reference, ReferenceError, ReferenceStep};
@@ -30,6 +30,10 @@ pub enum Drive {
     /// The three learned voltages from the reference, the rest pada's.
     Learned,
 }
+
+/// How far (control steps) a touchdown of pada's may lie from the
+/// reference's to count as the same touchdown.
+pub const TOUCHDOWN_MATCH_STEPS: i64 = 3;
 
 /// The angles compared, in the order of [`StepComparison::angle_error`]:
 /// the torso, then the joints in [`Joint`] order.
@@ -238,7 +242,7 @@ pub fn compare(
             .filter(|(_, (f, _))| *f == foot)
             .min_by_key(|(_, (_, s))| (*s as i64 - step as i64).abs());
         let (pada_step, diff) = match nearest {
-            Some((k, &(_, s))) if (s as i64 - step as i64).abs() <= 3 => {
+            Some((k, &(_, s))) if (s as i64 - step as i64).abs() <= TOUCHDOWN_MATCH_STEPS => {
                 pada_touchdowns.remove(k);
                 (Some(s), Some(s as i64 - step as i64))
             }
@@ -276,9 +280,4 @@ pub fn compare(
         pada_fall,
         steps,
     })
-}
-
-/// Joint names in [`Joint`] order, for tables.
-pub fn joint_name(joint: Joint) -> &'static str {
-    ANGLE_NAMES[1 + JOINTS.iter().position(|&j| j == joint).unwrap_or(0)]
 }

@@ -17,6 +17,7 @@
 use std::fmt;
 
 use crate::leo::model::{Joint, NUM_JOINTS};
+use crate::leo::task::{learned_joints, Leg};
 
 /// The framework's joint order of its state and action vectors, as pada
 /// joints (the eighth state entry is the torso).
@@ -90,18 +91,12 @@ impl ReferenceStep {
     /// this step, read off the applied ones with the stance leg the step
     /// began with.
     pub fn learned_voltages(&self, stance_left_before: bool) -> [f32; 3] {
-        let v = &self.voltages;
-        let (st, sw) = if stance_left_before {
-            (Joint::HipLeft, Joint::HipRight)
+        let stance = if stance_left_before {
+            Leg::Left
         } else {
-            (Joint::HipRight, Joint::HipLeft)
+            Leg::Right
         };
-        let knee = if stance_left_before {
-            Joint::KneeRight
-        } else {
-            Joint::KneeLeft
-        };
-        [v[st as usize], v[sw as usize], v[knee as usize]]
+        learned_joints(stance).map(|j| self.voltages[j as usize])
     }
 }
 
