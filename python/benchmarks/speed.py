@@ -1,4 +1,4 @@
-"""The speed targets of issue 24, measured (a benchmark, not a test):
+"""The Python package's speed targets, measured (a benchmark, not a test):
 
 1. one pada/Leo-v0 step from Python against the Rust step alone (the same
    plant stepped in a Rust loop, `pada._pada.bench_rust_steps`), target
