@@ -315,7 +315,21 @@ fn an_array_task_cancelled_while_it_runs_is_submitted_again() {
         };
         let cancelled = c.command("scancel").arg(&task).status().unwrap();
         assert!(cancelled.success(), "scancel {task}");
-        while running().as_deref() == Some(task.as_str()) {
+        // Wait until the task has left the queue in every state, not only
+        // RUNNING: a task leaves RUNNING for COMPLETING while its process
+        // may still be writing its result.
+        let queued = || {
+            let out = c
+                .command("squeue")
+                .args(["--noheader", "--array", "--format=%i"])
+                .arg(format!("--jobs={task}"))
+                .output()
+                .unwrap();
+            String::from_utf8_lossy(&out.stdout)
+                .lines()
+                .any(|l| l.trim() == task)
+        };
+        while queued() {
             std::thread::sleep(Duration::from_millis(20));
         }
         let index: u32 = task.split('_').nth(1).unwrap().parse().unwrap();
