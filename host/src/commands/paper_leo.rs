@@ -9,7 +9,8 @@ use crate::display::{fmt_estimate, fmt_mtbf};
 use crate::error::CliError;
 use crate::experiment::algo::label;
 use crate::output::OutDir;
-use crate::paper::figure_data::{curves, point};
+use crate::experiment::algo::Algo;
+use crate::paper::figure_data::{curves, figure_label, point};
 use crate::paper::leo::{self, LeoOptions, LeoResults};
 use crate::paper::objective::Objective;
 use crate::plan::mode::{obtain, Trials};
@@ -178,25 +179,65 @@ pub fn render(r: &LeoResults, command: &str) -> String {
     s
 }
 
+/// The filtered configurations that Fig. 7 shows beside SARSA(λ): the
+/// paper's shows a PADA and a low-pass filter, both switching back to
+/// SARSA(λ) at half the run, "which both have the same MTBF". Of the
+/// switching PADA and low-pass configurations this picks the pair whose
+/// MTBFs are closest in ratio.
+fn equal_mtbf_pair(r: &LeoResults) -> Option<(usize, usize)> {
+    let of = |algo: Algo| {
+        (0..r.configs.len())
+            .filter(move |&i| r.switched[i] && r.configs[i].algo() == algo)
+            .filter(|&i| r.configs[i].summary.mtbf_s.mean.is_finite())
+    };
+    of(Algo::Pada)
+        .flat_map(|p| of(Algo::LowPass).map(move |l| (p, l)))
+        .min_by(|a, b| {
+            let gap = |(p, l): (usize, usize)| {
+                (r.configs[p].summary.mtbf_s.mean / r.configs[l].summary.mtbf_s.mean)
+                    .ln()
+                    .abs()
+            };
+            gap(*a).total_cmp(&gap(*b))
+        })
+}
+
 fn draw(r: &LeoResults, out: &OutDir) -> anyhow::Result<()> {
     let dir = out.path();
     let sarsa = &r.configs[0].summary;
     let obj = Objective::from_sarsa(&sarsa.end_performance, &sarsa.rise_time_s, &sarsa.mtbf_s);
-    let curve_set: Vec<_> = curves(&r.configs, |_| true)
-        .into_iter()
-        .enumerate()
-        .map(|(i, mut c)| {
-            c.label = name(r, i);
+    let mut shown = vec![0];
+    let mut title = "Fig. 7 — LEO learning curves".to_string();
+    if let Some((p, l)) = equal_mtbf_pair(r) {
+        shown.extend([p, l]);
+        let _ = write!(
+            title,
+            ", PADA and low-pass at about equal MTBF ({:.0} s, {:.0} s)",
+            r.configs[p].summary.mtbf_s.mean,
+            r.configs[l].summary.mtbf_s.mean
+        );
+    }
+    let all = curves(&r.configs, |_| true);
+    let curve_set: Vec<_> = shown
+        .iter()
+        .map(|&i| {
+            let mut c = all[i].clone();
+            c.label = format!(
+                "{}{}, MTBF {:.0} s",
+                figure_label(&r.configs[i].policy),
+                if r.switched[i] { ", switching back" } else { "" },
+                r.configs[i].summary.mtbf_s.mean
+            );
             c
         })
-        .filter(|c| c.label == "sarsa" || c.label.contains("switch"))
         .collect();
     save(
         &LearningCurves {
-            title: "Fig. 7 — LEO learning curves (filters switch back to SARSA at half)".into(),
+            title,
             curves: curve_set,
             sarsa_end: sarsa.end_performance.mean,
             sarsa_rise_s: sarsa.rise_time_s.mean,
+            switch_at_s: (shown.len() > 1).then_some(r.options.seconds / 2.0),
         },
         dir,
         "fig7-learning-curves",

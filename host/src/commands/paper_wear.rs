@@ -140,6 +140,7 @@ fn draw(r: &WearResults, out: &OutDir) -> anyhow::Result<()> {
                 .collect(),
             sarsa_end: sarsa.end_performance.mean,
             sarsa_rise_s: sarsa.rise_time_s.mean,
+            switch_at_s: None,
         },
         out.path(),
         "wear-curves",

@@ -171,11 +171,17 @@ fn symbol(name: &str) -> &'static str {
 /// A short label: `sarsa`, `lowpass α=0.834`, `pada Δ=0.5`, `ou θ=0.15
 /// σ=0.2`.
 pub fn label(kind: &PolicyKind) -> String {
+    label_with(kind, |v| v.to_string())
+}
+
+/// [`label`] with each parameter value written by `value` (the figures
+/// write Δ = 1/6 where the plans and reports write 0.16666667).
+pub fn label_with(kind: &PolicyKind, value: impl Fn(f32) -> String) -> String {
     let algo = algo_of(kind);
     let values = kind.parameters();
     let mut s = algo.name().to_string();
     for (i, name) in algo.parameter_names().iter().enumerate() {
-        s += &format!(" {}={}", symbol(name), values[i]);
+        s += &format!(" {}={}", symbol(name), value(values[i]));
     }
     s
 }

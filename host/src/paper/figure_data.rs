@@ -2,8 +2,15 @@
 //! learning curves, shared by the pendulum and LEO reports.
 
 use super::pendulum::ConfigResult;
-use crate::experiment::algo::{algo_of, label, parameter_of};
+use crate::experiment::algo::{algo_of, label_with, parameter_of};
 use crate::plot::figures::{Curve, SweepPoint};
+use crate::plot::legend::parameter_text;
+use pada_core::policy::PolicyKind;
+
+/// A configuration's name in a figure's key: `pada Δ=1/6`, `lowpass α=0.2`.
+pub fn figure_label(policy: &PolicyKind) -> String {
+    label_with(policy, |v| parameter_text(f64::from(v)))
+}
 
 /// A configuration's summary as a point of the sweep figures (Figs. 3–5, 8).
 pub fn point(c: &ConfigResult) -> SweepPoint {
@@ -21,7 +28,7 @@ pub fn curves(cs: &[ConfigResult], pick: impl Fn(&ConfigResult) -> bool) -> Vec<
     cs.iter()
         .filter(|c| pick(c))
         .map(|c| Curve {
-            label: label(&c.policy),
+            label: figure_label(&c.policy),
             algo: algo_of(&c.policy),
             points: c.curve.clone(),
         })

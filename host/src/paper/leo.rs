@@ -15,7 +15,8 @@ use crate::experiment::{
     run_configs_keeping, run_trial_keep, FinishedTrial, HostAgent, RunConfig, TrialResult,
 };
 use crate::leo::rl::LeoTask;
-use crate::paper::pendulum::{mean_curve, ConfigResult};
+use crate::paper::curves::binned_curve;
+use crate::paper::pendulum::ConfigResult;
 use crate::plan::{Experiment, ExperimentKind};
 use crate::summary::RunSummary;
 use pada_core::policy::PolicyKind;
@@ -265,6 +266,14 @@ pub fn best_of_plan(
     }))
 }
 
+/// The width of a learning curve's bin: one test interval of full-length
+/// learning episodes (10 × 25 s = 250 s), the longest gap between two test
+/// runs, so a trial's held value spans at most one bin
+/// ([`binned_curve`]).
+fn curve_bin_s(spec: &crate::experiment::task::TaskSpec) -> f64 {
+    f64::from(spec.test_interval) * f64::from(spec.episode_steps) * spec.control_period_s
+}
+
 /// The results of Section VIII from every configuration's trials.
 pub fn assemble(
     o: &LeoOptions,
@@ -286,7 +295,7 @@ pub fn assemble(
         configs.push(ConfigResult {
             policy: cfg.policy,
             summary: RunSummary::new(task.spec(), &cfg, &r, f64::NAN),
-            curve: mean_curve(&r),
+            curve: binned_curve(&r, o.seconds, curve_bin_s(task.spec())),
         });
     }
     let env_steps = configs.iter().map(|c| c.summary.env_steps).sum();

@@ -1,8 +1,10 @@
-//! Reproducing the paper: its published numbers ([`numbers`]), the
+//! Reproducing the paper: its published numbers ([`numbers`]), the mean
+//! learning curves over trials ([`curves`]), the
 //! objective of Section VI ([`objective`]), the pendulum experiments of
 //! Section VII ([`pendulum`]) and their report ([`report`]), and learning
 //! on a wear budget ([`wear`], `pada paper wear`).
 
+pub mod curves;
 pub mod figure_data;
 pub mod leo;
 pub mod numbers;

@@ -15,10 +15,10 @@ use crate::experiment::algo::{algo_of, Algo};
 use crate::experiment::task::Task;
 use crate::experiment::tasks::TaskName;
 use crate::experiment::{RunConfig, TrialResult};
+use crate::paper::curves::{mean_curve, CurvePoint};
 use crate::paper::objective::{Objective, Verdict};
 use crate::pendulum::{PhysicalPendulumTask, SimulatedPendulumTask};
 use crate::plan::{Experiment, ExperimentKind};
-use crate::stats::Estimate;
 use crate::summary::RunSummary;
 use pada_core::policy::PolicyKind;
 use serde::Serialize;
@@ -43,17 +43,6 @@ pub struct PendulumOptions {
     pub phys_seconds: f64,
     /// Master seed.
     pub seed: u64,
-}
-
-/// One point of a mean learning curve.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct CurvePoint {
-    /// Mean learning time of the test run \[s\].
-    pub learning_time_s: f64,
-    /// Mean test return over trials.
-    pub mean: f64,
-    /// 95% half-width over trials.
-    pub ci95: f64,
 }
 
 /// The result of one configuration.
@@ -259,26 +248,4 @@ pub fn assemble(
         physical,
         env_steps,
     })
-}
-
-/// The mean learning curve over trials, test run by test run (up to the
-/// shortest trial's curve).
-pub fn mean_curve(results: &[TrialResult]) -> Vec<CurvePoint> {
-    let len = results.iter().map(|r| r.curve.len()).min().unwrap_or(0);
-    (0..len)
-        .map(|k| {
-            let returns: Vec<f64> = results.iter().map(|r| r.curve[k].test_return).collect();
-            let e = Estimate::of(&returns);
-            let t = results
-                .iter()
-                .map(|r| r.curve[k].learning_time_s)
-                .sum::<f64>()
-                / results.len() as f64;
-            CurvePoint {
-                learning_time_s: t,
-                mean: e.mean,
-                ci95: e.ci95,
-            }
-        })
-        .collect()
 }

@@ -12,7 +12,7 @@ use crate::experiment::algo::{algo_of, label, Algo, PolicyFlags};
 use crate::experiment::task::{Task, TaskSpec};
 use crate::experiment::tasks::{visit_task, TaskName, TaskVisitor};
 use crate::experiment::{RunConfig, TrialResult};
-use crate::paper::pendulum::{mean_curve, CurvePoint};
+use crate::paper::curves::{mean_curve, CurvePoint};
 use crate::plan::{Experiment, ExperimentKind};
 use crate::stats::Estimate;
 use crate::summary::RunSummary;

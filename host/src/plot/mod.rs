@@ -4,6 +4,7 @@
 
 pub mod compare;
 pub mod figures;
+pub mod legend;
 pub mod wear;
 
 use plotters::coord::Shift;
