@@ -8,6 +8,7 @@
 //! any drift between the two — a state range, a tile width, a level, a
 //! parameter, a table size — makes it fail.
 
+use pada::experiment::algo::{algo_of, policy_kind_of, Algo, PolicyFlags};
 use pada::experiment::build_agent;
 use pada::experiment::task::Task;
 use pada::leo::rl::{leo_params, LeoTask};
@@ -19,15 +20,31 @@ use pada_core::robot::Robot;
 use pada_core::weights::WeightStore;
 use pada_firmware::control::Controller;
 use pada_firmware::leo::Leo;
-use pada_firmware::pendulum::Pendulum33;
+use pada_firmware::pendulum::{Pendulum20, Pendulum33};
 use pada_firmware::robot::RobotAdapter;
 
-const POLICIES: [PolicyKind; 4] = [
-    PolicyKind::Sarsa,
-    PolicyKind::Pada { delta: 1.0 / 6.0 },
-    PolicyKind::LowPass { alpha: 0.5 },
-    PolicyKind::Integrator { delta: 0.5 },
-];
+/// Every policy of `--algo`, each with its default parameters (and PADA
+/// with LEO's Δ = 1/6 besides).
+fn policies() -> Vec<PolicyKind> {
+    let mut all: Vec<PolicyKind> = Algo::ALL
+        .into_iter()
+        .map(|a| {
+            policy_kind_of(a, &PolicyFlags::default())
+                .unwrap_or_else(|e| panic!("{}: no default policy: {e}", a.name()))
+        })
+        .collect();
+    all.push(PolicyKind::Pada { delta: 1.0 / 6.0 });
+    all
+}
+
+#[test]
+fn every_policy_every_robot_and_every_board_is_checked() {
+    assert_eq!(Algo::ALL.len(), 10, "a new policy: it is checked by the loops below");
+    assert_eq!(Robot::ALL.len(), 3, "a new robot needs its own check below");
+    assert_eq!(Board::ALL.len(), 3);
+    let kinds: std::collections::BTreeSet<&str> = policies().iter().map(|p| algo_of(p).name()).collect();
+    assert_eq!(kinds.len(), Algo::ALL.len(), "one policy of every algorithm");
+}
 
 /// The firmware controller's hash for `profile` and `policy` on a table of
 /// `weights` weights.
@@ -38,24 +55,40 @@ fn firmware_hash<R: RobotAdapter>(profile: LearnerProfile, policy: PolicyKind, w
     ctl.config_hash()
 }
 
-fn check<T: Task, R: RobotAdapter>(task: &T, profile: LearnerProfile) {
+/// Checks every policy on `profile`: where the host builds a learner, the
+/// firmware builds the same one; where the host refuses one (a Markov
+/// filter's learner on a pendulum's exact table, sized for the plain
+/// state), the firmware refuses it too. Returns how many it refused.
+fn check<T: Task, R: RobotAdapter>(task: &T, profile: LearnerProfile) -> usize {
     let spec = task.spec();
     assert_eq!(spec.profile, Some(profile));
-    for policy in POLICIES {
-        let host = build_agent(spec, policy).unwrap();
+    let (robot, board) = (profile.robot.name(), profile.board.name());
+    let mut refused = 0;
+    for policy in policies() {
+        let host = match build_agent(spec, policy) {
+            Ok(host) => host,
+            Err(host_error) => {
+                let n = profile.weights().unwrap_or(1 << 10);
+                let table = vec![Q16::ZERO; n].into_boxed_slice();
+                assert!(
+                    Controller::<_, R>::new(profile, policy, table, 1).is_err(),
+                    "{robot} on {board}: the host refuses {policy:?} ({host_error}) but the firmware builds it"
+                );
+                refused += 1;
+                continue;
+            }
+        };
         let host_hash = config_hash(&profile, &host);
         let fw = firmware_hash::<R>(profile, policy, host.weights().len());
         assert_eq!(
-            host_hash,
-            fw,
-            "{} on {} with {policy:?}: the host's learner and the firmware's differ",
-            profile.robot.name(),
-            profile.board.name()
+            host_hash, fw,
+            "{robot} on {board} with {policy:?}: the host's learner and the firmware's differ"
         );
         if let Some(n) = profile.weights() {
             assert_eq!(host.weights().len(), n, "the runner sizes the table as the profile says");
         }
     }
+    refused
 }
 
 #[test]
@@ -63,7 +96,16 @@ fn host_and_firmware_build_the_same_pendulum_learner_on_every_board() {
     for board in Board::ALL {
         let profile = board.profile(Robot::Pendulum33);
         let task = PhysicalPendulumTask::with_profile(PhysicalPendulumParams::default(), profile);
-        check::<_, Pendulum33>(&task, profile);
+        assert!(check::<_, Pendulum33>(&task, profile) <= 2, "only the two Markov filters are refused");
+    }
+}
+
+#[test]
+fn host_and_firmware_build_the_same_20_hz_pendulum_learner_on_every_board() {
+    for board in Board::ALL {
+        let profile = board.profile(Robot::Pendulum20);
+        let task = PhysicalPendulumTask::with_profile(PhysicalPendulumParams::default(), profile);
+        assert!(check::<_, Pendulum20>(&task, profile) <= 2, "only the two Markov filters are refused");
     }
 }
 
@@ -72,7 +114,7 @@ fn host_and_firmware_build_the_same_leo_learner_on_every_board() {
     for board in Board::ALL {
         let profile = board.profile(Robot::Leo);
         let task = LeoTask::with_profile(profile, leo_params());
-        check::<_, Leo>(&task, profile);
+        assert_eq!(check::<_, Leo>(&task, profile), 0, "LEO's hashed tables hold every learner");
     }
 }
 
