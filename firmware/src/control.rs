@@ -393,9 +393,10 @@ where
     }
 
     /// Seconds this board has operated: before this boot (as the
-    /// checkpoints carried it) and the control periods since.
+    /// checkpoints carried it) and the control periods since, each the
+    /// robot's period in whole µs (no float on the way).
     pub fn operating_s(&self) -> u64 {
-        let period_us = (self.config.period_s() as f64 * 1e6) as u64;
+        let period_us = u64::from(self.spec.period_us);
         self.operating_before_s.saturating_add(self.periods.saturating_mul(period_us) / 1_000_000)
     }
 
@@ -1693,6 +1694,38 @@ mod tests {
         // A saved F429 pendulum is not the F405's: the profile is in the hash.
         let mut f405 = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 1).unwrap();
         assert!(matches!(f405.load_checkpoint(&*store), Ok(LoadOutcome::ConfigMismatch { .. })));
+    }
+
+    /// A checkpoint's operating time after 10^6 periods of robot `R` on
+    /// `weights` weights is the controlled time to the period (10^6
+    /// periods are whole seconds), and after 17 more the whole seconds of
+    /// it, rounded down.
+    fn operating_time_is_the_controlled_time<R: RobotAdapter>(weights: usize) {
+        let table = vec![Q16::ZERO; weights].into_boxed_slice();
+        let mut c = Controller::<_, R>::new(profile(R::ROBOT), PolicyKind::Sarsa, table, 1).unwrap();
+        let mut store = Box::new(pada_core::checkpoint::RamStore::<FLASH_SLOT>::new());
+        let (clock, mut out) = (Clock(Cell::new(0)), PeriodOutput::default());
+        let period_us = R::spec().period_us as u64;
+        let mut periods = 0;
+        for more in [1_000_000, 17] {
+            for _ in 0..more {
+                c.period(&Readings::default(), &clock, &mut out);
+            }
+            periods += more;
+            c.save_checkpoint(&mut *store).unwrap();
+            let operating_s = checkpoint::stored_wear(&*store).unwrap().operating_s;
+            let controlled_us = periods * period_us;
+            assert_eq!(operating_s, controlled_us / 1_000_000, "{:?} after {periods} periods of {period_us} µs", R::ROBOT);
+        }
+    }
+
+    #[test]
+    fn a_checkpoints_operating_time_is_the_controlled_time() {
+        // 30 000 s of the 33 Hz pendulum, 50 000 s of the 20 Hz one,
+        // 33 333 s of LEO (33 333 µs a period).
+        operating_time_is_the_controlled_time::<Pendulum33>(WEIGHTS);
+        operating_time_is_the_controlled_time::<crate::pendulum::Pendulum20>(profile(Robot::Pendulum20).weights().unwrap());
+        operating_time_is_the_controlled_time::<Leo>(profile(Robot::Leo).weights().unwrap());
     }
 
     #[test]
