@@ -5,7 +5,7 @@
 //! and the step record of each decision (steps 2 and 4 of
 //! [`Controller::period`]).
 
-use super::{Controller, PeriodOutput, Readings};
+use super::{Controller, PeriodOutput, Phase, Readings};
 use crate::config::MAX_OBS;
 use crate::io::CycleCounter;
 use crate::robot::RobotAdapter;
@@ -14,20 +14,6 @@ use pada_core::agent::{Decision, EpisodeEnd, Mode};
 use pada_core::safety::RunMode;
 use pada_core::weights::WeightStore;
 use pada_core::wire::{self, StepKind};
-
-/// Where the episode cycle is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Phase {
-    /// Torque off.
-    Stopped,
-    /// Bringing the robot back to its start.
-    Resetting,
-    /// In an episode of `steps` transitions so far.
-    Running {
-        /// Transitions (rewards) so far.
-        steps: u32,
-    },
-}
 
 impl<W, R> Controller<W, R>
 where

@@ -73,7 +73,6 @@ pub use persist::CheckpointError;
 use crate::config::{hardware, FirmwareAgent, LearnerProfile, RobotConfig, MAX_SERVOS};
 use crate::encoder::Unwrapper;
 use crate::robot::RobotAdapter;
-use episodes::Phase;
 use heapless::Vec;
 use pada_core::checkpoint::FlashWear;
 use pada_core::error::ConfigError;
@@ -86,6 +85,20 @@ use pada_core::robot::RobotSpec;
 use pada_core::safety::{Event, RunMode, Safety, State, Transition};
 use pada_core::weights::WeightStore;
 use rand_core::SeedableRng;
+
+/// Where the episode cycle is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Phase {
+    /// Torque off.
+    Stopped,
+    /// Bringing the robot back to its start.
+    Resetting,
+    /// In an episode of `steps` transitions so far.
+    Running {
+        /// Transitions (rewards) so far.
+        steps: u32,
+    },
+}
 
 /// The control loop's state for robot `R` on weights `W`: agent, safety
 /// machine, the robot's adapter, fatigue.

@@ -5,8 +5,7 @@
 //! fatigue counter; with the period's readings and output and the fault
 //! thresholds.
 
-use super::episodes::Phase;
-use super::Controller;
+use super::{Controller, Phase};
 use crate::bus::BusConfig;
 use crate::config::MAX_SERVOS;
 use crate::io::CycleCounter;

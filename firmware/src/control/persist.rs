@@ -4,8 +4,7 @@
 //! loading with torque off, and the flash's erase budget (the operating
 //! time and the sectors' erase counts).
 
-use super::episodes::Phase;
-use super::Controller;
+use super::{Controller, Phase};
 use crate::config::MAX_SERVOS;
 use crate::robot::RobotAdapter;
 use heapless::Vec;
