@@ -5,7 +5,7 @@
 use std::{env, fs, path::PathBuf};
 
 fn main() {
-    // `emulated`: a board of the software-in-the-loop run (src/board/lockstep.rs);
+    // `emulated`: a board of the software-in-the-loop run (src/board/lockstep/);
     // `profile_f429`: the f429-sdram board learner profile (the F429I-DISC1
     // and its emulation on mps2-an386).
     println!("cargo::rustc-check-cfg=cfg(emulated)");

@@ -68,11 +68,6 @@ impl RobotConfig {
     pub fn period_us(&self) -> u32 {
         self.robot.spec().period_us
     }
-
-    /// The control period \[s\].
-    pub fn period_s(&self) -> f32 {
-        self.period_us() as f32 * 1e-6
-    }
 }
 
 /// The pendulum's motor: Dynamixel ID 1, position counts increasing with

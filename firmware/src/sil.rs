@@ -1,4 +1,4 @@
-//! Software in the loop: what the emulated boards (`src/board/lockstep.rs`
+//! Software in the loop: what the emulated boards (`src/board/lockstep/`
 //! with `qemu.rs` for QEMU's `netduinoplus2` or `mps2.rs` for its
 //! `mps2-an386`) and the host's plant side (`pada sil`, `host/src/sil/`)
 //! agree on. Both import this module, so the two ends cannot disagree.

@@ -17,6 +17,9 @@ use stm32_fmc::devices::is42s16400j_7::Is42s16400j;
 /// 45 MHz, APB2 90 MHz; the FMC runs on HCLK and clocks the SDRAM at half
 /// of it, 90 MHz).
 pub const CPU_HZ: u32 = 180_000_000;
+// The FMC runs on HCLK (AHB prescaler 1): the SDRAM's timings take it as
+// this clock.
+const _: () = assert!(sdram::FMC_HZ == CPU_HZ, "sdram.rs's FMC clock must be HCLK, the CPU's clock");
 
 bind_interrupts!(pub struct Irqs {
     UART5 => usart::InterruptHandler<UART5>;

@@ -78,6 +78,11 @@
 //! same `pada_firmware::io` traits; everything above (tasks, controller,
 //! agent) stays as it is.
 
+// The weight table's memory: what the board layer and the table both use
+// (a leaf, so that neither imports the other).
+mod memory;
+pub use memory::{MemoryFault, TableMemory};
+
 #[cfg(not(emulated))]
 mod hw;
 #[cfg(not(emulated))]
@@ -122,32 +127,3 @@ use no_watchdog as watchdog;
 mod injection;
 #[cfg(emulated)]
 pub use injection::injected_hang;
-
-/// Proof that the memory the weight table lives in works: only the board
-/// layer makes one, after it started that memory (the F429's SDRAM, which
-/// reads garbage and ignores writes before its power-up sequence) and
-/// checked it. `crate::table::take` needs one, so nothing touches the table
-/// before.
-pub struct TableMemory(());
-
-impl TableMemory {
-    /// Memory that works from reset (internal SRAM and CCM), or external
-    /// memory the board layer has started and checked.
-    fn ready() -> TableMemory {
-        TableMemory(())
-    }
-}
-
-/// The table's memory failed its check at boot: a word read back other
-/// than written (a data, byte-lane or address line stuck or shorted, or
-/// wrong timings).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, defmt::Format)]
-pub struct MemoryFault {
-    /// The address that read back wrong.
-    pub address: u32,
-    /// What was written there (or, for the address-line check, what the
-    /// word should still hold).
-    pub wrote: u32,
-    /// What was read.
-    pub read: u32,
-}

@@ -30,7 +30,9 @@ pub type DiscSdram = stm32_fmc::Sdram<Fmc<'static, FMC>, Is42s16400j>;
 // 100 MHz in 2 or 3 and that the refresh count fits its 13-bit register
 // (it would panic otherwise). Both follow from the fixed clocks, so they
 // are checked here at compile time and the assertions cannot fire.
-const FMC_HZ: u32 = super::f429::CPU_HZ; // AHB prescaler 1
+/// The FMC's clock, HCLK: the F429's 180 MHz with AHB prescaler 1
+/// (`f429.rs` checks that it is its `CPU_HZ`).
+pub const FMC_HZ: u32 = 180_000_000;
 const SD_DIVIDE: u32 = {
     let d = FMC_HZ.div_ceil(100_000_000);
     if d < 2 {

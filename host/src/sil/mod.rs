@@ -26,7 +26,7 @@
 //!   firmware's agent;
 //! - [`wall`]: where the wall-clock time goes.
 //!
-//! The board side is `firmware/src/board/lockstep.rs`; the protocol between
+//! The board side is `firmware/src/board/lockstep/`; the protocol between
 //! them is `pada_firmware::sil`.
 
 pub mod bus;

@@ -1,0 +1,119 @@
+//! What the controller's tests share: a cycle counter, the F405's
+//! learners and tables, healthy readings, starting and stopping, and the
+//! crude pendulum that the replay and checkpoint tests run.
+
+use super::*;
+use crate::config::{Board, Robot};
+use crate::io::CycleCounter;
+use crate::pendulum::Pendulum33;
+use core::cell::Cell;
+use core::f32::consts::PI;
+use pada_core::checkpoint;
+use pada_core::dynamixel::table::PresentState;
+use pada_core::fixed::Q16;
+use pada_core::profile::PENDULUM_EXACT_WEIGHTS as WEIGHTS;
+use pada_core::safety::RunMode;
+use pada_core::wire;
+
+/// A cycle counter that advances 1000 cycles at every read.
+pub(super) struct Clock(pub(super) Cell<u32>);
+
+impl CycleCounter for Clock {
+    fn cycles(&self) -> u32 {
+        let c = self.0.get();
+        self.0.set(c + 1000);
+        c
+    }
+}
+
+/// The F405's learner for `robot`.
+pub(super) fn profile(robot: Robot) -> LearnerProfile {
+    Board::F405.profile(robot)
+}
+
+/// The F405's pendulum table (exact).
+pub(super) fn table() -> Box<[Q16]> {
+    vec![Q16::ZERO; WEIGHTS].into_boxed_slice()
+}
+
+/// The F405's LEO table.
+pub(super) fn leo_table() -> Box<[Q16]> {
+    vec![Q16::ZERO; profile(Robot::Leo).weights().unwrap()].into_boxed_slice()
+}
+
+/// A healthy pendulum reading: the servo answers, the encoder at `counts`.
+pub(super) fn pendulum_readings(counts: u16, time_ms: u32) -> Readings {
+    let mut r = Readings { encoder: Some(counts), time_ms, ..Readings::default() };
+    r.servos[0].state = Some(PresentState { position: 512, speed: 0, load: 0, voltage: 120, temperature: 35 });
+    r
+}
+
+pub(super) fn start<R: RobotAdapter>(c: &mut Controller<Box<[Q16]>, R>, mode: RunMode) {
+    let (result, t) = c.command(&wire::ToChip::Start(mode));
+    assert_eq!(result, Ok(()));
+    assert!(t.unwrap().torque_enable);
+}
+
+// -----------------------------------------------------------------------
+// Saved learning
+// -----------------------------------------------------------------------
+
+pub(super) type Store = pada_core::checkpoint::RamStore<{ checkpoint::slot_len(WEIGHTS, 4) }>;
+
+/// `periods` periods of the crude pendulum of the replay test, from
+/// period `k0`; the Step records.
+pub(super) fn run_pendulum(c: &mut Controller<Box<[Q16]>, Pendulum33>, angle: &mut f32, k0: u32, periods: u32) -> std::vec::Vec<wire::Step> {
+    let clock = Clock(Cell::new(0));
+    let mut out = PeriodOutput::default();
+    let mut steps = std::vec::Vec::new();
+    for k in k0..k0 + periods {
+        let counts = (*angle / (2.0 * PI) * 4096.0).round() as i64;
+        c.period(&pendulum_readings(counts.rem_euclid(65536) as u16, k * 30), &clock, &mut out);
+        if let Some(s) = out.step.take() {
+            steps.push(s);
+        }
+        let u = c.applied[0];
+        *angle += 0.02 * u - 0.05 * libm::sinf(*angle);
+    }
+    steps
+}
+
+pub(super) fn stop(c: &mut Controller<Box<[Q16]>, Pendulum33>) {
+    assert_eq!(c.command(&wire::ToChip::Stop).0, Ok(()));
+    let mut out = PeriodOutput::default();
+    c.period(&pendulum_readings(0, 0), &Clock(Cell::new(0)), &mut out);
+    assert!(!out.torque);
+}
+
+// -----------------------------------------------------------------------
+// Learning on a wear budget
+// -----------------------------------------------------------------------
+
+/// The budget the governed tests hold: on the crude pendulum of
+/// `run_pendulum`, tight enough that the governor moves Δ both ways.
+pub(super) const TEST_BUDGET_S: f32 = 2.0e8;
+
+/// A governed run's records in the order the board sends them.
+pub(super) enum Sent {
+    Step(wire::Step),
+    Policy(wire::PolicyReport),
+}
+
+pub(super) fn run_governed(c: &mut Controller<Box<[Q16]>, Pendulum33>, angle: &mut f32, periods: u32) -> std::vec::Vec<Sent> {
+    let clock = Clock(Cell::new(0));
+    let mut out = PeriodOutput::default();
+    let mut sent = std::vec::Vec::new();
+    for k in 0..periods {
+        let counts = (*angle / (2.0 * PI) * 4096.0).round() as i64;
+        c.period(&pendulum_readings(counts.rem_euclid(65536) as u16, k * 30), &clock, &mut out);
+        if let Some(s) = out.step.take() {
+            sent.push(Sent::Step(s));
+        }
+        if let Some(p) = out.policy.take() {
+            sent.push(Sent::Policy(p));
+        }
+        let u = c.applied[0];
+        *angle += 0.02 * u - 0.05 * libm::sinf(*angle);
+    }
+    sent
+}
