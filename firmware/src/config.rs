@@ -95,8 +95,9 @@ const LEO_JOINTS: [Joint; NUM_JOINTS] = [
 /// this much is being driven into them.
 const STOP_MARGIN: f32 = 0.15;
 
-/// The shoulder has no stop (§1.5); its soft limit is ±90°.
-const SHOULDER_LIMITS: [f32; 2] = [-core::f32::consts::FRAC_PI_2, core::f32::consts::FRAC_PI_2];
+/// The shoulder has no stop (§1.5, `joint_limits` is `None`): its soft
+/// limit, a fault and not a physical stop, is ±90°.
+const SHOULDER_SOFT_LIMITS: [f32; 2] = [-core::f32::consts::FRAC_PI_2, core::f32::consts::FRAC_PI_2];
 
 const fn limit([min, max]: [f32; 2]) -> Option<SoftLimit> {
     Some(SoftLimit { min: min - STOP_MARGIN, max: max + STOP_MARGIN })
@@ -104,7 +105,7 @@ const fn limit([min, max]: [f32; 2]) -> Option<SoftLimit> {
 
 /// LEO's soft limits in joint order: its stops plus the margin.
 const LEO_LIMITS: [Option<SoftLimit>; NUM_JOINTS] = [
-    limit(SHOULDER_LIMITS),
+    limit(SHOULDER_SOFT_LIMITS),
     limit(leo::HIP_LIMITS),
     limit(leo::HIP_LIMITS),
     limit(leo::KNEE_LIMITS),

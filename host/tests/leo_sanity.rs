@@ -371,7 +371,7 @@ fn random_actions_end_in_falls_with_finite_rewards() {
 #[test]
 fn timeout_ends_the_episode() {
     let cfg = LeoConfig {
-        timeout: 0.2,
+        timeout: Some(0.2),
         ..LeoConfig::default()
     };
     let mut env = LeoEnv::new(cfg).unwrap();
@@ -496,7 +496,7 @@ fn invalid_config_is_refused() {
             ..Default::default()
         },
         LeoConfig {
-            timeout: -1.0,
+            timeout: Some(-1.0),
             ..Default::default()
         },
     ] {

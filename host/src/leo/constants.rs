@@ -161,8 +161,6 @@ pub const HIP_STOP: [f32; 2] = [100.0, 10.0];
 pub const KNEE_STOP: [f32; 2] = [50.0, 5.0];
 /// Ankle stop spring and damper (§1.5).
 pub const ANKLE_STOP: [f32; 2] = [100.0, 10.0];
-/// The shoulder has no limits (§1.5).
-pub const SHOULDER_LIMITS: Option<[f32; 2]> = None;
 
 /// Every servo joint: the RX-28 of §2.1 (dry friction 0.2 N m, §1.5).
 pub const SERVO: rx28::Rx28 = rx28::Rx28::LEO;

@@ -44,8 +44,10 @@ pub struct LeoConfig {
     /// configuration of the reference).
     pub randomize_start: bool,
     /// Episode timeout in simulated seconds after the first observation
-    /// (§3.8: 25 s).
-    pub timeout: f32,
+    /// (§3.8: 25 s); `None` when whoever drives the environment ends the
+    /// episodes (the learning runner ends them after the robot
+    /// definition's 750 steps).
+    pub timeout: Option<f32>,
 }
 
 impl Default for LeoConfig {
@@ -53,7 +55,7 @@ impl Default for LeoConfig {
         Self {
             model: ModelOptions::default(),
             randomize_start: false,
-            timeout: EPISODE_TIMEOUT,
+            timeout: Some(EPISODE_TIMEOUT),
         }
     }
 }
@@ -172,8 +174,8 @@ impl LeoEnv {
     /// A new environment; call [`LeoEnv::reset`] before stepping (a step
     /// before the first reset acts on the reference pose as if reset).
     pub fn new(config: LeoConfig) -> Result<Self, LeoError> {
-        if !(config.timeout.is_finite() && config.timeout > 0.0) {
-            return Err(LeoError::InvalidTimeout(config.timeout));
+        if let Some(t) = config.timeout.filter(|t| !(t.is_finite() && *t > 0.0)) {
+            return Err(LeoError::InvalidTimeout(t));
         }
         let mut model = LeoModel::new(config.model, &InitialPose::REFERENCE)?;
         // The first control period of every reference episode (§1.8).
@@ -423,7 +425,7 @@ impl LeoEnv {
         self.terminal = if fall {
             self.falls += 1;
             Terminal::Fall
-        } else if self.time > self.config.timeout {
+        } else if self.config.timeout.is_some_and(|t| self.time > t) {
             Terminal::Timeout
         } else {
             Terminal::None

@@ -146,7 +146,7 @@ pub fn passive_rollout(options: ModelOptions, seconds: f64) -> Result<PassiveRol
         model: options,
         // The rollout's own length decides; the task's 25 s timeout must
         // not end it first.
-        timeout: (steps as f32 + 1.0) * CONTROL_PERIOD,
+        timeout: Some((steps as f32 + 1.0) * CONTROL_PERIOD),
         ..LeoConfig::default()
     };
     let mut env = LeoEnv::new(config)?;

@@ -64,10 +64,10 @@ impl LeoTask {
         spec.params = params;
         spec.default_seconds = 14_666.0;
         spec.default_trials = 2;
-        // The runner ends episodes after 750 steps; the environment's own
-        // timeout is set beyond that so it never ends one first.
+        // The runner ends episodes after the definition's 750 steps, so
+        // the environment has no timeout of its own.
         let config = LeoConfig {
-            timeout: 1.0e6,
+            timeout: None,
             ..LeoConfig::default()
         };
         LeoTask { config, spec }

@@ -158,10 +158,12 @@ pub const SHANK_LENGTH: f32 = 0.1045;
 
 /// Control period: 30 Hz (§1.1, §3.6) \[µs\].
 pub const CONTROL_PERIOD_US: u32 = 33_333;
-/// Control steps of an episode: 25 s at 30 Hz (§3.8).
-pub const EPISODE_STEPS: u32 = 750;
 /// Episode timeout after the first observation (§3.8) \[s\].
 pub const EPISODE_TIMEOUT_S: f32 = 25.0;
+/// Control steps of an episode: the timeout's 25 s at 30 Hz, 750 (§3.8).
+pub const EPISODE_STEPS: u32 =
+    (EPISODE_TIMEOUT_S as u64 * 1_000_000 / CONTROL_PERIOD_US as u64) as u32;
+const _: () = assert!(EPISODE_STEPS == 750);
 /// Number of observation dimensions (§3.4).
 pub const OBS_DIM: usize = 10;
 /// Number of learned action dimensions (§3.4).

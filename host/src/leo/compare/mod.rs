@@ -182,8 +182,8 @@ pub fn compare(
 ) -> Result<Comparison, LeoError> {
     let mut env = LeoEnv::new(LeoConfig {
         model: options,
-        // Long enough for any reference; the reference's own end decides.
-        timeout: f32::MAX,
+        // No timeout: the reference's own end decides.
+        timeout: None,
         ..LeoConfig::default()
     })?;
     let first = &reference.steps[0];

@@ -121,8 +121,10 @@ pub(super) struct JointSpec {
     pub(super) child: Body,
     pub(super) parent_anchor: [f32; 2],
     pub(super) child_anchor: [f32; 2],
-    /// Limits and stop [K, D]; `None` for the unlimited shoulder.
-    pub(super) stop: Option<([f32; 2], [f32; 2])>,
+    /// The stop's spring and damper [K, D], at the joint's limits
+    /// ([`joint_limits`], the robot's one definition); `None` for the
+    /// unlimited shoulder.
+    pub(super) stop: Option<[f32; 2]>,
 }
 
 /// Joints in [`Joint`] order.
@@ -139,48 +141,50 @@ pub(super) const JOINT_SPECS: [JointSpec; NUM_JOINTS] = [
         child: Body::ThighLeft,
         parent_anchor: TORSO_HIP_ANCHOR,
         child_anchor: THIGH_HIP_ANCHOR,
-        stop: Some((HIP_LIMITS, HIP_STOP)),
+        stop: Some(HIP_STOP),
     },
     JointSpec {
         parent: Body::Torso,
         child: Body::ThighRight,
         parent_anchor: TORSO_HIP_ANCHOR,
         child_anchor: THIGH_HIP_ANCHOR,
-        stop: Some((HIP_LIMITS, HIP_STOP)),
+        stop: Some(HIP_STOP),
     },
     JointSpec {
         parent: Body::ThighLeft,
         child: Body::ShankLeft,
         parent_anchor: THIGH_KNEE_ANCHOR,
         child_anchor: SHANK_KNEE_ANCHOR,
-        stop: Some((KNEE_LIMITS, KNEE_STOP)),
+        stop: Some(KNEE_STOP),
     },
     JointSpec {
         parent: Body::ThighRight,
         child: Body::ShankRight,
         parent_anchor: THIGH_KNEE_ANCHOR,
         child_anchor: SHANK_KNEE_ANCHOR,
-        stop: Some((KNEE_LIMITS, KNEE_STOP)),
+        stop: Some(KNEE_STOP),
     },
     JointSpec {
         parent: Body::ShankLeft,
         child: Body::FootLeft,
         parent_anchor: SHANK_ANKLE_ANCHOR,
         child_anchor: FOOT_ANKLE_ANCHOR,
-        stop: Some((ANKLE_LIMITS, ANKLE_STOP)),
+        stop: Some(ANKLE_STOP),
     },
     JointSpec {
         parent: Body::ShankRight,
         child: Body::FootRight,
         parent_anchor: SHANK_ANKLE_ANCHOR,
         child_anchor: FOOT_ANKLE_ANCHOR,
-        stop: Some((ANKLE_LIMITS, ANKLE_STOP)),
+        stop: Some(ANKLE_STOP),
     },
 ];
 
-/// The limits of a joint (§1.5), `None` for the shoulder.
-pub fn joint_limits(joint: Joint) -> Option<[f32; 2]> {
-    JOINT_SPECS[joint as usize].stop.map(|(limits, _)| limits)
+pub use pada_core::robot::leo::joint_limits;
+
+/// Joint `k`'s limits and its stop's [K, D], when it has a stop.
+pub(super) fn limits_and_stop(k: usize) -> Option<([f32; 2], [f32; 2])> {
+    joint_limits(JOINTS[k]).zip(JOINT_SPECS[k].stop)
 }
 
 /// Absolute body pitches of a starting pose (§1.8). All velocities are zero.
@@ -264,4 +268,20 @@ pub(super) fn body_pose(origin: [f32; 2], pitch: f32) -> Pose {
         Vector::new(origin[0], 0.0, origin[1]),
         Rotation::from_rotation_y(pitch),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_joint_with_limits_has_a_stop_and_only_those() {
+        for (k, joint) in JOINTS.iter().enumerate() {
+            assert_eq!(
+                joint_limits(*joint).is_some(),
+                JOINT_SPECS[k].stop.is_some(),
+                "{joint:?}: limits and stop spring disagree"
+            );
+        }
+    }
 }

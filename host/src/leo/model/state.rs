@@ -6,7 +6,7 @@ use rapier3d::prelude::*;
 
 use super::super::constants::*;
 use super::super::stiction::FrictionState;
-use super::anatomy::{Body, BODY_SPECS, JOINT_SPECS, NUM_JOINTS};
+use super::anatomy::{limits_and_stop, Body, BODY_SPECS, JOINT_SPECS, NUM_JOINTS};
 use super::options::{BlowUp, ModelOptions};
 use super::{LeoModel, LATERAL_TIE, LINEAR_Y, ROOT_PITCH, ROOT_X, ROOT_Y, ROOT_Z};
 
@@ -216,7 +216,7 @@ impl LeoModel {
             // The armature the simulation uses (see `correct_motor_lag`).
             let armature = mb.armature()[self.dofs[k]];
             kinetic += 0.5 * (armature * qd[k] * qd[k]) as f64;
-            if let (Some((limits, stop)), true) = (JOINT_SPECS[k].stop, self.options.joint_stops) {
+            if let (Some((limits, stop)), true) = (limits_and_stop(k), self.options.joint_stops) {
                 let over = (q[k] - limits[1]).max(0.0) + (limits[0] - q[k]).max(0.0);
                 potential += 0.5 * (stop[0] * over * over) as f64;
             }

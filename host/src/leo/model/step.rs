@@ -5,7 +5,7 @@
 use rapier3d::prelude::*;
 
 use super::super::constants::*;
-use super::anatomy::{Body, JOINT_SPECS, NUM_JOINTS};
+use super::anatomy::{limits_and_stop, Body, JOINT_SPECS, NUM_JOINTS};
 use super::options::BlowUp;
 use super::{LeoModel, ANGULAR_X};
 
@@ -116,7 +116,7 @@ impl LeoModel {
             let mut damping = self.servo.damping + load.damping;
             torques[k] = load.torque;
             if let (Some((limits, [stop_k, stop_d])), true) =
-                (JOINT_SPECS[k].stop, self.options.joint_stops)
+                (limits_and_stop(k), self.options.joint_stops)
             {
                 let beyond = if q[k] > limits[1] {
                     Some((limits[1], qd[k] > 0.0))
