@@ -22,8 +22,11 @@ use pada_core::safety::SoftLimit;
 pub use pada_core::profile::{Board, LearnerProfile, TILINGS, TRACE};
 pub use pada_core::robot::Robot;
 
-/// Most servos on the bus.
-pub const MAX_SERVOS: usize = 7;
+/// The most servos of a robot this firmware drives (LEO's seven): the size
+/// of its per-servo arrays and of its fatigue counter. The bus, the wire
+/// and the checkpoint allow more ([`pada_core::limits::MAX_SERVOS`]).
+pub const MAX_ROBOT_SERVOS: usize = NUM_JOINTS;
+const _: () = assert!(MAX_ROBOT_SERVOS <= pada_core::limits::MAX_SERVOS);
 /// Most observation dimensions (LEO's 10).
 pub const MAX_OBS: usize = 10;
 
@@ -117,7 +120,7 @@ const LEO_LIMITS: [Option<SoftLimit>; NUM_JOINTS] = [
 /// The pendulum turns freely: no soft limit.
 const PENDULUM_LIMITS: [Option<SoftLimit>; 1] = [None];
 
-const _: () = assert!(LeoJoint::AnkleRight as usize == NUM_JOINTS - 1 && NUM_JOINTS <= MAX_SERVOS);
+const _: () = assert!(LeoJoint::AnkleRight as usize == NUM_JOINTS - 1 && NUM_JOINTS <= MAX_ROBOT_SERVOS);
 
 /// The robot's hardware.
 pub const fn hardware(robot: Robot) -> RobotConfig {
@@ -148,8 +151,8 @@ mod tests {
     #[test]
     fn leo_servos_are_in_joint_order_with_grl_ids() {
         let hw = hardware(Robot::Leo);
-        assert_eq!(hw.joints.len(), MAX_SERVOS);
-        assert_eq!(hw.soft_limits.len(), MAX_SERVOS);
+        assert_eq!(hw.joints.len(), MAX_ROBOT_SERVOS);
+        assert_eq!(hw.soft_limits.len(), MAX_ROBOT_SERVOS);
         let id = |j: LeoJoint| hw.joints[j as usize].id;
         assert_eq!(
             [LeoJoint::Shoulder, LeoJoint::HipRight, LeoJoint::HipLeft, LeoJoint::KneeRight, LeoJoint::KneeLeft]

@@ -17,7 +17,7 @@
 //!   same: it puts the robot back in the start pose and holds it there until
 //!   the firmware starts the episode.)
 
-use crate::config::{RobotConfig, MAX_OBS, MAX_SERVOS};
+use crate::config::{RobotConfig, MAX_OBS, MAX_ROBOT_SERVOS};
 use crate::robot::{RobotAdapter, Sensed};
 use core::ops::Range;
 use pada_core::robot::filter::RateFilter;
@@ -48,7 +48,7 @@ const READY_PHI: f32 = 0.15;
 /// … with a foot on the ground, for this long \[µs\].
 const READY_TIME_US: u32 = 1_000_000;
 
-const _: () = assert!(NUM_JOINTS == MAX_SERVOS);
+const _: () = assert!(NUM_JOINTS == MAX_ROBOT_SERVOS);
 
 /// LEO's adapter.
 #[derive(Debug, Clone)]
@@ -171,7 +171,7 @@ impl RobotAdapter for Leo {
         MAX_OBS
     }
 
-    fn reward(&self, _applied: &[f32; MAX_SERVOS]) -> f32 {
+    fn reward(&self, _applied: &[f32; MAX_ROBOT_SERVOS]) -> f32 {
         reward(self.energy, &self.update, self.absorbing())
     }
 
@@ -181,7 +181,7 @@ impl RobotAdapter for Leo {
 
     /// The learner's `[U_hip,st, U_hip,sw, U_knee,sw]` on the joints of the
     /// current stance, the held joints by §3.5.
-    fn commands(&self, output: &[f32], volts: &mut [f32; MAX_SERVOS]) {
+    fn commands(&self, output: &[f32], volts: &mut [f32; MAX_ROBOT_SERVOS]) {
         let mut action = [0.0; 3];
         for (a, o) in action.iter_mut().zip(output) {
             *a = *o;
@@ -190,12 +190,12 @@ impl RobotAdapter for Leo {
     }
 
     /// Every joint held in the start pose.
-    fn reset_commands(&self, volts: &mut [f32; MAX_SERVOS]) {
+    fn reset_commands(&self, volts: &mut [f32; MAX_ROBOT_SERVOS]) {
         *volts = pose_voltages(&self.q, &START_JOINT_ANGLES);
     }
 
     /// The RX-28 model's torque at each servo's filtered rate.
-    fn gear_torques(&self, applied: &[f32; MAX_SERVOS], torques: &mut [f32; MAX_SERVOS]) {
+    fn gear_torques(&self, applied: &[f32; MAX_ROBOT_SERVOS], torques: &mut [f32; MAX_ROBOT_SERVOS]) {
         for j in 0..NUM_JOINTS {
             torques[j] = estimated_gear_torque(applied[j], self.qd[j]);
         }
@@ -241,13 +241,13 @@ mod tests {
         l
     }
 
-    fn sense(l: &mut Leo, angles: [f32; NUM_JOINTS], boom: f32, contacts: u8, applied: [f32; MAX_SERVOS]) {
+    fn sense(l: &mut Leo, angles: [f32; NUM_JOINTS], boom: f32, contacts: u8, applied: [f32; MAX_ROBOT_SERVOS]) {
         l.sense(&Sensed { angles: angles.map(Some), encoder_angle: Some(boom), contacts, applied });
     }
 
     /// LEO in the start pose of §1.8 (left leg stance).
     fn start_pose(l: &mut Leo, contacts: u8) {
-        sense(l, START_JOINT_ANGLES, -START_PHI, contacts, [0.0; MAX_SERVOS]);
+        sense(l, START_JOINT_ANGLES, -START_PHI, contacts, [0.0; MAX_ROBOT_SERVOS]);
     }
 
     #[test]
@@ -265,11 +265,11 @@ mod tests {
         // The second update: L flips from x_L − x_R to x_R − x_L, the
         // +11.9 artefact of the first transition (§3.7).
         start_pose(&mut l, contact::LEFT);
-        let r = l.reward(&[0.0; MAX_SERVOS]);
+        let r = l.reward(&[0.0; MAX_ROBOT_SERVOS]);
         assert!((r - 11.9).abs() < 0.5, "{r}");
         // Standing still afterwards: the time penalty only.
         start_pose(&mut l, contact::LEFT);
-        assert!((l.reward(&[0.0; MAX_SERVOS]) + 1.0).abs() < 1e-4);
+        assert!((l.reward(&[0.0; MAX_ROBOT_SERVOS]) + 1.0).abs() < 1e-4);
     }
 
     #[test]
@@ -288,7 +288,7 @@ mod tests {
         // L is continuous across the switch: the next reward is the time
         // penalty only.
         start_pose(&mut l, contact::RIGHT);
-        assert!((l.reward(&[0.0; MAX_SERVOS]) + 1.0).abs() < 1e-4);
+        assert!((l.reward(&[0.0; MAX_ROBOT_SERVOS]) + 1.0).abs() < 1e-4);
         // Both feet down: the front foot stands (the right ankle is ahead).
         start_pose(&mut l, contact::LEFT | contact::RIGHT);
         assert_eq!(l.stance(), Leg::Right);
@@ -300,16 +300,16 @@ mod tests {
         start_pose(&mut l, contact::LEFT);
         start_pose(&mut l, contact::LEFT);
         assert!(!l.absorbing());
-        sense(&mut l, START_JOINT_ANGLES, 1.2, contact::LEFT, [0.0; MAX_SERVOS]);
+        sense(&mut l, START_JOINT_ANGLES, 1.2, contact::LEFT, [0.0; MAX_ROBOT_SERVOS]);
         assert!(l.absorbing());
-        assert!(l.reward(&[0.0; MAX_SERVOS]) < -100.0);
+        assert!(l.reward(&[0.0; MAX_ROBOT_SERVOS]) < -100.0);
     }
 
     #[test]
     fn learned_and_held_joints_by_stance() {
         let mut l = leo();
         start_pose(&mut l, contact::LEFT);
-        let mut v = [0.0; MAX_SERVOS];
+        let mut v = [0.0; MAX_ROBOT_SERVOS];
         l.commands(&[1.0, 2.0, 3.0], &mut v);
         let (hl, hr, kr, kl) =
             (Joint::HipLeft as usize, Joint::HipRight as usize, Joint::KneeRight as usize, Joint::KneeLeft as usize);
@@ -322,7 +322,7 @@ mod tests {
         // Learned voltages are clipped to ±10.7 V, held ones to 10.69 V.
         l.commands(&[50.0, 0.0, 0.0], &mut v);
         assert_eq!(v[hl], ACTION_VOLTAGE_LIMIT);
-        sense(&mut l, [3.0; NUM_JOINTS], 0.10, contact::LEFT, [0.0; MAX_SERVOS]);
+        sense(&mut l, [3.0; NUM_JOINTS], 0.10, contact::LEFT, [0.0; MAX_ROBOT_SERVOS]);
         l.commands(&[0.0; 3], &mut v);
         assert!((v[Joint::Shoulder as usize] + HELD_VOLTAGE_LIMIT).abs() < 1e-5);
         // Between episodes everything is held at the start pose.
@@ -336,7 +336,7 @@ mod tests {
         let mut l = leo();
         start_pose(&mut l, contact::LEFT);
         start_pose(&mut l, contact::LEFT);
-        let mut applied = [0.0; MAX_SERVOS];
+        let mut applied = [0.0; MAX_ROBOT_SERVOS];
         applied[Joint::HipLeft as usize] = 10.0;
         sense(&mut l, START_JOINT_ANGLES, -START_PHI, contact::LEFT, applied);
         // At stall: U²/R · T; reward −1 − 3E.

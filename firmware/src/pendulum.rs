@@ -12,7 +12,7 @@
 //! (|θ − π| < 0.15 rad and |θ̇| < 0.3 rad/s for 1 s) or 15 s have passed,
 //! so every episode starts, as in the simulation, hanging at rest.
 
-use crate::config::{RobotConfig, MAX_OBS, MAX_SERVOS};
+use crate::config::{RobotConfig, MAX_OBS, MAX_ROBOT_SERVOS};
 use crate::robot::{RobotAdapter, Sensed};
 use core::ops::Range;
 use pada_core::robot::pendulum::{clip_voltage, gearbox_torque, swing_up_reward, wrap_angle};
@@ -100,7 +100,7 @@ impl<const HZ20: bool> RobotAdapter for Pendulum<HZ20> {
         2
     }
 
-    fn reward(&self, applied: &[f32; MAX_SERVOS]) -> f32 {
+    fn reward(&self, applied: &[f32; MAX_ROBOT_SERVOS]) -> f32 {
         let u = clip_voltage(applied[0] as f64);
         swing_up_reward(self.theta as f64, self.omega as f64, u) as f32
     }
@@ -109,17 +109,17 @@ impl<const HZ20: bool> RobotAdapter for Pendulum<HZ20> {
         false
     }
 
-    fn commands(&self, output: &[f32], volts: &mut [f32; MAX_SERVOS]) {
-        *volts = [0.0; MAX_SERVOS];
+    fn commands(&self, output: &[f32], volts: &mut [f32; MAX_ROBOT_SERVOS]) {
+        *volts = [0.0; MAX_ROBOT_SERVOS];
         volts[0] = clip_voltage(output.first().copied().unwrap_or(0.0) as f64) as f32;
     }
 
-    fn reset_commands(&self, volts: &mut [f32; MAX_SERVOS]) {
-        *volts = [0.0; MAX_SERVOS];
+    fn reset_commands(&self, volts: &mut [f32; MAX_ROBOT_SERVOS]) {
+        *volts = [0.0; MAX_ROBOT_SERVOS];
     }
 
-    fn gear_torques(&self, applied: &[f32; MAX_SERVOS], torques: &mut [f32; MAX_SERVOS]) {
-        *torques = [0.0; MAX_SERVOS];
+    fn gear_torques(&self, applied: &[f32; MAX_ROBOT_SERVOS], torques: &mut [f32; MAX_ROBOT_SERVOS]) {
+        *torques = [0.0; MAX_ROBOT_SERVOS];
         torques[0] = gearbox_torque(applied[0] as f64) as f32;
     }
 
@@ -151,11 +151,11 @@ mod tests {
     use core::f32::consts::PI;
 
     fn sense(p: &mut Pendulum33, angle: Option<f32>) {
-        p.sense(&Sensed { angles: [None; MAX_SERVOS], encoder_angle: angle, contacts: 0, applied: [0.0; MAX_SERVOS] });
+        p.sense(&Sensed { angles: [None; MAX_ROBOT_SERVOS], encoder_angle: angle, contacts: 0, applied: [0.0; MAX_ROBOT_SERVOS] });
     }
 
-    fn applied(u: f32) -> [f32; MAX_SERVOS] {
-        let mut a = [0.0; MAX_SERVOS];
+    fn applied(u: f32) -> [f32; MAX_ROBOT_SERVOS] {
+        let mut a = [0.0; MAX_ROBOT_SERVOS];
         a[0] = u;
         a
     }
@@ -190,7 +190,7 @@ mod tests {
         let r = p.reward(&applied(0.0));
         let want = -5.0 * PI * PI - 0.1 * (PI / 0.03) * (PI / 0.03);
         assert!((r - want).abs() < 1e-2 * want.abs(), "{r} vs {want}");
-        let mut t = [0.0; MAX_SERVOS];
+        let mut t = [0.0; MAX_ROBOT_SERVOS];
         p.gear_torques(&applied(3.0), &mut t);
         assert!((t[0] - 3.0 * 0.0536 / 9.5).abs() < 1e-7);
     }

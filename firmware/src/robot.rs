@@ -11,7 +11,7 @@
 //! the bench lives here: turning counts into angles and rates, and waiting
 //! between episodes until the robot is back at its start.
 
-use crate::config::{RobotConfig, MAX_OBS, MAX_SERVOS};
+use crate::config::{RobotConfig, MAX_OBS, MAX_ROBOT_SERVOS};
 use core::ops::Range;
 use pada_core::robot::{Robot, RobotSpec};
 
@@ -19,13 +19,13 @@ use pada_core::robot::{Robot, RobotSpec};
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sensed {
     /// Each servo's joint angle \[rad\], `None` if it did not answer.
-    pub angles: [Option<f32>; MAX_SERVOS],
+    pub angles: [Option<f32>; MAX_ROBOT_SERVOS],
     /// The encoder's unwrapped angle since boot \[rad\], `None` if unread.
     pub encoder_angle: Option<f32>,
     /// Foot switches ([`crate::leo::contact`] bits).
     pub contacts: u8,
     /// The voltage each servo applied during the last period \[V\].
-    pub applied: [f32; MAX_SERVOS],
+    pub applied: [f32; MAX_ROBOT_SERVOS],
 }
 
 /// A robot as the controller drives it.
@@ -52,21 +52,21 @@ pub trait RobotAdapter {
 
     /// The reward of the transition into the current state, under the
     /// voltages applied during the last period.
-    fn reward(&self, applied: &[f32; MAX_SERVOS]) -> f32;
+    fn reward(&self, applied: &[f32; MAX_ROBOT_SERVOS]) -> f32;
 
     /// Whether the current state is absorbing (a fall).
     fn absorbing(&self) -> bool;
 
     /// Per-servo voltages for the learner's output (one value per motor
     /// dimension) in an episode.
-    fn commands(&self, output: &[f32], volts: &mut [f32; MAX_SERVOS]);
+    fn commands(&self, output: &[f32], volts: &mut [f32; MAX_ROBOT_SERVOS]);
 
     /// Per-servo voltages between episodes.
-    fn reset_commands(&self, volts: &mut [f32; MAX_SERVOS]);
+    fn reset_commands(&self, volts: &mut [f32; MAX_ROBOT_SERVOS]);
 
     /// The gearbox torque of each servo \[N·m\] for the fatigue counter,
     /// under the voltages applied during the last period.
-    fn gear_torques(&self, applied: &[f32; MAX_SERVOS], torques: &mut [f32; MAX_SERVOS]);
+    fn gear_torques(&self, applied: &[f32; MAX_ROBOT_SERVOS], torques: &mut [f32; MAX_ROBOT_SERVOS]);
 
     /// Starts waiting for the robot to be back at its start.
     fn begin_reset(&mut self);

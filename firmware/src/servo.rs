@@ -32,6 +32,17 @@ impl Joint {
         self.sign as f32 * counts as f32 * POSITION_UNIT_RAD
     }
 
+    /// The raw Present Position at joint angle `angle` \[rad\]: the
+    /// inverse of [`angle`](Self::angle), rounded to the nearest count and
+    /// clamped to the table's range (the potentiometer's dead zone reads as
+    /// the nearest end). What a simulated servo of this calibration reads.
+    /// In f64, so that a simulation's angle is not rounded twice.
+    pub fn position_of(&self, angle: f64) -> u16 {
+        let unit = table::POSITION_RANGE_RAD as f64 / table::POSITION_MAX as f64;
+        let counts = self.zero as f64 + self.sign as f64 * angle / unit;
+        libm::round(counts).clamp(0.0, table::POSITION_MAX as f64) as u16
+    }
+
     /// Moving Speed (wheel mode) that applies `voltage` \[V\] in the joint's
     /// positive direction with `supply` \[V\] on the servo. The ratio is
     /// clipped to ±1 (the servo cannot give more than its supply); a
@@ -63,6 +74,18 @@ mod tests {
         assert!((flipped.angle(612) + 100.0 * POSITION_UNIT_RAD).abs() < 1e-6);
         // Out-of-range readings saturate at the table's maximum.
         assert_eq!(j.angle(5000), j.angle(1023));
+    }
+
+    #[test]
+    fn position_of_inverts_angle_for_any_calibration() {
+        for j in [Joint { id: 1, zero: 512, sign: 1 }, Joint { id: 2, zero: 300, sign: -1 }] {
+            for raw in [0u16, 1, 299, 300, 512, 700, 1023] {
+                assert_eq!(j.position_of(j.angle(raw) as f64), raw, "{j:?} at {raw}");
+            }
+            // Past the range: the nearest end.
+            assert_eq!(j.position_of(j.sign as f64 * 10.0), table::POSITION_MAX);
+            assert_eq!(j.position_of(-j.sign as f64 * 10.0), 0);
+        }
     }
 
     #[test]

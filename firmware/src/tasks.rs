@@ -25,7 +25,7 @@ use pada_core::safety::Transition;
 use pada_core::wire::{self, FrameDecoder, FrameEncoder, NackReason, ToChip, ToHost, MAX_FRAME_LEN};
 use pada_firmware::bus::{BusConfig, BusStats, ServoBus};
 use crate::table::Ctl;
-use pada_firmware::config::MAX_SERVOS;
+use pada_firmware::config::MAX_ROBOT_SERVOS;
 use pada_core::weights::WeightStore;
 use pada_firmware::control::{CheckpointError, PeriodOutput, Readings, ServoRead};
 use pada_firmware::io::{ByteSink, ByteSource, CycleCounter, Sensors};
@@ -43,14 +43,14 @@ pub enum BusRequest {
         /// Torque Enable for all servos.
         torque: bool,
         /// (ID, Moving Speed) per servo.
-        speeds: Vec<(u8, u16), MAX_SERVOS>,
+        speeds: Vec<(u8, u16), MAX_ROBOT_SERVOS>,
     },
 }
 
 /// The servo bus's answer to [`BusRequest::Read`].
 pub struct BusReply {
     /// Per servo, in joint order.
-    pub servos: [ServoRead; MAX_SERVOS],
+    pub servos: [ServoRead; MAX_ROBOT_SERVOS],
     /// Counters since boot.
     pub stats: BusStats,
 }
@@ -113,7 +113,7 @@ pub async fn servo_bus(port: ServoPort, joints: &'static [Joint]) -> ! {
     loop {
         match BUS_REQUESTS.receive().await {
             BusRequest::Read => {
-                let mut servos = [ServoRead::default(); MAX_SERVOS];
+                let mut servos = [ServoRead::default(); MAX_ROBOT_SERVOS];
                 for (read, joint) in servos.iter_mut().zip(joints) {
                     let (state, exchange) = bus.read_present(joint.id).await;
                     *read = ServoRead {

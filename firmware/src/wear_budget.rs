@@ -10,7 +10,7 @@
 //! count them. Test runs and the waits between episodes are not learning
 //! and do not move the governor.
 
-use crate::config::MAX_SERVOS;
+use crate::config::MAX_ROBOT_SERVOS;
 use core::ops::Range;
 use pada_core::error::ConfigError;
 use pada_core::fatigue::{FatigueCounter, GearboxParams};
@@ -33,15 +33,15 @@ pub fn governor(spec: &RobotSpec, policy: &PolicyKind, budget_s: f32, reported: 
 }
 
 /// Each servo's damage (Q16.48), to diff after the period's update.
-pub fn damage_raws(fatigue: &FatigueCounter<MAX_SERVOS>) -> [u64; MAX_SERVOS] {
+pub fn damage_raws(fatigue: &FatigueCounter<MAX_ROBOT_SERVOS>) -> [u64; MAX_ROBOT_SERVOS] {
     core::array::from_fn(|j| fatigue.joints()[j].damage_raw())
 }
 
 /// The damage each reported joint took since `before`, in the governor's
 /// order.
 pub fn increments(
-    before: &[u64; MAX_SERVOS],
-    fatigue: &FatigueCounter<MAX_SERVOS>,
+    before: &[u64; MAX_ROBOT_SERVOS],
+    fatigue: &FatigueCounter<MAX_ROBOT_SERVOS>,
     reported: Range<usize>,
 ) -> [u64; GOVERNED_JOINTS] {
     let mut out = [0u64; GOVERNED_JOINTS];

@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 /// Most gearboxes one counter follows.
-pub const MAX_JOINTS: i64 = 64;
+pub const MAX_COUNTED_JOINTS: i64 = 64;
 
 /// The fatigue counter of every gearbox of a robot (Eqs. 3–7).
 ///
@@ -42,7 +42,7 @@ impl Fatigue {
         torque_per_volt: Option<f64>,
         window: i64,
     ) -> PyResult<Fatigue> {
-        let n = check::count("joints", joints, 1, MAX_JOINTS)?;
+        let n = check::count("joints", joints, 1, MAX_COUNTED_JOINTS)?;
         let rate_hz = check::rate_hz("rate_hz", rate_hz)?;
         if let Some(k) = torque_per_volt {
             if !(k.is_finite() && k > 0.0) {

@@ -10,10 +10,7 @@
 use crate::error::ConfigError;
 use heapless::Vec;
 
-/// Most action dimensions.
-pub const MAX_ACTION_DIMS: usize = 4;
-/// Most levels per action dimension.
-pub const MAX_LEVELS: usize = 16;
+pub use crate::limits::{MAX_ACTION_DIMS, MAX_LEVELS};
 
 /// Levels of one action dimension, one per entry of a joint action.
 pub type Levels = [u8; MAX_ACTION_DIMS];

@@ -34,6 +34,7 @@
 //! - [`rng`]: `rand_pcg::Pcg32` and its state as a checkpoint saves it;
 //! - [`safety`]: the Idle → Learning/Testing → Fault state machine that owns
 //!   torque enable;
+//! - [`limits`]: the capacities, each defined once;
 //! - [`rx28`]: the RX-28 servo's voltage-driven motor model (shared by the
 //!   LEO simulator and the firmware's torque estimate).
 //!
@@ -57,6 +58,7 @@ pub mod exploration;
 pub mod fatigue;
 pub mod fixed;
 pub mod governor;
+pub mod limits;
 pub mod policy;
 pub mod profile;
 pub mod rng;

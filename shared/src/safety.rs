@@ -53,8 +53,8 @@ use crate::dynamixel::ErrorFlags;
 use crate::error::ConfigError;
 use heapless::Vec;
 
-/// Joints that can have a soft limit (LEO has seven servos).
-pub const MAX_SOFT_LIMITS: usize = 8;
+/// Joints that can have a soft limit: one per servo.
+pub const MAX_SOFT_LIMITS: usize = crate::limits::MAX_SERVOS;
 /// Largest accepted `checksum_threshold`.
 pub const MAX_CHECKSUM_THRESHOLD: u8 = 32;
 /// Largest accepted `servo_retry_budget`.

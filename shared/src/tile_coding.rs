@@ -37,8 +37,7 @@ use crate::error::ConfigError;
 use crate::fixed::floor_i32;
 use heapless::Vec;
 
-/// Most state dimensions a coder takes (observation plus policy extension).
-pub const MAX_STATE_DIMS: usize = 16;
+pub use crate::limits::MAX_STATE_DIMS;
 
 /// MurmurHash2's multiplier.
 const MURMUR_M: u32 = 0x5bd1_e995;

@@ -30,12 +30,12 @@ fn full_step() -> Step {
         kind: StepKind::Timeout,
         state: HVec::from_slice(&[-1.5e30; MAX_STATE_DIMS]).unwrap(),
         action: u32::MAX,
-        output: HVec::from_slice(&[f32::MAX; MAX_OUTPUTS]).unwrap(),
+        output: HVec::from_slice(&[f32::MAX; MAX_ACTION_DIMS]).unwrap(),
         reward: f32::MIN,
         td_error: i32::MIN,
         explored: true,
         footstep: true,
-        joints: HVec::from_slice(&[JointFatigue { damage: 1e-300, reengagements: u32::MAX }; MAX_JOINTS]).unwrap(),
+        joints: HVec::from_slice(&[JointFatigue { damage: 1e-300, reengagements: u32::MAX }; MAX_GEARBOXES]).unwrap(),
         loop_us: u32::MAX,
         agent_cycles: u32::MAX,
     }
@@ -680,9 +680,9 @@ fn arb_step() -> impl Strategy<Value = Step> {
     (
         (any::<u32>(), any::<u32>(), any::<u32>(), any::<bool>(), 0u8..4),
         proptest::collection::vec(-1e9f32..1e9, 0..=MAX_STATE_DIMS),
-        (any::<u32>(), proptest::collection::vec(-1.0f32..1.0, 0..=MAX_OUTPUTS)),
+        (any::<u32>(), proptest::collection::vec(-1.0f32..1.0, 0..=MAX_ACTION_DIMS)),
         (-1e6f32..1e6, any::<i32>(), any::<bool>(), any::<u32>()),
-        proptest::collection::vec((0.0f64..1e3, any::<u32>()), 0..=MAX_JOINTS),
+        proptest::collection::vec((0.0f64..1e3, any::<u32>()), 0..=MAX_GEARBOXES),
     )
         .prop_map(|((step, time_ms, episode, testing, kind), state, (action, output), (reward, td, ex, lus), j)| {
             Step {

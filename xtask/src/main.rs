@@ -20,6 +20,7 @@
 mod elf;
 mod toolchain;
 
+use pada_core::robot::Robot;
 use std::{
     env,
     path::{Path, PathBuf},
@@ -156,38 +157,37 @@ impl Chip {
     }
 }
 
-/// The robot a firmware image drives (one cargo feature each, none for the
-/// default 33 Hz pendulum).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Robot {
-    Pendulum,
-    Pendulum20,
-    Leo,
+/// What xtask knows of a robot beyond its one definition
+/// (`pada_core::robot::Robot`): the short name its firmware images carry
+/// and that `--robot` takes beside the full one, and the firmware's cargo
+/// feature that selects it.
+trait FirmwareRobot: Sized {
+    /// The robot `--robot` names: its full name (`physical-pendulum`,
+    /// `physical-pendulum-20hz`, `leo`) or the image's short one.
+    fn parse(s: &str) -> Option<Self>;
+    /// The short name of its images, which `pada sil --task` also takes.
+    fn short_name(self) -> &'static str;
+    /// The firmware's cargo feature that selects this robot, if any.
+    fn feature(self) -> Option<&'static str>;
 }
 
-impl Robot {
+impl FirmwareRobot for Robot {
     fn parse(s: &str) -> Option<Robot> {
-        match s.to_ascii_lowercase().as_str() {
-            "pendulum" | "pendulum-33hz" => Some(Robot::Pendulum),
-            "pendulum-20hz" => Some(Robot::Pendulum20),
-            "leo" => Some(Robot::Leo),
-            _ => None,
-        }
+        let s = s.to_ascii_lowercase();
+        Robot::from_name(&s).or_else(|| Robot::ALL.into_iter().find(|r| r.short_name() == s || (s == "pendulum-33hz" && *r == Robot::Pendulum33)))
     }
 
-    /// The robot's name on the command line (and `pada sil --task`'s).
-    pub fn name(self) -> &'static str {
+    fn short_name(self) -> &'static str {
         match self {
-            Robot::Pendulum => "pendulum",
+            Robot::Pendulum33 => "pendulum",
             Robot::Pendulum20 => "pendulum-20hz",
             Robot::Leo => "leo",
         }
     }
 
-    /// The firmware's cargo feature that selects this robot, if any.
-    pub fn feature(self) -> Option<&'static str> {
+    fn feature(self) -> Option<&'static str> {
         match self {
-            Robot::Pendulum => None,
+            Robot::Pendulum33 => None,
             Robot::Pendulum20 => Some("robot-pendulum-20hz"),
             Robot::Leo => Some("robot-leo"),
         }
@@ -219,7 +219,7 @@ enum Task {
 /// `qemu` and `sil`: release unless `--debug`, a board profile, a robot,
 /// and for `sil` everything after `--`.
 fn parse_emulated(task: &str, rest: &[String]) -> Result<Task, String> {
-    let mut build = Build { release: true, chip: Chip::F405, robot: Robot::Pendulum };
+    let mut build = Build { release: true, chip: Chip::F405, robot: Robot::Pendulum33 };
     let (own, passed) = match rest.iter().position(|a| a == "--") {
         Some(i) if task == "sil" => (&rest[..i], rest[i + 1..].to_vec()),
         _ => (rest, Vec::new()),
@@ -262,7 +262,7 @@ fn parse_args(args: &[String]) -> Result<Task, String> {
         "help" | "-h" | "--help" => Ok(Task::Help),
         "firmware" | "flash" => {
             let mut release = false;
-            let (mut board, mut chip, mut robot) = (None, None, Robot::Pendulum);
+            let (mut board, mut chip, mut robot) = (None, None, Robot::Pendulum33);
             let mut rest = rest.iter();
             while let Some(arg) = rest.next() {
                 let (key, value) = match arg.as_str() {
@@ -531,7 +531,7 @@ fn qemu_image(root: &Path, build: Build) -> Result<PathBuf, String> {
     }
     let built = target_dir.join(TARGET).join(profile).join("pada-firmware");
     let debug = if build.release { "" } else { "-debug" };
-    let elf = images.join(format!("{}-{}{debug}.elf", build.chip.profile(), build.robot.name()));
+    let elf = images.join(format!("{}-{}{debug}.elf", build.chip.profile(), build.robot.short_name()));
     std::fs::copy(&built, &elf).map_err(|e| format!("cannot copy {} to {}: {e}", built.display(), elf.display()))?;
     drop(lock);
     println!("xtask: built in {:.1} s", started.elapsed().as_secs_f64());
@@ -556,7 +556,7 @@ fn sil(root: &Path, elf: &Path, build: Build, args: &[String]) -> Result<(), Str
         .arg(elf);
     let given = |flag: &str| args.iter().any(|a| a == flag || a.starts_with(&format!("{flag}=")));
     if !given("--task") {
-        cmd.args(["--task", build.robot.name()]);
+        cmd.args(["--task", build.robot.short_name()]);
     }
     if !given("--board") {
         cmd.args(["--board", build.chip.profile()]);
@@ -662,13 +662,13 @@ mod tests {
     fn firmware_defaults_to_debug_f405() {
         assert_eq!(
             parse_args(&args("firmware")),
-            Ok(Task::Firmware(Build { release: false, chip: Chip::F405, robot: Robot::Pendulum }))
+            Ok(Task::Firmware(Build { release: false, chip: Chip::F405, robot: Robot::Pendulum33 }))
         );
     }
 
     #[test]
     fn firmware_flags_in_any_order_and_both_chip_spellings() {
-        let want = Ok(Task::Firmware(Build { release: true, chip: Chip::F407, robot: Robot::Pendulum }));
+        let want = Ok(Task::Firmware(Build { release: true, chip: Chip::F407, robot: Robot::Pendulum33 }));
         assert_eq!(parse_args(&args("firmware --chip f407 --release")), want);
         assert_eq!(parse_args(&args("firmware --release --chip=stm32F407")), want);
     }
@@ -682,12 +682,12 @@ mod tests {
         assert_eq!(parse_args(&args("firmware --release --board f429-sdram --chip stm32f429 --robot leo")), f429_leo);
         assert_eq!(
             parse_args(&args("firmware --board f405")),
-            Ok(Task::Firmware(Build { release: false, chip: Chip::F405, robot: Robot::Pendulum }))
+            Ok(Task::Firmware(Build { release: false, chip: Chip::F405, robot: Robot::Pendulum33 }))
         );
         // The Discovery's F407 is an f405-profile board.
         assert_eq!(
             parse_args(&args("flash --board f405 --chip f407")),
-            Ok(Task::Flash(Build { release: false, chip: Chip::F407, robot: Robot::Pendulum }))
+            Ok(Task::Flash(Build { release: false, chip: Chip::F407, robot: Robot::Pendulum33 }))
         );
         assert_eq!((Chip::F407.profile(), Chip::F429.profile()), ("f405", "f429-sdram"));
         assert_eq!(Chip::F429.memory_x(), "firmware/memory-f429.x");
@@ -717,7 +717,7 @@ mod tests {
 
     #[test]
     fn emulated_board_builds_release_by_default_and_passes_sil_options_on() {
-        let release = Build { release: true, chip: Chip::F405, robot: Robot::Pendulum };
+        let release = Build { release: true, chip: Chip::F405, robot: Robot::Pendulum33 };
         assert_eq!(parse_args(&args("qemu")), Ok(Task::Qemu(release)));
         assert_eq!(
             parse_args(&args("qemu --debug --robot leo")),

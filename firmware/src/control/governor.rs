@@ -4,7 +4,7 @@
 //! ([`pada_core::governor`], [`crate::wear_budget`]).
 
 use super::{CommandResult, Controller, PeriodOutput};
-use crate::config::MAX_SERVOS;
+use crate::config::MAX_ROBOT_SERVOS;
 use crate::robot::RobotAdapter;
 use crate::wear_budget;
 use pada_core::error::ConfigError;
@@ -52,7 +52,7 @@ where
     /// Feeds the governor this period's damage of the learned joints; a
     /// move sets the policy's parameter for the next decision and is
     /// reported.
-    pub(super) fn govern(&mut self, before: &[u64; MAX_SERVOS], out: &mut PeriodOutput) {
+    pub(super) fn govern(&mut self, before: &[u64; MAX_ROBOT_SERVOS], out: &mut PeriodOutput) {
         let increments = wear_budget::increments(before, &self.fatigue, self.reported_joints());
         let Some(moved) = self.governor.as_mut().and_then(|g| g.observe(&increments)) else { return };
         // The governor's ladder is the policy's own range, so this is

@@ -70,7 +70,7 @@ pub use commands::CommandResult;
 pub use period::{safety_config, PeriodOutput, Readings, ServoRead};
 pub use persist::CheckpointError;
 
-use crate::config::{hardware, FirmwareAgent, LearnerProfile, RobotConfig, MAX_SERVOS};
+use crate::config::{hardware, FirmwareAgent, LearnerProfile, RobotConfig, MAX_ROBOT_SERVOS};
 use crate::encoder::Unwrapper;
 use crate::robot::RobotAdapter;
 use heapless::Vec;
@@ -112,7 +112,7 @@ pub struct Controller<W, R> {
     seed: u64,
     rng: Pcg32,
     safety: Safety,
-    fatigue: FatigueCounter<MAX_SERVOS>,
+    fatigue: FatigueCounter<MAX_ROBOT_SERVOS>,
     robot: R,
     encoder: Unwrapper,
     phase: Phase,
@@ -127,10 +127,10 @@ pub struct Controller<W, R> {
     last_action: u32,
     last_output: [f32; pada_core::action_space::MAX_ACTION_DIMS],
     /// Voltage each servo applied during the last period.
-    applied: [f32; MAX_SERVOS],
+    applied: [f32; MAX_ROBOT_SERVOS],
     /// Last supply each servo reported \[V\].
-    supply: [Option<f32>; MAX_SERVOS],
-    temps: [u8; MAX_SERVOS],
+    supply: [Option<f32>; MAX_ROBOT_SERVOS],
+    temps: [u8; MAX_ROBOT_SERVOS],
     steps: u32,
     /// Checkpoints found but not loaded since boot.
     checkpoints_refused: u32,
@@ -196,9 +196,9 @@ where
             episode_return: 0.0,
             last_action: 0,
             last_output: [0.0; pada_core::action_space::MAX_ACTION_DIMS],
-            applied: [0.0; MAX_SERVOS],
-            supply: [None; MAX_SERVOS],
-            temps: [0; MAX_SERVOS],
+            applied: [0.0; MAX_ROBOT_SERVOS],
+            supply: [None; MAX_ROBOT_SERVOS],
+            temps: [0; MAX_ROBOT_SERVOS],
             steps: 0,
             checkpoints_refused: 0,
             saves_failed: 0,
@@ -294,7 +294,7 @@ where
     }
 
     /// The fatigue counter (every servo, joint order).
-    pub fn fatigue(&self) -> &FatigueCounter<MAX_SERVOS> {
+    pub fn fatigue(&self) -> &FatigueCounter<MAX_ROBOT_SERVOS> {
         &self.fatigue
     }
 

@@ -7,7 +7,7 @@
 
 use super::{Controller, Phase};
 use crate::bus::BusConfig;
-use crate::config::MAX_SERVOS;
+use crate::config::MAX_ROBOT_SERVOS;
 use crate::io::CycleCounter;
 use crate::robot::{RobotAdapter, Sensed};
 use crate::wear_budget;
@@ -34,7 +34,7 @@ pub struct ServoRead {
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Readings {
     /// Per servo, in the robot's joint order.
-    pub servos: [ServoRead; MAX_SERVOS],
+    pub servos: [ServoRead; MAX_ROBOT_SERVOS],
     /// The encoder's counter, if it could be read.
     pub encoder: Option<u16>,
     /// Foot switches ([`crate::leo::contact`]).
@@ -51,7 +51,7 @@ pub struct PeriodOutput {
     /// Torque Enable for every servo.
     pub torque: bool,
     /// Moving Speed per servo (ID, value); all zero while torque is off.
-    pub speeds: Vec<(u8, u16), MAX_SERVOS>,
+    pub speeds: Vec<(u8, u16), MAX_ROBOT_SERVOS>,
     /// The agent's step, if one was taken (`loop_us` is the caller's to
     /// fill in).
     pub step: Option<wire::Step>,
@@ -63,7 +63,7 @@ pub struct PeriodOutput {
     pub agent_cycles: Option<u32>,
     /// The gearbox torque of each servo the fatigue counter saw this
     /// period \[N·m\] (the robot's estimate; 0 with torque off).
-    pub torques: [f32; MAX_SERVOS],
+    pub torques: [f32; MAX_ROBOT_SERVOS],
     /// A `Policy` report to send: the wear governor moved Δ or α this
     /// period, or an episode ended while it runs.
     pub policy: Option<wire::PolicyReport>,
@@ -100,7 +100,7 @@ where
         out.transitions.clear();
         out.speeds.clear();
         out.agent_cycles = None;
-        out.torques = [0.0; MAX_SERVOS];
+        out.torques = [0.0; MAX_ROBOT_SERVOS];
         out.policy = None;
         self.steps = self.steps.wrapping_add(1);
         self.periods = self.periods.saturating_add(1);
@@ -117,7 +117,7 @@ where
         }
         let overrun = Event::LoopTiming { overrun: readings.last_period_overran };
         feed(&mut self.safety, &mut out.transitions, overrun);
-        let mut angles = [None; MAX_SERVOS];
+        let mut angles = [None; MAX_ROBOT_SERVOS];
         for (i, (joint, read)) in joints.iter().zip(&readings.servos).enumerate() {
             for _ in 0..read.checksum_errors {
                 feed(&mut self.safety, &mut out.transitions, Event::ChecksumError { at_ms: now });
@@ -164,7 +164,7 @@ where
         self.robot.sense(&Sensed { angles, encoder_angle, contacts: readings.contacts, applied: self.applied });
 
         // 4. The agent's step, and the voltages.
-        let mut volts = [0.0f32; MAX_SERVOS];
+        let mut volts = [0.0f32; MAX_ROBOT_SERVOS];
         if torque {
             let mode = state.run_mode().unwrap_or(RunMode::Learning);
             if starting {
@@ -194,7 +194,7 @@ where
         // 6. Fatigue from the estimated gearbox torque (servos past the
         // robot's count stay at 0); the governor sees a learning action's.
         if torque {
-            let mut torques = [0.0f32; MAX_SERVOS];
+            let mut torques = [0.0f32; MAX_ROBOT_SERVOS];
             self.robot.gear_torques(&self.applied, &mut torques);
             torques[n..].fill(0.0);
             let before = wear_budget::damage_raws(&self.fatigue);

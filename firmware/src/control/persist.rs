@@ -5,7 +5,7 @@
 //! time and the sectors' erase counts).
 
 use super::{Controller, Phase};
-use crate::config::MAX_SERVOS;
+use crate::config::MAX_ROBOT_SERVOS;
 use crate::robot::RobotAdapter;
 use heapless::Vec;
 use pada_core::checkpoint::{self, CheckpointStore, FlashWear, LearnerState, LoadOutcome, SaveError, Saved, WearBudget};
@@ -24,7 +24,7 @@ fn fatigue_error(e: FatigueError) -> ConfigError {
 }
 
 /// The record has room for every servo's fatigue counter.
-const _: () = assert!(MAX_SERVOS <= checkpoint::MAX_JOINTS);
+const _: () = assert!(MAX_ROBOT_SERVOS <= checkpoint::RECORD_JOINTS);
 
 /// Why a checkpoint operation of the controller failed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -62,7 +62,7 @@ where
         LearnerState {
             agent: self.agent().state(),
             rng: self.rng.state(),
-            // Fits: MAX_SERVOS <= MAX_JOINTS (checked at compile time).
+            // Fits: MAX_ROBOT_SERVOS <= RECORD_JOINTS (checked at compile time).
             joints: Vec::from_slice(&self.fatigue.state()).unwrap_or_default(),
             user,
             wear: FlashWear { erases: self.flash_wear.erases, operating_s: self.operating_s() },

@@ -51,7 +51,7 @@ fn state(rng: &mut impl RngCore) -> LearnerState {
     s.rng.state = rng.next_u64();
     s.rng.increment = rng.next_u64();
     s.user = core::array::from_fn(|_| rng.next_u32());
-    for _ in 0..below(rng, MAX_JOINTS + 1) {
+    for _ in 0..below(rng, RECORD_JOINTS + 1) {
         let j = JointFatigueState {
             last_sign: [-1i8, 0, 1][below(rng, 3)],
             steps: rng.next_u64(),

@@ -96,20 +96,7 @@ pub fn table_len(profile: &LearnerProfile, policy: PolicyKind) -> anyhow::Result
     if let Some(n) = profile.weights() {
         return Ok(n);
     }
-    let spec = profile.robot.spec();
-    let p = pada_core::policy::Policy::new(policy, spec.motor().map_err(|e| anyhow!("{e}"))?).map_err(|e| anyhow!("{e}"))?;
-    let mut dims = spec.state.to_vec();
-    for i in 0..p.extension_len() {
-        dims.push(p.extension_dim(i).map_err(|e| anyhow!("{e}"))?);
-    }
-    let coder = pada_core::tile_coding::TileCoder::<TILINGS>::new(
-        &dims,
-        p.learner_space().joint_count(),
-        profile.layout,
-        u32::MAX as usize,
-    )
-    .map_err(|e| anyhow!("{e}"))?;
-    coder.exact_size().ok_or_else(|| anyhow!("a hashed profile has a fixed size"))
+    profile.robot.spec().exact_table_len::<TILINGS>(policy).map_err(|e| anyhow!("{e}"))
 }
 
 /// The rig a board trial of `robot` runs against: the physical pendulum's

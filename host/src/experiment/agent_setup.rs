@@ -8,8 +8,8 @@
 use crate::experiment::task::{TaskSpec, WeightTable};
 use pada_core::agent::Agent;
 use pada_core::fixed::Q16;
-use pada_core::policy::{Policy, PolicyKind};
-use pada_core::tile_coding::{Layout, TileCoder};
+use pada_core::policy::PolicyKind;
+use pada_core::tile_coding::Layout;
 
 pub use pada_core::profile::{TILINGS, TRACE};
 
@@ -24,22 +24,10 @@ pub fn build_agent(spec: &TaskSpec, policy: PolicyKind) -> anyhow::Result<HostAg
     let (layout, size) = match spec.table {
         WeightTable::Hashed { log2_size } => (Layout::Hashed, 1usize << log2_size),
         WeightTable::ExactOf { weights } => (Layout::Exact, weights),
+        // The exact size depends on the policy's state extension and its
+        // learner actions.
         WeightTable::Exact => {
-            // The exact size depends on the policy's state extension and
-            // its learner actions: ask a coder built like the agent's.
-            let p = Policy::new(policy, spec.motor.clone()).map_err(err)?;
-            let mut dims = spec.state.clone();
-            for i in 0..p.extension_len() {
-                dims.push(p.extension_dim(i).map_err(err)?);
-            }
-            let coder = TileCoder::<TILINGS>::new(
-                &dims,
-                p.learner_space().joint_count(),
-                Layout::Exact,
-                u32::MAX as usize,
-            )
-            .map_err(err)?;
-            (Layout::Exact, coder.exact_size().unwrap_or(0))
+            (Layout::Exact, pada_core::agent::exact_table_len::<TILINGS>(&spec.state, spec.motor.clone(), policy).map_err(err)?)
         }
     };
     let weights = vec![Q16::ZERO; size].into_boxed_slice();

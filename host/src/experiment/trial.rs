@@ -291,7 +291,7 @@ impl<P: Plant> Trial<'_, '_, P> {
             .fatigue
             .joints()
             .iter()
-            .take(self.spec.gearboxes.min(wire::MAX_JOINTS))
+            .take(self.spec.gearboxes.min(wire::MAX_GEARBOXES))
             .map(|j| wire::JointFatigue {
                 damage: j.damage(),
                 reengagements: j.reengagements().min(u32::MAX as u64) as u32,
@@ -315,7 +315,7 @@ impl<P: Plant> Trial<'_, '_, P> {
             action: decision.map_or(0, |d| d.action),
             output: decision
                 .map(|d| {
-                    d.output[..motors.min(wire::MAX_OUTPUTS)]
+                    d.output[..motors.min(wire::MAX_ACTION_DIMS)]
                         .iter()
                         .copied()
                         .collect()

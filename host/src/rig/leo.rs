@@ -35,12 +35,13 @@
 //! - **Torque off** (a fault, Stop): modelled as 0 V, the motor shorted,
 //!   which brakes the joint a little more than the RX-28's open winding.
 
-use super::{encoder_count, position_raw, Rig, TEMPERATURE_C};
+use super::{joint_volts, servo_reading, Rig, TEMPERATURE_C};
 use crate::leo::model::{InitialPose, LeoModel, ModelOptions, Snapshot, NUM_JOINTS};
-use pada_core::dynamixel::table::{self, PresentState};
+use pada_core::dynamixel::table::PresentState;
 use pada_core::robot::leo::{ankle_x, Leg, StanceTracker, CONTROL_PERIOD_US, JOINTS};
 use pada_core::robot::Robot;
-use pada_core::rx28::{Rx28, LEO_SUPPLY_VOLTAGE};
+use pada_core::rx28::Rx28;
+use pada_firmware::config::RobotConfig;
 use pada_firmware::leo::contact;
 
 /// LEO on its boom, behind seven emulated RX-28s.
@@ -49,6 +50,9 @@ pub struct LeoRig {
     /// The start of every episode: the reference pose after its first
     /// control period at 0 V.
     start: Snapshot,
+    /// The servos' IDs and calibration and the boom's encoder: the robot's
+    /// one hardware definition.
+    hw: RobotConfig,
     /// Servo ID of each joint ([`pada_core::robot::leo::Joint`] order).
     ids: [u8; NUM_JOINTS],
     /// Voltage and torque enable per joint.
@@ -69,13 +73,25 @@ pub struct LeoRig {
 }
 
 impl LeoRig {
-    /// LEO held at its start pose at time 0, torque off.
+    /// LEO held at its start pose at time 0, torque off, with the servos
+    /// and encoder of its hardware definition.
     pub fn new(options: ModelOptions) -> anyhow::Result<Self> {
+        Self::with_hardware(options, pada_firmware::config::hardware(Robot::Leo))
+    }
+
+    /// The same with another calibration of the same servos (a robot whose
+    /// servos are mounted or zeroed differently).
+    pub fn with_hardware(options: ModelOptions, hw: RobotConfig) -> anyhow::Result<Self> {
+        anyhow::ensure!(
+            hw.robot == Robot::Leo && hw.joints.len() == NUM_JOINTS,
+            "LEO's rig needs LEO's {NUM_JOINTS} servos, not {} of {}",
+            hw.joints.len(),
+            hw.robot.name()
+        );
         let mut model = LeoModel::new(options, &InitialPose::REFERENCE).map_err(|e| anyhow::anyhow!("{e}"))?;
         model.set_voltages([0.0; NUM_JOINTS]);
         model.control_step().map_err(|b| anyhow::anyhow!("the LEO model blew up settling into its start pose: {b:?}"))?;
         let start = model.snapshot();
-        let hw = pada_firmware::config::hardware(Robot::Leo);
         let mut ids = [0; NUM_JOINTS];
         for (id, servo) in ids.iter_mut().zip(hw.joints) {
             *id = servo.id;
@@ -83,6 +99,7 @@ impl LeoRig {
         Ok(LeoRig {
             model,
             start,
+            hw,
             ids,
             volts: [0.0; NUM_JOINTS],
             torque: [false; NUM_JOINTS],
@@ -144,16 +161,9 @@ impl LeoRig {
     /// Servo `k`'s reading now.
     fn reading(&self, k: usize) -> PresentState {
         let (q, qd) = self.model.joint_state();
-        let rpm = qd[k] as f64 * 60.0 / std::f64::consts::TAU;
-        let speed = rpm / (table::SPEED_UNIT_RPM as f64 * table::MAGNITUDE_MAX as f64);
-        let stall = Rx28::LEO.estimate_joint_torque(LEO_SUPPLY_VOLTAGE, 0.0);
-        PresentState {
-            position: position_raw(q[k] as f64),
-            speed: table::encode_signed(speed.clamp(-1.0, 1.0) as f32),
-            load: table::encode_signed((self.torques[k] / stall).clamp(-1.0, 1.0)),
-            voltage: (LEO_SUPPLY_VOLTAGE * 10.0).round() as u8,
-            temperature: TEMPERATURE_C,
-        }
+        let stall = Rx28::LEO.estimate_joint_torque(self.hw.supply_nominal_v, 0.0);
+        let load = (self.torques[k] / stall).clamp(-1.0, 1.0);
+        servo_reading(&self.hw.joints[k], q[k] as f64, qd[k] as f64, load, self.supply_v())
     }
 
     /// The boom's encoder and the foot switches now.
@@ -161,7 +171,7 @@ impl LeoRig {
         let s = self.model.state();
         let bits = [contact::TOE_L, contact::HEEL_L, contact::TOE_R, contact::HEEL_R];
         let contacts = s.contacts.iter().zip(bits).filter(|(on, _)| **on).fold(0, |b, (_, bit)| b | bit);
-        (encoder_count(s.torso_pitch as f64), contacts)
+        (self.hw.encoder.count_of(s.torso_pitch as f64), contacts)
     }
 
     /// Whether the state at `t_us` is the state now: no period boundary
@@ -189,7 +199,7 @@ impl Rig for LeoRig {
         self.advance_to(t_us);
         if let Some(k) = self.joint_of(id) {
             self.torque[k] = torque;
-            self.volts[k] = volts as f32;
+            self.volts[k] = joint_volts(&self.hw.joints[k], volts) as f32;
         }
     }
 
@@ -215,8 +225,10 @@ impl Rig for LeoRig {
         self.settled_until(t_us).then(|| self.sensor_reading())
     }
 
+    /// The nominal supply of the hardware definition (LEO's battery,
+    /// docs/reference/grl.md §2.2).
     fn supply_v(&self) -> f64 {
-        LEO_SUPPLY_VOLTAGE as f64
+        self.hw.supply_nominal_v as f64
     }
 
     fn walked_m(&self) -> Option<f64> {
@@ -224,7 +236,11 @@ impl Rig for LeoRig {
     }
 
     fn describe(&self) -> String {
-        "LEO in rapier3d (docs/reference/grl.md §1-2): 7 RX-28s, the boom's 4096-count encoder, 4 foot switches, set upright by an operator between episodes".into()
+        format!(
+            "LEO in rapier3d (docs/reference/grl.md §1-2): {} RX-28s, the boom's {}-count encoder, 4 foot switches, set upright by an operator between episodes",
+            self.hw.joints.len(),
+            self.hw.encoder.counts_per_rev
+        )
     }
 
     fn episode_ended(&mut self, _t_us: u64) {
@@ -251,6 +267,7 @@ const _: () = assert!(JOINTS.len() == NUM_JOINTS);
 #[cfg(test)]
 mod tests {
     use super::*;
+    use pada_core::dynamixel::table;
     use pada_core::robot::leo::{Joint, START_JOINT_ANGLES, START_PHI};
 
     #[test]
@@ -266,7 +283,7 @@ mod tests {
         assert!((before.0 as f64 - (512.0 + START_JOINT_ANGLES[Joint::HipRight as usize] as f64 / unit)).abs() <= 1.5);
         assert!((before.1 as f64 - (512.0 + START_JOINT_ANGLES[Joint::KneeRight as usize] as f64 / unit)).abs() <= 1.5);
         // (The first control period at 0 V tips the torso by a few mrad.)
-        let pitch = before.2 .0 as i32 - encoder_count(-START_PHI as f64) as i32;
+        let pitch = before.2 .0 as i32 - rig.hw.encoder.count_of(-START_PHI as f64) as i32;
         assert!(pitch.abs() <= 5, "{pitch} counts from the start pitch");
         assert_ne!(before.2 .1 & contact::LEFT, 0);
         // Held: a second passes, nothing moves, whatever is commanded.
@@ -289,5 +306,37 @@ mod tests {
         // The operator resets and holds it again.
         rig.episode_ended(0);
         assert_eq!(at(&mut rig, t0 + 10 * CONTROL_PERIOD_US as u64), before);
+    }
+
+    #[test]
+    fn an_offset_or_flipped_servo_reads_and_drives_in_its_own_frame() {
+        use pada_firmware::servo::Joint as Servo;
+        let stock = pada_firmware::config::hardware(Robot::Leo);
+        let remounted: Vec<Servo> = stock.joints.iter().map(|j| Servo { zero: 400, sign: -j.sign, ..*j }).collect();
+        let remounted = RobotConfig { joints: Box::leak(remounted.into_boxed_slice()), ..stock };
+        let mut rigs = [
+            (LeoRig::new(ModelOptions::default()).unwrap(), stock),
+            (LeoRig::with_hardware(ModelOptions::default(), remounted).unwrap(), remounted),
+        ];
+        let supply = stock.supply_nominal_v;
+        let t = 5 * CONTROL_PERIOD_US as u64;
+        let mut angles = Vec::new();
+        for (rig, hw) in rigs.iter_mut() {
+            rig.episode_started(0);
+            // +6 V on the right hip, as the firmware sends it through this calibration.
+            let j = hw.joints[Joint::HipRight as usize];
+            let servo_volts = table::ratio_from_moving_speed(j.moving_speed(6.0, Some(supply), supply)) as f64 * supply as f64;
+            rig.drive(0, j.id, true, servo_volts);
+            let read: Vec<f32> = hw.joints.iter().map(|j| j.angle(rig.present(t, j.id).position)).collect();
+            angles.push(read);
+        }
+        // The firmware's calibration undoes the mounting: the same joint
+        // angles within a count, and the hip moved.
+        for (a, b) in angles[0].iter().zip(&angles[1]) {
+            assert!((a - b).abs() <= 1.01 * pada_firmware::servo::POSITION_UNIT_RAD, "{:?} against {:?}", angles[0], angles[1]);
+        }
+        assert!(angles[0][Joint::HipRight as usize] > START_JOINT_ANGLES[Joint::HipRight as usize] + 0.01);
+        // A rig for another robot's servos is refused.
+        assert!(LeoRig::with_hardware(ModelOptions::default(), pada_firmware::config::hardware(Robot::Pendulum33)).is_err());
     }
 }

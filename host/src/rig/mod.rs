@@ -23,13 +23,8 @@ pub use leo::LeoRig;
 pub use pendulum::PendulumRig;
 
 use pada_core::dynamixel::table::{self, PresentState};
-use std::f64::consts::TAU;
+use pada_firmware::servo::Joint;
 
-/// Counts per revolution of the emulated encoder (a 1024-line encoder
-/// after ×4 decoding, as `pada_firmware::config::EncoderConfig`).
-pub const ENCODER_COUNTS_PER_REV: f64 = 4096.0;
-/// The pendulum servo's supply \[V\] (Present Voltage 120 = 12.0 V).
-pub const SUPPLY_V: f64 = 12.0;
 /// Present Temperature every emulated servo reports \[°C\].
 pub const TEMPERATURE_C: u8 = 40;
 
@@ -88,31 +83,50 @@ pub trait Rig: Send {
     fn gear_torque(&self, id: u8) -> f32;
 }
 
-/// The encoder count of an angle measured from the pose at boot.
-pub fn encoder_count(angle_from_boot: f64) -> u16 {
-    let counts = (angle_from_boot / TAU * ENCODER_COUNTS_PER_REV).round() as i64;
-    counts.rem_euclid(1 << 16) as u16
+/// What servo `joint` reads with its joint at `angle` \[rad\] turning at
+/// `rate` \[rad/s\] under `load` (a fraction of the stall torque, in the
+/// joint's direction) on a `supply_v` supply. The rigs read in the servo's
+/// own frame through the robot's one hardware definition
+/// (`pada_firmware::config::hardware`: its zero and sign), so an offset or
+/// flipped servo of the real robot is the same offset or flip here, and the
+/// firmware's calibration undoes it.
+pub fn servo_reading(joint: &Joint, angle: f64, rate: f64, load: f32, supply_v: f64) -> PresentState {
+    let rpm = rate * 60.0 / std::f64::consts::TAU;
+    let speed = joint.sign as f64 * rpm / (table::SPEED_UNIT_RPM as f64 * table::MAGNITUDE_MAX as f64);
+    PresentState {
+        position: joint.position_of(angle),
+        speed: table::encode_signed(speed.clamp(-1.0, 1.0) as f32),
+        load: table::encode_signed((joint.sign as f32 * load).clamp(-1.0, 1.0)),
+        voltage: (supply_v * 10.0).round() as u8,
+        temperature: TEMPERATURE_C,
+    }
 }
 
-/// The raw Present Position of a joint angle (512 at 0, 300° over 1023
-/// counts; the potentiometer's dead zone reads as the nearest end).
-pub fn position_raw(angle: f64) -> u16 {
-    let unit = table::POSITION_RANGE_RAD as f64 / table::POSITION_MAX as f64;
-    (512.0 + angle / unit)
-        .round()
-        .clamp(0.0, table::POSITION_MAX as f64) as u16
+/// The voltage a servo applies in its joint's direction when its Moving
+/// Speed applies `servo_volts` in its own (counter-clockwise positive).
+pub fn joint_volts(joint: &Joint, servo_volts: f64) -> f64 {
+    joint.sign as f64 * servo_volts
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::f64::consts::PI;
 
     #[test]
-    fn encoder_counts_wrap_like_a_16_bit_timer() {
-        assert_eq!(encoder_count(0.0), 0);
-        assert_eq!(encoder_count(PI), 2048);
-        assert_eq!(encoder_count(-TAU / 4096.0), 65535);
-        assert_eq!(encoder_count(16.0 * TAU), 0);
+    fn a_reading_is_in_the_servos_frame_and_the_calibration_undoes_it() {
+        for joint in [Joint { id: 1, zero: 512, sign: 1 }, Joint { id: 4, zero: 300, sign: -1 }] {
+            let r = servo_reading(&joint, 0.4, 2.0, 0.25, 12.0);
+            assert!((joint.angle(r.position) - 0.4).abs() <= 0.5 * pada_firmware::servo::POSITION_UNIT_RAD);
+            // Speed and load turn with the servo.
+            let speed = table::present_speed_ratio(r.speed);
+            let load = table::present_load_ratio(r.load);
+            assert_eq!(speed > 0.0, joint.sign > 0, "{joint:?}");
+            assert!((joint.sign as f32 * load - 0.25).abs() < 1e-3, "{joint:?}");
+            assert_eq!(r.voltage, 120);
+            // A voltage the firmware sends for this joint applies in the joint's direction.
+            let ms = joint.moving_speed(6.0, Some(12.0), 12.0);
+            let servo_volts = table::ratio_from_moving_speed(ms) as f64 * 12.0;
+            assert!((joint_volts(&joint, servo_volts) - 6.0).abs() < 0.02, "{joint:?}");
+        }
     }
 }

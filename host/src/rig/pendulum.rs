@@ -1,10 +1,12 @@
 //! The physical pendulum behind the bus.
 
-use super::{encoder_count, position_raw, Rig, SUPPLY_V, TEMPERATURE_C};
+use super::{joint_volts, servo_reading, Rig};
 use crate::pendulum::PhysicalPendulumParams;
-use pada_core::dynamixel::table::{self, PresentState};
+use pada_core::dynamixel::table::PresentState;
 use pada_core::robot::pendulum::gearbox_torque;
-use std::f64::consts::{PI, TAU};
+use pada_core::robot::Robot;
+use pada_firmware::config::{hardware, RobotConfig};
+use std::f64::consts::PI;
 
 /// The physical pendulum of Section VII on one RX-28 in wheel mode (ID 1)
 /// with the quadrature encoder on its axis: the constants of
@@ -33,6 +35,9 @@ pub struct PendulumRig {
     volts: f64,
     /// Whether a hand stops the pendulum at every episode's end.
     operator: bool,
+    /// Its servo's ID and calibration and the encoder: the robot's one
+    /// hardware definition.
+    hw: RobotConfig,
 }
 
 impl PendulumRig {
@@ -48,7 +53,19 @@ impl PendulumRig {
             torque: false,
             volts: 0.0,
             operator: false,
+            hw: hardware(Robot::Pendulum33),
         }
+    }
+
+    /// The same with another calibration of its servo and encoder.
+    pub fn with_hardware(params: PhysicalPendulumParams, hw: RobotConfig) -> anyhow::Result<Self> {
+        anyhow::ensure!(
+            matches!(hw.robot, Robot::Pendulum33 | Robot::Pendulum20) && hw.joints.len() == 1,
+            "the pendulum's rig needs the pendulum's one servo, not {} of {}",
+            hw.joints.len(),
+            hw.robot.name()
+        );
+        Ok(PendulumRig { hw, ..Self::new(params) })
     }
 
     /// The same, stopped hanging at rest by hand whenever the firmware ends
@@ -94,31 +111,26 @@ impl PendulumRig {
         self.t_us = self.t_us.max(t_us);
     }
 
-    fn reading(x: [f64; 2]) -> PresentState {
-        let rpm = x[1] * 60.0 / TAU;
-        let speed_ratio = rpm / (table::SPEED_UNIT_RPM as f64 * table::MAGNITUDE_MAX as f64);
-        PresentState {
-            position: position_raw(crate::pendulum::wrap_angle(x[0] - PI)),
-            speed: table::encode_signed(speed_ratio.clamp(-1.0, 1.0) as f32),
-            load: 0,
-            voltage: (SUPPLY_V * 10.0).round() as u8,
-            temperature: TEMPERATURE_C,
-        }
+    /// The servo's reading (its position measured from hanging; no load
+    /// is modelled).
+    fn reading(&self, x: [f64; 2]) -> PresentState {
+        servo_reading(&self.hw.joints[0], crate::pendulum::wrap_angle(x[0] - PI), x[1], 0.0, self.supply_v())
     }
 
     /// The firmware takes the pose at boot (hanging, θ = π) as count 0.
-    fn encoder(x: [f64; 2]) -> (u16, u8) {
-        (encoder_count(x[0] - PI), 0)
+    fn encoder(&self, x: [f64; 2]) -> (u16, u8) {
+        (self.hw.encoder.count_of(x[0] - PI), 0)
     }
 }
 
 impl Rig for PendulumRig {
     fn servo_ids(&self) -> &[u8] {
-        &[1]
+        core::slice::from_ref(&self.hw.joints[0].id)
     }
 
+    /// The nominal supply of the hardware definition (12 V).
     fn supply_v(&self) -> f64 {
-        SUPPLY_V
+        self.hw.supply_nominal_v as f64
     }
 
     fn advance_to(&mut self, t_us: u64) {
@@ -129,7 +141,8 @@ impl Rig for PendulumRig {
     }
 
     fn drive(&mut self, t_us: u64, id: u8, torque: bool, volts: f64) {
-        if id != 1 || (torque, volts) == (self.torque, self.volts) {
+        let volts = joint_volts(&self.hw.joints[0], volts);
+        if id != self.hw.joints[0].id || (torque, volts) == (self.torque, self.volts) {
             return;
         }
         self.restart_at(t_us);
@@ -139,17 +152,17 @@ impl Rig for PendulumRig {
 
     fn present(&mut self, t_us: u64, _id: u8) -> PresentState {
         self.advance_to(t_us);
-        Self::reading(self.state_at(t_us))
+        self.reading(self.state_at(t_us))
     }
 
     fn sensors(&mut self, t_us: u64) -> (u16, u8) {
         self.advance_to(t_us);
-        Self::encoder(self.state_at(t_us))
+        self.encoder(self.state_at(t_us))
     }
 
     fn peek_present(&self, t_us: u64, _id: u8) -> Option<PresentState> {
         let mut ahead = self.clone();
-        Some(ahead.present(t_us, 1))
+        Some(ahead.present(t_us, self.hw.joints[0].id))
     }
 
     fn peek_sensors(&self, t_us: u64) -> Option<(u16, u8)> {
@@ -159,7 +172,7 @@ impl Rig for PendulumRig {
 
     fn describe(&self) -> String {
         let hand = if self.operator { ", stopped by hand between episodes" } else { "" };
-        format!("the physical pendulum of Section VII (GRL constants, one RX-28 in wheel mode, 4096-count encoder){hand}")
+        format!("the physical pendulum of Section VII (GRL constants, one RX-28 in wheel mode, {}-count encoder){hand}", self.hw.encoder.counts_per_rev)
     }
 
     /// With an operator, the pendulum is stopped hanging at rest: the

@@ -399,8 +399,7 @@ impl BusEmulator {
         let past = self.faults.iter().any(|f| f.kind == FaultKind::PastLimit && f.applies(t, s.id));
         if let (true, Some((joint, Some(limit)))) = (past, s.joint) {
             let angle = limit.max + PAST_LIMIT_RAD;
-            let counts = joint.zero as f32 + joint.sign as f32 * angle / POSITION_UNIT_RAD;
-            p.position = counts.round().clamp(0.0, table::POSITION_MAX as f32) as u16;
+            p.position = joint.position_of(angle as f64);
         }
         (p, past)
     }

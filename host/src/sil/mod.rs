@@ -31,6 +31,7 @@
 
 pub mod bus;
 pub mod check;
+pub mod config;
 pub mod fault;
 pub mod forecast;
 pub mod power_cut;
@@ -42,4 +43,5 @@ pub mod session;
 pub mod wall;
 
 pub use report::{SilSummary, LEARNING_CHECK_S, WALKING_CHECK_S};
-pub use run::{machine, run, SilConfig, SilTask};
+pub use config::{machine, SilConfig, SilTask};
+pub use run::run;

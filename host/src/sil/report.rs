@@ -19,7 +19,7 @@
 use super::bus::{BusEmulator, BusStats};
 use super::forecast::ForecastStats;
 use super::replay::{replay, Record, ReplayReport};
-use super::run::{machine, SilConfig, SilTask};
+use super::config::{machine, SilConfig, SilTask};
 use super::wall::WallTime;
 use crate::board::{run_board_trial, run_board_trial_on, RunProtocol};
 use crate::capture::{Latest, MessageCounts};

@@ -1,4 +1,5 @@
-//! One software-in-the-loop run: what to run ([`SilConfig`]), setting it up
+//! One software-in-the-loop run: what to run ([`SilConfig`], in
+//! [`super::config`]), setting it up
 //! (QEMU, the plant, the output files), the lock-step loop
 //! ([`super::session`]) and the summary ([`super::report`]).
 //!
@@ -10,89 +11,12 @@
 //! `ClearFault` and `Start` again, as an operator would.
 
 use super::bus::BusEmulator;
-use super::fault::FaultSpec;
-use super::power_cut::CutSpec;
+use super::config::{machine, SilConfig};
 use super::qemu::{Emulator, QemuSetup};
 use super::report::SilSummary;
 use super::session::Session;
 use anyhow::{anyhow, Context};
-use pada_core::policy::PolicyKind;
-use pada_core::profile::{Board, LearnerProfile};
-use std::path::PathBuf;
-use std::time::{Duration, Instant};
-
-/// The robots `pada sil` runs (the registry's, [`crate::robots`]).
-pub use crate::robots::SilTask;
-
-/// The QEMU machine that emulates `board`: netduinoplus2 (an STM32F405)
-/// for `f405`, mps2-an386 (a Cortex-M4F with 16 MB of PSRAM standing in
-/// for the DISC1's SDRAM) for `f429-sdram`; `None` for the host.
-pub fn machine(board: Board) -> Option<&'static str> {
-    match board {
-        Board::F405 => Some("netduinoplus2"),
-        Board::F429Sdram => Some("mps2-an386"),
-        Board::Host => None,
-    }
-}
-
-/// What to run.
-#[derive(Debug, Clone)]
-pub struct SilConfig {
-    /// `qemu-system-arm`.
-    pub qemu: PathBuf,
-    /// The firmware image (built for `board`'s emulation and `task`'s
-    /// robot).
-    pub elf: PathBuf,
-    /// The robot.
-    pub task: SilTask,
-    /// The board learner profile the image was built for.
-    pub board: Board,
-    /// The policy the run sets (`SetPolicy`) before starting.
-    pub policy: PolicyKind,
-    /// The wear governor's budget \[s\] (`SetMtbfBudget`, after the policy
-    /// and before the first run), or none.
-    pub mtbf_budget_s: Option<f32>,
-    /// Learning time to reach \[s\].
-    pub seconds: f64,
-    /// The master seed (`pada run`'s: the board learns with
-    /// `crate::seed::trial_seed(seed, 0)`).
-    pub seed: u64,
-    /// Faults to inject.
-    pub faults: Vec<FaultSpec>,
-    /// Power cuts (`--power-cut`).
-    pub power_cuts: Vec<CutSpec>,
-    /// Hangs of the control loop (`--fault hang:at=S`) \[s\].
-    pub hangs_s: Vec<f64>,
-    /// Learning time between checkpoint saves \[s\] (none: no saves).
-    pub save_every_s: Option<f64>,
-    /// Forecast the bus's answers (fewer exchanges, the same run).
-    pub forecast: bool,
-    /// Also run the firmware's controller on the host to compare with (the
-    /// same trial of `pada run --board` for LEO; eight seeds for the
-    /// pendulum).
-    pub compare: bool,
-    /// Where the telemetry, logs and summary go (created).
-    pub out_dir: PathBuf,
-    /// Longest wall-clock wait for the board before calling it hung.
-    pub hang_timeout: Duration,
-    /// Show a progress bar on stderr.
-    pub progress: bool,
-    /// Also stream the firmware's telemetry, as it comes, to a file or a
-    /// loopback TCP listener.
-    pub telemetry: Option<crate::telemetry::TelemetryTarget>,
-}
-
-impl SilConfig {
-    /// The learner the image runs.
-    pub fn profile(&self) -> LearnerProfile {
-        self.board.profile(self.task.robot())
-    }
-
-    /// The seed of the board's learner.
-    pub fn learner_seed(&self) -> u64 {
-        crate::seed::trial_seed(self.seed, 0)
-    }
-}
+use std::time::Instant;
 
 /// Runs `cfg`; the summary is also written to `summary.json`.
 pub fn run(cfg: &SilConfig) -> anyhow::Result<SilSummary> {

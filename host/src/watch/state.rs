@@ -13,7 +13,7 @@ use crate::capture::{Latest, MessageCounts};
 use crate::experiment::metrics::{end_performance, rise_time};
 use pada_core::fatigue::PAPER_WINDOW_STEPS;
 use pada_core::wire::{
-    Decoded, Hello, LinkStats, PolicyReport, RunMode, StepKind, ToHost, MAX_JOINTS,
+    Decoded, Hello, LinkStats, PolicyReport, RunMode, StepKind, ToHost, MAX_GEARBOXES,
 };
 use serde::Serialize;
 
@@ -44,9 +44,9 @@ pub struct FatiguePoint {
     /// Time since boot \[s\] (the step's `time_ms`).
     pub time_s: f64,
     /// Accumulated damage J per learned joint (Eq. 7).
-    pub damage: [f64; MAX_JOINTS],
+    pub damage: [f64; MAX_GEARBOXES],
     /// Backlash re-engagements per learned joint.
-    pub reengagements: [u32; MAX_JOINTS],
+    pub reengagements: [u32; MAX_GEARBOXES],
 }
 
 /// One control step of an episode's trace.
@@ -253,13 +253,13 @@ pub struct WatchState {
     #[serde(skip)]
     current: Option<EpisodeTrace>,
     #[serde(skip)]
-    last_step: Option<(u32, u32, [u32; MAX_JOINTS])>,
+    last_step: Option<(u32, u32, [u32; MAX_GEARBOXES])>,
     #[serde(skip)]
     step_period_ms: Option<u32>,
     #[serde(skip)]
-    window_start: Option<[f64; MAX_JOINTS]>,
+    window_start: Option<[f64; MAX_GEARBOXES]>,
     #[serde(skip)]
-    window_end: Option<[f64; MAX_JOINTS]>,
+    window_end: Option<[f64; MAX_GEARBOXES]>,
     #[serde(skip)]
     joints: usize,
 }
@@ -383,11 +383,11 @@ impl WatchState {
     }
 
     fn step(&mut self, s: &pada_core::wire::Step) {
-        let n = s.joints.len().min(MAX_JOINTS);
+        let n = s.joints.len().min(MAX_GEARBOXES);
         self.joints = self.joints.max(n);
-        let mut damage = [0.0; MAX_JOINTS];
-        let mut reeng = [0u32; MAX_JOINTS];
-        for (i, j) in s.joints.iter().take(MAX_JOINTS).enumerate() {
+        let mut damage = [0.0; MAX_GEARBOXES];
+        let mut reeng = [0u32; MAX_GEARBOXES];
+        for (i, j) in s.joints.iter().take(MAX_GEARBOXES).enumerate() {
             damage[i] = j.damage;
             reeng[i] = j.reengagements;
         }

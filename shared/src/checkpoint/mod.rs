@@ -92,7 +92,7 @@ pub mod store;
 pub mod wear;
 
 pub use crate::crc::{config_hash, crc32, ConfigHasher, CRC32};
-pub use record::{LearnerState, MAX_JOINTS, STATE_LEN, STATE_VERSION, USER_COUNTERS};
+pub use record::{LearnerState, RECORD_JOINTS, STATE_LEN, STATE_VERSION, USER_COUNTERS};
 pub use slots::{
     find, inspect, is_newer, load, read_weights, save, save_within, slot_len, stored_wear, Found, Header,
     HeaderError, LoadOutcome, SaveError, Saved, SlotStatus, FORMAT_VERSION, HEADER_LEN, MAGIC, SLOTS,

@@ -16,7 +16,7 @@
 //! | 3 | 1 | `KIND` | policy kind built ([`kind_code`]): 0 sarsa, 1 lowpass, 2 markov-lowpass, 3 integrator, 4 markov-integrator, 5 pada, 6 epsilon-pada, 7 ou, 8 pink, 9 action-penalty |
 //! | 4 | 4 | `PARAMETER` | its first parameter, `f32`: α of the low-pass filters, Δ of the integrators and the PADAs, θ of ou, σ of pink, the weight of action-penalty, 0 for sarsa |
 //! | 8 | 1 | `SWITCHED` | switched back to SARSA: 0 no, 1 yes |
-//! | 9 | 1 | `JOINTS` | fatigue joints in use `j`, 0–[`MAX_JOINTS`] |
+//! | 9 | 1 | `JOINTS` | fatigue joints in use `j`, 0–[`RECORD_JOINTS`] |
 //! | 10 | 4 | `PREVIOUS` | previous action: level per action dimension, 4 × `u8` (0 unused) |
 //! | 14 | 2 | `RESERVED_A` | reserved |
 //! | 16 | 4 × 4 | `OUTPUT` | previous output (filter/integrator memory), 4 × `f32` (0 unused) |
@@ -32,7 +32,7 @@
 //! | 80 | 8 | `RNG_STATE` | generator state ([`RngState::state`]), `u64` |
 //! | 88 | 8 | `RNG_INCREMENT` | generator increment ([`RngState::increment`], odd), `u64` |
 //! | 96 | 4 × 4 | `USER` | user counters, 4 × `u32` ([`USER_COUNTERS`], the caller's) |
-//! | 112 | 8 × 48 | `FATIGUE` | fatigue per joint ([`JointFatigueState`]), [`MAX_JOINTS`] entries of `JOINT_LEN` = 48 bytes, the first `j` in use, the others all 0 |
+//! | 112 | 8 × 48 | `FATIGUE` | fatigue per joint ([`JointFatigueState`]), [`RECORD_JOINTS`] entries of `JOINT_LEN` = 48 bytes, the first `j` in use, the others all 0 |
 //! | 496 | 2 × 4 | `ERASES` | erases of slot 0's and slot 1's sector, 2 × `u32` ([`FlashWear`], written by [`super::save`]) |
 //! | 504 | 8 | `OPERATING_S` | operating seconds when saved, `u64` ([`FlashWear::operating_s`]) |
 //! | 512 | 1 | `GOVERNOR` | wear governor: 0 none (then every byte from here on is 0), 1 one runs |
@@ -93,8 +93,10 @@ use heapless::Vec;
 pub const STATE_VERSION: u16 = 3;
 /// Bytes of the learner-state record (a multiple of 4).
 pub const STATE_LEN: usize = 1024;
-/// Fatigue joints the state record has room for.
-pub const MAX_JOINTS: usize = 8;
+/// Fatigue counters the state record has room for: one per servo. A layout
+/// constant: the compile-time check below fails if it moves the offsets
+/// after it.
+pub const RECORD_JOINTS: usize = crate::limits::MAX_SERVOS;
 /// Counters the state record keeps for the caller ([`LearnerState::user`]).
 pub const USER_COUNTERS: usize = 4;
 
@@ -145,7 +147,7 @@ pub(super) mod at {
     pub const GOV_END: usize = GOV_HEADROOM_AT_MOVE + 8;
 }
 
-const _: () = assert!(at::FATIGUE + MAX_JOINTS * at::JOINT_LEN == at::ERASES);
+const _: () = assert!(at::FATIGUE + RECORD_JOINTS * at::JOINT_LEN == at::ERASES);
 const _: () = assert!(at::OPERATING_S + 8 == at::GOVERNOR);
 const _: () = assert!(at::GOV_END == 944 && at::GOV_END <= STATE_LEN);
 // The record has four action dimensions: previous levels and outputs.
@@ -166,8 +168,8 @@ pub struct LearnerState {
     /// The agent's generator ([`crate::rng::Pcg32::state`]).
     pub rng: RngState,
     /// Fatigue counters, one per joint in joint order (at most
-    /// [`MAX_JOINTS`]; [`crate::fatigue::FatigueCounter::state`]).
-    pub joints: Vec<JointFatigueState, MAX_JOINTS>,
+    /// [`RECORD_JOINTS`]; [`crate::fatigue::FatigueCounter::state`]).
+    pub joints: Vec<JointFatigueState, RECORD_JOINTS>,
     /// The caller's counters (the firmware: episodes since the first boot,
     /// learning episodes since the last test episode).
     pub user: [u32; USER_COUNTERS],
@@ -334,7 +336,7 @@ impl LearnerState {
             s => return Err(ConfigError::new("policy.switched", s as f32, "0 or 1")),
         };
         let joints = r.u8(at::JOINTS) as usize;
-        if joints > MAX_JOINTS {
+        if joints > RECORD_JOINTS {
             return Err(ConfigError::new("joints", joints as f32, "0 ..= 8 fatigue joints"));
         }
         if !r.zero(at::RESERVED_A, 2) {
@@ -353,7 +355,7 @@ impl LearnerState {
             last_td_error: Q16(r.u32(at::TD_ERROR) as i32),
         };
         let mut fatigue = Vec::new();
-        for j in 0..MAX_JOINTS {
+        for j in 0..RECORD_JOINTS {
             let o = at::FATIGUE + j * at::JOINT_LEN;
             if j >= joints {
                 if !r.zero(o, at::JOINT_LEN) {
@@ -372,7 +374,7 @@ impl LearnerState {
                 window_reengagements: r.u64(o + 32),
                 window_damage_raw: r.u64(o + 40),
             };
-            // Cannot fail: j < joints <= MAX_JOINTS.
+            // Cannot fail: j < joints <= RECORD_JOINTS.
             let _ = fatigue.push(state);
         }
         Ok(LearnerState {
@@ -537,6 +539,6 @@ mod layout_doc {
             .filter(|l| l.trim_start().starts_with("pub const ") && !l.contains("JOINT_LEN"))
             .count();
         assert_eq!(consts, OFFSETS.len(), "an offset of `at` is missing from the test's list");
-        assert_eq!(at::FATIGUE + super::MAX_JOINTS * at::JOINT_LEN, at::ERASES);
+        assert_eq!(at::FATIGUE + super::RECORD_JOINTS * at::JOINT_LEN, at::ERASES);
     }
 }

@@ -22,12 +22,11 @@ pub mod leo;
 pub mod pendulum;
 
 use crate::action_space::{ActionDim, ActionSpace, MAX_ACTION_DIMS};
-use crate::agent::{Agent, SarsaParams};
+use crate::agent::{coder_for, exact_table_len, Agent, SarsaParams};
 use crate::error::ConfigError;
 use crate::policy::{Policy, PolicyKind};
-use crate::tile_coding::{Layout, StateDim, TileCoder, MAX_STATE_DIMS};
+use crate::tile_coding::{Layout, StateDim};
 use crate::weights::WeightStore;
-use heapless::Vec;
 
 /// A robot with a board.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -205,19 +204,17 @@ impl RobotSpec {
     ) -> Result<(), ConfigError> {
         self.params.validate()?;
         let policy = Policy::new(policy, self.motor()?)?;
-        let mut dims: Vec<StateDim, MAX_STATE_DIMS> = Vec::new();
-        for d in self.state.iter().copied() {
-            dims.push(d).map_err(|_| ConfigError::new("state dimensions", self.state.len() as f32, "at most 16"))?;
-        }
-        for i in 0..policy.extension_len() {
-            dims.push(policy.extension_dim(i)?)
-                .map_err(|_| ConfigError::new("state dimensions", dims.len() as f32 + 1.0, "at most 16"))?;
-        }
-        let coder = TileCoder::<TILINGS>::new(&dims, policy.learner_space().joint_count(), layout, table_len)?;
+        let coder = coder_for::<TILINGS>(self.state, &policy, layout, table_len)?;
         if let Some(widths) = self.action_tiles {
             coder.with_action_tiles(policy.learner_space(), widths)?;
         }
         Ok(())
+    }
+
+    /// Weights of the robot's exact table with `policy` (tilings × tiles ×
+    /// learner actions): what a board's exact profile or the host allocates.
+    pub fn exact_table_len<const TILINGS: usize>(&self, policy: PolicyKind) -> Result<usize, ConfigError> {
+        exact_table_len::<TILINGS>(self.state, self.motor()?, policy)
     }
 
     /// The robot's agent learning with `policy` on `weights` laid out as

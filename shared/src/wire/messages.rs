@@ -20,14 +20,10 @@ pub use crate::safety::RunMode;
 /// [`PolicyKind`], the wear governor's status in [`PolicyReport`] and
 /// [`ToChip::SetMtbfBudget`]).
 pub const PROTOCOL_VERSION: u16 = 6;
-/// State dimensions a [`Step`] carries.
-pub const MAX_STATE_DIMS: usize = 16;
-/// Action dimensions (motor outputs) a [`Step`] carries.
-pub const MAX_OUTPUTS: usize = 4;
-/// Learned joints with a fatigue counter in a [`Step`].
-pub const MAX_JOINTS: usize = 4;
-/// Servos reported in [`Health`] (LEO has seven).
-pub const MAX_SERVOS: usize = 8;
+/// The capacities of a [`Step`] (state dimensions, motor outputs and
+/// counted gearboxes) and of a [`Health`] report (servos): pada-core's own
+/// ([`crate::limits`]).
+pub use crate::limits::{MAX_ACTION_DIMS, MAX_GEARBOXES, MAX_SERVOS, MAX_STATE_DIMS};
 /// Weights per [`WeightsChunk`].
 pub const WEIGHTS_PER_CHUNK: usize = 32;
 /// Bytes of text in [`Log`] and [`Warning::Text`].
@@ -127,7 +123,7 @@ pub struct Step {
     /// The learner's joint action index.
     pub action: u32,
     /// Output applied per action dimension, after the policy.
-    pub output: Vec<f32, MAX_OUTPUTS>,
+    pub output: Vec<f32, MAX_ACTION_DIMS>,
     /// Reward of the transition into this observation.
     pub reward: f32,
     /// TD error δ of the update, raw Q15.16 ([`crate::fixed::Q16`]).
@@ -139,7 +135,7 @@ pub struct Step {
     /// same to take the same action.
     pub footstep: bool,
     /// Fatigue per learned joint.
-    pub joints: Vec<JointFatigue, MAX_JOINTS>,
+    pub joints: Vec<JointFatigue, MAX_GEARBOXES>,
     /// Duration of this control period's work, µs.
     pub loop_us: u32,
     /// Cycles of the agent call of this period (DWT cycles on the chip;

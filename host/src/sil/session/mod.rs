@@ -18,7 +18,7 @@ use super::power_cut::{CutPlan, HangRecord, OFF_US};
 use super::qemu::Emulator;
 use super::replay::Record;
 use super::report::{self, Facts, SilSummary};
-use super::run::SilConfig;
+use super::config::SilConfig;
 use super::wall::{Account, WallClock};
 use crate::board::{EpisodeOutcome, Phase, RunProtocol};
 use crate::capture::{mode_name, Recorder};
