@@ -17,6 +17,8 @@ pub enum Mark {
     Dotted,
     /// A filled dot.
     Dot,
+    /// A filled triangle.
+    Triangle,
 }
 
 impl Mark {
@@ -28,7 +30,7 @@ impl Mark {
         match self {
             Mark::Dashed => Some((10, 6)),
             Mark::Dotted => Some((2, 4)),
-            Mark::Line | Mark::Dot => None,
+            Mark::Line | Mark::Dot | Mark::Triangle => None,
         }
     }
 }
@@ -74,6 +76,9 @@ where
         match e.mark {
             Mark::Dot => area
                 .draw(&Circle::new((x + 12, y), 4, e.color.filled()))
+                .map_err(plot_err)?,
+            Mark::Triangle => area
+                .draw(&TriangleMarker::new((x + 12, y), 6, e.color.filled()))
                 .map_err(plot_err)?,
             mark => {
                 let segments = match mark.dashes() {

@@ -4,6 +4,7 @@
 //! triangles, and the Pareto front as a line.
 
 use super::figures::{color, finite_ci, lin_range, log_range};
+use super::legend::{self, Entry, Mark};
 use super::{plot_err, Figure, FONT};
 use crate::experiment::algo::Algo;
 use crate::stats::Estimate;
@@ -116,10 +117,7 @@ impl WearPareto {
                     .map(|p| (x_of(p), p.end.mean)),
                 BLACK.stroke_width(2),
             ))
-            .map_err(plot_err)?
-            .label("Pareto front")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2)));
-        let mut labelled = Vec::new();
+            .map_err(plot_err)?;
         for p in self.points.iter().filter(|p| x_of(p).is_finite()) {
             let c = color(p.algo);
             let e = finite_ci(&p.end);
@@ -133,45 +131,46 @@ impl WearPareto {
                     6,
                 )))
                 .map_err(plot_err)?;
-            let key = (p.algo.name(), p.governed);
-            let first = !labelled.contains(&key);
-            labelled.push(key);
             let at = (x_of(p), p.end.mean);
             if p.governed {
-                let s = chart
+                chart
                     .draw_series(std::iter::once(TriangleMarker::new(at, 7, c.filled())))
                     .map_err(plot_err)?;
-                if first {
-                    s.label(format!("{} + governor", p.algo.name()))
-                        .legend(move |(x, y)| TriangleMarker::new((x + 10, y), 6, c.filled()));
-                }
             } else {
-                let s = chart
+                chart
                     .draw_series(std::iter::once(Circle::new(at, 4, c.filled())))
                     .map_err(plot_err)?;
-                if first {
-                    s.label(p.algo.name())
-                        .legend(move |(x, y)| Circle::new((x + 10, y), 4, c.filled()));
-                }
             }
         }
-        if !physical {
-            chart
-                .configure_series_labels()
-                .label_font((FONT, 12))
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .position(SeriesLabelPosition::LowerRight)
-                .draw()
-                .map_err(plot_err)?;
-        }
         Ok(())
+    }
+
+    /// The key: the Pareto front, then every strategy once, in the order
+    /// of the points (a governed one as a triangle). It is drawn in a strip
+    /// under both panels, never over a point.
+    fn key(&self) -> Vec<Entry> {
+        let mut key = vec![Entry { label: "Pareto front".into(), color: BLACK, mark: Mark::Line }];
+        let mut seen = Vec::new();
+        for p in &self.points {
+            if seen.contains(&(p.algo.name(), p.governed)) {
+                continue;
+            }
+            seen.push((p.algo.name(), p.governed));
+            let (label, mark) = if p.governed {
+                (format!("{} + governor", p.algo.name()), Mark::Triangle)
+            } else {
+                (p.algo.name().to_string(), Mark::Dot)
+            };
+            key.push(Entry { label, color: color(p.algo), mark });
+        }
+        key
     }
 }
 
 impl Figure for WearPareto {
     fn size(&self) -> (u32, u32) {
-        (1500, 640)
+        // The plots' 640 px and the key's strip (two entries a row).
+        (1500, 640 + 22 * self.key().len().div_ceil(2) as u32 + 12)
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> anyhow::Result<()>
@@ -180,9 +179,65 @@ impl Figure for WearPareto {
     {
         root.fill(&WHITE).map_err(plot_err)?;
         let root = root.titled(&self.title, (FONT, 22)).map_err(plot_err)?;
-        let (left, right) = root.split_horizontally(750);
+        let key = self.key();
+        let (plots, key_area) = legend::split(&root, key.len());
+        legend::draw(&key_area, &key)?;
+        let (left, right) = plots.split_horizontally(750);
         self.panel(&left, false)?;
         self.panel(&right, true)?;
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn estimate(v: &serde_json::Value) -> Estimate {
+        Estimate {
+            // `null` means infinite (a trial without damage) or too few trials.
+            mean: v["mean"].as_f64().unwrap_or(f64::INFINITY),
+            ci95: v["ci95"].as_f64().unwrap_or(f64::NAN),
+            n: v["n"].as_u64().unwrap_or(0) as usize,
+        }
+    }
+
+    /// Draws the LEO sweep of `docs/wear/` again from its `leo-summary.json`
+    /// (into the temporary folder `pada-wear-leo-figure/`): every strategy
+    /// once in the key, which sits in its own strip under the plots.
+    #[test]
+    fn the_leo_sweep_draws_with_its_key_under_the_plots() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/wear/leo-summary.json");
+        let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+        let configs = v["configs"].as_array().unwrap();
+        let points: Vec<WearPoint> = configs
+            .iter()
+            .map(|c| WearPoint {
+                algo: Algo::from_name(c["summary"]["algo"].as_str().unwrap()).unwrap(),
+                governed: !c["budget_s"].is_null(),
+                mtbf_s: estimate(&c["summary"]["mtbf_s"]),
+                physical_mtbf_s: estimate(&c["summary"]["physical_mtbf_s"]),
+                end: estimate(&c["summary"]["end_performance"]),
+                pareto: c["pareto"].as_bool().unwrap(),
+                pareto_physical: c["pareto_physical"].as_bool().unwrap(),
+            })
+            .collect();
+        let sarsa = &points[0];
+        let figure = WearPareto {
+            title: "End performance against MTBF (leo): every strategy and the wear governor".into(),
+            sarsa_mtbf_s: [sarsa.mtbf_s.mean, sarsa.physical_mtbf_s.mean],
+            points: points.clone(),
+        };
+        let key = figure.key();
+        // The front, the sweep's ten strategies and the two governed ones.
+        assert_eq!(key.len(), 1 + 10 + 2, "{key:?}");
+        assert_eq!(key.iter().filter(|e| e.mark == Mark::Triangle).count(), 2);
+        assert_eq!(key[0].label, "Pareto front");
+        // The figure grows by the key's strip instead of drawing it over a plot.
+        assert_eq!(figure.size(), (1500, 640 + 22 * 7 + 12));
+        let dir = std::env::temp_dir().join("pada-wear-leo-figure");
+        std::fs::create_dir_all(&dir).unwrap();
+        crate::plot::save(&figure, &dir, "leo-wear-pareto").unwrap();
+        assert!(std::fs::metadata(dir.join("leo-wear-pareto.png")).unwrap().len() > 10_000);
     }
 }
