@@ -120,7 +120,7 @@ const LEO_LIMITS: [Option<SoftLimit>; NUM_JOINTS] = [
 /// The pendulum turns freely: no soft limit.
 const PENDULUM_LIMITS: [Option<SoftLimit>; 1] = [None];
 
-const _: () = assert!(LeoJoint::AnkleRight as usize == NUM_JOINTS - 1 && NUM_JOINTS <= MAX_ROBOT_SERVOS);
+const _: () = assert!(LeoJoint::AnkleRight as usize == NUM_JOINTS - 1);
 
 /// The robot's hardware.
 pub const fn hardware(robot: Robot) -> RobotConfig {

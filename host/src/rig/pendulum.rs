@@ -57,16 +57,6 @@ impl PendulumRig {
         }
     }
 
-    /// The same with another calibration of its servo and encoder.
-    pub fn with_hardware(params: PhysicalPendulumParams, hw: RobotConfig) -> anyhow::Result<Self> {
-        anyhow::ensure!(
-            matches!(hw.robot, Robot::Pendulum33 | Robot::Pendulum20) && hw.joints.len() == 1,
-            "the pendulum's rig needs the pendulum's one servo, not {} of {}",
-            hw.joints.len(),
-            hw.robot.name()
-        );
-        Ok(PendulumRig { hw, ..Self::new(params) })
-    }
 
     /// The same, stopped hanging at rest by hand whenever the firmware ends
     /// an episode ([`Rig::episode_ended`]).
