@@ -15,9 +15,8 @@
 //! | [`servo`] | joint calibration, commanded voltage → Moving Speed ratio |
 //! | [`encoder`] | quadrature counts → unwrapped angle |
 //! | [`pendulum`], [`leo`] | per robot: the adapter from counts to the robot's definition, and the wait between episodes |
-//! | [`control`] | one control period: safety, agent step, episodes, fatigue, telemetry records |
+//! | [`control`] | one control period: safety, the shared episode cycle, fatigue, the wear governor, telemetry records |
 //! | [`timing`] | loop-time and overrun accounting |
-//! | [`wear_budget`] | the wear governor on the board: built for the robot, fed each learning period's damage |
 //! | [`sil`] | software in the loop: the emulated board's lock-step clock and sensor device, shared with the host |
 #![cfg_attr(not(test), no_std)]
 #![deny(missing_docs)]
@@ -35,4 +34,3 @@ pub mod robot;
 pub mod servo;
 pub mod sil;
 pub mod timing;
-pub mod wear_budget;

@@ -53,6 +53,7 @@ pub mod agent;
 pub mod checkpoint;
 pub mod crc;
 pub mod dynamixel;
+pub mod episodes;
 pub mod error;
 pub mod exploration;
 pub mod fatigue;

@@ -8,7 +8,7 @@
 //! `pada_core::checkpoint::CheckpointStore`) and does nothing else.
 
 use super::chip::{self, Irqs, Resources};
-use super::{MemoryFault, TableMemory};
+use super::Parts;
 use core::task::Poll;
 use embassy_stm32::gpio::{Input, Level, Output, Pull, Speed};
 use embassy_stm32::mode::Async;
@@ -42,33 +42,8 @@ const SERVO_RX_BUF: usize = 256;
 /// Bytes of the telemetry link's circular DMA receive buffer.
 const TELEMETRY_RX_BUF: usize = 512;
 
-/// Everything the tasks get from the board.
-pub struct Board {
-    /// The servo bus.
-    pub servo_port: ServoPort,
-    /// Telemetry out.
-    pub telemetry_tx: TelemetryTx,
-    /// Commands in.
-    pub telemetry_rx: TelemetryRx,
-    /// Encoder and foot switches.
-    pub sensors: BoardSensors,
-    /// The checkpoint slots.
-    pub flash: FlashStore,
-    /// The independent watchdog (not started yet).
-    pub watchdog: Watchdog,
-    /// The cycle counter.
-    pub cycles: Cycles,
-    /// Status LED.
-    pub led: Led,
-    /// Whether the last reset came from the independent watchdog.
-    pub watchdog_reset: bool,
-    /// The weight table's memory, started and checked (the F429's SDRAM),
-    /// or why not.
-    pub table_memory: Result<TableMemory, MemoryFault>,
-    /// The learner's seed: `DEFAULT_SEED` (the emulated boards take their
-    /// run's).
-    pub seed: u64,
-}
+/// Everything the tasks get from the board ([`Parts`]).
+pub type Board = Parts<ServoPort, TelemetryTx, TelemetryRx, BoardSensors, FlashStore, Watchdog, Cycles, Led>;
 
 impl Board {
     /// Clocks, pins and peripherals, and the table's memory. Call once.

@@ -74,14 +74,18 @@
 //! (feature `mps2`: `mps2-an386`, a Cortex-M4 whose PSRAM stands in for the
 //! F429I-DISC1's SDRAM, for the `f429-sdram` profile). They have the same
 //! type names (`ServoPort`, `TelemetryTx`, `TelemetryRx`, `BoardSensors`,
-//! `FlashStore`, `Watchdog`, `Cycles`, `Led`, `Board`) implementing the
-//! same `pada_firmware::io` traits; everything above (tasks, controller,
+//! `FlashStore`, `Watchdog`, `Cycles`, `Led`) implementing the
+//! same `pada_firmware::io` traits, handed to the tasks in one
+//! [`Parts`] struct (each variant's `Board`); everything above (tasks, controller,
 //! agent) stays as it is.
 
 // The weight table's memory: what the board layer and the table both use
 // (a leaf, so that neither imports the other).
 mod memory;
 pub use memory::{MemoryFault, TableMemory};
+// What a board hands the tasks, with each variant's own parts.
+mod parts;
+pub use parts::Parts;
 
 #[cfg(not(emulated))]
 mod hw;

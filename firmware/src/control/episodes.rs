@@ -1,19 +1,18 @@
-//! The episode cycle: bringing the robot back to its start between
-//! episodes, the agent's `start_episode`, `step` and `end_episode` (at an
-//! absorbing state or the time limit), one greedy test episode every
-//! `test_interval` learning episodes (Section VI), LEO's footstep remap,
-//! and the step record of each decision (steps 2 and 4 of
-//! [`Controller::period`]).
+//! The chip's side of the episode cycle ([`pada_core::episodes`], written
+//! once for the chip and the host): bringing the robot back to its start
+//! between episodes, and handing each period's observation, reward and
+//! absorbing state to the shared cycle (steps 2 and 4 of
+//! [`Controller::period`]). What stays here is I/O: the robot's adapter,
+//! the cycle counter and the period's output.
 
 use super::{Controller, PeriodOutput, Phase, Readings};
 use crate::config::MAX_OBS;
 use crate::io::CycleCounter;
 use crate::robot::RobotAdapter;
-use heapless::Vec;
-use pada_core::agent::{Decision, EpisodeEnd, Mode};
+use pada_core::episodes::record::Stamp;
+use pada_core::episodes::Transition;
 use pada_core::safety::RunMode;
 use pada_core::weights::WeightStore;
-use pada_core::wire::{self, StepKind};
 
 impl<W, R> Controller<W, R>
 where
@@ -22,79 +21,45 @@ where
 {
     pub(super) fn begin_reset(&mut self) {
         self.phase = Phase::Resetting;
+        self.episodes.abandon();
         self.robot.begin_reset();
     }
 
     pub(super) fn start_episode(&mut self, mode: RunMode, readings: &Readings, cycles: &impl CycleCounter, out: &mut PeriodOutput) {
-        // Every `test_interval` learning episodes, one greedy test episode.
-        let test = mode == RunMode::Testing || self.since_test >= self.spec.test_interval;
-        self.episode_mode = if test { RunMode::Testing } else { RunMode::Learning };
-        if test {
-            if mode == RunMode::Learning {
-                self.since_test = 0;
-            }
-        } else {
-            self.since_test += 1;
-        }
-        self.agent_mut().set_mode(if test { Mode::Testing } else { Mode::Learning });
-        self.episode_return = 0.0;
         let mut obs = [0.0; MAX_OBS];
         let dims = self.robot.observe(&mut obs);
         let t0 = cycles.cycles();
         let result = {
-            let (agent, rng) = (self.agent.as_mut(), &mut self.rng);
-            agent.map(|a| a.start_episode(&obs[..dims], rng))
+            let (Some(agent), rng) = (self.agent.as_mut(), &mut self.rng) else { return };
+            self.episodes.begin(agent, mode, &obs[..dims], rng)
         };
         out.agent_cycles = Some(cycles.cycles().wrapping_sub(t0));
         match result {
-            Some(Ok(decision)) => {
-                self.phase = Phase::Running { steps: 0 };
-                self.record(StepKind::Start, &obs[..dims], 0.0, Some(decision), false, readings.time_ms, out);
+            Ok(t) => {
+                self.phase = Phase::Running;
+                self.record(&t, &obs[..dims], readings.time_ms, out);
             }
             // A non-finite observation (a broken sensor): try again next
             // period.
-            _ => self.begin_reset(),
+            Err(_) => self.begin_reset(),
         }
     }
 
-    pub(super) fn continue_episode(&mut self, steps: u32, readings: &Readings, cycles: &impl CycleCounter, out: &mut PeriodOutput) {
+    pub(super) fn continue_episode(&mut self, readings: &Readings, cycles: &impl CycleCounter, out: &mut PeriodOutput) {
         let mut obs = [0.0; MAX_OBS];
         let dims = self.robot.observe(&mut obs);
-        let (reward, absorbing) = (self.robot.reward(&self.applied), self.robot.absorbing());
-        let timeout = steps >= self.spec.episode_steps;
-        // A footstep: the policy's memory moves with the joints before the
-        // next decision.
-        let footstep = self.robot.footstep() && self.spec.footstep_remap.is_some();
-        if let (true, Some(map)) = (footstep, self.spec.footstep_remap) {
-            self.agent_mut().remap_memory(&map);
-        }
+        let (reward, absorbing, footstep) = (self.robot.reward(&self.applied), self.robot.absorbing(), self.robot.footstep());
         let t0 = cycles.cycles();
-        let (kind, result) = {
-            let Some(agent) = self.agent.as_mut() else { return };
-            let rng = &mut self.rng;
-            if absorbing {
-                (StepKind::Absorbing, agent.end_episode(reward, EpisodeEnd::Absorbing, rng).map(|_| None))
-            } else if timeout {
-                (StepKind::Timeout, agent.end_episode(reward, EpisodeEnd::Timeout(&obs[..dims]), rng).map(|_| None))
-            } else {
-                (StepKind::Step, agent.step(reward, &obs[..dims], rng).map(Some))
-            }
+        let result = {
+            let (Some(agent), rng) = (self.agent.as_mut(), &mut self.rng) else { return };
+            self.episodes.advance(agent, &obs[..dims], reward, absorbing, footstep, rng)
         };
         out.agent_cycles = Some(cycles.cycles().wrapping_sub(t0));
         match result {
-            Ok(decision) => {
-                self.episode_return += reward;
-                self.record(kind, &obs[..dims], reward, decision, footstep, readings.time_ms, out);
-                if decision.is_some() {
-                    self.phase = Phase::Running { steps };
-                } else {
-                    out.episode = Some(wire::Episode {
-                        index: self.episodes.wrapping_sub(1),
-                        mode: self.episode_mode,
-                        total_reward: self.episode_return,
-                        length: steps,
-                        weights_checksum: self.agent().weights_checksum(),
-                    });
+            Ok(t) => {
+                self.record(&t, &obs[..dims], readings.time_ms, out);
+                if t.ended.is_some() {
+                    out.episode = t.ended;
                     self.begin_reset();
                 }
             }
@@ -104,59 +69,12 @@ where
         }
     }
 
-    /// Fills the step record.
-    #[allow(clippy::too_many_arguments)]
-    fn record(
-        &mut self,
-        kind: StepKind,
-        obs: &[f32],
-        reward: f32,
-        decision: Option<Decision>,
-        footstep: bool,
-        time_ms: u32,
-        out: &mut PeriodOutput,
-    ) {
-        if kind == StepKind::Start {
-            self.episodes = self.episodes.wrapping_add(1);
-        }
-        let outputs = self.agent().policy().motor_space().dims();
-        match decision {
-            Some(d) => {
-                self.last_action = d.action;
-                self.last_output = d.output;
-            }
-            None => self.last_output = [0.0; pada_core::action_space::MAX_ACTION_DIMS],
-        }
-        let td_error = match (kind, self.episode_mode) {
-            (StepKind::Start, _) | (_, RunMode::Testing) => 0,
-            _ => self.agent().stats().last_td_error.0,
-        };
-        let mut joints = Vec::new();
-        for j in self.reported_joints() {
-            if let Some(f) = self.fatigue.joint(j) {
-                let _ = joints.push(wire::JointFatigue {
-                    damage: f.damage(),
-                    reengagements: f.reengagements().min(u32::MAX as u64) as u32,
-                });
-            }
-        }
-        out.step = Some(wire::Step {
-            step: self.steps,
-            time_ms,
-            episode: self.episodes.wrapping_sub(1),
-            mode: self.episode_mode,
-            kind,
-            state: Vec::from_slice(obs).unwrap_or_default(),
-            action: self.last_action,
-            output: Vec::from_slice(&self.last_output[..outputs]).unwrap_or_default(),
-            reward,
-            td_error,
-            explored: decision.is_some_and(|d| d.explored),
-            footstep,
-            joints,
-            loop_us: 0,
-            agent_cycles: out.agent_cycles.unwrap_or(0),
-        });
+    /// Keeps the decision's output for the servos and fills the step record.
+    fn record(&mut self, t: &Transition, obs: &[f32], time_ms: u32, out: &mut PeriodOutput) {
+        self.last_output = t.decision.map_or([0.0; pada_core::action_space::MAX_ACTION_DIMS], |d| d.output);
+        let stamp = Stamp { step: self.steps, time_ms, agent_cycles: out.agent_cycles.unwrap_or(0) };
+        let gearboxes = self.fatigue.joints().get(self.reported_joints()).unwrap_or(&[]);
+        out.step = Some(self.episodes.record(t, self.agent(), obs, gearboxes, stamp));
     }
 }
 
@@ -168,6 +86,7 @@ mod tests {
     use crate::pendulum::Pendulum33;
     use core::cell::Cell;
     use pada_core::policy::PolicyKind;
+    use pada_core::wire::StepKind;
 
     #[test]
     fn pendulum_episodes_start_after_hanging_still_and_end_by_time() {
@@ -183,7 +102,9 @@ mod tests {
             if let Some(s) = &out.step {
                 kinds.push(s.kind);
                 assert_eq!(s.state.len(), 2);
-                assert_eq!(s.output.len(), 1);
+                // An end reports no output (no decision).
+                let ends = matches!(s.kind, StepKind::Absorbing | StepKind::Timeout);
+                assert_eq!(s.output.len(), if ends { 0 } else { 1 });
                 assert_eq!(s.joints.len(), 1);
                 assert!(out.agent_cycles.is_some());
             }

@@ -1,14 +1,23 @@
 //! The wear governor on the controller: `SetMtbfBudget` starts or stops
 //! it, and after every learning period it is fed the damage of the learned
 //! joints and moves PADA's Δ or the low-pass filter's α
-//! ([`pada_core::governor`], [`crate::wear_budget`]).
+//! ([`pada_core::governor`]; its feed, [`pada_core::episodes::wear`]).
+//!
+//! What the board adds to the learning core's rule is its input: the
+//! damage of the **reported joints** (the gearboxes the learned actions
+//! drive: the pendulum's motor, LEO's hips and knees) as the board's own
+//! torque estimate counts it, in periods that applied a **learning
+//! action**, as `pada run` and the paper's MTBF count them. Test runs and
+//! the waits between episodes are not learning and do not move the
+//! governor.
 
 use super::{CommandResult, Controller, PeriodOutput};
 use crate::config::MAX_ROBOT_SERVOS;
 use crate::robot::RobotAdapter;
-use crate::wear_budget;
+use pada_core::episodes::wear;
 use pada_core::error::ConfigError;
-use pada_core::governor::Governor;
+use pada_core::fatigue::GearboxParams;
+use pada_core::governor::{Governor, GovernorConfig, GOVERNED_JOINTS};
 use pada_core::policy::PolicyKind;
 use pada_core::weights::WeightStore;
 use pada_core::wire::NackReason;
@@ -18,9 +27,17 @@ where
     W: WeightStore,
     R: RobotAdapter,
 {
-    /// A fresh governor for the built `policy` holding `budget_s`.
+    /// A fresh governor for the built `policy` holding `budget_s`,
+    /// following the reported joints (at most [`GOVERNED_JOINTS`]).
     pub(super) fn governor_for(&self, policy: &PolicyKind, budget_s: f32) -> Result<Governor, ConfigError> {
-        wear_budget::governor(self.spec, policy, budget_s, self.reported_joints())
+        let config = GovernorConfig {
+            budget_s,
+            period_s: self.spec.period_s(),
+            gearbox: GearboxParams::TABLE_I,
+            worst_torque_nm: self.spec.worst_commanded_torque(),
+            joints: self.reported_joints().len().min(GOVERNED_JOINTS) as u8,
+        };
+        Governor::new(policy, &self.spec.motor()?, &config)
     }
 
     /// Starts the wear governor with `budget_s` (the smallest predicted
@@ -53,7 +70,7 @@ where
     /// move sets the policy's parameter for the next decision and is
     /// reported.
     pub(super) fn govern(&mut self, before: &[u64; MAX_ROBOT_SERVOS], out: &mut PeriodOutput) {
-        let increments = wear_budget::increments(before, &self.fatigue, self.reported_joints());
+        let increments = wear::increments(before, &self.fatigue, self.reported_joints());
         let Some(moved) = self.governor.as_mut().and_then(|g| g.observe(&increments)) else { return };
         // The governor's ladder is the policy's own range, so this is
         // accepted; a refusal would leave the previous parameter in force.

@@ -30,7 +30,7 @@
 //! numbers and takes the same actions.
 //!
 //! Learning on a wear budget: after `SetMtbfBudget` a wear governor
-//! ([`pada_core::governor`], [`crate::wear_budget`]) moves PADA's Δ or the
+//! ([`pada_core::governor`], [`pada_core::episodes::wear`]) moves PADA's Δ or the
 //! low-pass filter's α after every learning period from the fatigue
 //! counter's damage of the learned joints, and the period's output carries
 //! a `Policy` report at every move and after every episode.
@@ -49,7 +49,7 @@
 //! |---|---|
 //! | `mod.rs` | the controller: its state, construction and accessors |
 //! | `period.rs` | one period, steps 1–6: readings → safety, voltages → Moving Speeds, torques → fatigue; the period's types |
-//! | `episodes.rs` | the episode cycle and the step records |
+//! | `episodes.rs` | the chip's side of the shared episode cycle: resets, observations, the step records |
 //! | `persist.rs` | the learner's state, checkpoints and the flash's erase budget |
 //! | `governor.rs` | the wear governor's budget command and its feed |
 //! | `commands.rs` | the host commands the controller owns |
@@ -75,6 +75,7 @@ use crate::encoder::Unwrapper;
 use crate::robot::RobotAdapter;
 use heapless::Vec;
 use pada_core::checkpoint::FlashWear;
+use pada_core::episodes::Episodes;
 use pada_core::error::ConfigError;
 use pada_core::fatigue::{FatigueCounter, GearboxParams, PAPER_WINDOW_STEPS};
 use pada_core::governor::Governor;
@@ -82,7 +83,7 @@ use pada_core::policy::PolicyKind;
 use pada_core::profile::config_hash;
 use pada_core::rng::Pcg32;
 use pada_core::robot::RobotSpec;
-use pada_core::safety::{Event, RunMode, Safety, State, Transition};
+use pada_core::safety::{Event, Safety, State, Transition};
 use pada_core::weights::WeightStore;
 use rand_core::SeedableRng;
 
@@ -93,11 +94,8 @@ enum Phase {
     Stopped,
     /// Bringing the robot back to its start.
     Resetting,
-    /// In an episode of `steps` transitions so far.
-    Running {
-        /// Transitions (rewards) so far.
-        steps: u32,
-    },
+    /// In an episode (its progress is the cycle's, [`Episodes`]).
+    Running,
 }
 
 /// The control loop's state for robot `R` on weights `W`: agent, safety
@@ -118,13 +116,10 @@ pub struct Controller<W, R> {
     phase: Phase,
     /// The safety state at the end of the last period.
     last_state: State,
-    episode_mode: RunMode,
-    /// Episodes started since boot (the index of the next one).
-    episodes: u32,
-    /// Learning episodes since the last test episode.
-    since_test: u32,
-    episode_return: f32,
-    last_action: u32,
+    /// The episode cycle: test cadence, episode counters, the episode in
+    /// progress.
+    episodes: Episodes,
+    /// The last decision's output, applied while an episode runs.
     last_output: [f32; pada_core::action_space::MAX_ACTION_DIMS],
     /// Voltage each servo applied during the last period.
     applied: [f32; MAX_ROBOT_SERVOS],
@@ -190,11 +185,7 @@ where
             encoder: Unwrapper::new(),
             phase: Phase::Stopped,
             last_state: State::Idle,
-            episode_mode: RunMode::Learning,
-            episodes: 0,
-            since_test: 0,
-            episode_return: 0.0,
-            last_action: 0,
+            episodes: Episodes::new(spec.episode_rules()),
             last_output: [0.0; pada_core::action_space::MAX_ACTION_DIMS],
             applied: [0.0; MAX_ROBOT_SERVOS],
             supply: [None; MAX_ROBOT_SERVOS],

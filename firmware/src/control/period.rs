@@ -10,12 +10,12 @@ use crate::bus::BusConfig;
 use crate::config::MAX_ROBOT_SERVOS;
 use crate::io::CycleCounter;
 use crate::robot::{RobotAdapter, Sensed};
-use crate::wear_budget;
 use heapless::Vec;
 use pada_core::dynamixel::{table::PresentState, ErrorFlags};
 use pada_core::safety::{Event, RunMode, Safety, SafetyConfig, Transition};
+use pada_core::episodes::{is_learning_action, wear};
 use pada_core::weights::WeightStore;
-use pada_core::wire::{self, StepKind};
+use pada_core::wire;
 
 /// One servo's part of a period's readings.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -169,11 +169,11 @@ where
             let mode = state.run_mode().unwrap_or(RunMode::Learning);
             if starting {
                 self.start_episode(mode, readings, cycles, out);
-            } else if let Phase::Running { steps } = self.phase {
-                self.continue_episode(steps + 1, readings, cycles, out);
+            } else if self.phase == Phase::Running {
+                self.continue_episode(readings, cycles, out);
             }
             match self.phase {
-                Phase::Running { .. } => {
+                Phase::Running => {
                     let dims = self.spec.motor_dims as usize;
                     self.robot.commands(&self.last_output[..dims], &mut volts)
                 }
@@ -197,12 +197,10 @@ where
             let mut torques = [0.0f32; MAX_ROBOT_SERVOS];
             self.robot.gear_torques(&self.applied, &mut torques);
             torques[n..].fill(0.0);
-            let before = wear_budget::damage_raws(&self.fatigue);
+            let before = wear::damage_raws(&self.fatigue);
             let _ = self.fatigue.update(&torques);
             out.torques = torques;
-            let learning_action = out.step.as_ref().is_some_and(|s| {
-                s.mode == RunMode::Learning && matches!(s.kind, StepKind::Start | StepKind::Step)
-            });
+            let learning_action = out.step.as_ref().is_some_and(|s| is_learning_action(s.mode, s.kind));
             if learning_action {
                 self.govern(&before, out);
             }

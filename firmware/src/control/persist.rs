@@ -57,8 +57,8 @@ where
     /// episodes started, 1: learning episodes since the last test).
     pub fn learner_state(&self) -> LearnerState {
         let mut user = [0u32; checkpoint::USER_COUNTERS];
-        user[user::EPISODES] = self.episodes;
-        user[user::SINCE_TEST] = self.since_test;
+        user[user::EPISODES] = self.episodes.started();
+        user[user::SINCE_TEST] = self.episodes.since_test();
         LearnerState {
             agent: self.agent().state(),
             rng: self.rng.state(),
@@ -152,11 +152,8 @@ where
         let previous = agent.policy().learner_space().encode(&agent.policy().previous());
         self.policy = policy;
         self.rng = rng;
-        self.episodes = state.user[user::EPISODES];
-        self.since_test = state.user[user::SINCE_TEST];
-        self.last_action = previous;
+        self.episodes.restore(state.user[user::EPISODES], state.user[user::SINCE_TEST], previous);
         self.last_output = [0.0; pada_core::action_space::MAX_ACTION_DIMS];
-        self.episode_return = 0.0;
         self.governor = governor;
         // Torque is off (the callers check): no episode runs.
         self.phase = Phase::Stopped;
@@ -348,8 +345,8 @@ mod tests {
         assert!(a.fatigue().joint(0).unwrap().reengagements() > 0);
         assert_eq!(a.save_checkpoint(&mut store), Ok(Saved { generation: 1, slot: 0, erases: 1 }));
         let saved = a.learner_state();
-        assert_eq!(saved.user[user::EPISODES], a.episodes);
-        assert!(a.episodes >= 3);
+        assert_eq!(saved.user[user::EPISODES], a.episodes.started());
+        assert!(a.episodes.started() >= 3);
 
         // The board resets: it boots with SARSA and another seed, and loads.
         let mut b = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 99).unwrap();

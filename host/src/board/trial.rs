@@ -41,6 +41,7 @@ use anyhow::{anyhow, bail};
 use pada_core::fatigue::{FatigueCounter, GearboxParams, PAPER_WINDOW_STEPS};
 use pada_core::fixed::Q16;
 use pada_core::policy::PolicyKind;
+use pada_core::episodes::is_learning_action;
 use pada_core::profile::{LearnerProfile, TILINGS};
 use pada_core::robot::Robot;
 use pada_core::weights::{Half, WeightFormat, WeightStore};
@@ -229,7 +230,7 @@ fn run<R: RobotAdapter, W: WeightStore>(
             if s.kind == StepKind::Start {
                 rig.episode_started(t);
             }
-            learning_action = s.mode == RunMode::Learning && matches!(s.kind, StepKind::Start | StepKind::Step);
+            learning_action = is_learning_action(s.mode, s.kind);
         }
         // The operator hears of an episode's end in its period, before the
         // next boundary, as in the SIL run; the distance is the plant's.

@@ -10,6 +10,7 @@
 
 use crate::experiment::task::TaskSpec;
 use anyhow::anyhow;
+use pada_core::episodes::wear;
 use pada_core::fatigue::{FatigueCounter, GearboxParams};
 use pada_core::governor::{Governor, GovernorConfig, GOVERNED_JOINTS};
 use pada_core::policy::PolicyKind;
@@ -114,11 +115,7 @@ impl TrialGovernor {
     /// moved.
     pub fn observe<const N: usize>(&mut self, before: &[u64; N], fatigue: &FatigueCounter<N>) -> Option<f32> {
         self.stats.record(&self.governor);
-        let mut increments = [0u64; GOVERNED_JOINTS];
-        for (j, inc) in increments.iter_mut().enumerate().take(self.gearboxes.min(N)) {
-            *inc = fatigue.joints()[j].damage_raw() - before[j];
-        }
-        self.governor.observe(&increments)
+        self.governor.observe(&wear::increments(before, fatigue, 0..self.gearboxes))
     }
 
     /// The trial's record, given its two MTBFs.
@@ -127,7 +124,3 @@ impl TrialGovernor {
     }
 }
 
-/// Each counted gearbox's damage (Q16.48), to diff after an update.
-pub fn damage_raws<const N: usize>(fatigue: &FatigueCounter<N>) -> [u64; N] {
-    core::array::from_fn(|j| fatigue.joints()[j].damage_raw())
-}

@@ -155,6 +155,16 @@ impl WeightTable {
 }
 
 impl TaskSpec {
+    /// The rules of the task's episodes, for the shared episode cycle
+    /// ([`pada_core::episodes::Episodes`]).
+    pub fn episode_rules(&self) -> pada_core::episodes::EpisodeRules {
+        pada_core::episodes::EpisodeRules {
+            episode_steps: self.episode_steps,
+            test_interval: self.test_interval,
+            footstep_remap: self.footstep_remap,
+        }
+    }
+
     /// The task of a robot of `pada_core::robot` on a board's learner
     /// `profile`: name, timing, state, motor, action tiles and learning
     /// parameters from the robot's one definition, the table from the

@@ -2,6 +2,12 @@
 //! greedy test run before learning and after every
 //! [`TaskSpec::test_interval`](crate::experiment::task::TaskSpec) learning episodes.
 //!
+//! The episodes themselves (the test cadence, the kinds of end, LEO's
+//! footstep remap, the return, the telemetry records) are the episode
+//! cycle the firmware runs too ([`pada_core::episodes`]); this file drives
+//! it with the simulated plant and keeps the trial's books: the learning
+//! curve, the MTBF counters, the governor's and the switch's moments.
+//!
 //! - The learning curve is the test-run return against learning time (the
 //!   simulated time of learning episodes only; test runs do not count).
 //! - End performance and rise time follow from it ([`super::metrics`]).
@@ -15,14 +21,17 @@
 //!   ([`Plant::gearbox_torques`]).
 
 use super::agent_setup::{build_agent, HostAgent};
-use super::governed::{damage_raws, GovernorTrial, TrialGovernor};
+use super::governed::{GovernorTrial, TrialGovernor};
 use super::metrics::{end_performance, rise_time};
 use super::config::RunConfig;
 use crate::experiment::task::{Plant, Task, TaskSpec};
 use crate::seed::{trial_rng, trial_seed};
 use anyhow::anyhow;
 use pada_core::action_space::MAX_ACTION_DIMS;
-use pada_core::agent::{Decision, EpisodeEnd, Mode};
+use pada_core::agent::Mode;
+use pada_core::episodes::record::Stamp;
+use pada_core::episodes::wear::damage_raws;
+use pada_core::episodes::{Episodes, Transition};
 use pada_core::fatigue::{FatigueCounter, GearboxParams, PAPER_WINDOW_STEPS};
 use pada_core::tile_coding::MAX_STATE_DIMS;
 use pada_core::wire::{self, RunMode, StepKind, ToHost};
@@ -177,21 +186,25 @@ pub fn run_trial_observed<T: Task>(
         curve: Vec::new(),
         observer,
         calls: 0,
-        reported_episodes: 0,
+        cycle: Episodes::new(spec.episode_rules()),
         governor,
+        progress,
     };
 
     let budget = (cfg.seconds / spec.control_period_s).round() as u64;
     t.report_policy();
-    t.test_run()?;
+    // A test run before learning; then the cycle's own test run after
+    // every `test_interval` learning episodes; a final one once the
+    // learning time is spent (unless the last episode was one).
+    let mut last = t.episode(RunMode::Testing)?;
     while t.learning_steps < budget {
-        let mut done = t.episode(true)?.1 as u64;
-        t.episodes += 1;
-        if t.episodes % spec.test_interval.max(1) == 0 || t.learning_steps >= budget {
-            done += t.test_run()?;
-        }
-        progress(done);
+        last = t.episode(RunMode::Learning)?;
     }
+    if last == RunMode::Learning {
+        t.episode(RunMode::Testing)?;
+    }
+    // The agent as a finished run leaves it: learning (for saving).
+    t.agent.set_mode(Mode::Learning);
 
     let times: Vec<f64> = t.curve.iter().map(|p| p.learning_time_s).collect();
     let returns: Vec<f64> = t.curve.iter().map(|p| p.test_return).collect();
@@ -241,7 +254,7 @@ pub fn run_trial_observed<T: Task>(
 }
 
 /// The state of a running trial.
-struct Trial<'a, 'o, P: Plant> {
+struct Trial<'a, 'o, 'p, P: Plant> {
     spec: &'a TaskSpec,
     agent: HostAgent,
     plant: P,
@@ -261,115 +274,38 @@ struct Trial<'a, 'o, P: Plant> {
     observer: Option<TrialObserver<'o>>,
     /// Agent calls so far (the `step` of telemetry).
     calls: u32,
-    /// Episodes reported so far (the `episode` of telemetry).
-    reported_episodes: u32,
+    /// The episode cycle, shared with the firmware.
+    cycle: Episodes,
     /// The wear governor, with `--mtbf-budget`.
     governor: Option<TrialGovernor>,
+    /// Told the environment steps after every episode.
+    progress: &'p (dyn Fn(u64) + Sync),
 }
 
-impl<P: Plant> Trial<'_, '_, P> {
-    /// Reports one agent call to the observer.
-    fn report_step(
-        &mut self,
-        kind: StepKind,
-        learning: bool,
-        reward: f32,
-        decision: Option<&Decision>,
-        footstep: bool,
-    ) {
+impl<P: Plant> Trial<'_, '_, '_, P> {
+    /// Reports one agent call to the observer, as the firmware does
+    /// (the cycle's record).
+    fn report_step(&mut self, t: &Transition) {
         let Some(observer) = self.observer.as_mut() else {
             return;
         };
         self.calls = self.calls.wrapping_add(1);
-        let n = self.spec.state.len();
-        let motors = self.spec.motor.dims();
-        let td_error = match (kind, learning) {
-            (StepKind::Start, _) | (_, false) => 0,
-            _ => self.agent.stats().last_td_error.0,
-        };
-        let joints = self
-            .fatigue
-            .joints()
-            .iter()
-            .take(self.spec.gearboxes.min(wire::MAX_GEARBOXES))
-            .map(|j| wire::JointFatigue {
-                damage: j.damage(),
-                reengagements: j.reengagements().min(u32::MAX as u64) as u32,
-            })
-            .collect();
         let env_steps = self.learning_steps + self.test_steps;
-        observer(ToHost::Step(wire::Step {
+        let stamp = Stamp {
             step: self.calls,
             time_ms: (env_steps as f64 * self.spec.control_period_s * 1000.0) as u32,
-            episode: self.reported_episodes,
-            mode: if learning {
-                RunMode::Learning
-            } else {
-                RunMode::Testing
-            },
-            kind,
-            state: self.obs[..n.min(wire::MAX_STATE_DIMS)]
-                .iter()
-                .copied()
-                .collect(),
-            action: decision.map_or(0, |d| d.action),
-            output: decision
-                .map(|d| {
-                    d.output[..motors.min(wire::MAX_ACTION_DIMS)]
-                        .iter()
-                        .copied()
-                        .collect()
-                })
-                .unwrap_or_default(),
-            reward,
-            td_error,
-            explored: decision.is_some_and(|d| d.explored),
-            footstep,
-            joints,
-            loop_us: 0,
             agent_cycles: 0,
-        }));
-    }
-
-    /// Reports a finished episode to the observer.
-    fn report_episode(&mut self, learning: bool, ret: f64, length: u32) {
-        let Some(observer) = self.observer.as_mut() else {
-            return;
         };
-        observer(ToHost::Episode(wire::Episode {
-            index: self.reported_episodes,
-            mode: if learning {
-                RunMode::Learning
-            } else {
-                RunMode::Testing
-            },
-            total_reward: ret as f32,
-            length,
-            weights_checksum: self.agent.weights_checksum(),
-        }));
-        self.reported_episodes = self.reported_episodes.wrapping_add(1);
-        // While a governor runs, its damage rate after every episode.
-        if self.governor.is_some() {
-            self.report_policy();
+        let gearboxes = &self.fatigue.joints()[..self.spec.gearboxes.min(MAX_ACTION_DIMS)];
+        let obs = &self.obs[..self.spec.state.len()];
+        observer(ToHost::Step(self.cycle.record(t, &self.agent, obs, gearboxes, stamp)));
+        if let Some(report) = t.ended {
+            observer(ToHost::Episode(report));
+            // While a governor runs, its damage rate after every episode.
+            if self.governor.is_some() {
+                self.report_policy();
+            }
         }
-    }
-
-    /// A greedy test run, recorded on the curve; returns its steps.
-    fn test_run(&mut self) -> anyhow::Result<u64> {
-        self.agent.set_mode(Mode::Testing);
-        let result = self.episode(false);
-        self.agent.set_mode(Mode::Learning);
-        let (ret, steps, fell) = result?;
-        self.curve.push(TestPoint {
-            learning_time_s: self.learning_steps as f64 * self.spec.control_period_s,
-            learning_episodes: self.episodes,
-            test_return: ret,
-            walked_m: self.plant.walked_distance_m(),
-            fell,
-            duration_s: steps as f64 * self.spec.control_period_s,
-        });
-        self.test_steps += steps as u64;
-        Ok(steps as u64)
     }
 
     /// Switches to SARSA(λ) once the learning steps reach the switch point.
@@ -397,32 +333,26 @@ impl<P: Plant> Trial<'_, '_, P> {
         }));
     }
 
-    /// One episode to the time limit or an absorbing state; returns the
-    /// undiscounted return, the steps and whether it ended absorbing. A
-    /// learning episode counts its steps, falls and applied torques.
-    fn episode(&mut self, learning: bool) -> anyhow::Result<(f64, u32, bool)> {
+    /// One episode to the time limit or an absorbing state, in the mode the
+    /// cycle gives `requested`; returns that mode. A learning episode
+    /// counts its steps, falls and applied torques; a test run goes on the
+    /// learning curve.
+    fn episode(&mut self, requested: RunMode) -> anyhow::Result<RunMode> {
         let spec = self.spec;
         let (n, motors) = (spec.state.len(), spec.motor.dims());
         let bad = |e: pada_core::error::StepError| anyhow!("{}: {e}", spec.name);
+        let mode = self.cycle.next_mode(requested);
+        let learning = mode == RunMode::Learning;
         if learning {
             self.maybe_switch()?;
         }
         self.plant.reset(&mut self.rng, &mut self.obs[..n]);
-        let mut d: Decision = self
-            .agent
-            .start_episode(&self.obs[..n], &mut self.rng)
-            .map_err(bad)?;
-        self.report_step(StepKind::Start, learning, 0.0, Some(&d), false);
-        let mut ret = 0.0f64;
-        for k in 1..=spec.episode_steps {
+        let mut t = self.cycle.begin(&mut self.agent, requested, &self.obs[..n], &mut self.rng).map_err(bad)?;
+        self.report_step(&t);
+        let report = loop {
+            let Some(d) = t.decision else { unreachable!("a decision until the episode ends") };
             let command = &d.output[..motors];
             let step = self.plant.step(command, &mut self.obs[..n]);
-            // A footstep: the policy's memory moves with the joints before
-            // the next decision (the robot's definition).
-            let footstep = self.plant.footstep() && spec.footstep_remap.is_some();
-            if let (true, Some(map)) = (footstep, spec.footstep_remap) {
-                self.agent.remap_memory(&map);
-            }
             if learning {
                 let before = damage_raws(&self.fatigue);
                 self.fatigue
@@ -439,37 +369,34 @@ impl<P: Plant> Trial<'_, '_, P> {
                     .map_err(|e| anyhow!("{e}"))?;
                 self.learning_steps += 1;
                 self.learning_falls += step.terminal as u64;
+                if !self.cycle.ends_next(step.terminal) {
+                    self.maybe_switch()?;
+                }
             }
-            ret += step.reward as f64;
-            let obs = &self.obs[..n];
-            if step.terminal || k == spec.episode_steps {
-                let end = if step.terminal {
-                    EpisodeEnd::Absorbing
-                } else {
-                    EpisodeEnd::Timeout(obs)
-                };
-                self.agent
-                    .end_episode(step.reward, end, &mut self.rng)
-                    .map_err(bad)?;
-                let kind = if step.terminal {
-                    StepKind::Absorbing
-                } else {
-                    StepKind::Timeout
-                };
-                self.report_step(kind, learning, step.reward, None, footstep);
-                self.report_episode(learning, ret, k);
-                return Ok((ret, k, step.terminal));
-            }
-            if learning {
-                self.maybe_switch()?;
-            }
-            let obs = &self.obs[..n];
-            d = self
-                .agent
-                .step(step.reward, obs, &mut self.rng)
+            let (obs, footstep) = (&self.obs[..n], self.plant.footstep());
+            t = self
+                .cycle
+                .advance(&mut self.agent, obs, step.reward, step.terminal, footstep, &mut self.rng)
                 .map_err(bad)?;
-            self.report_step(StepKind::Step, learning, step.reward, Some(&d), footstep);
+            self.report_step(&t);
+            if let Some(report) = t.ended {
+                break report;
+            }
+        };
+        (self.progress)(report.length as u64);
+        if learning {
+            self.episodes += 1;
+        } else {
+            self.curve.push(TestPoint {
+                learning_time_s: self.learning_steps as f64 * spec.control_period_s,
+                learning_episodes: self.episodes,
+                test_return: t.episode_return,
+                walked_m: self.plant.walked_distance_m(),
+                fell: t.kind == StepKind::Absorbing,
+                duration_s: report.length as f64 * spec.control_period_s,
+            });
+            self.test_steps += report.length as u64;
         }
-        Ok((ret, spec.episode_steps, false))
+        Ok(mode)
     }
 }

@@ -158,6 +158,15 @@ impl RobotSpec {
         self.robot.name()
     }
 
+    /// The rules of the robot's episodes, for [`crate::episodes::Episodes`].
+    pub const fn episode_rules(&self) -> crate::episodes::EpisodeRules {
+        crate::episodes::EpisodeRules {
+            episode_steps: self.episode_steps,
+            test_interval: self.test_interval,
+            footstep_remap: self.footstep_remap,
+        }
+    }
+
     /// The control period \[s\].
     pub fn period_s(&self) -> f64 {
         // Divided, not multiplied by 1e-6: 30 000 µs is then exactly the

@@ -53,7 +53,7 @@ pub(super) use peripherals::lockstep_now_us;
 pub use super::watchdog::Watchdog;
 
 use super::machine;
-use super::{MemoryFault, TableMemory};
+use super::{Parts, TableMemory};
 use crate::table::PROFILE;
 use core::sync::atomic::Ordering;
 use executor::LINK_OPEN;
@@ -66,32 +66,8 @@ use pada_firmware::sil::{self, FromBoard, ToBoard};
 
 pub use machine::CPU_HZ;
 
-/// Everything the tasks get from the board.
-pub struct Board {
-    /// The servo bus.
-    pub servo_port: ServoPort,
-    /// Telemetry out.
-    pub telemetry_tx: TelemetryTx,
-    /// Commands in.
-    pub telemetry_rx: TelemetryRx,
-    /// Encoder and foot switches (a device on the servo bus).
-    pub sensors: BoardSensors,
-    /// The checkpoint slots (a file on the host).
-    pub flash: FlashStore,
-    /// The machine's watchdog (none on netduinoplus2).
-    pub watchdog: Watchdog,
-    /// Lock-step time plus instructions.
-    pub cycles: Cycles,
-    /// No LED.
-    pub led: Led,
-    /// The watchdog reset the chip (mps2-an386; never on netduinoplus2).
-    pub watchdog_reset: bool,
-    /// The table's memory: internal SRAM and CCM, or the mps2's PSRAM,
-    /// which QEMU models from reset.
-    pub table_memory: Result<TableMemory, MemoryFault>,
-    /// The learner's seed, as the host configured it.
-    pub seed: u64,
-}
+/// Everything the tasks get from the board ([`Parts`]).
+pub type Board = Parts<ServoPort, TelemetryTx, TelemetryRx, BoardSensors, FlashStore, Watchdog, Cycles, Led>;
 
 impl Board {
     /// Counter, clock link, the Boot message and the host's configuration.
