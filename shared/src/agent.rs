@@ -73,16 +73,10 @@ pub struct SarsaParams {
 }
 
 impl Default for SarsaParams {
+    /// The paper's Section VII parameters (the pendulum's,
+    /// [`crate::robot::pendulum::PARAMS`]), from zero weights.
     fn default() -> Self {
-        SarsaParams {
-            alpha: 0.2,
-            gamma: 0.99,
-            lambda: 0.92,
-            epsilon: 0.05,
-            trace_threshold: 0.01,
-            trace_kind: TraceKind::Replacing,
-            init: WeightInit::Constant(0.0),
-        }
+        SarsaParams { init: WeightInit::Constant(0.0), ..crate::robot::pendulum::PARAMS }
     }
 }
 

@@ -25,54 +25,82 @@ const SHT_NOBITS: u32 = 8;
 const SHF_WRITE: u32 = 0x1;
 const SHF_ALLOC: u32 = 0x2;
 
-/// The allocated (loaded or reserved) sections of a 32-bit little-endian ELF.
-pub fn section_sizes(elf: &[u8]) -> Result<Vec<Section>, String> {
-    if elf.len() < 52 || &elf[..4] != b"\x7fELF" {
-        return Err("no ELF header".into());
+/// A 32-bit little-endian ELF's bytes and its section header table, read
+/// with bounds checks (a truncated file is an error, never a panic).
+struct Elf32<'a> {
+    elf: &'a [u8],
+    shoff: usize,
+    shentsize: usize,
+    shnum: usize,
+}
+
+impl<'a> Elf32<'a> {
+    fn open(elf: &'a [u8]) -> Result<Self, String> {
+        if elf.len() < 52 || &elf[..4] != b"\x7fELF" {
+            return Err("no ELF header".into());
+        }
+        if elf[4] != 1 || elf[5] != 1 {
+            return Err("not a 32-bit little-endian ELF".into());
+        }
+        let mut e = Elf32 { elf, shoff: 0, shentsize: 0, shnum: 0 };
+        e.shoff = e.u32_at(0x20)? as usize;
+        e.shentsize = e.u16_at(0x2e)?;
+        e.shnum = e.u16_at(0x30)?;
+        if e.shentsize < 40 {
+            return Err("bad section header table".into());
+        }
+        Ok(e)
     }
-    if elf[4] != 1 || elf[5] != 1 {
-        return Err("not a 32-bit little-endian ELF".into());
-    }
-    let u16_at = |off: usize| -> Result<u32, String> {
-        elf.get(off..off + 2)
-            .map(|b| u16::from_le_bytes([b[0], b[1]]) as u32)
+
+    fn u16_at(&self, off: usize) -> Result<usize, String> {
+        self.elf
+            .get(off..off + 2)
+            .map(|b| u16::from_le_bytes([b[0], b[1]]) as usize)
             .ok_or_else(|| format!("truncated at {off:#x}"))
-    };
-    let u32_at = |off: usize| -> Result<u32, String> {
-        elf.get(off..off + 4)
+    }
+
+    fn u32_at(&self, off: usize) -> Result<u32, String> {
+        self.elf
+            .get(off..off + 4)
             .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
             .ok_or_else(|| format!("truncated at {off:#x}"))
-    };
-    let shoff = u32_at(0x20)? as usize;
-    let shentsize = u16_at(0x2e)? as usize;
-    let shnum = u16_at(0x30)? as usize;
-    let shstrndx = u16_at(0x32)? as usize;
-    if shentsize < 40 || shstrndx >= shnum {
+    }
+
+    /// The offset of section header `i`.
+    fn header(&self, i: usize) -> usize {
+        self.shoff + i * self.shentsize
+    }
+
+    /// The NUL-terminated string at `off` (empty past the end).
+    fn c_str(&self, off: usize) -> &'a [u8] {
+        let bytes = self.elf.get(off..).unwrap_or_default();
+        let end = bytes.iter().position(|&b| b == 0).unwrap_or(bytes.len());
+        &bytes[..end]
+    }
+}
+
+/// The allocated (loaded or reserved) sections of a 32-bit little-endian ELF.
+pub fn section_sizes(elf: &[u8]) -> Result<Vec<Section>, String> {
+    let e = Elf32::open(elf)?;
+    let shstrndx = e.u16_at(0x32)?;
+    if shstrndx >= e.shnum {
         return Err("bad section header table".into());
     }
-    let header = |i: usize| shoff + i * shentsize;
-    let strtab = u32_at(header(shstrndx) + 16)? as usize;
-    let name_at = |off: u32| -> String {
-        let start = strtab + off as usize;
-        let bytes = elf.get(start..).unwrap_or_default();
-        let end = bytes.iter().position(|&b| b == 0).unwrap_or(bytes.len());
-        String::from_utf8_lossy(&bytes[..end]).into_owned()
-    };
-
+    let strtab = e.u32_at(e.header(shstrndx) + 16)? as usize;
     let mut sections = Vec::new();
-    for i in 1..shnum {
-        let h = header(i);
-        let flags = u32_at(h + 8)?;
-        let size = u32_at(h + 20)?;
+    for i in 1..e.shnum {
+        let h = e.header(i);
+        let flags = e.u32_at(h + 8)?;
+        let size = e.u32_at(h + 20)?;
         if flags & SHF_ALLOC == 0 || size == 0 {
             continue;
         }
         sections.push(Section {
-            name: name_at(u32_at(h)?),
-            addr: u32_at(h + 12)?,
+            name: String::from_utf8_lossy(e.c_str(strtab + e.u32_at(h)? as usize)).into_owned(),
+            addr: e.u32_at(h + 12)?,
             size,
             writable: flags & SHF_WRITE != 0,
-            nobits: u32_at(h + 4)? == SHT_NOBITS,
+            nobits: e.u32_at(h + 4)? == SHT_NOBITS,
         });
     }
     Ok(sections)
@@ -93,49 +121,28 @@ const SYM_LEN: usize = 16;
 /// a 32-bit little-endian ELF (none if it has no symbol table: a stripped
 /// ELF).
 pub fn symbols(elf: &[u8], prefix: &str) -> Result<Vec<Symbol>, String> {
-    if elf.len() < 52 || &elf[..4] != b"\x7fELF" || elf[4] != 1 || elf[5] != 1 {
-        return Err("not a 32-bit little-endian ELF".into());
-    }
-    let u16_at = |off: usize| -> Result<usize, String> {
-        elf.get(off..off + 2)
-            .map(|b| u16::from_le_bytes([b[0], b[1]]) as usize)
-            .ok_or_else(|| format!("truncated at {off:#x}"))
-    };
-    let u32_at = |off: usize| -> Result<u32, String> {
-        elf.get(off..off + 4)
-            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-            .ok_or_else(|| format!("truncated at {off:#x}"))
-    };
-    let shoff = u32_at(0x20)? as usize;
-    let shentsize = u16_at(0x2e)?;
-    let shnum = u16_at(0x30)?;
-    if shentsize < 40 {
-        return Err("bad section header table".into());
-    }
-    let header = |i: usize| shoff + i * shentsize;
+    let e = Elf32::open(elf)?;
     let mut found = Vec::new();
-    for i in 1..shnum {
-        let h = header(i);
-        if u32_at(h + 4)? != SHT_SYMTAB {
+    for i in 1..e.shnum {
+        let h = e.header(i);
+        if e.u32_at(h + 4)? != SHT_SYMTAB {
             continue;
         }
-        let (offset, size) = (u32_at(h + 16)? as usize, u32_at(h + 20)? as usize);
-        let link = u32_at(h + 24)? as usize;
-        if link >= shnum {
-            return Err(format!("symbol table {i} links to section {link} of {shnum}"));
+        let (offset, size) = (e.u32_at(h + 16)? as usize, e.u32_at(h + 20)? as usize);
+        let link = e.u32_at(h + 24)? as usize;
+        if link >= e.shnum {
+            return Err(format!("symbol table {i} links to section {link} of {}", e.shnum));
         }
-        let strtab = u32_at(header(link) + 16)? as usize;
+        let strtab = e.u32_at(e.header(link) + 16)? as usize;
         for s in (offset..offset + size).step_by(SYM_LEN) {
-            let name_off = strtab + u32_at(s)? as usize;
-            let bytes = elf.get(name_off..).unwrap_or_default();
-            let end = bytes.iter().position(|&b| b == 0).unwrap_or(bytes.len());
-            if !bytes[..end].starts_with(prefix.as_bytes()) {
+            let name = e.c_str(strtab + e.u32_at(s)? as usize);
+            if !name.starts_with(prefix.as_bytes()) {
                 continue;
             }
             found.push(Symbol {
-                name: String::from_utf8_lossy(&bytes[..end]).into_owned(),
-                addr: u32_at(s + 4)?,
-                size: u32_at(s + 8)?,
+                name: String::from_utf8_lossy(name).into_owned(),
+                addr: e.u32_at(s + 4)?,
+                size: e.u32_at(s + 8)?,
             });
         }
     }

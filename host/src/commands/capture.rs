@@ -15,12 +15,12 @@
 use crate::console::{errln, outln};
 use crate::capture::Recorder;
 use crate::serial_link::LinkEvent;
+use super::stream_args::{Opened, StreamInput, StreamRecord};
 use crate::error::{usage, CliError};
 use anyhow::Context;
 use clap::Args;
 use serde::Serialize;
 use std::io::{IsTerminal, Read, Write};
-use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -29,25 +29,12 @@ use std::time::{Duration, Instant};
 #[derive(Debug, Clone, Args)]
 #[command(group(clap::ArgGroup::new("input").required(true).args(["port", "file"])))]
 pub struct CaptureArgs {
-    /// A serial port with a board on it (e.g. /dev/ttyUSB0, /dev/ttyACM0).
-    #[arg(long, value_name = "DEVICE")]
-    pub port: Option<PathBuf>,
-    /// A recorded byte stream (a board's raw output, or `pada run
-    /// --telemetry FILE`); `-` reads standard input.
-    #[arg(long, value_name = "FILE")]
-    pub file: Option<PathBuf>,
-    /// The port's baud rate.
-    #[arg(long, value_name = "B", default_value_t = 921_600)]
-    pub baud: u32,
-    /// Write every frame, lost frame and sequence gap as a CSV row.
-    #[arg(long, value_name = "FILE.csv")]
-    pub out: Option<PathBuf>,
-    /// Stop after this many wall-clock seconds.
-    #[arg(long, value_name = "S")]
-    pub seconds: Option<f64>,
-    /// Print the final summary as JSON on stdout.
-    #[arg(long)]
-    pub json: bool,
+    /// Where the telemetry comes from.
+    #[command(flatten)]
+    pub input: StreamInput,
+    /// What is kept of it.
+    #[command(flatten)]
+    pub record: StreamRecord,
 }
 
 /// The end of a capture.
@@ -71,56 +58,14 @@ pub struct CaptureSummary {
     pub disconnects: u32,
 }
 
-enum Source {
-    Port(crate::serial_link::SerialLink),
-    Reader(Box<dyn Read + Send>),
-}
-
 /// Runs `pada capture`.
 pub fn run(args: CaptureArgs) -> Result<(), CliError> {
-    if let Some(s) = args.seconds {
-        if !(s.is_finite() && s > 0.0) {
-            return Err(usage(format!(
-                "--seconds {s} is out of range: valid is > 0"
-            )));
-        }
-    }
-    if args.baud == 0 || args.baud > 12_000_000 {
-        return Err(usage(format!(
-            "--baud {} is out of range: valid is 1..=12000000",
-            args.baud
-        )));
-    }
-    let (mut source, name) = match (&args.port, &args.file) {
-        (Some(port), _) => {
-            let p = crate::serial_link::SerialLink::open(port, args.baud)
-                .map_err(|e| usage(format!("--port {}: cannot open: {e}", port.display())))?;
-            (Source::Port(p), port.display().to_string())
-        }
-        (None, Some(file)) if file.as_os_str() == "-" => (
-            Source::Reader(Box::new(std::io::stdin())),
-            "standard input".to_string(),
-        ),
-        (None, Some(file)) => {
-            if file.is_dir() {
-                return Err(usage(format!(
-                    "--file {}: is a directory; valid is a recorded stream file or - for standard input",
-                    file.display()
-                )));
-            }
-            let f = std::fs::File::open(file)
-                .map_err(|e| usage(format!("--file {}: cannot open: {e}", file.display())))?;
-            (Source::Reader(Box::new(f)), file.display().to_string())
-        }
-        (None, None) => return Err(usage("give --port DEVICE or --file FILE")),
+    args.record.check()?;
+    args.input.check()?;
+    let Some((mut source, name)) = args.input.open()? else {
+        return Err(usage("give --port DEVICE or --file FILE"));
     };
-    let csv: Option<Box<dyn Write + Send>> = match &args.out {
-        Some(p) => Some(Box::new(std::io::BufWriter::new(
-            std::fs::File::create(p)
-                .map_err(|e| usage(format!("--out {}: cannot create: {e}", p.display())))?,
-        ))),
-        None => None,
-    };
+    let csv = args.record.csv()?;
     let mut rec = Recorder::new(csv)
         .context("cannot write the CSV header")
         .map_err(CliError::Runtime)?;
@@ -144,13 +89,14 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
             break ("interrupted".to_string(), false, false);
         }
         if args
+            .record
             .seconds
             .is_some_and(|s| started.elapsed().as_secs_f64() >= s)
         {
             break ("time limit".to_string(), false, false);
         }
         let n = match &mut source {
-            Source::Port(p) => match p.read(&mut buf) {
+            Opened::Port(p) => match p.read(&mut buf) {
                 LinkEvent::Data(n) => n,
                 LinkEvent::Nothing => 0,
                 LinkEvent::Lost(why) => {
@@ -166,7 +112,7 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
                     0
                 }
             },
-            Source::Reader(r) => match r.read(&mut buf) {
+            Opened::Reader(r) => match r.read(&mut buf) {
                 Ok(0) => break ("end of file".to_string(), true, false),
                 Ok(n) => n,
                 Err(e) if e.kind() == std::io::ErrorKind::Interrupted => 0,
@@ -198,8 +144,8 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
     status(&rec, tty, true);
     let link = rec.stats();
     let disconnects = match &source {
-        Source::Port(p) => p.disconnects(),
-        Source::Reader(_) => 0,
+        Opened::Port(p) => p.disconnects(),
+        Opened::Reader(_) => 0,
     };
     let summary = CaptureSummary {
         disconnects,
@@ -211,7 +157,7 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
         messages: rec.counts(),
         latest: rec.latest().clone(),
     };
-    if args.json {
+    if args.record.json {
         outln!(
             "{}",
             serde_json::to_string_pretty(&summary).map_err(|e| CliError::Runtime(e.into()))?

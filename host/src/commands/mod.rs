@@ -12,5 +12,6 @@ pub mod paper_wear;
 pub mod render;
 pub mod run;
 pub mod sil;
+pub mod stream_args;
 pub mod trial;
 pub mod watch;

@@ -6,6 +6,7 @@
 //! command: the page keeps showing the final state until Ctrl-C or
 //! `--seconds`, which print the summary as `pada capture` does.
 
+use super::stream_args::{Opened, StreamInput, StreamRecord};
 use crate::capture::Recorder;
 use crate::error::{usage, CliError};
 use crate::watch::server::{self, Shared};
@@ -16,7 +17,6 @@ use clap::Args;
 use serde::Serialize;
 use std::io::{IsTerminal, Write};
 use std::net::{SocketAddr, ToSocketAddrs};
-use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -25,34 +25,20 @@ use std::time::{Duration, Instant};
 #[derive(Debug, Clone, Args)]
 #[command(group(clap::ArgGroup::new("input").required(true).args(["port", "file", "listen"])))]
 pub struct WatchArgs {
-    /// A serial port with a board on it (e.g. /dev/ttyUSB0, /dev/ttyACM0).
-    #[arg(long, value_name = "DEVICE")]
-    pub port: Option<PathBuf>,
-    /// A recorded byte stream (a board's raw output, `pada run --telemetry
-    /// FILE`, `pada sil`'s telemetry.bin); `-` reads standard input.
-    #[arg(long, value_name = "FILE")]
-    pub file: Option<PathBuf>,
+    /// Where the telemetry comes from (or `--listen`).
+    #[command(flatten)]
+    pub input: StreamInput,
     /// Wait on this loopback address for one sender (`pada run --telemetry
     /// tcp:…`, `pada sil --telemetry tcp:…`); port 0 picks a free one.
     #[arg(long, value_name = "tcp:HOST:PORT")]
     pub listen: Option<String>,
-    /// The port's baud rate.
-    #[arg(long, value_name = "B", default_value_t = 921_600)]
-    pub baud: u32,
     /// Where the page is served. Loopback unless another address is given
     /// here (the page has no authentication); port 0 picks a free one.
     #[arg(long, value_name = "HOST:PORT", default_value = "127.0.0.1:8080")]
     pub serve: String,
-    /// Write every frame, lost frame and sequence gap as a CSV row (the
-    /// columns of `pada capture --out`).
-    #[arg(long, value_name = "FILE.csv")]
-    pub out: Option<PathBuf>,
-    /// Stop after this many wall-clock seconds.
-    #[arg(long, value_name = "S")]
-    pub seconds: Option<f64>,
-    /// Print the final summary as JSON on stdout.
-    #[arg(long)]
-    pub json: bool,
+    /// What is kept of it (`--out` has the columns of `pada capture --out`).
+    #[command(flatten)]
+    pub record: StreamRecord,
 }
 
 /// The end of a watch: `pada capture --json`'s summary, plus the page.
@@ -110,28 +96,11 @@ pub fn parse_serve(spec: &str) -> Result<SocketAddr, CliError> {
 
 /// Runs `pada watch`.
 pub fn run(args: WatchArgs) -> Result<(), CliError> {
-    if let Some(s) = args.seconds {
-        if !(s.is_finite() && s > 0.0) {
-            return Err(usage(format!(
-                "--seconds {s} is out of range: valid is > 0"
-            )));
-        }
-    }
-    if args.baud == 0 || args.baud > 12_000_000 {
-        return Err(usage(format!(
-            "--baud {} is out of range: valid is 1..=12000000",
-            args.baud
-        )));
-    }
+    args.record.check()?;
+    args.input.check()?;
     let serve = parse_serve(&args.serve)?;
     let (source, name) = open(&args)?;
-    let csv: Option<Box<dyn Write + Send>> = match &args.out {
-        Some(p) => Some(Box::new(std::io::BufWriter::new(
-            std::fs::File::create(p)
-                .map_err(|e| usage(format!("--out {}: cannot create: {e}", p.display())))?,
-        ))),
-        None => None,
-    };
+    let csv = args.record.csv()?;
     let recorder = Arc::new(Mutex::new(
         Recorder::new(csv)
             .context("cannot write the CSV header")
@@ -181,6 +150,7 @@ pub fn run(args: WatchArgs) -> Result<(), CliError> {
             break "interrupted";
         }
         if args
+            .record
             .seconds
             .is_some_and(|s| started.elapsed().as_secs_f64() >= s)
         {
@@ -240,7 +210,7 @@ pub fn run(args: WatchArgs) -> Result<(), CliError> {
         disconnects: shared.disconnects.load(Ordering::SeqCst),
     };
     drop(rec);
-    if args.json {
+    if args.record.json {
         let text =
             serde_json::to_string_pretty(&summary).map_err(|e| CliError::Runtime(e.into()))?;
         let mut out = std::io::stdout().lock();
@@ -273,27 +243,10 @@ pub fn run(args: WatchArgs) -> Result<(), CliError> {
 
 /// Opens the source named by `--port`, `--file` or `--listen`.
 fn open(args: &WatchArgs) -> Result<(Source, String), CliError> {
-    if let Some(port) = &args.port {
-        let p = crate::serial_link::SerialLink::open(port, args.baud)
-            .map_err(|e| usage(format!("--port {}: cannot open: {e}", port.display())))?;
-        return Ok((Source::Port(p), port.display().to_string()));
-    }
-    if let Some(file) = &args.file {
-        if file.as_os_str() == "-" {
-            return Ok((
-                Source::Reader(Box::new(std::io::stdin())),
-                "standard input".to_string(),
-            ));
-        }
-        if file.is_dir() {
-            return Err(usage(format!(
-                "--file {}: is a directory, not a recorded stream",
-                file.display()
-            )));
-        }
-        let f = std::fs::File::open(file)
-            .map_err(|e| usage(format!("--file {}: cannot open: {e}", file.display())))?;
-        return Ok((Source::Reader(Box::new(f)), file.display().to_string()));
+    match args.input.open()? {
+        Some((Opened::Port(p), name)) => return Ok((Source::Port(p), name)),
+        Some((Opened::Reader(r), name)) => return Ok((Source::Reader(r), name)),
+        None => {}
     }
     if let Some(spec) = &args.listen {
         let addr = parse_listen(spec)?;

@@ -19,6 +19,8 @@ pub enum Mark {
     Dot,
     /// A filled triangle.
     Triangle,
+    /// A shaded square, for a shaded band of the plot.
+    Band,
 }
 
 impl Mark {
@@ -30,7 +32,7 @@ impl Mark {
         match self {
             Mark::Dashed => Some((10, 6)),
             Mark::Dotted => Some((2, 4)),
-            Mark::Line | Mark::Dot | Mark::Triangle => None,
+            Mark::Line | Mark::Dot | Mark::Triangle | Mark::Band => None,
         }
     }
 }
@@ -45,6 +47,9 @@ pub struct Entry {
     /// Its mark.
     pub mark: Mark,
 }
+
+/// The opacity of a shaded band, in the plot and in its key.
+pub const BAND_ALPHA: f64 = 0.35;
 
 /// Entries per row of the key.
 const COLUMNS: usize = 2;
@@ -79,6 +84,9 @@ where
                 .map_err(plot_err)?,
             Mark::Triangle => area
                 .draw(&TriangleMarker::new((x + 12, y), 6, e.color.filled()))
+                .map_err(plot_err)?,
+            Mark::Band => area
+                .draw(&Rectangle::new([(x + 4, y - 6), (x + 24, y + 6)], e.color.mix(BAND_ALPHA).filled()))
                 .map_err(plot_err)?,
             mark => {
                 let segments = match mark.dashes() {

@@ -9,9 +9,13 @@
 //! - [`ReengagementsPlot`]: backlash re-engagements per gearbox;
 //! - [`EpisodePlot`]: the last episode's applied output per joint, with the
 //!   steps where a gearbox re-engaged marked.
+//!
+//! Each key is a strip under its plot ([`crate::plot::legend`]), so that
+//! it never covers a point.
 
 use super::state::WatchState;
 use crate::plot::figures::lin_range;
+use crate::plot::legend::{self, Entry, Mark};
 use crate::plot::{plot_err, Figure, FONT};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -28,6 +32,11 @@ pub fn joint_color(i: usize) -> RGBColor {
         RGBColor(148, 103, 189),
     ];
     C[i % C.len()]
+}
+
+/// The key of per-joint curves: one solid line per joint, in its colour.
+fn joint_key(joints: usize) -> Vec<Entry> {
+    (0..joints).map(|i| Entry { label: format!("joint {i}"), color: joint_color(i), mark: Mark::Line }).collect()
 }
 
 /// A tick label: scientific outside 0.01..10⁴, else at most three
@@ -84,9 +93,21 @@ impl Figure for ReturnsPlot<'_> {
             return empty(root, title, "waiting for the first test run");
         }
         root.fill(&WHITE).map_err(plot_err)?;
+        let k = l.end_window_runs.min(l.curve.len());
+        let window = l.end_performance.filter(|_| k > 0);
+        let (shade, dash) = (RGBColor(255, 200, 80), RGBColor(200, 120, 0));
+        let key: Vec<Entry> = window
+            .map(|end| {
+                vec![
+                    Entry { label: format!("end-performance window ({k} runs)"), color: shade, mark: Mark::Band },
+                    Entry { label: format!("end performance {end:.1}"), color: dash, mark: Mark::Dashed },
+                ]
+            })
+            .unwrap_or_default();
+        let (area, key_area) = legend::split(root, key.len());
         let x = lin_range(l.curve.iter().map(|p| p.learning_time_s).chain([0.0]));
         let y = lin_range(l.curve.iter().map(|p| p.test_return));
-        let mut chart = ChartBuilder::on(root)
+        let mut chart = ChartBuilder::on(&area)
             .caption(title, (FONT, 18))
             .margin(8)
             .x_label_area_size(40)
@@ -103,36 +124,26 @@ impl Figure for ReturnsPlot<'_> {
             .axis_desc_style((FONT, 13))
             .draw()
             .map_err(plot_err)?;
-        let k = l.end_window_runs.min(l.curve.len());
-        if let (Some(end), true) = (l.end_performance, k > 0) {
+        if let Some(end) = window {
             let from = l.curve[l.curve.len() - k].learning_time_s;
             let to = l.curve[l.curve.len() - 1].learning_time_s;
-            let shade = RGBColor(255, 200, 80).mix(0.35);
             // At least a few pixels wide, so one test run's window shows.
             let w = ((x.end - x.start) * 0.004).max(to - from);
             chart
                 .draw_series([Rectangle::new(
                     [(to - w, y.start), (to, y.end)],
-                    shade.filled(),
+                    shade.mix(legend::BAND_ALPHA).filled(),
                 )])
-                .map_err(plot_err)?
-                .label(format!("end-performance window ({k} runs)"))
-                .legend(move |(x, y)| {
-                    Rectangle::new([(x, y - 5), (x + 14, y + 5)], shade.filled())
-                });
-            let dash = RGBColor(200, 120, 0);
+                .map_err(plot_err)?;
+            let (dash_px, gap_px) = Mark::Dashed.dashes().unwrap_or((6, 4));
             chart
                 .draw_series(DashedLineSeries::new(
                     vec![(x.start, end), (x.end, end)],
-                    6,
-                    4,
+                    dash_px,
+                    gap_px,
                     dash.stroke_width(2),
                 ))
-                .map_err(plot_err)?
-                .label(format!("end performance {end:.1}"))
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 14, y)], dash.stroke_width(2))
-                });
+                .map_err(plot_err)?;
         }
         let black = RGBColor(0, 0, 0);
         chart
@@ -148,15 +159,7 @@ impl Figure for ReturnsPlot<'_> {
                     .map(|p| Circle::new((p.learning_time_s, p.test_return), 2, black.filled())),
             )
             .map_err(plot_err)?;
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(180, 180, 180))
-            .label_font((FONT, 12))
-            .draw()
-            .map_err(plot_err)?;
-        Ok(())
+        legend::draw(&key_area, &key)
     }
 }
 
@@ -220,6 +223,7 @@ where
         return empty(root, title, "waiting for the first step");
     }
     root.fill(&WHITE).map_err(plot_err)?;
+    let (area, key_area) = legend::split(root, n);
     let x = lin_range(h.with_last().map(|p| p.time_s));
     // Counters only grow from 0: the axis starts at 0 exactly.
     let top = h
@@ -228,7 +232,7 @@ where
         .filter(|v| v.is_finite())
         .fold(0.0f64, f64::max);
     let y = 0.0..if top > 0.0 { top * 1.06 } else { 1.0 };
-    let mut chart = ChartBuilder::on(root)
+    let mut chart = ChartBuilder::on(&area)
         .caption(title, (FONT, 18))
         .margin(8)
         .x_label_area_size(40)
@@ -252,19 +256,9 @@ where
                 h.with_last().map(|p| (p.time_s, value(p, i))),
                 c.stroke_width(2),
             ))
-            .map_err(plot_err)?
-            .label(format!("joint {i}"))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 14, y)], c.stroke_width(2)));
+            .map_err(plot_err)?;
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.85))
-        .border_style(RGBColor(180, 180, 180))
-        .label_font((FONT, 12))
-        .draw()
-        .map_err(plot_err)?;
-    Ok(())
+    legend::draw(&key_area, &joint_key(n))
 }
 
 /// The last episode's applied output per joint.
@@ -288,6 +282,7 @@ impl Figure for EpisodePlot<'_> {
             return empty(root, title, "the last episode had no actions");
         }
         root.fill(&WHITE).map_err(plot_err)?;
+        let (area, key_area) = legend::split(root, dims);
         let caption = format!(
             "Last episode ({} {}{}): applied action per joint",
             e.mode,
@@ -302,7 +297,7 @@ impl Figure for EpisodePlot<'_> {
                 .iter()
                 .flat_map(|s| s.output.iter().map(|&v| v as f64)),
         );
-        let mut chart = ChartBuilder::on(root)
+        let mut chart = ChartBuilder::on(&area)
             .caption(caption, (FONT, 16))
             .margin(8)
             .x_label_area_size(40)
@@ -334,11 +329,7 @@ impl Figure for EpisodePlot<'_> {
             }
             chart
                 .draw_series(LineSeries::new(pts, c.stroke_width(2)))
-                .map_err(plot_err)?
-                .label(format!("joint {i}"))
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 14, y)], c.stroke_width(2))
-                });
+                .map_err(plot_err)?;
             let marks: Vec<(f64, f64)> = e
                 .steps
                 .windows(2)
@@ -353,14 +344,6 @@ impl Figure for EpisodePlot<'_> {
                 )
                 .map_err(plot_err)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(180, 180, 180))
-            .label_font((FONT, 12))
-            .draw()
-            .map_err(plot_err)?;
-        Ok(())
+        legend::draw(&key_area, &joint_key(dims))
     }
 }
