@@ -11,10 +11,9 @@ use crate::paper::figure_data::{curves, point};
 use crate::paper::numbers::{PHYS_TRIALS, SIM_TRIALS};
 use crate::paper::pendulum::{self, ConfigResult, PendulumOptions, PendulumResults};
 use crate::paper::report;
-use crate::plan::mode::{obtain, Trials};
+use crate::plan::mode::obtain_with_bar;
 use crate::plot::figures::{LearningCurves, Measure, MtbfSweep, PerformanceVsMtbf, SweepPoint};
 use crate::plot::save;
-use crate::progress::steps_bar;
 use crate::timing::RunTiming;
 
 
@@ -60,14 +59,11 @@ fn pendulum_cmd(args: PaperArgs) -> Result<(), CliError> {
         command += &format!(" --physical-seconds {}", options.phys_seconds);
     }
     let experiment = pendulum::experiment(&options, command.clone());
-    let (per_config, timing) = match obtain(&mode, &experiment, false, || {
-        let bar = steps_bar(pendulum::expected_steps(&options), "Section VII");
-        let r = pendulum::run_local(&experiment, &|n| bar.inc(n));
-        bar.finish_and_clear();
-        r
-    })? {
-        Trials::PlanWritten => return Ok(()),
-        Trials::Results(r, t) => (r, t),
+    let steps = pendulum::expected_steps(&options);
+    let Some((per_config, timing)) =
+        obtain_with_bar(&mode, &experiment, steps, "Section VII", |p| pendulum::run_local(&experiment, p))?
+    else {
+        return Ok(());
     };
     let results = pendulum::assemble(&options, &experiment, per_config)?;
 

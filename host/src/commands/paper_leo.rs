@@ -13,10 +13,9 @@ use crate::experiment::algo::Algo;
 use crate::paper::figure_data::{curves, figure_label, point};
 use crate::paper::leo::{self, LeoOptions, LeoResults};
 use crate::paper::objective::Objective;
-use crate::plan::mode::{obtain, Trials};
+use crate::plan::mode::obtain_with_bar;
 use crate::plot::figures::{LearningCurves, Measure, PerformanceVsMtbf, SweepPoint};
 use crate::plot::save;
-use crate::progress::steps_bar;
 use std::fmt::Write as _;
 
 /// Default trials per configuration of `pada paper leo` (paper: 15).
@@ -43,15 +42,14 @@ pub fn run(args: PaperArgs) -> Result<(), CliError> {
     );
     let experiment = leo::experiment(&o, command.clone());
     let mut kept = None;
-    let (per_config, timing) = match obtain(&mode, &experiment, false, || {
-        let bar = steps_bar(leo::expected_steps(&o), "Section VIII (LEO)");
-        let (r, best) = leo::run_local(&experiment, &|n| bar.inc(n))?;
-        bar.finish_and_clear();
+    let steps = leo::expected_steps(&o);
+    let Some((per_config, timing)) = obtain_with_bar(&mode, &experiment, steps, "Section VIII (LEO)", |p| {
+        let (r, best) = leo::run_local(&experiment, p)?;
         kept = Some(best);
         Ok(r)
-    })? {
-        Trials::PlanWritten => return Ok(()),
-        Trials::Results(r, t) => (r, t),
+    })?
+    else {
+        return Ok(());
     };
     let best = match (kept, mode.plan_dir()) {
         (Some(best), _) => best,

@@ -10,11 +10,10 @@ use crate::experiment::algo::Algo;
 use crate::experiment::tasks::TaskName;
 use crate::output::OutDir;
 use crate::paper::wear::{self, WearOptions, WearResult, WearResults};
-use crate::plan::mode::{obtain, Trials};
+use crate::plan::mode::obtain_with_bar;
 use crate::plot::figures::{Curve, LearningCurves};
 use crate::plot::save;
 use crate::plot::wear::{WearPareto, WearPoint};
-use crate::progress::steps_bar;
 
 /// Default trials per configuration: the paper's 29 on the pendulum; 3 on
 /// LEO (as `pada paper leo`: a LEO trial of an hour costs minutes).
@@ -53,14 +52,12 @@ pub fn run(args: PaperArgs) -> Result<(), CliError> {
     let command =
         format!("pada paper wear --task {task} --trials {} --seconds {} --seed {}", o.trials, o.seconds, o.seed);
     let experiment = wear::experiment(&o, command.clone());
-    let (per_config, timing) = match obtain(&mode, &experiment, false, || {
-        let bar = steps_bar(wear::expected_steps(&o, &experiment), "wear sweep");
-        let r = crate::plan::local::run_experiment(&experiment, &|n| bar.inc(n));
-        bar.finish_and_clear();
-        r
-    })? {
-        Trials::PlanWritten => return Ok(()),
-        Trials::Results(r, t) => (r, t),
+    let steps = wear::expected_steps(&o, &experiment);
+    let Some((per_config, timing)) = obtain_with_bar(&mode, &experiment, steps, "wear sweep", |p| {
+        crate::plan::local::run_experiment(&experiment, p)
+    })?
+    else {
+        return Ok(());
     };
     let r = wear::assemble(&o, &experiment, per_config)?;
     let report = wear::render(&r, &command);

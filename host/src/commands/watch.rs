@@ -6,6 +6,7 @@
 //! command: the page keeps showing the final state until Ctrl-C or
 //! `--seconds`, which print the summary as `pada capture` does.
 
+use super::capture::CaptureSummary;
 use super::stream_args::{Opened, StreamInput, StreamRecord};
 use crate::capture::Recorder;
 use crate::error::{usage, CliError};
@@ -44,26 +45,13 @@ pub struct WatchArgs {
 /// The end of a watch: `pada capture --json`'s summary, plus the page.
 #[derive(Debug, Clone, Serialize)]
 pub struct WatchSummary {
-    /// What was read.
-    pub source: String,
-    /// Why the stream (or, before its end, the watch) ended.
-    pub ended: String,
-    /// Wall-clock duration \[s\].
-    pub wall_s: f64,
-    /// Frames, bytes and every kind of loss.
-    pub link: pada_core::wire::LinkStats,
-    /// Frames that could not be used (all kinds).
-    pub bad_frames: u32,
-    /// Frames by message.
-    pub messages: crate::capture::MessageCounts,
-    /// The latest values (episodes, returns, fatigue, fault).
-    pub latest: crate::capture::Latest,
+    /// What `pada capture --json` reports.
+    #[serde(flatten)]
+    pub capture: CaptureSummary,
     /// The page's address.
     pub url: String,
     /// HTTP requests answered.
     pub requests: u64,
-    /// Times the serial port went away (and was waited for).
-    pub disconnects: u32,
 }
 
 /// Parses `tcp:HOST:PORT` on the loopback interface.
@@ -198,16 +186,18 @@ pub fn run(args: WatchArgs) -> Result<(), CliError> {
     }
     let link = rec.stats();
     let summary = WatchSummary {
-        source: name,
-        ended,
-        wall_s: started.elapsed().as_secs_f64(),
-        link,
-        bad_frames: link.bad_frames(),
-        messages: rec.counts(),
-        latest: rec.latest().clone(),
+        capture: CaptureSummary {
+            source: name,
+            ended,
+            wall_s: started.elapsed().as_secs_f64(),
+            link,
+            bad_frames: link.bad_frames(),
+            messages: rec.counts(),
+            latest: rec.latest().clone(),
+            disconnects: shared.disconnects.load(Ordering::SeqCst),
+        },
         url,
         requests: shared.requests.load(Ordering::Relaxed),
-        disconnects: shared.disconnects.load(Ordering::SeqCst),
     };
     drop(rec);
     if args.record.json {
@@ -221,21 +211,21 @@ pub fn run(args: WatchArgs) -> Result<(), CliError> {
     } else {
         eprintln!(
             "watch of {} ended ({}): {} frames, {} lost, {} sequence gaps ({} frames missing), {} disconnects; {} requests served",
-            summary.source,
-            summary.ended,
+            summary.capture.source,
+            summary.capture.ended,
             link.frames,
-            summary.bad_frames,
+            summary.capture.bad_frames,
             link.seq_gaps,
             link.frames_missed,
-            summary.disconnects,
+            summary.capture.disconnects,
             summary.requests
         );
     }
     if shared.failed.load(Ordering::SeqCst) {
         return Err(CliError::Runtime(anyhow::anyhow!(
             "the stream of {} failed: {}",
-            summary.source,
-            summary.ended
+            summary.capture.source,
+            summary.capture.ended
         )));
     }
     Ok(())

@@ -265,3 +265,25 @@ pub fn obtain(
         FromPlan::Results { collected, timing } => Trials::Results(collected.per_config, *timing),
     })
 }
+
+/// [`obtain`] for a paper experiment: while its trials run in this
+/// process, a progress bar over its `expected_steps` environment steps,
+/// labelled `label`. `None` when only the plan was written.
+pub fn obtain_with_bar(
+    mode: &Mode,
+    experiment: &super::Experiment,
+    expected_steps: u64,
+    label: &str,
+    run: impl FnOnce(&(dyn Fn(u64) + Sync)) -> anyhow::Result<Vec<Vec<crate::experiment::TrialResult>>>,
+) -> Result<Option<(Vec<Vec<crate::experiment::TrialResult>>, RunTiming)>, CliError> {
+    let trials = obtain(mode, experiment, false, || {
+        let bar = crate::progress::steps_bar(expected_steps, label);
+        let results = run(&|n| bar.inc(n));
+        bar.finish_and_clear();
+        results
+    })?;
+    Ok(match trials {
+        Trials::PlanWritten => None,
+        Trials::Results(r, t) => Some((r, t)),
+    })
+}

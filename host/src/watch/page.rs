@@ -3,7 +3,7 @@
 //! Nothing is loaded from anywhere else, so it works offline; without
 //! script, it reloads itself every two seconds.
 
-use super::plots::{DamagePlot, EpisodePlot, ReengagementsPlot, ReturnsPlot};
+use super::plots::{EpisodePlot, FatiguePlot, ReturnsPlot};
 use super::state::WatchState;
 use crate::plot::to_svg;
 use std::fmt::Write as _;
@@ -173,8 +173,8 @@ pub fn live(state: &WatchState, clock: Clock) -> String {
     h.push_str("<div class=\"grid\">");
     let svgs = [
         to_svg(&ReturnsPlot(s)),
-        to_svg(&DamagePlot(s)),
-        to_svg(&ReengagementsPlot(s)),
+        to_svg(&FatiguePlot::damage(s)),
+        to_svg(&FatiguePlot::reengagements(s)),
         to_svg(&EpisodePlot(s)),
     ];
     for (id, svg) in PLOT_IDS.iter().zip(svgs) {

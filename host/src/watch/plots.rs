@@ -5,8 +5,8 @@
 //! - [`ReturnsPlot`]: test returns against learning time, the
 //!   end-performance window (the last ⌈n/10⌉ test runs, Section VI) shaded
 //!   and its mean dashed;
-//! - [`DamagePlot`]: damage J per gearbox against time (Eq. 7);
-//! - [`ReengagementsPlot`]: backlash re-engagements per gearbox;
+//! - [`FatiguePlot`]: damage J per gearbox against time (Eq. 7), or
+//!   backlash re-engagements per gearbox;
 //! - [`EpisodePlot`]: the last episode's applied output per joint, with the
 //!   steps where a gearbox re-engaged marked.
 //!
@@ -17,7 +17,9 @@ use super::state::WatchState;
 use crate::plot::figures::lin_range;
 use crate::plot::legend::{self, Entry, Mark};
 use crate::plot::{plot_err, Figure, FONT};
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
+use std::ops::Range;
 use plotters::prelude::*;
 
 /// Pixel size of each plot.
@@ -51,6 +53,48 @@ fn tick(v: f64) -> String {
         "0".into()
     } else {
         s.to_string()
+    }
+}
+
+/// The axes of every plot of the page: its caption, the ranges, the
+/// tick labels of [`tick`] and the axis descriptions.
+struct Axes<'t> {
+    caption: &'t str,
+    caption_px: u32,
+    /// Width of the y labels' area \[px\] (wide enough for its ticks).
+    y_label_px: u32,
+    x_desc: &'t str,
+    y_desc: &'t str,
+}
+
+impl Axes<'_> {
+    fn draw<'a, DB: DrawingBackend>(
+        &self,
+        area: &'a DrawingArea<DB, Shift>,
+        x: Range<f64>,
+        y: Range<f64>,
+    ) -> anyhow::Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>>
+    where
+        DB::ErrorType: 'static,
+    {
+        let mut chart = ChartBuilder::on(area)
+            .caption(self.caption, (FONT, self.caption_px))
+            .margin(8)
+            .x_label_area_size(40)
+            .y_label_area_size(self.y_label_px)
+            .build_cartesian_2d(x, y)
+            .map_err(plot_err)?;
+        chart
+            .configure_mesh()
+            .x_label_formatter(&|v| tick(*v))
+            .y_label_formatter(&|v| tick(*v))
+            .x_desc(self.x_desc)
+            .y_desc(self.y_desc)
+            .label_style((FONT, 12))
+            .axis_desc_style((FONT, 13))
+            .draw()
+            .map_err(plot_err)?;
+        Ok(chart)
     }
 }
 
@@ -107,23 +151,8 @@ impl Figure for ReturnsPlot<'_> {
         let (area, key_area) = legend::split(root, key.len());
         let x = lin_range(l.curve.iter().map(|p| p.learning_time_s).chain([0.0]));
         let y = lin_range(l.curve.iter().map(|p| p.test_return));
-        let mut chart = ChartBuilder::on(&area)
-            .caption(title, (FONT, 18))
-            .margin(8)
-            .x_label_area_size(40)
-            .y_label_area_size(64)
-            .build_cartesian_2d(x.clone(), y.clone())
-            .map_err(plot_err)?;
-        chart
-            .configure_mesh()
-            .x_label_formatter(&|v| tick(*v))
-            .y_label_formatter(&|v| tick(*v))
-            .x_desc("learning time [s]")
-            .y_desc("return")
-            .label_style((FONT, 12))
-            .axis_desc_style((FONT, 13))
-            .draw()
-            .map_err(plot_err)?;
+        let axes = Axes { caption: title, caption_px: 18, y_label_px: 64, x_desc: "learning time [s]", y_desc: "return" };
+        let mut chart = axes.draw(&area, x.clone(), y.clone())?;
         if let Some(end) = window {
             let from = l.curve[l.curve.len() - k].learning_time_s;
             let to = l.curve[l.curve.len() - 1].learning_time_s;
@@ -163,32 +192,34 @@ impl Figure for ReturnsPlot<'_> {
     }
 }
 
-/// Damage J per gearbox against time.
-pub struct DamagePlot<'a>(pub &'a WatchState);
+/// A fatigue counter's quantity per gearbox against time: damage J
+/// ([`FatiguePlot::damage`], Eq. 7) or backlash re-engagements
+/// ([`FatiguePlot::reengagements`]).
+pub struct FatiguePlot<'a> {
+    state: &'a WatchState,
+    title: &'static str,
+    y_desc: &'static str,
+    value: fn(&super::state::FatiguePoint, usize) -> f64,
+}
 
-impl Figure for DamagePlot<'_> {
-    fn size(&self) -> (u32, u32) {
-        SIZE
+impl<'a> FatiguePlot<'a> {
+    /// Damage J per gearbox (Eq. 7).
+    pub fn damage(state: &'a WatchState) -> Self {
+        FatiguePlot { state, title: "Damage J per gearbox (Eq. 7)", y_desc: "damage J", value: |p, i| p.damage[i] }
     }
 
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> anyhow::Result<()>
-    where
-        DB::ErrorType: 'static,
-    {
-        fatigue_plot(
-            root,
-            self.0,
-            "Damage J per gearbox (Eq. 7)",
-            "damage J",
-            |p, i| p.damage[i],
-        )
+    /// Backlash re-engagements per gearbox.
+    pub fn reengagements(state: &'a WatchState) -> Self {
+        FatiguePlot {
+            state,
+            title: "Backlash re-engagements per gearbox",
+            y_desc: "re-engagements",
+            value: |p, i| p.reengagements[i] as f64,
+        }
     }
 }
 
-/// Backlash re-engagements per gearbox against time.
-pub struct ReengagementsPlot<'a>(pub &'a WatchState);
-
-impl Figure for ReengagementsPlot<'_> {
+impl Figure for FatiguePlot<'_> {
     fn size(&self) -> (u32, u32) {
         SIZE
     }
@@ -197,13 +228,7 @@ impl Figure for ReengagementsPlot<'_> {
     where
         DB::ErrorType: 'static,
     {
-        fatigue_plot(
-            root,
-            self.0,
-            "Backlash re-engagements per gearbox",
-            "re-engagements",
-            |p, i| p.reengagements[i] as f64,
-        )
+        fatigue_plot(root, self.state, self.title, self.y_desc, self.value)
     }
 }
 
@@ -232,23 +257,8 @@ where
         .filter(|v| v.is_finite())
         .fold(0.0f64, f64::max);
     let y = 0.0..if top > 0.0 { top * 1.06 } else { 1.0 };
-    let mut chart = ChartBuilder::on(&area)
-        .caption(title, (FONT, 18))
-        .margin(8)
-        .x_label_area_size(40)
-        .y_label_area_size(72)
-        .build_cartesian_2d(x, y)
-        .map_err(plot_err)?;
-    chart
-        .configure_mesh()
-        .x_label_formatter(&|v| tick(*v))
-        .y_label_formatter(&|v| tick(*v))
-        .x_desc("time since boot [s]")
-        .y_desc(y_desc)
-        .label_style((FONT, 12))
-        .axis_desc_style((FONT, 13))
-        .draw()
-        .map_err(plot_err)?;
+    let axes = Axes { caption: title, caption_px: 18, y_label_px: 72, x_desc: "time since boot [s]", y_desc };
+    let mut chart = axes.draw(&area, x, y)?;
     for i in 0..n {
         let c = joint_color(i);
         chart
@@ -297,23 +307,14 @@ impl Figure for EpisodePlot<'_> {
                 .iter()
                 .flat_map(|s| s.output.iter().map(|&v| v as f64)),
         );
-        let mut chart = ChartBuilder::on(&area)
-            .caption(caption, (FONT, 16))
-            .margin(8)
-            .x_label_area_size(40)
-            .y_label_area_size(64)
-            .build_cartesian_2d(x, y)
-            .map_err(plot_err)?;
-        chart
-            .configure_mesh()
-            .x_label_formatter(&|v| tick(*v))
-            .y_label_formatter(&|v| tick(*v))
-            .x_desc("time in the episode [s]")
-            .y_desc("applied output (torque or voltage)")
-            .label_style((FONT, 12))
-            .axis_desc_style((FONT, 13))
-            .draw()
-            .map_err(plot_err)?;
+        let axes = Axes {
+            caption: &caption,
+            caption_px: 16,
+            y_label_px: 64,
+            x_desc: "time in the episode [s]",
+            y_desc: "applied output (torque or voltage)",
+        };
+        let mut chart = axes.draw(&area, x, y)?;
         for i in 0..dims {
             let c = joint_color(i);
             // Held for the whole control period: a staircase.

@@ -7,7 +7,7 @@
 //! ignored write error.
 
 use super::page::{self, Clock, STALL_AFTER_S};
-use super::plots::{DamagePlot, EpisodePlot, ReengagementsPlot, ReturnsPlot};
+use super::plots::{EpisodePlot, FatiguePlot, ReturnsPlot};
 use super::state::WatchState;
 use crate::plot::to_svg;
 use serde::Serialize;
@@ -227,8 +227,8 @@ pub fn handle(rq: Request, shared: &Shared) {
             let state = shared.snapshot();
             let (status, body) = svg(match path.as_str() {
                 "/plot/returns.svg" => to_svg(&ReturnsPlot(&state)),
-                "/plot/damage.svg" => to_svg(&DamagePlot(&state)),
-                "/plot/reengagements.svg" => to_svg(&ReengagementsPlot(&state)),
+                "/plot/damage.svg" => to_svg(&FatiguePlot::damage(&state)),
+                "/plot/reengagements.svg" => to_svg(&FatiguePlot::reengagements(&state)),
                 _ => to_svg(&EpisodePlot(&state)),
             });
             respond(rq, status, "image/svg+xml", body.into_bytes());

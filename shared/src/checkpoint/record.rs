@@ -59,7 +59,7 @@
 //! Records of version 1 (496 bytes, before the flash wear) and 2 (512
 //! bytes, before the governor) are refused; the flash wear sits at the
 //! same offsets in versions 2 and 3, so a version-2 record's wear is still
-//! read ([`WEAR_END`]).
+//! read (`WEAR_END`).
 //!
 //! The record holds what a learner carries between episodes
 //! ([`AgentState`]), not the eligibility trace: restoring ends the episode

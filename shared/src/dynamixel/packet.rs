@@ -392,20 +392,7 @@ pub fn sync_write<'b>(
         }
         params += 1 + data.len();
     }
-    if params > MAX_PARAMS {
-        return Err(EncodeError::TooManyParams { params });
-    }
-    let total = params + OVERHEAD;
-    if out.len() < total {
-        return Err(EncodeError::BufferTooSmall { needed: total, available: out.len() });
-    }
-    out[0] = 0xFF;
-    out[1] = 0xFF;
-    out[2] = BROADCAST_ID;
-    out[3] = (params + 2) as u8;
-    out[4] = InstructionCode::SyncWrite as u8;
-    out[5] = addr;
-    out[6] = data_len;
+    let total = sync_write_header(addr, data_len, params, out)?;
     let mut i = 7;
     for (id, data) in entries {
         out[i] = *id;
@@ -416,10 +403,10 @@ pub fn sync_write<'b>(
     Ok(&out[..total])
 }
 
-/// Encodes a SYNC_WRITE of one little-endian 16-bit value per servo at
-/// `addr` (the usual case: Moving Speed of every joint in one packet).
-pub fn sync_write_u16<'b>(addr: u8, entries: &[(u8, u16)], out: &'b mut [u8]) -> Result<&'b [u8], EncodeError> {
-    let params = 2 + 3 * entries.len();
+/// Checks that a SYNC_WRITE of `params` parameter bytes fits a packet and
+/// `out`, and writes its first 7 bytes (header, broadcast ID, length,
+/// instruction, `addr`, `data_len`); returns the packet's whole length.
+fn sync_write_header(addr: u8, data_len: u8, params: usize, out: &mut [u8]) -> Result<usize, EncodeError> {
     if params > MAX_PARAMS {
         return Err(EncodeError::TooManyParams { params });
     }
@@ -427,13 +414,14 @@ pub fn sync_write_u16<'b>(addr: u8, entries: &[(u8, u16)], out: &'b mut [u8]) ->
     if out.len() < total {
         return Err(EncodeError::BufferTooSmall { needed: total, available: out.len() });
     }
-    out[0] = 0xFF;
-    out[1] = 0xFF;
-    out[2] = BROADCAST_ID;
-    out[3] = (params + 2) as u8;
-    out[4] = InstructionCode::SyncWrite as u8;
-    out[5] = addr;
-    out[6] = 2;
+    out[..7].copy_from_slice(&[0xFF, 0xFF, BROADCAST_ID, (params + 2) as u8, InstructionCode::SyncWrite as u8, addr, data_len]);
+    Ok(total)
+}
+
+/// Encodes a SYNC_WRITE of one little-endian 16-bit value per servo at
+/// `addr` (the usual case: Moving Speed of every joint in one packet).
+pub fn sync_write_u16<'b>(addr: u8, entries: &[(u8, u16)], out: &'b mut [u8]) -> Result<&'b [u8], EncodeError> {
+    let total = sync_write_header(addr, 2, 2 + 3 * entries.len(), out)?;
     let mut i = 7;
     for &(id, value) in entries {
         out[i] = id;

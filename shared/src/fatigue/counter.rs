@@ -33,7 +33,7 @@ pub struct JointFatigueState {
     pub steps: u64,
     /// Re-engagements so far.
     pub reengagements: u64,
-    /// Total damage J in Q16.48 units ([`DAMAGE_FRAC_BITS`]).
+    /// Total damage J in Q16.48 units ([`super::DAMAGE_FRAC_BITS`]).
     pub damage_raw: u64,
     /// Re-engagements inside the window (0 without window).
     pub window_reengagements: u64,
@@ -282,7 +282,7 @@ impl JointFatigue {
     }
 
     /// Total damage J in accumulator units of 2⁻⁴⁸ (unsigned Q16.48, see
-    /// [`DAMAGE_FRAC_BITS`]); bit-identical across platforms.
+    /// [`super::DAMAGE_FRAC_BITS`]); bit-identical across platforms.
     pub fn damage_raw(&self) -> u64 {
         self.damage_raw
     }

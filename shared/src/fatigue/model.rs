@@ -60,9 +60,9 @@ pub enum FatigueError {
         /// The valid range, in words (`"0 < k_nm_per_rad < ∞"`).
         valid: &'static str,
     },
-    /// A torque given to [`JointFatigue::update`] is NaN or infinite.
+    /// A torque given to [`super::JointFatigue::update`] is NaN or infinite.
     NonFiniteTorque,
-    /// The torque of joint `joint` given to [`FatigueCounter::update`] is NaN
+    /// The torque of joint `joint` given to [`super::FatigueCounter::update`] is NaN
     /// or infinite (no joint was updated).
     NonFiniteJointTorque {
         /// Index of the offending joint.

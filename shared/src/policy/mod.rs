@@ -1,5 +1,5 @@
 //! The action policies as one concept: Section V's six and the four gentle
-//! explorations ([`kind`]).
+//! explorations (`kind.rs`).
 //!
 //! A [`Policy`] sits between the learner and the motor. It decides
 //! 1. which actions the learner may choose from ([`Policy::candidates`] for

@@ -28,79 +28,14 @@ use crate::error::{check_range, ConfigError, StepError};
 use crate::fixed::{Frac, Q16};
 use crate::policy::{uniform_below, Candidates, Exploration, Policy, PolicyKind, PolicyState};
 use crate::tile_coding::{Layout, StateCode, StateDim, TileCoder, MAX_STATE_DIMS};
-use crate::trace::{Trace, TraceKind};
+use crate::trace::Trace;
 use crate::weights::{entry_factor, WeightStore};
-use heapless::Vec;
 use rand_core::RngCore;
 
-/// How weights start.
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum WeightInit {
-    /// Every weight equal (optimistic initialisation when above the
-    /// achievable returns).
-    Constant(f32),
-    /// Independent uniform draws in `[min, max]` (GRL uses U[0, 1]).
-    Uniform {
-        /// Lower end.
-        min: f32,
-        /// Upper end.
-        max: f32,
-    },
-}
-
-/// Learning parameters. [`Default`] is the paper's (Section VII): α 0.2,
-/// γ 0.99, ε 0.05, λ 0.92, replacing traces pruned at 0.01, weights 0.
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub struct SarsaParams {
-    /// Learning rate α, `0 < α ≤ 1`: Q moves by α·δ.
-    pub alpha: f32,
-    /// Discount γ per step, `0 ≤ γ ≤ 1`.
-    pub gamma: f32,
-    /// Trace decay λ per step, `0 ≤ λ ≤ 1`.
-    pub lambda: f32,
-    /// Exploration rate ε, `0 ≤ ε ≤ 1`.
-    pub epsilon: f32,
-    /// Trace entries with eligibility `(γλ)^k` below this are pruned,
-    /// `0 < threshold < 1`.
-    pub trace_threshold: f32,
-    /// Replacing (default) or accumulating traces.
-    pub trace_kind: TraceKind,
-    /// Initial weights.
-    pub init: WeightInit,
-}
-
-impl Default for SarsaParams {
-    /// The paper's Section VII parameters (the pendulum's,
-    /// [`crate::robot::pendulum::PARAMS`]), from zero weights.
-    fn default() -> Self {
-        SarsaParams { init: WeightInit::Constant(0.0), ..crate::robot::pendulum::PARAMS }
-    }
-}
-
-impl SarsaParams {
-    /// Checks every parameter's range.
-    pub fn validate(&self) -> Result<(), ConfigError> {
-        if !(self.alpha.is_finite() && self.alpha > 0.0 && self.alpha <= 1.0) {
-            return Err(ConfigError::new("alpha", self.alpha, "0 < alpha <= 1"));
-        }
-        check_range("gamma", self.gamma, 0.0, 1.0, "0 <= gamma <= 1")?;
-        check_range("lambda", self.lambda, 0.0, 1.0, "0 <= lambda <= 1")?;
-        check_range("epsilon", self.epsilon, 0.0, 1.0, "0 <= epsilon <= 1")?;
-        if !(self.trace_threshold.is_finite() && self.trace_threshold > 0.0 && self.trace_threshold < 1.0) {
-            return Err(ConfigError::new("trace_threshold", self.trace_threshold, "0 < trace_threshold < 1"));
-        }
-        match self.init {
-            WeightInit::Constant(c) => check_range("init", c, -30000.0, 30000.0, "-30000 <= init <= 30000"),
-            WeightInit::Uniform { min, max } => {
-                check_range("init.min", min, -30000.0, 30000.0, "-30000 <= init.min <= init.max <= 30000")?;
-                check_range("init.max", max, min, 30000.0, "-30000 <= init.min <= init.max <= 30000")
-            }
-        }
-    }
-}
+mod coder;
+mod params;
+pub use coder::{coder_for, exact_table_len};
+pub use params::{SarsaParams, WeightInit};
 
 /// Learning (ε-greedy, updates) or testing (greedy, no updates: the test
 /// runs of Section VI).
@@ -765,43 +700,4 @@ where
         self.stats.saturations = self.stats.saturations.saturating_add(saturations);
         self.stats.updates += 1;
     }
-}
-
-/// The tile coder of an agent for `obs` driving `policy`, on a table of
-/// `table_len` weights laid out as `layout`: the observation's dimensions,
-/// then the policy's own (the Markov filters' previous action), over the
-/// policy's learner actions. The one place it is built, for the agent
-/// ([`Agent::new`]), the robot's check before a new policy
-/// ([`crate::robot::RobotSpec::check`]) and the size of an exact table
-/// ([`exact_table_len`]).
-pub fn coder_for<const TILINGS: usize>(
-    obs: &[StateDim],
-    policy: &Policy,
-    layout: Layout,
-    table_len: usize,
-) -> Result<TileCoder<TILINGS>, ConfigError> {
-    let too_many = || {
-        ConfigError::new("state dimensions", (obs.len() + policy.extension_len()) as f32, "at most 16 including the policy's")
-    };
-    let mut dims: Vec<StateDim, MAX_STATE_DIMS> = Vec::new();
-    for d in obs {
-        dims.push(*d).map_err(|_| too_many())?;
-    }
-    for i in 0..policy.extension_len() {
-        dims.push(policy.extension_dim(i)?).map_err(|_| too_many())?;
-    }
-    TileCoder::new(&dims, policy.learner_space().joint_count(), layout, table_len)
-}
-
-/// Weights of the exact table (tilings × tiles × learner actions) an agent
-/// for `obs` driving `motor` through `policy` needs: a Markov filter's extra
-/// state dimension and PADA's fewer learner actions change it.
-pub fn exact_table_len<const TILINGS: usize>(
-    obs: &[StateDim],
-    motor: ActionSpace,
-    policy: PolicyKind,
-) -> Result<usize, ConfigError> {
-    let policy = Policy::new(policy, motor)?;
-    let coder = coder_for::<TILINGS>(obs, &policy, Layout::Exact, u32::MAX as usize)?;
-    coder.exact_size().ok_or_else(|| ConfigError::new("exact table size", f32::INFINITY, "fewer than 2^32 weights"))
 }
