@@ -106,16 +106,21 @@ const fn limit([min, max]: [f32; 2]) -> Option<SoftLimit> {
     Some(SoftLimit { min: min - STOP_MARGIN, max: max + STOP_MARGIN })
 }
 
-/// LEO's soft limits in joint order: its stops plus the margin.
-const LEO_LIMITS: [Option<SoftLimit>; NUM_JOINTS] = [
-    limit(SHOULDER_SOFT_LIMITS),
-    limit(leo::HIP_LIMITS),
-    limit(leo::HIP_LIMITS),
-    limit(leo::KNEE_LIMITS),
-    limit(leo::KNEE_LIMITS),
-    limit(leo::ANKLE_LIMITS),
-    limit(leo::ANKLE_LIMITS),
-];
+/// LEO's soft limits in joint order: the definition's stops
+/// (`leo::joint_limits`; the shoulder's ±90° where it has none) plus the
+/// margin.
+const LEO_LIMITS: [Option<SoftLimit>; NUM_JOINTS] = {
+    let mut out = [None; NUM_JOINTS];
+    let mut i = 0;
+    while i < NUM_JOINTS {
+        out[i] = limit(match leo::joint_limits(leo::JOINTS[i]) {
+            Some(stop) => stop,
+            None => SHOULDER_SOFT_LIMITS,
+        });
+        i += 1;
+    }
+    out
+};
 
 /// The pendulum turns freely: no soft limit.
 const PENDULUM_LIMITS: [Option<SoftLimit>; 1] = [None];
@@ -160,6 +165,12 @@ mod tests {
             [1, 2, 3, 4, 5]
         );
         assert_eq!([id(LeoJoint::AnkleRight), id(LeoJoint::AnkleLeft)], [6, 7]);
+        // Each soft limit is the definition's stop (the shoulder's ±90°
+        // where it has none) widened by the margin.
+        for (i, l) in hw.soft_limits.iter().enumerate() {
+            let [min, max] = leo::joint_limits(leo::JOINTS[i]).unwrap_or(SHOULDER_SOFT_LIMITS);
+            assert_eq!(*l, Some(SoftLimit { min: min - STOP_MARGIN, max: max + STOP_MARGIN }), "joint {i}");
+        }
         // The start pose is inside every soft limit.
         for (i, l) in hw.soft_limits.iter().enumerate() {
             let l = l.unwrap();

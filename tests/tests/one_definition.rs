@@ -6,7 +6,9 @@
 //! computed from what each built agent knows of itself (its tile coder as
 //! prepared, its actions and their tiles, its parameters, its table), so
 //! any drift between the two — a state range, a tile width, a level, a
-//! parameter, a table size — makes it fail.
+//! parameter, a table size — makes it fail. The episodes' rules (length,
+//! test cadence, footstep remap), the control period and the counted
+//! gearboxes are compared directly.
 
 use pada::experiment::algo::{algo_of, policy_kind_of, Algo, PolicyFlags};
 use pada::experiment::build_agent;
@@ -63,6 +65,11 @@ fn check<T: Task, R: RobotAdapter>(task: &T, profile: LearnerProfile) -> usize {
     let spec = task.spec();
     assert_eq!(spec.profile, Some(profile));
     let (robot, board) = (profile.robot.name(), profile.board.name());
+    // The episodes: the runner's task and the firmware's robot run the
+    // same cycle (`pada_core::episodes`) under the same rules.
+    assert_eq!(spec.episode_rules(), R::spec().episode_rules(), "{robot}: the host's episodes and the firmware's differ");
+    assert_eq!(spec.control_period_s, R::spec().period_s(), "{robot}: control period");
+    assert_eq!(spec.gearboxes, R::spec().gearboxes as usize, "{robot}: counted gearboxes");
     let mut refused = 0;
     for policy in policies() {
         let host = match build_agent(spec, policy) {

@@ -112,7 +112,7 @@ pub const KNEE_LIMITS: [f32; 2] = [-2.617994, 0.034907];
 pub const ANKLE_LIMITS: [f32; 2] = [-1.570796, 1.448623];
 
 /// The joint's stops (§1.5); the shoulder has none.
-pub fn joint_limits(joint: Joint) -> Option<[f32; 2]> {
+pub const fn joint_limits(joint: Joint) -> Option<[f32; 2]> {
     match joint {
         Joint::Shoulder => None,
         Joint::HipLeft | Joint::HipRight => Some(HIP_LIMITS),

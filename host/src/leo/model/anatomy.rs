@@ -275,6 +275,17 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_models_stops_are_the_robot_definitions() {
+        for (k, joint) in JOINTS.iter().enumerate() {
+            assert_eq!(
+                limits_and_stop(k).map(|(limits, _)| limits),
+                pada_core::robot::leo::joint_limits(*joint),
+                "{joint:?}: the simulated stop is not the definition's"
+            );
+        }
+    }
+
+    #[test]
     fn every_joint_with_limits_has_a_stop_and_only_those() {
         for (k, joint) in JOINTS.iter().enumerate() {
             assert_eq!(
