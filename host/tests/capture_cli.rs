@@ -7,6 +7,9 @@
 //! `pada sil --seconds 3` (telemetry.bin; wire protocol 6). Regenerate it
 //! with that command when the wire format changes.
 
+mod common;
+use common::frames;
+
 use pada_core::wire::{HostDecoder, ToHost};
 use rustix::fd::OwnedFd;
 use rustix::pty::{grantpt, openpt, ptsname, unlockpt, OpenptFlags};
@@ -20,19 +23,6 @@ fn recording() -> Vec<u8> {
         "/../tests/data/sil-pendulum-3s.bin"
     ))
     .expect("the recorded stream")
-}
-
-/// Frame boundaries (start, end-exclusive including the 0x00) of a stream.
-fn frames(stream: &[u8]) -> Vec<(usize, usize)> {
-    let mut out = Vec::new();
-    let mut start = 0;
-    for (i, &b) in stream.iter().enumerate() {
-        if b == 0 {
-            out.push((start, i + 1));
-            start = i + 1;
-        }
-    }
-    out
 }
 
 /// What was done to the stream, and what a capture must count.

@@ -1,37 +1,10 @@
 //! The `pada` binary: bad input gives one line on stderr, exit code 2 and
 //! no files; good input gives the documented outputs.
 
+mod common;
+use common::{assert_bad_input, pada};
+
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn pada(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_pada"))
-        .args(args)
-        .output()
-        .expect("pada runs")
-}
-
-/// Asserts a bad-input failure: exit code 2, nothing on stdout, exactly
-/// one line on stderr starting with `error:` and containing every `needle`.
-fn assert_bad_input(args: &[&str], needles: &[&str]) {
-    let out = pada(args);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{args:?}: stderr {stderr}");
-    assert!(
-        out.stdout.is_empty(),
-        "{args:?}: stdout {}",
-        String::from_utf8_lossy(&out.stdout)
-    );
-    assert_eq!(
-        stderr.lines().count(),
-        1,
-        "{args:?}: not one line: {stderr}"
-    );
-    assert!(stderr.starts_with("error: "), "{stderr}");
-    for n in needles {
-        assert!(stderr.contains(n), "{args:?}: {stderr:?} lacks {n:?}");
-    }
-}
 
 #[test]
 fn unknown_names_list_the_valid_values() {

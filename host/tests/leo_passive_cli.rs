@@ -2,31 +2,11 @@
 //! consistency, the text table, one-line errors for bad flags, `--help`,
 //! and a reader that closes the pipe early.
 
+mod common;
+use common::{assert_bad_input, pada};
+
 use std::io::Read;
-use std::process::{Command, Output, Stdio};
-
-fn pada(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_pada"))
-        .args(args)
-        .output()
-        .expect("pada runs")
-}
-
-fn assert_bad_input(args: &[&str], needles: &[&str]) {
-    let out = pada(args);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{args:?}: stderr {stderr}");
-    assert!(out.stdout.is_empty(), "{args:?}: printed to stdout");
-    assert_eq!(
-        stderr.lines().count(),
-        1,
-        "{args:?}: not one line: {stderr}"
-    );
-    assert!(stderr.starts_with("error: "), "{stderr}");
-    for n in needles {
-        assert!(stderr.contains(n), "{args:?}: {stderr:?} lacks {n:?}");
-    }
-}
+use std::process::{Command, Stdio};
 
 #[test]
 fn json_has_the_documented_keys_and_they_agree() {

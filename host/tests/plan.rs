@@ -3,34 +3,12 @@
 //! are listed and stop the merge; a changed plan is refused; a killed trial
 //! leaves no result; the index comes from the environment.
 
+mod common;
+use common::{ok, pada, pada_env, without_timing};
+
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
-
-fn pada(args: &[&str]) -> Output {
-    pada_env(args, &[])
-}
-
-fn pada_env(args: &[&str], env: &[(&str, &str)]) -> Output {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_pada"));
-    cmd.args(args)
-        .env_remove("SLURM_ARRAY_TASK_ID")
-        .env_remove("JOB_COMPLETION_INDEX");
-    for (k, v) in env {
-        cmd.env(k, v);
-    }
-    cmd.output().expect("pada runs")
-}
-
-fn ok(out: &Output) -> String {
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "stderr: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
 
 fn fails(out: &Output, code: i32, needles: &[&str]) -> String {
     let err = String::from_utf8_lossy(&out.stderr).into_owned();
@@ -207,15 +185,6 @@ fn run_args(trials: &str, extra: &[&str]) -> Vec<String> {
 
 fn pada_s(args: &[String]) -> Output {
     pada(&args.iter().map(String::as_str).collect::<Vec<_>>())
-}
-
-/// The JSON summary without the three measurements of the run's timing.
-fn without_timing(v: &serde_json::Value) -> serde_json::Value {
-    let mut v = v.clone();
-    for k in ["wall_s", "env_steps_per_s", "threads"] {
-        v.as_object_mut().unwrap().remove(k);
-    }
-    v
 }
 
 #[test]

@@ -8,9 +8,12 @@
 //! `$PADA_SLURM_DIR/slurm.conf` (default /tmp/pada-slurm). Without one the
 //! tests fail under CI=true and are skipped, with the reason, elsewhere.
 
+mod common;
+use common::{ok, without_timing};
+
 use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -110,16 +113,6 @@ fn cluster() -> Option<Cluster> {
     }
 }
 
-fn ok(out: &Output) -> String {
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "stderr: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
 /// `pada run` of PADA on the pendulum with `trials` trials of `seconds`.
 fn run_args(trials: &str, seconds: &str, seed: &str, out: &Path) -> Vec<String> {
     [
@@ -145,18 +138,6 @@ fn run_args(trials: &str, seconds: &str, seed: &str, out: &Path) -> Vec<String> 
 
 fn json(text: &str) -> serde_json::Value {
     serde_json::from_str(text).unwrap_or_else(|e| panic!("not JSON ({e}): {text}"))
-}
-
-/// The summary without the run's timing (wall time, rate, workers).
-fn without_timing(v: &serde_json::Value) -> serde_json::Value {
-    let mut v = v.clone();
-    for k in ["wall_s", "env_steps_per_s", "threads"] {
-        assert!(
-            v.as_object_mut().unwrap().remove(k).is_some(),
-            "{k} present"
-        );
-    }
-    v
 }
 
 fn assert_same_trial_files(a: &Path, b: &Path, trials: usize) {

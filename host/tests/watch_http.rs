@@ -5,6 +5,9 @@
 //! `/api/state` is checked against `pada capture --json` of the same bytes
 //! and against the run's own summary.
 
+mod common;
+use common::frames;
+
 mod watch_common;
 
 use std::io::{Read, Write};
@@ -147,19 +150,6 @@ fn a_recorded_run_shows_what_capture_and_the_run_itself_report() {
         without_time(&b),
         "watch --out differs from capture --out"
     );
-}
-
-/// Frame boundaries (start, end with the 0x00).
-fn frames(stream: &[u8]) -> Vec<(usize, usize)> {
-    let mut out = Vec::new();
-    let mut start = 0;
-    for (i, &b) in stream.iter().enumerate() {
-        if b == 0 {
-            out.push((start, i + 1));
-            start = i + 1;
-        }
-    }
-    out
 }
 
 #[test]
