@@ -51,3 +51,20 @@ pub fn flush() -> Result<(), CliError> {
 fn error(e: std::io::Error) -> CliError {
     CliError::Runtime(anyhow::anyhow!("cannot write to standard output: {e}"))
 }
+
+/// Shows a live one-line status on stderr: redrawn in place on a
+/// terminal (a newline after the `last` one), one line each otherwise (a
+/// log keeps every one).
+pub fn status_line(line: &str, tty: bool, last: bool) {
+    use std::io::Write;
+    let mut err = std::io::stderr().lock();
+    if tty {
+        let _ = write!(err, "\r\x1b[K{line}");
+        if last {
+            let _ = writeln!(err);
+        }
+    } else {
+        let _ = writeln!(err, "{line}");
+    }
+    let _ = err.flush();
+}

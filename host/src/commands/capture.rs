@@ -12,7 +12,7 @@
 //! cut it itself, so it is not). A read error ends the capture with its
 //! summary and exit code 1.
 
-use crate::console::{errln, outln};
+use crate::console::{errln, outln, status_line};
 use crate::capture::Recorder;
 use crate::serial_link::LinkEvent;
 use super::stream_args::{Opened, StreamInput, StreamRecord};
@@ -20,7 +20,7 @@ use crate::error::{usage, CliError};
 use anyhow::Context;
 use clap::Args;
 use serde::Serialize;
-use std::io::{IsTerminal, Read, Write};
+use std::io::{IsTerminal, Read};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -130,7 +130,7 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
         };
         if last_status.elapsed() >= every {
             last_status = Instant::now();
-            status(&rec, tty, false);
+            status_line(&rec.status_line(), tty, false);
         }
     };
     if input_ended {
@@ -141,7 +141,7 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
     rec.flush()
         .context("cannot write the CSV")
         .map_err(CliError::Runtime)?;
-    status(&rec, tty, true);
+    status_line(&rec.status_line(), tty, true);
     let link = rec.stats();
     let disconnects = match &source {
         Opened::Port(p) => p.disconnects(),
@@ -182,18 +182,4 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
         )));
     }
     Ok(())
-}
-
-fn status(rec: &Recorder, tty: bool, last: bool) {
-    let line = rec.status_line();
-    let mut err = std::io::stderr().lock();
-    if tty {
-        let _ = write!(err, "\r\x1b[K{line}");
-        if last {
-            let _ = writeln!(err);
-        }
-    } else {
-        let _ = writeln!(err, "{line}");
-    }
-    let _ = err.flush();
 }

@@ -106,42 +106,28 @@ pub fn run(args: DemoArgs) -> Result<(), CliError> {
         "Simulated pendulum of Section VII, {} trials × {} s of learning each (seed {}):\n",
         args.trials, seconds, args.trial.seed
     )?;
-    outln!(
-        "{:<22} {:>18} {:>18} {:>18}",
-        "", "SARSA(λ)", "PADA Δ=0.5", "paper SARSA(λ)"
-    )?;
-    outln!(
-        "{:<22} {:>18} {:>18} {:>18}",
+    let row = |label: &str, sarsa: String, pada: String, paper: String| {
+        outln!("{label:<22} {sarsa:>18} {pada:>18} {paper:>18}")
+    };
+    let paper = |v: &Published, unit: &str| format!("{:.0} ± {:.0}{unit}", v.mean, v.ci95.unwrap_or(f64::NAN));
+    row("", "SARSA(λ)".into(), "PADA Δ=0.5".into(), "paper SARSA(λ)".into())?;
+    row(
         "end performance",
         fmt_estimate(s.end_performance.mean, s.end_performance.ci95, 0, ""),
         fmt_estimate(p.end_performance.mean, p.end_performance.ci95, 0, ""),
-        format!(
-            "{:.0} ± {:.0}",
-            SIM_SARSA_END.mean,
-            SIM_SARSA_END.ci95.unwrap_or(f64::NAN)
-        )
+        paper(&SIM_SARSA_END, ""),
     )?;
-    outln!(
-        "{:<22} {:>18} {:>18} {:>18}",
+    row(
         "rise time",
         fmt_estimate(s.rise_time_s.mean, s.rise_time_s.ci95, 0, " s"),
         fmt_estimate(p.rise_time_s.mean, p.rise_time_s.ci95, 0, " s"),
-        format!(
-            "{:.0} ± {:.0} s",
-            SIM_SARSA_RISE_S.mean,
-            SIM_SARSA_RISE_S.ci95.unwrap_or(f64::NAN)
-        )
+        paper(&SIM_SARSA_RISE_S, " s"),
     )?;
-    outln!(
-        "{:<22} {:>18} {:>18} {:>18}",
+    row(
         "MTBF (1200 actions)",
         fmt_mtbf(s.mtbf_s.mean, s.mtbf_s.ci95),
         fmt_mtbf(p.mtbf_s.mean, p.mtbf_s.ci95),
-        format!(
-            "{:.0} ± {:.0} s",
-            SIM_SARSA_MTBF_S.mean,
-            SIM_SARSA_MTBF_S.ci95.unwrap_or(f64::NAN)
-        )
+        paper(&SIM_SARSA_MTBF_S, " s"),
     )?;
     outln!(
         "{:<22} {:>18.0} {:>18.0} {:>18}",

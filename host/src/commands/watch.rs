@@ -254,20 +254,8 @@ fn open(args: &WatchArgs) -> Result<(Source, String), CliError> {
 }
 
 fn status(recorder: &Mutex<Recorder>, tty: bool, last: bool) {
-    let line = recorder
-        .lock()
-        .unwrap_or_else(|e| e.into_inner())
-        .status_line();
-    let mut err = std::io::stderr().lock();
-    if tty {
-        let _ = write!(err, "\r\x1b[K{line}");
-        if last {
-            let _ = writeln!(err);
-        }
-    } else {
-        let _ = writeln!(err, "{line}");
-    }
-    let _ = err.flush();
+    let line = recorder.lock().unwrap_or_else(|e| e.into_inner()).status_line();
+    crate::console::status_line(&line, tty, last);
 }
 
 #[cfg(test)]
