@@ -8,7 +8,7 @@
 //! with that command when the wire format changes.
 
 mod common;
-use common::frames;
+use common::{damaged, frames};
 
 use pada_core::wire::{HostDecoder, ToHost};
 use rustix::fd::OwnedFd;
@@ -55,24 +55,7 @@ fn damage(clean: &[u8]) -> Damaged {
     let corrupt = [step_near(0.1), step_near(0.4), step_near(0.8)];
     let dropped = step_near(0.6);
     let garbage_before = [step_near(0.3), step_near(0.9)];
-    let mut out = Vec::new();
-    for (k, &(a, b)) in f.iter().enumerate() {
-        if garbage_before.contains(&k) {
-            // Non-zero bytes, then a delimiter: one unusable "frame".
-            out.extend((1..=37u8).map(|x| x.wrapping_mul(73) | 1));
-            out.push(0);
-        }
-        if k == dropped {
-            continue;
-        }
-        let start = out.len();
-        out.extend_from_slice(&clean[a..b]);
-        if corrupt.contains(&k) {
-            // A byte in the middle, changed to another non-zero value.
-            let i = start + (b - a) / 2;
-            out[i] = if out[i] == 0xFF { 0x7F } else { out[i] + 1 };
-        }
-    }
+    let out = damaged(clean, &garbage_before, &[dropped], &corrupt);
     Damaged {
         bytes: out,
         good_frames: (n - corrupt.len() - 1) as u32,

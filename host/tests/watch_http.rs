@@ -6,7 +6,7 @@
 //! and against the run's own summary.
 
 mod common;
-use common::frames;
+use common::{damaged, frames};
 
 mod watch_common;
 
@@ -167,30 +167,15 @@ fn a_corrupted_recording_counts_the_same_losses_as_capture() {
         .collect();
     let dropped = [n / 4, 3 * n / 4];
     let garbage = [n / 3, 2 * n / 3];
-    let mut out = Vec::new();
-    for (k, &(a, b)) in f.iter().enumerate() {
-        if garbage.contains(&k) {
-            out.extend((1..=41u8).map(|x| x.wrapping_mul(37) | 1));
-            out.push(0);
-        }
-        if dropped.contains(&k) {
-            continue;
-        }
-        let start = out.len();
-        out.extend_from_slice(&clean[a..b]);
-        if corrupt.contains(&k) {
-            let i = start + (b - a) / 2;
-            out[i] = if out[i] == 0xFF { 0x7F } else { out[i] + 1 };
-        }
-    }
+    let mut out = damaged(&clean, &garbage, &dropped, &corrupt);
     let (a, b) = f[n / 2];
     out.extend_from_slice(&clean[a..a + (b - a) / 2]);
-    let damaged = dir.path().join("damaged.bin");
-    std::fs::write(&damaged, &out).unwrap();
+    let damaged_file = dir.path().join("damaged.bin");
+    std::fs::write(&damaged_file, &out).unwrap();
 
-    let capture = capture_json(&damaged, None);
+    let capture = capture_json(&damaged_file, None);
     assert!(capture["bad_frames"].as_u64().unwrap() >= 7, "{capture:#}");
-    let w = Watch::start(&["--file", damaged.to_str().unwrap()]);
+    let w = Watch::start(&["--file", damaged_file.to_str().unwrap()]);
     let s = w.wait_for(60, "end of file", |s| !s["ended"].is_null());
     assert_same_as_capture(&s, &capture);
     assert!(s["link"]["seq_gaps"].as_u64().unwrap() >= 7);

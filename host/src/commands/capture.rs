@@ -58,6 +58,23 @@ pub struct CaptureSummary {
     pub disconnects: u32,
 }
 
+impl CaptureSummary {
+    /// The summary of what `rec` recorded from `source` since `started`.
+    pub fn of(rec: &Recorder, source: String, ended: String, started: Instant, disconnects: u32) -> Self {
+        let link = rec.stats();
+        CaptureSummary {
+            source,
+            ended,
+            wall_s: started.elapsed().as_secs_f64(),
+            link,
+            bad_frames: link.bad_frames(),
+            messages: rec.counts(),
+            latest: rec.latest().clone(),
+            disconnects,
+        }
+    }
+}
+
 /// Runs `pada capture`.
 pub fn run(args: CaptureArgs) -> Result<(), CliError> {
     args.record.check()?;
@@ -142,21 +159,11 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
         .context("cannot write the CSV")
         .map_err(CliError::Runtime)?;
     status_line(&rec.status_line(), tty, true);
-    let link = rec.stats();
     let disconnects = match &source {
         Opened::Port(p) => p.disconnects(),
         Opened::Reader(_) => 0,
     };
-    let summary = CaptureSummary {
-        disconnects,
-        source: name,
-        ended,
-        wall_s: started.elapsed().as_secs_f64(),
-        link,
-        bad_frames: link.bad_frames(),
-        messages: rec.counts(),
-        latest: rec.latest().clone(),
-    };
+    let summary = CaptureSummary::of(&rec, name, ended, started, disconnects);
     if args.record.json {
         outln!(
             "{}",
@@ -167,10 +174,10 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
             "capture of {} ended ({}): {} frames, {} lost, {} sequence gaps ({} frames missing), {} disconnects",
             summary.source,
             summary.ended,
-            link.frames,
+            summary.link.frames,
             summary.bad_frames,
-            link.seq_gaps,
-            link.frames_missed,
+            summary.link.seq_gaps,
+            summary.link.frames_missed,
             summary.disconnects
         );
     }

@@ -9,6 +9,7 @@ use crate::experiment::task::Task;
 use crate::experiment::{run_configs, RunConfig};
 use crate::output::OutDir;
 use crate::paper::numbers::*;
+use crate::stats::Estimate;
 use crate::pendulum::SimulatedPendulumTask;
 use crate::progress::steps_bar;
 use crate::summary::{run_files, RunSummary};
@@ -111,24 +112,13 @@ pub fn run(args: DemoArgs) -> Result<(), CliError> {
     };
     let paper = |v: &Published, unit: &str| format!("{:.0} ± {:.0}{unit}", v.mean, v.ci95.unwrap_or(f64::NAN));
     row("", "SARSA(λ)".into(), "PADA Δ=0.5".into(), "paper SARSA(λ)".into())?;
-    row(
-        "end performance",
-        fmt_estimate(s.end_performance.mean, s.end_performance.ci95, 0, ""),
-        fmt_estimate(p.end_performance.mean, p.end_performance.ci95, 0, ""),
-        paper(&SIM_SARSA_END, ""),
-    )?;
-    row(
-        "rise time",
-        fmt_estimate(s.rise_time_s.mean, s.rise_time_s.ci95, 0, " s"),
-        fmt_estimate(p.rise_time_s.mean, p.rise_time_s.ci95, 0, " s"),
-        paper(&SIM_SARSA_RISE_S, " s"),
-    )?;
-    row(
-        "MTBF (1200 actions)",
-        fmt_mtbf(s.mtbf_s.mean, s.mtbf_s.ci95),
-        fmt_mtbf(p.mtbf_s.mean, p.mtbf_s.ci95),
-        paper(&SIM_SARSA_MTBF_S, " s"),
-    )?;
+    // Each measure as the paper writes it: returns, seconds, an MTBF.
+    let e = |x: &Estimate| fmt_estimate(x.mean, x.ci95, 0, "");
+    let r = |x: &Estimate| fmt_estimate(x.mean, x.ci95, 0, " s");
+    let m = |x: &Estimate| fmt_mtbf(x.mean, x.ci95);
+    row("end performance", e(&s.end_performance), e(&p.end_performance), paper(&SIM_SARSA_END, ""))?;
+    row("rise time", r(&s.rise_time_s), r(&p.rise_time_s), paper(&SIM_SARSA_RISE_S, " s"))?;
+    row("MTBF (1200 actions)", m(&s.mtbf_s), m(&p.mtbf_s), paper(&SIM_SARSA_MTBF_S, " s"))?;
     outln!(
         "{:<22} {:>18.0} {:>18.0} {:>18}",
         "re-engagements", s.window_reengagements.mean, p.window_reengagements.mean, "–"

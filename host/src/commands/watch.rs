@@ -184,18 +184,9 @@ pub fn run(args: WatchArgs) -> Result<(), CliError> {
             writeln!(err, "{line}")
         };
     }
-    let link = rec.stats();
+    let disconnects = shared.disconnects.load(Ordering::SeqCst);
     let summary = WatchSummary {
-        capture: CaptureSummary {
-            source: name,
-            ended,
-            wall_s: started.elapsed().as_secs_f64(),
-            link,
-            bad_frames: link.bad_frames(),
-            messages: rec.counts(),
-            latest: rec.latest().clone(),
-            disconnects: shared.disconnects.load(Ordering::SeqCst),
-        },
+        capture: CaptureSummary::of(&rec, name, ended, started, disconnects),
         url,
         requests: shared.requests.load(Ordering::Relaxed),
     };
@@ -213,10 +204,10 @@ pub fn run(args: WatchArgs) -> Result<(), CliError> {
             "watch of {} ended ({}): {} frames, {} lost, {} sequence gaps ({} frames missing), {} disconnects; {} requests served",
             summary.capture.source,
             summary.capture.ended,
-            link.frames,
+            summary.capture.link.frames,
             summary.capture.bad_frames,
-            link.seq_gaps,
-            link.frames_missed,
+            summary.capture.link.seq_gaps,
+            summary.capture.link.frames_missed,
             summary.capture.disconnects,
             summary.requests
         );

@@ -65,3 +65,29 @@ pub fn without_timing(v: &serde_json::Value) -> serde_json::Value {
     }
     v
 }
+
+/// `clean`, a recorded stream, damaged as a serial line damages one:
+/// before each frame of `garbage_before` a burst of non-zero bytes ending
+/// in a delimiter (line noise that looks like a frame), the frames of
+/// `dropped` cut out (lost on the line), and in each frame of `corrupt` a
+/// byte in the middle changed to another non-zero value (a CRC error or
+/// broken COBS). Frame indices are those of [`frames`].
+pub fn damaged(clean: &[u8], garbage_before: &[usize], dropped: &[usize], corrupt: &[usize]) -> Vec<u8> {
+    let mut out = Vec::new();
+    for (k, &(a, b)) in frames(clean).iter().enumerate() {
+        if garbage_before.contains(&k) {
+            out.extend((1..=37u8).map(|x| x.wrapping_mul(73) | 1));
+            out.push(0);
+        }
+        if dropped.contains(&k) {
+            continue;
+        }
+        let start = out.len();
+        out.extend_from_slice(&clean[a..b]);
+        if corrupt.contains(&k) {
+            let i = start + (b - a) / 2;
+            out[i] = if out[i] == 0xFF { 0x7F } else { out[i] + 1 };
+        }
+    }
+    out
+}

@@ -16,20 +16,23 @@
 
 use std::fmt;
 
-use crate::leo::model::{Joint, NUM_JOINTS};
+use crate::leo::model::{Joint, JOINTS, NUM_JOINTS};
 use crate::leo::task::{learned_joints, Leg};
 
-/// The framework's joint order of its state and action vectors, as pada
-/// joints (the eighth state entry is the torso).
-const REFERENCE_JOINTS: [Joint; NUM_JOINTS] = [
-    Joint::HipLeft,
-    Joint::HipRight,
-    Joint::KneeLeft,
-    Joint::KneeRight,
-    Joint::AnkleLeft,
-    Joint::AnkleRight,
-    Joint::Shoulder,
-];
+/// The framework's joint order of its state and action vectors: pada's
+/// ([`JOINTS`]) with the shoulder last (the eighth state entry is the
+/// torso).
+const REFERENCE_JOINTS: [Joint; NUM_JOINTS] = {
+    let mut out = JOINTS;
+    let mut i = 0;
+    while i + 1 < NUM_JOINTS {
+        out[i] = JOINTS[i + 1];
+        i += 1;
+    }
+    out[NUM_JOINTS - 1] = JOINTS[0];
+    out
+};
+const _: () = assert!(matches!(JOINTS[0], Joint::Shoulder));
 
 /// The framework's contact bits in pada's sensor order (left toe, left
 /// heel, right toe, right heel).
