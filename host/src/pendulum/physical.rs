@@ -20,7 +20,6 @@
 
 use super::{swing_up_reward, wrap_angle};
 use crate::experiment::task::{Plant, Step, Task, TaskSpec};
-use crate::integrator::{rk4_step, SinNear};
 use pada_core::action_space::{Output, MAX_ACTION_DIMS};
 use pada_core::profile::{Board, LearnerProfile};
 use pada_core::robot::pendulum::{self as robot, gearbox_torque};
@@ -85,21 +84,14 @@ impl PhysicalPendulumParams {
 
     /// The state after one control period with voltage `u` (clipped): RK4
     /// over [`substeps`](Self::substeps) equal steps, voltage held.
-    pub fn advance(&self, mut x: [f64; 2], u: f64) -> [f64; 2] {
+    pub fn advance(&self, x: [f64; 2], u: f64) -> [f64; 2] {
         let u = u.clamp(-self.voltage_limit, self.voltage_limit);
-        let h = self.period_s / self.substeps as f64;
         // The constants of the derivative, once per control period.
         let k_over_r = self.torque_constant / self.resistance_ohm;
         let gain = self.mass_kg * self.gravity * self.length_m / self.inertia_kg_m2;
         let drive = k_over_r * u / self.inertia_kg_m2;
         let friction = (self.damping + self.torque_constant * k_over_r) / self.inertia_kg_m2;
-        for _ in 0..self.substeps {
-            let near = SinNear::new(x[0]);
-            x = rk4_step(&x, h, |y| {
-                [y[1], gain * near.sin(y[0]) + drive - friction * y[1]]
-            });
-        }
-        x
+        super::swing(x, self.period_s, self.substeps, gain, drive, friction)
     }
 
     /// Gearbox torque per volt \[N·m/V\]: the motor's stall torque `K/R`
@@ -131,8 +123,7 @@ impl PhysicalPendulum {
     }
 
     fn observe(&self, obs: &mut [f32]) {
-        obs[0] = wrap_angle(self.x[0]) as f32;
-        obs[1] = self.x[1] as f32;
+        super::observe(&self.x, obs);
     }
 }
 

@@ -16,7 +16,6 @@
 
 use super::{swing_up_reward, wrap_angle};
 use crate::experiment::task::{Plant, Step, Task, TaskSpec, WeightTable};
-use crate::integrator::{rk4_step, SinNear};
 use pada_core::action_space::{ActionDim, ActionSpace, Output, MAX_ACTION_DIMS};
 use pada_core::agent::{SarsaParams, WeightInit};
 use pada_core::tile_coding::StateDim;
@@ -73,19 +72,12 @@ impl SimulatedPendulumParams {
 
     /// The state after one control period with torque `u` (clipped): RK4
     /// over [`substeps`](Self::substeps) equal steps, torque held.
-    pub fn advance(&self, mut x: [f64; 2], u: f64) -> [f64; 2] {
+    pub fn advance(&self, x: [f64; 2], u: f64) -> [f64; 2] {
         let u = u.clamp(-self.torque_limit, self.torque_limit);
-        let h = self.period_s / self.substeps as f64;
         // The constants of the derivative, once per control period.
         let gain = self.mass_kg * self.gravity * self.length_m / self.inertia_kg_m2;
         let (drive, friction) = (u / self.inertia_kg_m2, self.damping / self.inertia_kg_m2);
-        for _ in 0..self.substeps {
-            let near = SinNear::new(x[0]);
-            x = rk4_step(&x, h, |y| {
-                [y[1], gain * near.sin(y[0]) + drive - friction * y[1]]
-            });
-        }
-        x
+        super::swing(x, self.period_s, self.substeps, gain, drive, friction)
     }
 
     /// Total mechanical energy `½Jθ̇² + m·g·l·cos θ` \[J\] (conserved
@@ -118,8 +110,7 @@ impl SimulatedPendulum {
     }
 
     fn observe(&self, obs: &mut [f32]) {
-        obs[0] = wrap_angle(self.x[0]) as f32;
-        obs[1] = self.x[1] as f32;
+        super::observe(&self.x, obs);
     }
 }
 
