@@ -8,11 +8,9 @@
 //! with that command when the wire format changes.
 
 mod common;
-use common::{damaged, frames};
+use common::{damaged, frames, plug_at, raw_pty};
 
 use pada_core::wire::{HostDecoder, ToHost};
-use rustix::fd::OwnedFd;
-use rustix::pty::{grantpt, openpt, ptsname, unlockpt, OpenptFlags};
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -65,19 +63,6 @@ fn damage(clean: &[u8]) -> Damaged {
     }
 }
 
-fn pty() -> (OwnedFd, String) {
-    // Close-on-exec: a child holding the master would keep the pty alive.
-    let master =
-        openpt(OpenptFlags::RDWR | OpenptFlags::NOCTTY | OpenptFlags::CLOEXEC).expect("openpt");
-    grantpt(&master).expect("grantpt");
-    unlockpt(&master).expect("unlockpt");
-    let name = ptsname(&master, Vec::new())
-        .expect("ptsname")
-        .into_string()
-        .unwrap();
-    (master, name)
-}
-
 fn check_summary(json: &serde_json::Value, want: &Damaged) {
     let link = &json["link"];
     assert_eq!(link["frames"], want.good_frames, "{json:#}");
@@ -93,19 +78,7 @@ fn check_summary(json: &serde_json::Value, want: &Damaged) {
 #[test]
 fn capture_from_a_pseudo_terminal_resynchronises_counts_every_loss_and_keeps_going() {
     let want = damage(&recording());
-    let (master, slave) = pty();
-    // Raw mode before anything is written, so the line discipline passes
-    // every byte through (pada capture sets it too, through serialport).
-    {
-        let fd = std::fs::OpenOptions::new()
-            .read(true)
-            .write(true)
-            .open(&slave)
-            .unwrap();
-        let mut t = rustix::termios::tcgetattr(&fd).unwrap();
-        t.make_raw();
-        rustix::termios::tcsetattr(&fd, rustix::termios::OptionalActions::Now, &t).unwrap();
-    }
+    let (master, slave) = raw_pty();
     let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("capture.csv");
     let mut child = Command::new(env!("CARGO_BIN_EXE_pada"))
@@ -243,18 +216,7 @@ struct Adapter {
 
 impl Adapter {
     fn plug(&mut self) {
-        let (master, slave) = pty();
-        {
-            let fd = std::fs::OpenOptions::new().read(true).write(true).open(&slave).unwrap();
-            let mut t = rustix::termios::tcgetattr(&fd).unwrap();
-            t.make_raw();
-            rustix::termios::tcsetattr(&fd, rustix::termios::OptionalActions::Now, &t).unwrap();
-        }
-        let tmp = self.link.with_extension("new");
-        let _ = std::fs::remove_file(&tmp);
-        std::os::unix::fs::symlink(&slave, &tmp).unwrap();
-        std::fs::rename(&tmp, &self.link).unwrap();
-        self.master = Some(std::fs::File::from(master));
+        self.master = Some(plug_at(&self.link));
     }
 
     fn pull(&mut self) {

@@ -6,7 +6,7 @@
 //! and against the run's own summary.
 
 mod common;
-use common::{damaged, frames};
+use common::{damaged, frames, plug_at, raw_pty};
 
 mod watch_common;
 
@@ -350,27 +350,11 @@ fn a_live_run_over_tcp_and_a_sender_that_stalls() {
 
 #[test]
 fn a_serial_port_is_a_source_too() {
-    use rustix::pty::{grantpt, openpt, ptsname, unlockpt, OpenptFlags};
     let dir = tempfile::tempdir().unwrap();
     let (bin, _) = recorded_run(dir.path());
     let bytes = std::fs::read(&bin).unwrap();
     let capture = capture_json(&bin, None);
-    let master =
-        openpt(OpenptFlags::RDWR | OpenptFlags::NOCTTY | OpenptFlags::CLOEXEC).expect("openpt");
-    grantpt(&master).unwrap();
-    unlockpt(&master).unwrap();
-    let slave = ptsname(&master, Vec::new()).unwrap().into_string().unwrap();
-    {
-        // Raw mode before anything is written (as in the capture test).
-        let fd = std::fs::OpenOptions::new()
-            .read(true)
-            .write(true)
-            .open(&slave)
-            .unwrap();
-        let mut t = rustix::termios::tcgetattr(&fd).unwrap();
-        t.make_raw();
-        rustix::termios::tcsetattr(&fd, rustix::termios::OptionalActions::Now, &t).unwrap();
-    }
+    let (master, slave) = raw_pty();
     let w = Watch::start(&["--port", &slave]);
     std::thread::sleep(Duration::from_millis(300));
     let mut m = std::fs::File::from(master);
@@ -485,27 +469,12 @@ fn watch_waits_for_its_port_to_come_back_and_counts_each_disconnect() {
     // A pty behind a symlink (as udev names a USB adapter): closing the
     // master pulls the adapter, a new pty behind the link plugs it in.
     use pada_core::wire::HostDecoder;
-    use rustix::pty::{grantpt, openpt, ptsname, unlockpt, OpenptFlags};
     let dir = tempfile::tempdir().unwrap();
     let (bin, _) = recorded_run(dir.path());
     let bytes = std::fs::read(&bin).unwrap();
     let capture = capture_json(&bin, None);
     let link = dir.path().join("ttyUSB-pada");
-    let plug = || {
-        let master = openpt(OpenptFlags::RDWR | OpenptFlags::NOCTTY | OpenptFlags::CLOEXEC).expect("openpt");
-        grantpt(&master).unwrap();
-        unlockpt(&master).unwrap();
-        let slave = ptsname(&master, Vec::new()).unwrap().into_string().unwrap();
-        let fd = std::fs::OpenOptions::new().read(true).write(true).open(&slave).unwrap();
-        let mut t = rustix::termios::tcgetattr(&fd).unwrap();
-        t.make_raw();
-        rustix::termios::tcsetattr(&fd, rustix::termios::OptionalActions::Now, &t).unwrap();
-        let tmp = link.with_extension("new");
-        let _ = std::fs::remove_file(&tmp);
-        std::os::unix::fs::symlink(&slave, &tmp).unwrap();
-        std::fs::rename(&tmp, &link).unwrap();
-        std::fs::File::from(master)
-    };
+    let plug = || plug_at(&link);
     // Split the stream at frame boundaries into three stretches.
     let ends: Vec<usize> = bytes.iter().enumerate().filter(|(_, b)| **b == 0).map(|(i, _)| i + 1).collect();
     let cuts = [0, ends[ends.len() / 3], ends[2 * ends.len() / 3], bytes.len()];

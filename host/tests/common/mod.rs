@@ -91,3 +91,34 @@ pub fn damaged(clean: &[u8], garbage_before: &[usize], dropped: &[usize], corrup
     }
     out
 }
+
+/// A pseudo-terminal standing in for a USB serial adapter: its master and
+/// the path of its slave, already in raw mode (set before anything is
+/// written, so the line discipline passes every byte through, as `pada
+/// capture` sets it through serialport). The master is close-on-exec: a
+/// child holding it would keep the pty alive.
+pub fn raw_pty() -> (std::os::fd::OwnedFd, String) {
+    use rustix::pty::{grantpt, openpt, ptsname, unlockpt, OpenptFlags};
+    use rustix::termios::{tcgetattr, tcsetattr, OptionalActions};
+    let master = openpt(OpenptFlags::RDWR | OpenptFlags::NOCTTY | OpenptFlags::CLOEXEC).expect("openpt");
+    grantpt(&master).expect("grantpt");
+    unlockpt(&master).expect("unlockpt");
+    let slave = ptsname(&master, Vec::new()).expect("ptsname").into_string().unwrap();
+    let fd = std::fs::OpenOptions::new().read(true).write(true).open(&slave).unwrap();
+    let mut t = tcgetattr(&fd).unwrap();
+    t.make_raw();
+    tcsetattr(&fd, OptionalActions::Now, &t).unwrap();
+    (master, slave)
+}
+
+/// Plugs an adapter in at `link`: a fresh [`raw_pty`] whose slave the
+/// symbolic link `link` names from now on (replaced in one rename, as
+/// udev does); returns its master.
+pub fn plug_at(link: &std::path::Path) -> std::fs::File {
+    let (master, slave) = raw_pty();
+    let tmp = link.with_extension("new");
+    let _ = std::fs::remove_file(&tmp);
+    std::os::unix::fs::symlink(&slave, &tmp).unwrap();
+    std::fs::rename(&tmp, link).unwrap();
+    std::fs::File::from(master)
+}
