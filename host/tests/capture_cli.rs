@@ -8,7 +8,7 @@
 //! with that command when the wire format changes.
 
 mod common;
-use common::{damaged, frames, plug_at, raw_pty};
+use common::{capture_json, damaged, frames, plug_at, raw_pty};
 
 use pada_core::wire::{HostDecoder, ToHost};
 use std::io::{BufRead, BufReader, Write};
@@ -161,17 +161,7 @@ fn capture_from_a_file_counts_the_same() {
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("damaged.bin");
     std::fs::write(&file, &want.bytes).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_pada"))
-        .args(["capture", "--json", "--file"])
-        .arg(&file)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let json = capture_json(&file, None);
     check_summary(&json, &want);
     assert_eq!(json["ended"], "end of file");
 }

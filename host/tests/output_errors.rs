@@ -4,6 +4,8 @@
 //! problem, never panic (exit 101). Also `pada capture`'s exit code on a
 //! read error and on a directory.
 
+mod common;
+
 use std::fs::File;
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
@@ -150,17 +152,7 @@ fn a_stream_cut_off_at_the_end_reports_the_loss() {
     let dir = tempfile::tempdir().unwrap();
     let noise = dir.path().join("noise.bin");
     std::fs::write(&noise, vec![0x5Au8; 10 << 20]).unwrap();
-    let out = pada()
-        .args(["capture", "--json", "--file"])
-        .arg(&noise)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let json = common::capture_json(&noise, None);
     assert_eq!(json["link"]["truncated"], 1, "{json}");
     assert_eq!(json["bad_frames"], 1, "{json}");
     assert_eq!(json["link"]["frames"], 0);

@@ -6,7 +6,7 @@
 //! and against the run's own summary.
 
 mod common;
-use common::{damaged, frames, plug_at, raw_pty};
+use common::{capture_json, damaged, frames, plug_at, raw_pty};
 
 mod watch_common;
 
@@ -15,7 +15,7 @@ use std::net::TcpStream;
 use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Duration;
-use watch_common::{capture_json, pada_run, Watch};
+use watch_common::{pada_run, Watch};
 
 /// The fields `/api/state` shares with `pada capture --json`.
 const CAPTURE_FIELDS: [&str; 6] = [

@@ -122,3 +122,15 @@ pub fn plug_at(link: &std::path::Path) -> std::fs::File {
     std::fs::rename(&tmp, link).unwrap();
     std::fs::File::from(master)
 }
+
+/// `pada capture --file F --json [--out CSV]`, parsed.
+pub fn capture_json(file: &std::path::Path, csv: Option<&std::path::Path>) -> serde_json::Value {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_pada"));
+    c.args(["capture", "--json", "--file"]).arg(file);
+    if let Some(csv) = csv {
+        c.arg("--out").arg(csv);
+    }
+    let o = c.output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    serde_json::from_slice(&o.stdout).unwrap()
+}

@@ -218,14 +218,3 @@ pub fn pada_run(task: &str, seconds: &str, telemetry: &str, out: &Path) -> Outpu
     o
 }
 
-/// `pada capture --file F --json [--out CSV]`, parsed.
-pub fn capture_json(file: &Path, csv: Option<&Path>) -> serde_json::Value {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_pada"));
-    c.args(["capture", "--json", "--file"]).arg(file);
-    if let Some(csv) = csv {
-        c.arg("--out").arg(csv);
-    }
-    let o = c.output().unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    serde_json::from_slice(&o.stdout).unwrap()
-}
