@@ -60,41 +60,20 @@ fn initial_pose_has_the_left_foot_on_the_floor() {
         (c[2] - 0.0229).abs() < 1e-3 && (c[3] - 0.0652).abs() < 1e-3,
         "right toe/heel {c:?}"
     );
-    assert!(close(
-        m.body_point(Body::Torso, TORSO_HIP_ANCHOR),
-        [0.0274, 0.2691],
-        1e-3
-    ));
-    assert!(close(
-        m.body_point(Body::ThighLeft, THIGH_KNEE_ANCHOR),
-        [0.0274, 0.1531],
-        1e-3
-    ));
-    assert!(close(
-        m.body_point(Body::ShankLeft, SHANK_ANKLE_ANCHOR),
-        [0.0315, 0.0486],
-        1e-3
-    ));
-    assert!(close(
-        m.body_point(Body::ThighRight, THIGH_KNEE_ANCHOR),
-        [0.1039, 0.1819],
-        1e-3
-    ));
-    assert!(close(
-        m.body_point(Body::ShankRight, SHANK_ANKLE_ANCHOR),
-        [0.0528, 0.0907],
-        1e-3
-    ));
-    assert!(close(
-        m.body_point(Body::Torso, TORSO_SHOULDER_ANCHOR),
-        [0.0405, 0.4809],
-        1e-3
-    ));
-    assert!(close(
-        m.body_point(Body::Torso, TORSO_COM),
-        [0.0344, 0.3659],
-        1e-3
-    ));
+    // Anchors and the torso's centre of mass where the framework's
+    // assembly puts them (§1.8) [m].
+    for (body, point, want) in [
+        (Body::Torso, TORSO_HIP_ANCHOR, [0.0274, 0.2691]),
+        (Body::ThighLeft, THIGH_KNEE_ANCHOR, [0.0274, 0.1531]),
+        (Body::ShankLeft, SHANK_ANKLE_ANCHOR, [0.0315, 0.0486]),
+        (Body::ThighRight, THIGH_KNEE_ANCHOR, [0.1039, 0.1819]),
+        (Body::ShankRight, SHANK_ANKLE_ANCHOR, [0.0528, 0.0907]),
+        (Body::Torso, TORSO_SHOULDER_ANCHOR, [0.0405, 0.4809]),
+        (Body::Torso, TORSO_COM, [0.0344, 0.3659]),
+    ] {
+        let got = m.body_point(body, point);
+        assert!(close(got, want, 1e-3), "{body:?} at {point:?}: {got:?}, want {want:?}");
+    }
     let s = m.state();
     assert_eq!(s.contacts, [true, true, false, false]);
     let q = InitialPose::REFERENCE.joint_angles();
