@@ -207,26 +207,6 @@ mod tests {
     use super::*;
     use crate::experiment::task::Plant;
 
-    fn rollout(substeps: u32) -> [f64; 2] {
-        let p = PhysicalPendulumParams {
-            substeps,
-            ..Default::default()
-        };
-        let mut x = [PI, 0.0];
-        for k in 0..100 {
-            let u = if (k / 7) % 2 == 0 { 3.0 } else { -3.0 };
-            x = p.advance(x, u);
-        }
-        x
-    }
-
-    #[test]
-    fn halving_the_step_changes_a_3s_rollout_by_less_than_1e_6_rad() {
-        let n = PhysicalPendulumParams::default().substeps;
-        let d = (rollout(n)[0] - rollout(2 * n)[0]).abs();
-        assert!(d < 1e-6, "Δθ = {d:e} rad");
-    }
-
     #[test]
     fn energy_is_conserved_without_voltage_and_friction() {
         // No friction and no back-EMF (K = 0 also removes the motor).

@@ -44,14 +44,25 @@ pub struct SarsaParams {
 }
 
 impl Default for SarsaParams {
-    /// The paper's Section VII parameters (the pendulum's,
-    /// [`crate::robot::pendulum::PARAMS`]), from zero weights.
+    /// [`SarsaParams::SECTION_VII`].
     fn default() -> Self {
-        SarsaParams { init: WeightInit::Constant(0.0), ..crate::robot::pendulum::PARAMS }
+        SarsaParams::SECTION_VII
     }
 }
 
 impl SarsaParams {
+    /// The paper's parameters (Section VII: α 0.2, γ 0.99, ε 0.05, λ 0.92),
+    /// replacing traces pruned at 0.01, from zero weights.
+    pub const SECTION_VII: SarsaParams = SarsaParams {
+        alpha: 0.2,
+        gamma: 0.99,
+        lambda: 0.92,
+        epsilon: 0.05,
+        trace_threshold: 0.01,
+        trace_kind: TraceKind::Replacing,
+        init: WeightInit::Constant(0.0),
+    };
+
     /// Checks every parameter's range.
     pub fn validate(&self) -> Result<(), ConfigError> {
         if !(self.alpha.is_finite() && self.alpha > 0.0 && self.alpha <= 1.0) {

@@ -16,7 +16,6 @@
 use super::{MotorLevels, Robot, RobotSpec};
 use crate::agent::{SarsaParams, WeightInit};
 use crate::tile_coding::StateDim;
-use crate::trace::TraceKind;
 use core::f32::consts::PI;
 
 /// Motor torque constant K \[N·m/A\] (docs/reference/grl.md §4).
@@ -39,18 +38,11 @@ pub const STATE: [StateDim; 2] = [
 /// The voltage levels \[V\].
 pub const LEVELS: [f32; 3] = [-VOLTAGE_LIMIT as f32, 0.0, VOLTAGE_LIMIT as f32];
 
-/// The paper's learning parameters (Section VII: α 0.2, γ 0.99, ε 0.05,
-/// λ 0.92), replacing traces pruned at 0.01, weights U[0, 1] (GRL's
-/// pendulum configuration; optimistic, since every reward ≤ 0).
-pub const PARAMS: SarsaParams = SarsaParams {
-    alpha: 0.2,
-    gamma: 0.99,
-    lambda: 0.92,
-    epsilon: 0.05,
-    trace_threshold: 0.01,
-    trace_kind: TraceKind::Replacing,
-    init: WeightInit::Uniform { min: 0.0, max: 1.0 },
-};
+/// The paper's learning parameters ([`SarsaParams::SECTION_VII`]: α 0.2,
+/// γ 0.99, ε 0.05, λ 0.92, replacing traces pruned at 0.01), weights
+/// U[0, 1] (GRL's pendulum configuration; optimistic, since every reward
+/// ≤ 0).
+pub const PARAMS: SarsaParams = SarsaParams { init: WeightInit::Uniform { min: 0.0, max: 1.0 }, ..SarsaParams::SECTION_VII };
 
 /// 16-bit weights hold ±16384 in steps of 1/2. Typical Q-values are
 /// −100 … −2000; the bound of a return over the 100-step horizon of
