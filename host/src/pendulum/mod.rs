@@ -13,7 +13,11 @@ pub use simulated::{SimulatedPendulum, SimulatedPendulumParams, SimulatedPendulu
 /// same, on its torque instead of a voltage).
 pub use pada_core::robot::pendulum::{swing_up_reward, wrap_angle};
 
+use crate::experiment::task::{Plant, Step};
 use crate::integrator::{rk4_step, SinNear};
+use pada_core::action_space::{Output, MAX_ACTION_DIMS};
+use rand_core::RngCore;
+use std::f64::consts::PI;
 
 /// One control period of `θ̈ = gain·sin θ + drive − friction·θ̇`, the
 /// equation of motion both pendulums share once their constants are folded
@@ -36,10 +40,64 @@ pub(crate) fn observe(x: &[f64; 2], obs: &mut [f32]) {
     obs[1] = x[1] as f32;
 }
 
+/// What a pendulum model gives its plant ([`Pendulum`]).
+pub trait PendulumModel: Clone + Send + Sync {
+    /// The bound of the drive, torque \[N·m\] or voltage \[V\]: commands
+    /// beyond it are clipped.
+    fn drive_limit(&self) -> f64;
+    /// The state after one control period with the drive `u` held (within
+    /// the bound).
+    fn advance(&self, x: [f64; 2], u: f64) -> [f64; 2];
+    /// The gearbox torque of the motor command `command` \[N·m\].
+    fn gearbox_torque(&self, command: f32) -> f32;
+}
+
+/// A pendulum plant of model `M`: state `[θ, θ̇]` with θ unwrapped
+/// internally, swung up from hanging down at rest; the reward is Section
+/// VII's ([`swing_up_reward`]) on the clipped drive.
+#[derive(Debug, Clone)]
+pub struct Pendulum<M> {
+    params: M,
+    x: [f64; 2],
+}
+
+impl<M: PendulumModel> Pendulum<M> {
+    /// A pendulum hanging down at rest.
+    pub fn new(params: M) -> Self {
+        Pendulum { params, x: [PI, 0.0] }
+    }
+
+    /// The internal state `[θ (unwrapped), θ̇]`.
+    pub fn state(&self) -> [f64; 2] {
+        self.x
+    }
+}
+
+impl<M: PendulumModel> Plant for Pendulum<M> {
+    fn reset(&mut self, _rng: &mut dyn RngCore, obs: &mut [f32]) {
+        self.x = [PI, 0.0];
+        observe(&self.x, obs);
+    }
+
+    fn step(&mut self, command: &[f32], obs: &mut [f32]) -> Step {
+        let limit = self.params.drive_limit();
+        let u = (command[0] as f64).clamp(-limit, limit);
+        self.x = self.params.advance(self.x, u);
+        observe(&self.x, obs);
+        let reward = swing_up_reward(wrap_angle(self.x[0]), self.x[1], u);
+        Step { reward: reward as f32, terminal: false }
+    }
+
+    fn gearbox_torques(&self, command: &[f32]) -> Output {
+        let mut t = [0.0; MAX_ACTION_DIMS];
+        t[0] = self.params.gearbox_torque(command[0]);
+        t
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::f64::consts::PI;
 
     /// One pendulum's 3 s bang-bang swing-up: ±`bound` switching every 7
     /// control periods pumps it over the top (the most demanding motion

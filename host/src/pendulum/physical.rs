@@ -18,14 +18,10 @@
 //! own stall torque per volt `K/R` = 5.642·10⁻³ N·m/V
 //! ([`pada_core::robot::pendulum::gearbox_torque`]).
 
-use super::{swing_up_reward, wrap_angle};
-use crate::experiment::task::{Plant, Step, Task, TaskSpec};
-use pada_core::action_space::{Output, MAX_ACTION_DIMS};
+use crate::experiment::task::{Task, TaskSpec};
 use pada_core::profile::{Board, LearnerProfile};
 use pada_core::robot::pendulum::{self as robot, gearbox_torque};
 use pada_core::robot::Robot;
-use rand_core::RngCore;
-use std::f64::consts::PI;
 
 /// Constants of the physical pendulum's model (docs/reference/grl.md §4).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -101,55 +97,22 @@ impl PhysicalPendulumParams {
     }
 }
 
-/// The physical pendulum's model: state `[θ, θ̇]`, θ unwrapped internally.
-#[derive(Debug, Clone)]
-pub struct PhysicalPendulum {
-    params: PhysicalPendulumParams,
-    x: [f64; 2],
-}
+/// The physical pendulum's model ([`super::Pendulum`] of these constants).
+pub type PhysicalPendulum = super::Pendulum<PhysicalPendulumParams>;
 
-impl PhysicalPendulum {
-    /// A pendulum hanging down at rest.
-    pub fn new(params: PhysicalPendulumParams) -> Self {
-        PhysicalPendulum {
-            params,
-            x: [PI, 0.0],
-        }
+impl super::PendulumModel for PhysicalPendulumParams {
+    fn drive_limit(&self) -> f64 {
+        self.voltage_limit
     }
 
-    /// The internal state `[θ (unwrapped), θ̇]`.
-    pub fn state(&self) -> [f64; 2] {
-        self.x
+    fn advance(&self, x: [f64; 2], u: f64) -> [f64; 2] {
+        PhysicalPendulumParams::advance(self, x, u)
     }
 
-    fn observe(&self, obs: &mut [f32]) {
-        super::observe(&self.x, obs);
-    }
-}
-
-impl Plant for PhysicalPendulum {
-    fn reset(&mut self, _rng: &mut dyn RngCore, obs: &mut [f32]) {
-        self.x = [PI, 0.0];
-        self.observe(obs);
-    }
-
-    fn step(&mut self, command: &[f32], obs: &mut [f32]) -> Step {
-        let u = (command[0] as f64).clamp(-self.params.voltage_limit, self.params.voltage_limit);
-        self.x = self.params.advance(self.x, u);
-        self.observe(obs);
-        let reward = swing_up_reward(wrap_angle(self.x[0]), self.x[1], u);
-        Step {
-            reward: reward as f32,
-            terminal: false,
-        }
-    }
-
-    fn gearbox_torques(&self, command: &[f32]) -> Output {
-        let u = (command[0] as f64).clamp(-self.params.voltage_limit, self.params.voltage_limit);
-        let mut t = [0.0; MAX_ACTION_DIMS];
+    fn gearbox_torque(&self, command: f32) -> f32 {
+        let u = (command as f64).clamp(-self.voltage_limit, self.voltage_limit);
         // The robot's definition (the model's K/R with its defaults).
-        t[0] = gearbox_torque(u) as f32;
-        t
+        gearbox_torque(u) as f32
     }
 }
 
@@ -206,6 +169,7 @@ impl Task for PhysicalPendulumTask {
 mod tests {
     use super::*;
     use crate::experiment::task::Plant;
+    use std::f64::consts::PI;
 
     #[test]
     fn energy_is_conserved_without_voltage_and_friction() {
