@@ -19,6 +19,9 @@
 //!   filter's α while learning to hold a stated MTBF;
 //! - [`trace`]: bounded eligibility traces;
 //! - [`agent`]: SARSA(λ) with ε-greedy selection over the policy's candidates;
+//! - [`episodes`]: the episode cycle the chip and the host both drive (test
+//!   cadence, the kinds of end, LEO's footstep remap, the step records, the
+//!   governor's feed);
 //! - [`fatigue`]: backlash re-engagements → damage J → predicted MTBF
 //!   (Section IV, Eqs. 1–7);
 //! - [`dynamixel`]: the Dynamixel Protocol 1.0 codec and the RX-28 control
