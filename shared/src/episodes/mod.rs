@@ -121,11 +121,6 @@ impl Episodes {
         Episodes { rules, started: 0, since_test: 0, current: None, last_action: 0 }
     }
 
-    /// The rules.
-    pub fn rules(&self) -> &EpisodeRules {
-        &self.rules
-    }
-
     /// Episodes started so far.
     pub fn started(&self) -> u32 {
         self.started
@@ -143,16 +138,6 @@ impl Episodes {
         self.since_test = since_test;
         self.last_action = last_action;
         self.current = None;
-    }
-
-    /// The mode of the episode in progress.
-    pub fn mode(&self) -> Option<RunMode> {
-        self.current.map(|c| c.mode)
-    }
-
-    /// Transitions of the episode in progress.
-    pub fn steps(&self) -> Option<u32> {
-        self.current.map(|c| c.steps)
     }
 
     /// Whether an episode is in progress.
@@ -285,11 +270,6 @@ impl Episodes {
             episode_return: current.ret,
             ended,
         })
-    }
-
-    /// The undiscounted return of the episode in progress.
-    pub fn episode_return(&self) -> Option<f64> {
-        self.current.map(|c| c.ret)
     }
 }
 
