@@ -191,7 +191,7 @@ where
     /// Bytes a checkpoint of this learner takes in a slot: header, learner
     /// state and the whole table.
     pub fn checkpoint_bytes(&self) -> usize {
-        checkpoint::slot_len(self.weights().len(), self.weights().format().bytes())
+        checkpoint::slot_len(self.weights().len(), self.weights().entry_bytes())
     }
 
     /// Saves that failed since boot (too large for a slot, the store

@@ -84,6 +84,12 @@ pub enum WeightTable {
         /// Base-2 logarithm of the table size.
         log2_size: u32,
     },
+    /// A claim table of `2^log2_size` slots, Q16 weights with 32-bit tags
+    /// ([`pada_core::claim_table`]): hashed features without collisions.
+    Claimed {
+        /// Base-2 logarithm of the table size.
+        log2_size: u32,
+    },
 }
 
 /// The fixed description of a task.
@@ -150,6 +156,8 @@ impl WeightTable {
             // coder); FitExact is an exact-layout size only.
             (Layout::Hashed, TableSize::Weights(n)) => WeightTable::Hashed { log2_size: n.trailing_zeros() },
             (Layout::Hashed, TableSize::FitExact) => WeightTable::Hashed { log2_size: 0 },
+            (Layout::Claimed, TableSize::Weights(n)) => WeightTable::Claimed { log2_size: n.trailing_zeros() },
+            (Layout::Claimed, TableSize::FitExact) => WeightTable::Claimed { log2_size: 0 },
         }
     }
 }
