@@ -209,14 +209,16 @@ fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
         outln!("{}", summary.to_json())?;
     } else {
         print_summary(&summary.run, &run_label(&policy, cfg.mtbf_budget_s))?;
+        let p = &summary.profile;
         outln!(
-            "  board                {}: {} {} weights ({} KiB, {}-bit) in {}",
+            "  board                {}: {} table of {} entries ({} KiB: {}-bit weights{}) in {}",
             board.name(),
-            summary.profile.layout,
-            summary.profile.weights,
-            summary.profile.table_bytes / 1024,
-            summary.profile.weight_bits,
-            summary.profile.memory
+            p.layout,
+            p.weights,
+            p.table_bytes / 1024,
+            p.weight_bits,
+            if p.tag_bits > 0 { format!(", {}-bit tags", p.tag_bits) } else { String::new() },
+            p.memory
         )?;
         outln!("wrote {}", out.path().display())?;
     }
@@ -447,6 +449,17 @@ pub fn print_summary(s: &RunSummary, label: &str) -> Result<(), CliError> {
         "  falls                {:.1} learning, {:.1} test runs per trial",
         s.learning_falls.mean, s.test_falls.mean
     )?;
+    let tables: Vec<_> = s.per_trial.iter().filter_map(|t| t.table).collect();
+    if let Some(most) = tables.iter().max_by_key(|o| o.claimed) {
+        outln!(
+            "  claim table          {} of {} slots claimed ({:.1} %, the fullest trial), {} claims refused in all, longest probe {}",
+            most.claimed,
+            most.slots,
+            100.0 * most.fraction(),
+            tables.iter().map(|o| o.refused as u64).sum::<u64>(),
+            tables.iter().map(|o| o.longest_probe).max().unwrap_or(0)
+        )?;
+    }
     outln!(
         "  wall {:.1} s, {:.0} env steps/s on {} threads",
         s.wall_s, s.env_steps_per_s, s.threads

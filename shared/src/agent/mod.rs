@@ -380,6 +380,8 @@ where
     /// - `epsilon`: finite, `0 ≤ ε ≤ 1`;
     /// - `stats.explorations`, `stats.updates`: at most `stats.steps` (each
     ///   is counted with a decision);
+    /// - `table_seed` and `stats.claims_refused`: 0 unless the table is a
+    ///   claim table;
     /// - the policy ([`Policy::check_state`]): its kind's Δ or α in range
     ///   ([`PolicyKind::validate`]: `delta`, `lowpass alpha`), a kind whose
     ///   learner means the same as the running one (`policy.kind`), the
@@ -396,6 +398,13 @@ where
         }
         if s.updates > s.steps {
             return Err(ConfigError::new("stats.updates", s.updates as f32, "updates <= steps"));
+        }
+        if !self.weights.claims() && (state.table_seed != 0 || s.claims_refused != 0) {
+            return Err(ConfigError::new(
+                "table_seed",
+                state.table_seed as f32,
+                "0 with no claims refused: this learner's table is not a claim table",
+            ));
         }
         self.policy.check_state(&state.policy)
     }

@@ -533,9 +533,13 @@ mod tests {
         assert_eq!(Header::parse(&h1.to_bytes()), Err(HeaderError::UnsupportedVersion { found: 1 }));
         let h2 = Header { version: 2, ..h };
         assert_eq!(Header::parse(&h2.to_bytes()), Err(HeaderError::UnsupportedVersion { found: 2 }));
-        let h4 = Header { version: 4, ..h };
-        assert_eq!(Header::parse(&h4.to_bytes()), Err(HeaderError::UnsupportedVersion { found: 4 }));
-        // A weight width other than 2 or 4 bytes describes no slot.
+        let h3 = Header { version: 3, ..h };
+        assert_eq!(Header::parse(&h3.to_bytes()), Err(HeaderError::UnsupportedVersion { found: 3 }));
+        let h5 = Header { version: 5, ..h };
+        assert_eq!(Header::parse(&h5.to_bytes()), Err(HeaderError::UnsupportedVersion { found: 5 }));
+        // An entry of 8 bytes (a Q16 weight and a 32-bit tag) is a slot;
+        // a width other than 2, 4 or 8 bytes describes none.
+        assert_eq!(Header { weight_bytes: 8, ..h }.slot_bytes(), Some(HEADER_LEN + STATE_LEN + 24));
         let mut store = super::super::store::RamStore::<{ slot_len(3, 4) }>::new();
         let odd = Header { weight_bytes: 3, ..h };
         let _ = store.write(0, 0, &odd.to_bytes());
