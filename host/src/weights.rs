@@ -82,14 +82,14 @@ impl WeightsHeader {
                 (WeightTable::Hashed { log2_size }, Some(w)) => {
                     format!("hashed 2^{log2_size}, action tiles {w:?}")
                 }
-                (WeightTable::Claimed { log2_size }, None) => format!("claim 2^{log2_size}"),
-                (WeightTable::Claimed { log2_size }, Some(w)) => {
+                (WeightTable::Claimed { log2_size, .. }, None) => format!("claim 2^{log2_size}"),
+                (WeightTable::Claimed { log2_size, .. }, Some(w)) => {
                     format!("claim 2^{log2_size}, action tiles {w:?}")
                 }
             },
             weights: n,
             entry_bytes: match spec.table {
-                WeightTable::Claimed { .. } => 8,
+                WeightTable::Claimed { format, tag_bytes, .. } => format.bytes() + tag_bytes,
                 _ => 4,
             },
             table_seed: 0,

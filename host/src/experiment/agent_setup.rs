@@ -24,7 +24,7 @@ pub fn build_agent(spec: &TaskSpec, policy: PolicyKind) -> anyhow::Result<HostAg
     let err = |e: pada_core::error::ConfigError| anyhow::anyhow!("{e}");
     let (layout, size) = match spec.table {
         WeightTable::Hashed { log2_size } => (Layout::Hashed, 1usize << log2_size),
-        WeightTable::Claimed { log2_size } => (Layout::Claimed, 1usize << log2_size),
+        WeightTable::Claimed { log2_size, .. } => (Layout::Claimed, 1usize << log2_size),
         WeightTable::ExactOf { weights } => (Layout::Exact, weights),
         // The exact size depends on the policy's state extension and its
         // learner actions.
@@ -32,9 +32,9 @@ pub fn build_agent(spec: &TaskSpec, policy: PolicyKind) -> anyhow::Result<HostAg
             (Layout::Exact, pada_core::agent::exact_table_len::<TILINGS>(&spec.state, spec.motor.clone(), policy).map_err(err)?)
         }
     };
-    let weights = match layout {
-        Layout::Claimed => HostTable::claimed(size)?,
-        Layout::Exact | Layout::Hashed => HostTable::plain(size),
+    let weights = match spec.table {
+        WeightTable::Claimed { format, tag_bytes, .. } => HostTable::claimed(size, format, tag_bytes)?,
+        _ => HostTable::plain(size),
     };
     let mut agent = Agent::new(
         &spec.state,

@@ -1,18 +1,26 @@
-//! The host's weight table: a plain slice (exact or hashed layouts) or a
-//! claim table of Q16 weights with 32-bit tags (LEO,
-//! [`pada_core::claim_table`]), behind one type so that every host agent
-//! is one [`crate::experiment::HostAgent`].
+//! The host's weight table: a plain slice (exact or hashed layouts), a
+//! claim table of Q16 weights with 32-bit tags (the host's LEO,
+//! [`pada_core::claim_table`]), or the chips' LEO claim table of 16-bit
+//! weights and 16-bit tags (to build a board's learner on the host),
+//! behind one type so that every host agent is one
+//! [`crate::experiment::HostAgent`].
 //!
 //! Each access matches on the kind once; the branch goes the same way for
 //! a whole run, so it costs next to nothing against the table read behind
 //! it.
 
-use pada_core::claim_table::{Claim, ClaimTable, InitialWeights, Occupancy, Tags32};
+use pada_core::claim_table::{Claim, ClaimTable, InitialWeights, Occupancy, Tags16, Tags32};
 use pada_core::fixed::Q16;
-use pada_core::weights::{WeightFormat, WeightStore};
+use pada_core::weights::{Half, WeightFormat, WeightStore};
 
 /// A claim table on the heap: Q16 weights, 32-bit tags.
 pub type HostClaimTable = ClaimTable<Box<[Q16]>, Tags32<Box<[u32]>>>;
+
+/// The shift of the chips' 16-bit LEO weights.
+const LEO_SHIFT: u32 = pada_core::robot::leo::HALF_SHIFT as u32;
+
+/// The chips' LEO claim table on the heap: 16-bit weights, 16-bit tags.
+pub type ChipClaimTable = ClaimTable<Half<Box<[i16]>, LEO_SHIFT>, Tags16<Box<[u16]>>>;
 
 /// The host's table.
 #[derive(Debug, Clone)]
@@ -21,6 +29,8 @@ pub enum HostTable {
     Plain(Box<[Q16]>),
     /// A claim table.
     Claimed(HostClaimTable),
+    /// The chips' LEO claim table.
+    Chip(ChipClaimTable),
 }
 
 impl HostTable {
@@ -29,11 +39,28 @@ impl HostTable {
         HostTable::Plain(vec![Q16::ZERO; n].into_boxed_slice())
     }
 
-    /// A claim table of `n` free slots (`n` a power of two).
-    pub fn claimed(n: usize) -> anyhow::Result<HostTable> {
-        let weights = vec![Q16::ZERO; n].into_boxed_slice();
-        let tags = Tags32(vec![0u32; n].into_boxed_slice());
-        Ok(HostTable::Claimed(ClaimTable::new(weights, tags).map_err(|e| anyhow::anyhow!("{e}"))?))
+    /// A claim table of `n` free slots (`n` a power of two): Q16 weights
+    /// with 32-bit tags, or LEO's 16-bit weights with 16-bit tags (the
+    /// chips'); no other combination is built on the host.
+    pub fn claimed(n: usize, format: WeightFormat, tag_bytes: usize) -> anyhow::Result<HostTable> {
+        let err = |e: pada_core::claim_table::ClaimTableError| anyhow::anyhow!("{e}");
+        match (format, tag_bytes) {
+            (WeightFormat::Q16, 4) => {
+                let weights = vec![Q16::ZERO; n].into_boxed_slice();
+                let tags = Tags32(vec![0u32; n].into_boxed_slice());
+                Ok(HostTable::Claimed(ClaimTable::new(weights, tags).map_err(err)?))
+            }
+            (WeightFormat::Half { shift }, 2) if shift as u32 == LEO_SHIFT => {
+                let weights = Half::new(vec![0i16; n].into_boxed_slice());
+                let tags = Tags16(vec![0u16; n].into_boxed_slice());
+                Ok(HostTable::Chip(ClaimTable::new(weights, tags).map_err(err)?))
+            }
+            _ => anyhow::bail!(
+                "no host claim table with {format:?} weights and {}-bit tags (Q16 with 32-bit tags, or 16-bit weights \
+                 shifted by {LEO_SHIFT} with 16-bit tags)",
+                tag_bytes * 8
+            ),
+        }
     }
 }
 
@@ -42,6 +69,7 @@ macro_rules! each {
         match $self {
             HostTable::Plain($t) => $e,
             HostTable::Claimed($t) => $e,
+            HostTable::Chip($t) => $e,
         }
     };
 }
@@ -67,7 +95,7 @@ impl WeightStore for HostTable {
     }
 
     fn format(&self) -> WeightFormat {
-        WeightFormat::Q16
+        each!(self, t => t.format())
     }
 
     fn stored_le(&self, i: usize, out: &mut [u8]) {
@@ -85,7 +113,7 @@ impl WeightStore for HostTable {
 
     #[inline]
     fn claims(&self) -> bool {
-        matches!(self, HostTable::Claimed(_))
+        !matches!(self, HostTable::Plain(_))
     }
 
     fn tag_bytes(&self) -> usize {
