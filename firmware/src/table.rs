@@ -22,6 +22,7 @@
 
 use crate::board::TableMemory;
 use core::mem::MaybeUninit;
+#[allow(unused_imports)] // the pendulum's tables only
 use pada_core::fixed::Q16;
 use pada_core::profile::{Board, LearnerProfile, Memory};
 use pada_firmware::robot::RobotAdapter;
