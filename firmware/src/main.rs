@@ -85,10 +85,11 @@ async fn main(spawner: Spawner) {
         Err(e) => defmt::panic!("controller configuration: {}", defmt::Debug2Format(&e)),
     };
     info!(
-        "table: {=usize} weights ({=usize} bytes, {}) in {}; configuration hash {=u32:x}",
+        "table: {=usize} entries ({=usize} bytes, {} weights, {=usize}-byte tags) in {}; configuration hash {=u32:x}",
         ctl.weights().len(),
-        ctl.weights().len() * PROFILE.format.bytes(),
+        ctl.weights().len() * PROFILE.entry_bytes(),
         PROFILE.format,
+        PROFILE.tag_bytes,
         PROFILE.memory.name(),
         ctl.config_hash()
     );

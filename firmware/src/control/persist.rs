@@ -583,7 +583,7 @@ mod tests {
     fn every_f405_checkpoint_fits_a_flash_sector() {
         for robot in Robot::ALL {
             let p = profile(robot);
-            let bytes = checkpoint::slot_len(p.weights().unwrap(), p.format.bytes());
+            let bytes = checkpoint::slot_len(p.weights().unwrap(), p.entry_bytes());
             assert!(bytes <= FLASH_SLOT, "{robot:?}: {bytes}");
         }
     }

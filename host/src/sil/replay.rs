@@ -14,8 +14,9 @@
 //! firmware reported it.
 
 use pada_core::agent::{EpisodeEnd, Mode};
-use pada_core::fixed::Q16;
+use crate::experiment::table::HostTable;
 use pada_core::policy::PolicyKind;
+use pada_core::tile_coding::Layout;
 use pada_core::wire::{Episode, RunMode, Step, StepKind};
 use pada_core::profile::{LearnerProfile, TILINGS, TRACE};
 use rand_core::SeedableRng;
@@ -76,7 +77,16 @@ pub fn replay(profile: &LearnerProfile, policy: PolicyKind, seed: u64, records: 
         report.error = Some(format!("board profile {} has no fixed table size", profile.board.name()));
         return report;
     };
-    let table = vec![Q16::ZERO; weights].into_boxed_slice();
+    let table = match profile.layout {
+        Layout::Claimed => match HostTable::claimed(weights, profile.format, profile.tag_bytes) {
+            Ok(t) => t,
+            Err(e) => {
+                report.error = Some(format!("cannot build the table: {e}"));
+                return report;
+            }
+        },
+        Layout::Exact | Layout::Hashed => HostTable::plain(weights),
+    };
     let agent = profile.robot.spec().agent::<_, TILINGS, TRACE>(policy, profile.layout, table);
     let mut agent = match agent {
         Ok(a) => a,
@@ -96,11 +106,13 @@ pub fn replay(profile: &LearnerProfile, policy: PolicyKind, seed: u64, records: 
             Record::Boot => {
                 report.boots += 1;
                 let (state, weights, generator) = &saved;
+                // The table first: a claim table's restore counts its slots.
+                agent.weights_mut().clone_from(weights);
+                agent.rehash();
                 if let Err(e) = agent.restore_state(state) {
                     report.error = Some(format!("boot {}: the saved state does not restore: {e}", report.boots));
                     break;
                 }
-                agent.weights_mut().copy_from_slice(weights);
                 rng = generator.clone();
             }
             Record::Step(s) => {

@@ -530,7 +530,7 @@ pub fn summarize(cfg: &SilConfig, facts: Facts<'_>) -> SilSummary {
         });
     }
     let mut power = facts.power;
-    let fits = super::power_cut::checkpoint_bytes(profile.weights().unwrap_or(0), profile.format.bytes())
+    let fits = super::power_cut::checkpoint_bytes(profile.weights().unwrap_or(0), profile.entry_bytes())
         <= pada_firmware::sil::CHECKPOINT_SLOT_LEN;
     checks.extend(super::power_cut::checks(&mut power, period_ms, facts.emulated_s, fits));
     if let Some(sink) = facts.sink {

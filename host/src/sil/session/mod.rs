@@ -107,7 +107,7 @@ impl<'a> Session<'a> {
             "emulated_time_s",
         ])?;
         let profile = cfg.profile();
-        let ckpt = super::power_cut::checkpoint_bytes(profile.weights().unwrap_or(0), profile.format.bytes());
+        let ckpt = super::power_cut::checkpoint_bytes(profile.weights().unwrap_or(0), profile.entry_bytes());
         let plan = CutPlan::new(&cfg.power_cuts, cfg.seconds, cfg.save_every_s.unwrap_or(f64::INFINITY), ckpt, CHECKPOINT_SLOT_LEN);
         let mut hangs_us: Vec<u64> = cfg.hangs_s.iter().map(|t| (t * 1e6).round() as u64).collect();
         hangs_us.sort_unstable();
