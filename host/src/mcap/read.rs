@@ -44,7 +44,11 @@ pub fn replay(bytes: &[u8]) -> Result<Replayed, String> {
     let mut latest = Latest::default();
     let mut link = None;
     let mut per_topic = BTreeMap::new();
-    let stream = ::mcap::MessageStream::new(bytes).map_err(|e| format!("not a valid MCAP file ({e})"))?;
+    // Every chunk's CRC checked: a damaged message is an error, not a
+    // different summary.
+    let options = ::mcap::read::Options::ValidateChunkCrcs.into();
+    let stream =
+        ::mcap::MessageStream::new_with_options(bytes, options).map_err(|e| format!("not a valid MCAP file ({e})"))?;
     for m in stream {
         let m = m.map_err(|e| format!("not a valid MCAP file ({e})"))?;
         let name = m.channel.topic.as_str();

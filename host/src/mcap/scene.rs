@@ -28,15 +28,23 @@ use pada_core::robot::Robot;
 use pada_core::wire::{Step, StepKind};
 use serde::Serialize;
 
-/// A point or vector.
+/// A point or vector, rounded to 0.1 mm when serialized (shorter JSON;
+/// far finer than a viewer shows).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Vec3 {
+    #[serde(serialize_with = "tenth_mm")]
     /// x \[m\] (forwards).
     pub x: f64,
     /// y \[m\] (left).
+    #[serde(serialize_with = "tenth_mm")]
     pub y: f64,
     /// z \[m\] (up).
+    #[serde(serialize_with = "tenth_mm")]
     pub z: f64,
+}
+
+fn tenth_mm<S: serde::Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_f64((v * 1e4).round() / 1e4)
 }
 
 /// A colour, 0–1 per channel.
