@@ -230,3 +230,24 @@ fn the_live_server_delivers_every_message_of_every_channel_to_a_foxglove_client(
     let total: u64 = received.values().sum();
     assert_eq!(summary["foxglove"]["sent"].as_u64(), Some(total));
 }
+
+#[test]
+fn pada_run_records_the_same_file_as_a_capture_of_its_stream() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    ok(&pada(&[
+        "run", "--task", "pendulum", "--algo", "sarsa", "--trials", "1", "--seconds", "30", "--json",
+        "--telemetry", &p("run.bin"), "--mcap", &p("run.mcap"), "--out", &p("out"),
+    ]));
+    capture_to_mcap(Path::new(&p("run.bin")), Path::new(&p("cap.mcap")));
+    // Board times and sequence numbers only: the same stream, the same bytes.
+    assert!(std::fs::read(p("run.mcap")).unwrap() == std::fs::read(p("cap.mcap")).unwrap());
+    assert_bad_input(
+        &["run", "--task", "pendulum", "--algo", "sarsa", "--seconds", "1", "--trials", "1", "--out", &p("o2"), "--mcap", "/nonexistent/dir/x.mcap"],
+        &["--mcap", "cannot create"],
+    );
+    assert_bad_input(
+        &["run", "--board", "f405", "--task", "physical-pendulum", "--algo", "sarsa", "--mcap", &p("b.mcap")],
+        &["--mcap", "not available with --board"],
+    );
+}

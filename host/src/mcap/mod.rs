@@ -16,6 +16,7 @@
 pub mod channels;
 pub mod read;
 pub mod scene;
+pub mod tee;
 pub mod schemas;
 pub mod writer;
 
