@@ -35,6 +35,10 @@ pub struct CaptureArgs {
     /// What is kept of it.
     #[command(flatten)]
     pub record: StreamRecord,
+    /// With --file X.mcap: draw 8 frames of its last 3 s of /scene (the
+    /// robot from its joint angles) side by side as a PNG, side view.
+    #[arg(long, value_name = "FILE.png")]
+    pub scene_png: Option<std::path::PathBuf>,
 }
 
 /// The end of a capture.
@@ -93,6 +97,16 @@ fn replay_mcap(args: &CaptureArgs, path: &std::path::Path) -> Result<(), CliErro
     let started = Instant::now();
     let bytes = std::fs::read(path).map_err(|e| usage(format!("--file {}: cannot read: {e}", path.display())))?;
     let rep = crate::mcap::read::replay(&bytes).map_err(|e| usage(format!("--file {}: {e}", path.display())))?;
+    if let Some(png) = &args.scene_png {
+        let name = path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned());
+        let title = format!(
+            "{name}: /scene (foxglove.SceneUpdate lines) drawn by pada, side view. Blue left leg, orange right leg, grey torso, purple arm, green floor"
+        );
+        // 90 messages: the last 3 s of LEO (30 Hz) or of the pendulum (33 Hz).
+        let picture = crate::mcap::picture::scene_strip_png(&bytes, 8, 90, &title)
+            .map_err(|e| usage(format!("--scene-png: {e}")))?;
+        std::fs::write(png, picture).map_err(|e| usage(format!("--scene-png {}: cannot write: {e}", png.display())))?;
+    }
     let summary = CaptureSummary {
         source: path.display().to_string(),
         ended: "end of file".to_string(),
@@ -137,6 +151,9 @@ fn is_mcap_file(path: &std::path::Path) -> bool {
 pub fn run(args: CaptureArgs) -> Result<(), CliError> {
     args.record.check()?;
     args.input.check()?;
+    if args.scene_png.is_some() && !args.input.file.as_deref().is_some_and(is_mcap_file) {
+        return Err(usage("--scene-png draws a recording: give --file X.mcap (an MCAP file written by --mcap)"));
+    }
     if let Some(file) = args.input.file.as_deref().filter(|f| f.as_os_str() != "-" && is_mcap_file(f)) {
         return replay_mcap(&args, file);
     }

@@ -15,6 +15,7 @@
 
 pub mod channels;
 pub mod read;
+pub mod picture;
 pub mod scene;
 pub mod tee;
 pub mod schemas;

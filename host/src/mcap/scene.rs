@@ -16,7 +16,6 @@
 //! The pendulum's arm turns about the axis at the origin, θ = 0 upright,
 //! to its centre of mass (`PhysicalPendulumParams::length_m`).
 
-use super::channels::json;
 use crate::leo::constants::{
     ANKLE_GAIN_SETPOINT, ARM_HAND, ARM_SHOULDER_ANCHOR, FOOT_ANKLE_ANCHOR, FOOT_HEEL, FOOT_TOE,
     INIT_LEFT_FOOT_POINT, SHANK_ANKLE_ANCHOR, SHANK_KNEE_ANCHOR, SHOULDER_GAIN_SETPOINT,
@@ -26,29 +25,21 @@ use crate::leo::model::{assemble, Body, InitialPose};
 use pada_core::robot::leo::Leg;
 use pada_core::robot::Robot;
 use pada_core::wire::{Step, StepKind};
-use serde::Serialize;
 
-/// A point or vector, rounded to 0.1 mm when serialized (shorter JSON;
-/// far finer than a viewer shows).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+/// A point, written to 0.1 mm in the JSON (far finer than a viewer
+/// shows).
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Vec3 {
-    #[serde(serialize_with = "tenth_mm")]
     /// x \[m\] (forwards).
     pub x: f64,
     /// y \[m\] (left).
-    #[serde(serialize_with = "tenth_mm")]
     pub y: f64,
     /// z \[m\] (up).
-    #[serde(serialize_with = "tenth_mm")]
     pub z: f64,
 }
 
-fn tenth_mm<S: serde::Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
-    s.serialize_f64((v * 1e4).round() / 1e4)
-}
-
 /// A colour, 0–1 per channel.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Color {
     /// Red.
     pub r: f64,
@@ -60,32 +51,6 @@ pub struct Color {
     pub a: f64,
 }
 
-#[derive(Debug, Clone, Copy, Serialize)]
-struct Quat {
-    x: f64,
-    y: f64,
-    z: f64,
-    w: f64,
-}
-
-#[derive(Debug, Clone, Copy, Serialize)]
-struct Pose {
-    position: Vec3,
-    orientation: Quat,
-}
-
-const IDENTITY: Pose = Pose {
-    position: Vec3 { x: 0.0, y: 0.0, z: 0.0 },
-    orientation: Quat { x: 0.0, y: 0.0, z: 0.0, w: 1.0 },
-};
-
-/// Foxglove's `Time` and `Duration`.
-#[derive(Debug, Clone, Copy, Serialize)]
-struct Time {
-    sec: u64,
-    nsec: u32,
-}
-
 /// One line strip of a scene: a body or a chain of bodies.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Strip {
@@ -95,49 +60,6 @@ pub struct Strip {
     pub points: Vec<Vec3>,
     /// Its colour.
     pub color: Color,
-}
-
-#[derive(Serialize)]
-struct Line<'a> {
-    #[serde(rename = "type")]
-    kind: u8,
-    pose: Pose,
-    thickness: f64,
-    scale_invariant: bool,
-    points: &'a [Vec3],
-    color: Color,
-    colors: [Color; 0],
-    indices: [u32; 0],
-}
-
-#[derive(Serialize)]
-struct KeyValue<'a> {
-    key: &'a str,
-    value: &'a str,
-}
-
-#[derive(Serialize)]
-struct Entity<'a> {
-    timestamp: Time,
-    frame_id: &'a str,
-    id: &'a str,
-    lifetime: Time,
-    frame_locked: bool,
-    metadata: Vec<KeyValue<'a>>,
-    arrows: [u8; 0],
-    cubes: [u8; 0],
-    spheres: [u8; 0],
-    cylinders: [u8; 0],
-    lines: Vec<Line<'a>>,
-    triangles: [u8; 0],
-    texts: [u8; 0],
-    models: [u8; 0],
-}
-
-#[derive(Serialize)]
-struct SceneUpdate<'a> {
-    deletions: [u8; 0],
-    entities: [Entity<'a>; 1],
 }
 
 const TORSO: Color = Color { r: 0.25, g: 0.25, b: 0.25, a: 1.0 };
@@ -284,38 +206,102 @@ fn pendulum(s: &Step) -> Option<Vec<Strip>> {
     ])
 }
 
+/// The `SceneUpdate` JSON of one frame, written directly: it is most of a
+/// recording's bytes, and serde's map serialisation and float formatting
+/// were most of the cost of `--mcap` (docs/foxglove.md, "Costs"). The
+/// Python test validates it against the schema.
 fn scene_json(strips: &[Strip], t: u64, robot: Robot) -> Vec<u8> {
-    let lines = strips
-        .iter()
-        .map(|s| Line {
-            kind: 0,
-            pose: IDENTITY,
-            thickness: if s.name == "floor" { 0.004 } else { 0.012 },
-            scale_invariant: false,
-            points: &s.points,
-            color: s.color,
-            colors: [],
-            indices: [],
-        })
-        .collect();
-    let time = Time { sec: t / 1_000_000_000, nsec: (t % 1_000_000_000) as u32 };
-    json(&SceneUpdate {
-        deletions: [],
-        entities: [Entity {
-            timestamp: time,
-            frame_id: "world",
-            id: robot.name(),
-            lifetime: Time { sec: 0, nsec: 0 },
-            frame_locked: false,
-            metadata: vec![KeyValue { key: "robot", value: robot.name() }],
-            arrows: [],
-            cubes: [],
-            spheres: [],
-            cylinders: [],
-            lines,
-            triangles: [],
-            texts: [],
-            models: [],
-        }],
-    })
+    use std::io::Write as _;
+    let mut v = Vec::with_capacity(256 + strips.len() * 400);
+    let (sec, nsec) = (t / 1_000_000_000, t % 1_000_000_000);
+    let name = robot.name();
+    let _ = write!(
+        v,
+        r#"{{"deletions":[],"entities":[{{"timestamp":{{"sec":{sec},"nsec":{nsec}}},"frame_id":"world","id":"{name}","lifetime":{{"sec":0,"nsec":0}},"frame_locked":false,"metadata":[{{"key":"robot","value":"{name}"}}],"arrows":[],"cubes":[],"spheres":[],"cylinders":[],"lines":["#
+    );
+    for (i, s) in strips.iter().enumerate() {
+        if i > 0 {
+            v.push(b',');
+        }
+        let thickness = if s.name == "floor" { "0.004" } else { "0.012" };
+        let _ = write!(
+            v,
+            r#"{{"type":0,"pose":{{"position":{{"x":0,"y":0,"z":0}},"orientation":{{"x":0,"y":0,"z":0,"w":1}}}},"thickness":{thickness},"scale_invariant":false,"points":["#
+        );
+        for (k, p) in s.points.iter().enumerate() {
+            if k > 0 {
+                v.push(b',');
+            }
+            v.extend_from_slice(br#"{"x":"#);
+            tenth_mm(&mut v, p.x);
+            v.extend_from_slice(br#","y":"#);
+            tenth_mm(&mut v, p.y);
+            v.extend_from_slice(br#","z":"#);
+            tenth_mm(&mut v, p.z);
+            v.push(b'}');
+        }
+        let c = s.color;
+        let _ = write!(v, r#"],"color":{{"r":{},"g":{},"b":{},"a":{}}},"colors":[],"indices":[]}}"#, c.r, c.g, c.b, c.a);
+    }
+    v.extend_from_slice(br#"],"triangles":[],"texts":[],"models":[]}]}"#);
+    v
+}
+
+/// Writes metres as a JSON number to 0.1 mm (integer arithmetic; a value
+/// that is not finite, which the kinematics cannot give, is written 0).
+fn tenth_mm(v: &mut Vec<u8>, m: f64) {
+    use std::io::Write as _;
+    let n = if m.is_finite() { (m * 1e4).round().clamp(-1e15, 1e15) as i64 } else { 0 };
+    if n < 0 {
+        v.push(b'-');
+    }
+    let a = n.unsigned_abs();
+    let _ = write!(v, "{}.{:04}", a / 10_000, a % 10_000);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn metres_to_a_tenth_of_a_millimetre() {
+        for (m, s) in [(0.0, "0.0000"), (0.12345, "0.1235"), (-0.0405, "-0.0405"), (1.5, "1.5000"), (-0.00004, "0.0000"), (f64::NAN, "0.0000")] {
+            let mut v = Vec::new();
+            tenth_mm(&mut v, m);
+            assert_eq!(String::from_utf8(v).unwrap(), s, "{m}");
+        }
+    }
+
+    #[test]
+    fn a_leo_step_is_drawn_as_five_strips_of_valid_json() {
+        let mut b = SceneBuilder::default();
+        b.robot(Some(Robot::Leo));
+        let mut s = Step {
+            step: 0, time_ms: 1500, episode: 0, mode: pada_core::wire::RunMode::Learning, kind: StepKind::Start,
+            state: heapless::Vec::new(), action: 0, output: heapless::Vec::new(), reward: 0.0, td_error: 0,
+            explored: false, footstep: false, joints: heapless::Vec::new(), loop_us: 0, agent_cycles: 0,
+        };
+        assert!(b.step(&s, 0).is_none(), "a state too short is not drawn");
+        for x in [-0.1f32, 0.0, 0.1, 0.0, 0.82, 0.0, 0.0, 0.0, -1.27, 0.0] {
+            s.state.push(x).unwrap();
+        }
+        let json = b.step(&s, 1_500_000_000).unwrap();
+        let v: serde_json::Value = serde_json::from_slice(&json).unwrap();
+        let e = &v["entities"][0];
+        assert_eq!(e["timestamp"]["sec"], 1);
+        assert_eq!(e["timestamp"]["nsec"], 500_000_000);
+        let lines = e["lines"].as_array().unwrap();
+        assert_eq!(lines.len(), 5);
+        // The stance (left) heel's wheel on the floor: its centre one
+        // wheel radius (3.5 mm) up.
+        let left = &lines[1]["points"];
+        let heel_z = left[5]["z"].as_f64().unwrap() as f32;
+        assert!((heel_z - crate::leo::constants::WHEEL_RADIUS).abs() < 2e-4, "{left}");
+        // The thigh is the model's: hip to knee anchor.
+        let thigh = left[0]["z"].as_f64().unwrap() - left[1]["z"].as_f64().unwrap();
+        let want = (crate::leo::constants::THIGH_HIP_ANCHOR[1] - crate::leo::constants::THIGH_KNEE_ANCHOR[1]) as f64;
+        assert!((thigh - want).abs() < 2e-4, "{thigh} {want}");
+        // The hips of both legs meet at the torso's hip anchor.
+        assert_eq!(lines[1]["points"][0]["x"], lines[2]["points"][0]["x"]);
+    }
 }
