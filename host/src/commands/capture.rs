@@ -35,8 +35,9 @@ pub struct CaptureArgs {
     /// What is kept of it.
     #[command(flatten)]
     pub record: StreamRecord,
-    /// With --file X.mcap: draw 8 frames of its last 3 s of /scene (the
-    /// robot from its joint angles) side by side as a PNG, side view.
+    /// With --file X.mcap: draw 8 frames over 3 s of its /scene (the robot
+    /// from its joint angles; the start of the last test episode that
+    /// long, else the end) side by side as a PNG, side view.
     #[arg(long, value_name = "FILE.png")]
     pub scene_png: Option<std::path::PathBuf>,
 }
@@ -102,7 +103,7 @@ fn replay_mcap(args: &CaptureArgs, path: &std::path::Path) -> Result<(), CliErro
         let title = format!(
             "{name}: /scene (foxglove.SceneUpdate lines) drawn by pada, side view. Blue left leg, orange right leg, grey torso, purple arm, green floor"
         );
-        // 90 messages: the last 3 s of LEO (30 Hz) or of the pendulum (33 Hz).
+        // 90 messages: 3 s of LEO (30 Hz) or of the pendulum (33 Hz).
         let picture = crate::mcap::picture::scene_strip_png(&bytes, 8, 90, &title)
             .map_err(|e| usage(format!("--scene-png: {e}")))?;
         std::fs::write(png, picture).map_err(|e| usage(format!("--scene-png {}: cannot write: {e}", png.display())))?;

@@ -45,31 +45,67 @@ struct Update {
     entities: Vec<Entity>,
 }
 
-/// One drawn frame: its time and its lines.
+/// One drawn frame: its time, its step and episode, and its lines.
 struct Frame {
     time_s: f64,
+    step: u32,
+    episode: (u32, bool),
     lines: Vec<Line>,
 }
 
-/// The PNG of `n` frames evenly spaced over the last `span` messages of
-/// the recording's `/scene` channel, with `title` above them.
+/// What a frame's `/step` said (the `/scene` message follows it).
+#[derive(Deserialize)]
+struct StepHead {
+    step: u32,
+    episode: u32,
+    mode: String,
+}
+
+/// The PNG of `n` frames evenly spaced over `span` messages of the
+/// recording's `/scene` channel, with `title` above them: the first `span`
+/// of the last test episode that has as many (a test run shows the
+/// learned gait), else the last `span`.
 pub fn scene_strip_png(mcap: &[u8], n: usize, span: usize, title: &str) -> Result<Vec<u8>, String> {
     let mut frames = Vec::new();
+    let mut head = StepHead { step: 0, episode: 0, mode: String::new() };
     let stream = ::mcap::MessageStream::new(mcap).map_err(|e| format!("not a valid MCAP file ({e})"))?;
     for m in stream {
         let m = m.map_err(|e| format!("not a valid MCAP file ({e})"))?;
+        if m.channel.topic == "/step" {
+            head = serde_json::from_slice(&m.data).map_err(|e| format!("a /step message is not pada.Step ({e})"))?;
+            continue;
+        }
         if m.channel.topic != "/scene" {
             continue;
         }
         let u: Update = serde_json::from_slice(&m.data).map_err(|e| format!("a /scene message is not a SceneUpdate ({e})"))?;
         for e in u.entities {
-            frames.push(Frame { time_s: e.timestamp.sec as f64 + e.timestamp.nsec as f64 * 1e-9, lines: e.lines });
+            frames.push(Frame {
+                time_s: e.timestamp.sec as f64 + e.timestamp.nsec as f64 * 1e-9,
+                step: head.step,
+                episode: (head.episode, head.mode == "testing"),
+                lines: e.lines,
+            });
         }
     }
     if frames.is_empty() {
         return Err("the recording has no /scene messages (no Hello of a known robot)".into());
     }
-    let tail = &frames[frames.len().saturating_sub(span.max(1))..];
+    let span = span.max(1);
+    // The start of each test episode with at least `span` frames.
+    let mut best = None;
+    let mut i = 0;
+    while i < frames.len() {
+        let j = frames[i..].iter().position(|f| f.episode != frames[i].episode).map_or(frames.len(), |k| i + k);
+        if frames[i].episode.1 && j - i >= span {
+            best = Some(i);
+        }
+        i = j;
+    }
+    let tail = match best {
+        Some(i) => &frames[i..i + span],
+        None => &frames[frames.len().saturating_sub(span)..],
+    };
     let n = n.clamp(1, tail.len());
     let picks: Vec<&Frame> = (0..n).map(|i| &tail[if n == 1 { 0 } else { i * (tail.len() - 1) / (n - 1) }]).collect();
     let svg = draw(&picks, title).map_err(|e| format!("{e:#}"))?;
@@ -98,7 +134,7 @@ fn draw(picks: &[&Frame], title: &str) -> anyhow::Result<String> {
             let (cx, _) = centre(f);
             let mut chart = ChartBuilder::on(panel)
                 .margin(6)
-                .caption(format!("t = {:.2} s", f.time_s), (FONT, 13))
+                .caption(format!("step {}, t = {:.2} s", f.step, f.time_s), (FONT, 13))
                 .build_cartesian_2d(cx - half..cx + half, zmin - pad..zmin - pad + 2.0 * half)
                 .map_err(plot_err)?;
             for l in &f.lines {
