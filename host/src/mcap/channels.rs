@@ -197,37 +197,15 @@ pub struct EpisodeView {
     pub weights_checksum: u32,
 }
 
-/// `/health`: the `Health` record's fields, with the hottest servo.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct HealthView {
-    /// The board's clock \[ms since boot\].
-    pub uptime_ms: u32,
-    /// Present temperature of each servo \[°C\].
-    pub servo_temps_c: Vec<u8>,
+/// `/health`: the `Health` record itself (its fields, as the wire defines
+/// them), with the hottest servo.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct HealthView<'a> {
+    /// The report.
+    #[serde(flatten)]
+    pub health: &'a pada_core::wire::Health,
     /// The hottest servo \[°C\] (0 without servos).
     pub max_servo_temp_c: u8,
-    /// Lowest servo voltage \[0.1 V\].
-    pub min_voltage_dv: u8,
-    /// Failed servo-bus transactions.
-    pub bus_errors: u32,
-    /// Status packets with a bad checksum.
-    pub checksum_errors: u32,
-    /// Servo requests that timed out.
-    pub timeouts: u32,
-    /// Eligibility-trace entries dropped.
-    pub trace_drops: u32,
-    /// Weight updates that saturated.
-    pub weight_saturations: u32,
-    /// Control periods that overran.
-    pub overruns: u32,
-    /// Longest period's work \[µs\].
-    pub max_loop_us: u32,
-    /// Telemetry frames the board dropped.
-    pub telemetry_drops: u32,
-    /// Erases of the more worn checkpoint sector.
-    pub checkpoint_erases: u32,
-    /// Checkpoint saves refused by the wear budget.
-    pub saves_refused: u32,
 }
 
 /// `/safety/state`.
@@ -462,20 +440,8 @@ impl Channelizer {
             ToHost::Health(h) => {
                 let t = self.clock.at_ms(h.uptime_ms);
                 push(Topic::Health, t, json(&HealthView {
-                    uptime_ms: h.uptime_ms,
-                    servo_temps_c: h.servo_temps_c.to_vec(),
+                    health: h,
                     max_servo_temp_c: h.servo_temps_c.iter().copied().max().unwrap_or(0),
-                    min_voltage_dv: h.min_voltage_dv,
-                    bus_errors: h.bus_errors,
-                    checksum_errors: h.checksum_errors,
-                    timeouts: h.timeouts,
-                    trace_drops: h.trace_drops,
-                    weight_saturations: h.weight_saturations,
-                    overruns: h.overruns,
-                    max_loop_us: h.max_loop_us,
-                    telemetry_drops: h.telemetry_drops,
-                    checkpoint_erases: h.checkpoint_erases,
-                    saves_refused: h.saves_refused,
                 }));
             }
             ToHost::State(s) => push(Topic::SafetyState, self.clock.now(), json(&StateView {

@@ -1,22 +1,40 @@
-//! `pada run --mcap FILE`: the messages a run streams (`--telemetry`'s
-//! frames) recorded as MCAP through the same path as `pada capture
-//! --mcap`: each message framed as the firmware frames it, decoded by a
-//! [`Recorder`] and handed to its tap, so a run's recording and a capture
-//! of its `--telemetry` stream are the same file.
+//! `pada run --mcap FILE`: the messages a run streams recorded as MCAP
+//! through the same path as `pada capture --mcap`: a
+//! [`TelemetrySink`] frames each message as the firmware frames it, into a
+//! [`Recorder`] that decodes the frames and hands them to its tap, so a
+//! run's recording and a capture of its `--telemetry` stream are the same
+//! file.
 
 use super::writer::McapFile;
 use super::Tap;
 use crate::capture::Recorder;
 use crate::error::{usage, CliError};
-use pada_core::wire::{FrameEncoder, ToHost, MAX_FRAME_LEN};
+use crate::telemetry::TelemetrySink;
+use pada_core::wire::ToHost;
+use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+
+/// Bytes written here are decoded by the recorder.
+struct Feed(Arc<Mutex<Recorder>>);
+
+impl Write for Feed {
+    fn write(&mut self, bytes: &[u8]) -> std::io::Result<usize> {
+        let mut frames = Vec::new();
+        self.0.lock().unwrap_or_else(|e| e.into_inner()).feed(bytes, 0.0, &mut frames)?;
+        Ok(bytes.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
 
 /// A run's telemetry on its way into an MCAP file.
 pub struct McapTee {
-    encoder: FrameEncoder,
-    recorder: Recorder,
+    sink: TelemetrySink,
+    recorder: Arc<Mutex<Recorder>>,
     path: PathBuf,
-    error: Option<String>,
 }
 
 impl McapTee {
@@ -29,34 +47,22 @@ impl McapTee {
             McapFile::create(path).map_err(|e| usage(format!("{flag} {}: cannot create: {e}", path.display())))?;
         let mut recorder = Recorder::new(None).map_err(|e| CliError::Runtime(e.into()))?;
         recorder.set_tap(Tap::new(vec![Box::new(file)]));
-        Ok(McapTee { encoder: FrameEncoder::new(), recorder, path: path.to_path_buf(), error: None })
+        let recorder = Arc::new(Mutex::new(recorder));
+        let sink = TelemetrySink::to_writer(Box::new(Feed(recorder.clone())), path.display().to_string());
+        Ok(McapTee { sink, recorder, path: path.to_path_buf() })
     }
 
     /// Records one message.
     pub fn send(&mut self, msg: &ToHost) {
-        if self.error.is_some() {
-            return;
-        }
-        let mut buf = [0u8; MAX_FRAME_LEN];
-        match self.encoder.encode(msg, &mut buf) {
-            Ok(frame) => {
-                let mut frames = Vec::new();
-                if let Err(e) = self.recorder.feed(frame, 0.0, &mut frames) {
-                    self.error = Some(e.to_string());
-                }
-            }
-            Err(e) => self.error = Some(format!("cannot encode a frame: {e:?}")),
-        }
+        self.sink.send(msg);
     }
 
-    /// Closes the file: its summary and metadata; an error if any write
-    /// failed. Returns the messages recorded.
-    pub fn finish(mut self) -> anyhow::Result<(u64, PathBuf)> {
-        let closed = self.recorder.close_tap();
-        if let Some(e) = self.error {
-            anyhow::bail!("the MCAP file {} failed: {e}", self.path.display());
-        }
+    /// Closes the file (its summary and metadata); an error if any write
+    /// failed. Returns the frames recorded and the file.
+    pub fn finish(self) -> anyhow::Result<(u64, PathBuf)> {
+        let totals = self.sink.finish()?;
+        let closed = self.recorder.lock().unwrap_or_else(|e| e.into_inner()).close_tap();
         closed.map_err(|e| anyhow::anyhow!("the MCAP file {} failed: {e}", self.path.display()))?;
-        Ok((self.recorder.stats().frames as u64, self.path))
+        Ok((totals.frames, self.path))
     }
 }
