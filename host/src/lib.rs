@@ -16,6 +16,7 @@ pub mod foxglove;
 pub mod integrator;
 pub mod leo;
 pub mod mcap;
+pub mod model_presets;
 pub mod output;
 pub mod paper;
 pub mod pendulum;
