@@ -41,7 +41,7 @@ const BOOT_POLICY: PolicyKind = PolicyKind::Sarsa;
     embassy_executor::main(entry = "cortex_m_rt::entry", executor = "crate::board::Executor")
 )]
 async fn main(spawner: Spawner) {
-    let board = board::Board::init();
+    let board = board::Board::init(PROFILE.memory);
     info!(
         "pada firmware {}: {} on board profile {}",
         env!("CARGO_PKG_VERSION"),

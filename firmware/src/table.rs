@@ -4,8 +4,8 @@
 //!
 //! | board (cargo feature) | pendulum | LEO |
 //! |---|---|---|
-//! | F405/F407, and QEMU's netduinoplus2 (`stm32f405`, `stm32f407`, `qemu`) | exact table: all 64 KiB of CCM, then 33.5 KiB of SRAM (`Split`) | 2^14 weights in CCM |
-//! | F429I-DISC1 (`stm32f429`), and QEMU's mps2-an386 (`mps2`) | exact table, 97.5 KiB of SRAM | 2^21 weights, all 8 MiB of the SDRAM (on mps2-an386: its PSRAM, `.sdram` in `memory-mps2.x`) |
+//! | F405/F407, and QEMU's netduinoplus2 (`stm32f405`, `stm32f407`, `qemu`) | exact table: all 64 KiB of CCM, then 33.5 KiB of SRAM (`Split`) | claim table of 2^14 slots (16-bit weights and 16-bit tags) in CCM |
+//! | F429I-DISC1 (`stm32f429`), and QEMU's mps2-an386 (`mps2`) | exact table, 97.5 KiB of SRAM | claim table of 2^21 slots (16-bit weights and 16-bit tags), all 8 MiB of the SDRAM (on mps2-an386: its PSRAM, `.sdram` in `memory-mps2.x`) |
 //!
 //! (`profile_f429` is build.rs's cfg for the `stm32f429` and `mps2`
 //! features: the boards of the f429-sdram profile.)
@@ -16,11 +16,13 @@
 //! the controller then initialises every weight from its seed.
 //!
 //! Each static has a symbol name of its own (`PADA_TABLE_CCM`,
-//! `PADA_TABLE_SRAM`, `PADA_TABLE_SDRAM`), by which `cargo xtask firmware`
+//! `PADA_TABLE_SRAM`, `PADA_TABLE_SDRAM`, and a claim table's tags
+//! `PADA_TABLE_TAGS_CCM`, `PADA_TABLE_TAGS_SDRAM`), by which `cargo xtask firmware`
 //! finds the table's placement in the ELF.
 
 use crate::board::TableMemory;
 use core::mem::MaybeUninit;
+#[allow(unused_imports)] // the pendulum's tables only
 use pada_core::fixed::Q16;
 use pada_core::profile::{Board, LearnerProfile, Memory};
 use pada_firmware::robot::RobotAdapter;
@@ -53,16 +55,17 @@ pub const WEIGHTS: usize = match PROFILE.weights() {
     None => panic!("a chip's profile has a fixed table size"),
 };
 
-/// A zeroed `&'static mut` array from a static `MaybeUninit` (all-zero bits
-/// are valid `Q16`s). The caller takes each static once.
+/// A zeroed `&'static mut` array from a static `MaybeUninit`. The caller
+/// takes each static once.
 ///
 /// # Safety
-/// `cell` must not be referenced anywhere else.
-unsafe fn zeroed<const N: usize>(cell: *mut MaybeUninit<[Q16; N]>) -> &'static mut [Q16; N] {
+/// `cell` must not be referenced anywhere else, and all-zero bits must be
+/// a valid `T` (they are for `Q16`, `i16` and `u16`, the tables' words).
+unsafe fn zeroed<T, const N: usize>(cell: *mut MaybeUninit<[T; N]>) -> &'static mut [T; N] {
     // SAFETY: the caller's guarantee makes the reference unique; the
     // memory is zeroed before it is made.
     unsafe {
-        (*cell).as_mut_ptr().cast::<Q16>().write_bytes(0, N);
+        (*cell).as_mut_ptr().cast::<T>().write_bytes(0, N);
         (*cell).assume_init_mut()
     }
 }
@@ -131,10 +134,52 @@ mod layout {
     }
 }
 
-// LEO on an F405: the 64 KiB of CCM.
+/// A claim table in one memory: 16-bit weights in one static, 16-bit tags
+/// in another, both in `$section` (`pada_core::claim_table`).
+#[allow(unused_macros)]
+macro_rules! claim_table {
+    ($memory:pat, $section:literal, $weights:literal, $tags:literal) => {
+        use super::*;
+        use pada_core::claim_table::{ClaimTable, Tags16};
+        use pada_core::weights::Half;
+
+        const _: () = assert!(matches!(PROFILE.memory, $memory), "the profile puts the table elsewhere");
+        const _: () = assert!(PROFILE.tag_bytes == 2 && PROFILE.format.bytes() == 2, "16-bit weights and tags");
+        const _: () = assert!(WEIGHTS >= 2 && WEIGHTS.is_power_of_two(), "a claim table has 2^n slots");
+        const SHIFT: u32 = match PROFILE.format {
+            pada_core::weights::WeightFormat::Half { shift } => shift as u32,
+            pada_core::weights::WeightFormat::Q16 => panic!("the chips' LEO table has 16-bit weights"),
+        };
+
+        #[link_section = $section]
+        #[export_name = $weights]
+        static mut WEIGHTS_16: MaybeUninit<[i16; WEIGHTS]> = MaybeUninit::uninit();
+        #[link_section = $section]
+        #[export_name = $tags]
+        static mut TAGS_16: MaybeUninit<[u16; WEIGHTS]> = MaybeUninit::uninit();
+
+        /// The table.
+        pub type Table = ClaimTable<Half<&'static mut [i16; WEIGHTS], SHIFT>, Tags16<&'static mut [u16; WEIGHTS]>>;
+
+        pub fn take() -> Table {
+            TAKEN.init(());
+            // SAFETY: reached once (TAKEN), and nothing else names the
+            // statics; all-zero bits are valid i16 and u16.
+            let (weights, tags) = unsafe { (zeroed(core::ptr::addr_of_mut!(WEIGHTS_16)), zeroed(core::ptr::addr_of_mut!(TAGS_16))) };
+            match ClaimTable::new(Half::new(weights), Tags16(tags)) {
+                Ok(t) => t,
+                // Unreachable: both statics have WEIGHTS entries, a power
+                // of two (asserted at compile time above).
+                Err(_) => panic!("the claim table's statics disagree"),
+            }
+        }
+    };
+}
+
+// LEO on an F405: the 64 KiB of CCM, weights and tags.
 #[cfg(all(not(profile_f429), feature = "robot-leo"))]
 mod layout {
-    one_memory!(Memory::Ccm, ".ccmram", "PADA_TABLE_CCM");
+    claim_table!(Memory::Ccm, ".ccmram", "PADA_TABLE_CCM", "PADA_TABLE_TAGS_CCM");
 }
 
 // The pendulum on the F429: 97.5 KiB of its 192 KiB SRAM.
@@ -143,10 +188,10 @@ mod layout {
     one_memory!(Memory::Sram, ".uninit.pada_table", "PADA_TABLE_SRAM");
 }
 
-// LEO on the F429: all 8 MiB of the SDRAM.
+// LEO on the F429: all 8 MiB of the SDRAM, weights and tags.
 #[cfg(all(profile_f429, feature = "robot-leo"))]
 mod layout {
-    one_memory!(Memory::Sdram, ".sdram", "PADA_TABLE_SDRAM");
+    claim_table!(Memory::Sdram, ".sdram", "PADA_TABLE_SDRAM", "PADA_TABLE_TAGS_SDRAM");
 }
 
 pub use layout::Table;

@@ -339,6 +339,9 @@ pub async fn control(mut cl: ControlLoop) -> ! {
                 telemetry_drops: drops,
                 checkpoint_erases: 0,
                 saves_refused: 0,
+                table_claimed: 0,
+                table_slots: 0,
+                claims_refused: 0,
             };
             cl.ctl.health(&mut health);
             send(ToHost::Health(health), &mut skipped, &mut drops);

@@ -81,6 +81,35 @@ pub struct Latest {
     pub fault: Option<String>,
     /// The last state.
     pub state: Option<String>,
+    /// The claim table's occupancy in the last `Health` (a board whose
+    /// table is a claim table).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub table: Option<TableOccupancy>,
+}
+
+/// A claim table's occupancy as the board's `Health` reports it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TableOccupancy {
+    /// Slots claimed.
+    pub claimed: u32,
+    /// Slots in the table.
+    pub slots: u32,
+    /// The claimed fraction, 0–1.
+    pub fraction: f64,
+    /// Claims refused (updates dropped because the table was full).
+    pub claims_refused: u32,
+}
+
+impl TableOccupancy {
+    /// The occupancy a `Health` reports, `None` for a plain table.
+    pub fn of(h: &pada_core::wire::Health) -> Option<TableOccupancy> {
+        (h.table_slots > 0).then(|| TableOccupancy {
+            claimed: h.table_claimed,
+            slots: h.table_slots,
+            fraction: h.table_claimed as f64 / h.table_slots as f64,
+            claims_refused: h.claims_refused,
+        })
+    }
 }
 
 /// Decodes a telemetry stream, writes CSV, keeps counts.
@@ -300,7 +329,10 @@ impl Recorder {
                     }
                 }
             }
-            ToHost::Health(_) => c.health += 1,
+            ToHost::Health(h) => {
+                c.health += 1;
+                l.table = TableOccupancy::of(h);
+            }
             ToHost::State(s) => {
                 c.state += 1;
                 l.state = Some(format!("{:?}", s.to));
@@ -426,7 +458,7 @@ pub fn describe(msg: &ToHost) -> (&'static str, String) {
         ToHost::Health(h) => (
             "health",
             format!(
-                "uptime {} ms temps {:?} min voltage {} dV bus errors {} checksum errors {} timeouts {} overruns {} max loop {} us telemetry drops {}",
+                "uptime {} ms temps {:?} min voltage {} dV bus errors {} checksum errors {} timeouts {} overruns {} max loop {} us telemetry drops {} table claimed {} of {} refused {}",
                 h.uptime_ms,
                 h.servo_temps_c.as_slice(),
                 h.min_voltage_dv,
@@ -435,7 +467,10 @@ pub fn describe(msg: &ToHost) -> (&'static str, String) {
                 h.timeouts,
                 h.overruns,
                 h.max_loop_us,
-                h.telemetry_drops
+                h.telemetry_drops,
+                h.table_claimed,
+                h.table_slots,
+                h.claims_refused
             ),
         ),
         ToHost::State(s) => ("state", format!("{:?} -> {:?} at step {}", s.from, s.to, s.step)),

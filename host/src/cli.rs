@@ -35,6 +35,10 @@ pub enum Command {
     /// Predicted MTBF of a recorded torque log (Eqs. 3–7).
     #[command(allow_negative_numbers = true)]
     Mtbf(commands::mtbf::MtbfArgs),
+    /// What LEO's trials write into the claim table: slots claimed over
+    /// learning time from `pada run` outputs, and when each board's table
+    /// would be full (claims.png).
+    Claims(commands::claims::ClaimsArgs),
     /// Software in the loop: the firmware learns inside QEMU against the
     /// simulated plant (docs/sil.md).
     #[command(allow_negative_numbers = true)]
@@ -131,6 +135,7 @@ where
         Command::Demo(a) => commands::demo::run(a),
         Command::Paper(a) => commands::paper::run(a),
         Command::Mtbf(a) => commands::mtbf::run(a),
+        Command::Claims(a) => commands::claims::run(a),
         Command::Sil(a) => commands::sil::run(a),
         Command::Capture(a) => commands::capture::run(a),
         Command::Watch(a) => commands::watch::run(a),

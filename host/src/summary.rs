@@ -255,13 +255,18 @@ fn no_threads(n: &usize) -> bool {
 
 /// A trial's learning curve as CSV:
 /// `test_run,learning_time_s,learning_episodes,return`, and for a walking
-/// task (a plant that measures walked distance) also `walked_m,fell,duration_s`.
+/// task (a plant that measures walked distance) also `walked_m,fell,duration_s`,
+/// and for a claim table `claimed_slots` (the slots claimed before the test run).
 pub fn curve_csv(result: &TrialResult) -> anyhow::Result<Vec<u8>> {
     let walking = result.curve.iter().all(|p| p.walked_m.is_some()) && !result.curve.is_empty();
+    let claims = result.curve.iter().all(|p| p.claimed_slots.is_some()) && !result.curve.is_empty();
     let mut w = csv::Writer::from_writer(Vec::new());
     let mut header = vec!["test_run", "learning_time_s", "learning_episodes", "return"];
     if walking {
         header.extend(["walked_m", "fell", "duration_s"]);
+    }
+    if claims {
+        header.push("claimed_slots");
     }
     w.write_record(&header)?;
     for (i, p) in result.curve.iter().enumerate() {
@@ -273,6 +278,9 @@ pub fn curve_csv(result: &TrialResult) -> anyhow::Result<Vec<u8>> {
         ];
         if walking {
             row.extend([format!("{}", p.walked_m.unwrap_or(f64::NAN)), (p.fell as u8).to_string(), format!("{}", p.duration_s)]);
+        }
+        if claims {
+            row.push(p.claimed_slots.unwrap_or(0).to_string());
         }
         w.write_record(&row)?;
     }

@@ -2,26 +2,31 @@
 //! files written for another configuration and names the parameter that
 //! differs.
 //!
-//! # Format (version 1)
+//! # Format (version 2)
 //!
 //! ```text
-//! "PADAWTS1"                      8 bytes: magic with the format version
+//! "PADAWTS2"                      8 bytes: magic with the format version
 //! header length n                 u32 little endian
 //! header                          n bytes of JSON (WeightsHeader)
-//! weights                         count × i32 little endian (raw Q16.16)
+//! entries                         count × entry_bytes: each the weight (i32
+//!                                 little endian, raw Q16.16), then a claim
+//!                                 table's 32-bit tag (pada_core::claim_table)
 //! CRC-32/ISO-HDLC                 u32 little endian, of everything before
 //! ```
+//!
+//! Version 1 (weights without claim tags, from before the claim table) is
+//! refused with a line that says so.
 
 use crate::experiment::task::{TaskSpec, WeightTable};
 use crate::experiment::{HostAgent, TILINGS};
 use pada_core::checkpoint::crc32;
-use pada_core::fixed::Q16;
 use pada_core::policy::PolicyKind;
+use pada_core::weights::WeightStore;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 /// Magic and format version.
-pub const MAGIC: &[u8; 8] = b"PADAWTS1";
+pub const MAGIC: &[u8; 8] = b"PADAWTS2";
 
 /// Everything the weights depend on; loading compares it field by field.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -39,6 +44,15 @@ pub struct WeightsHeader {
     pub table: String,
     /// Number of weights.
     pub weights: usize,
+    /// Bytes per stored entry: the weight's 4, plus a claim tag's 4.
+    pub entry_bytes: usize,
+    /// A claim table's seed of its unclaimed features' initial weights (0
+    /// for other tables).
+    #[serde(default)]
+    pub table_seed: u64,
+    /// Claims the claim table refused while it learned.
+    #[serde(default)]
+    pub claims_refused: u32,
     /// State dimensions as `min..max/width` (with `~` for wrapping).
     pub state: Vec<String>,
     /// Motor levels per dimension.
@@ -68,8 +82,18 @@ impl WeightsHeader {
                 (WeightTable::Hashed { log2_size }, Some(w)) => {
                     format!("hashed 2^{log2_size}, action tiles {w:?}")
                 }
+                (WeightTable::Claimed { log2_size, .. }, None) => format!("claim 2^{log2_size}"),
+                (WeightTable::Claimed { log2_size, .. }, Some(w)) => {
+                    format!("claim 2^{log2_size}, action tiles {w:?}")
+                }
             },
             weights: n,
+            entry_bytes: match spec.table {
+                WeightTable::Claimed { format, tag_bytes, .. } => format.bytes() + tag_bytes,
+                _ => 4,
+            },
+            table_seed: 0,
+            claims_refused: 0,
             state: spec.state.iter().map(|d| format!("{:?}", d)).collect(),
             motor: (0..spec.motor.dims())
                 .map(|i| spec.motor.dim(i).values().to_vec())
@@ -100,6 +124,7 @@ impl WeightsHeader {
         cmp!(tilings);
         cmp!(table);
         cmp!(weights);
+        cmp!(entry_bytes);
         cmp!(state);
         cmp!(motor);
         cmp!(alpha);
@@ -110,26 +135,44 @@ impl WeightsHeader {
     }
 }
 
-/// The file's bytes for `header` and `weights`.
-pub fn encode(header: &WeightsHeader, weights: &[Q16]) -> anyhow::Result<Vec<u8>> {
+/// The file's bytes for `header` and the entries of `table` (as many as
+/// `header.weights`, `header.entry_bytes` each).
+pub fn encode<W: WeightStore + ?Sized>(header: &WeightsHeader, table: &W) -> anyhow::Result<Vec<u8>> {
+    anyhow::ensure!(
+        header.weights == table.len() && header.entry_bytes == table.entry_bytes(),
+        "weights header says {} entries of {} bytes, the table has {} of {}",
+        header.weights,
+        header.entry_bytes,
+        table.len(),
+        table.entry_bytes()
+    );
     let json = serde_json::to_vec(header)?;
-    let mut b = Vec::with_capacity(16 + json.len() + 4 * weights.len());
+    let eb = header.entry_bytes;
+    let mut b = Vec::with_capacity(16 + json.len() + eb * table.len());
     b.extend_from_slice(MAGIC);
     b.extend_from_slice(&(json.len() as u32).to_le_bytes());
     b.extend_from_slice(&json);
-    for w in weights {
-        b.extend_from_slice(&w.0.to_le_bytes());
+    let start = b.len();
+    b.resize(start + eb * table.len(), 0);
+    for (i, dst) in b[start..].chunks_exact_mut(eb).enumerate() {
+        table.stored_le(i, dst);
     }
     let crc = crc32(&b);
     b.extend_from_slice(&crc.to_le_bytes());
     Ok(b)
 }
 
-/// Parses a file's bytes: magic, checksum, header, weights.
-pub fn decode(b: &[u8]) -> anyhow::Result<(WeightsHeader, Vec<Q16>)> {
+/// Parses a file's bytes: magic, checksum, header, and the entries'
+/// bytes (`header.entry_bytes` each).
+pub fn decode(b: &[u8]) -> anyhow::Result<(WeightsHeader, &[u8])> {
     anyhow::ensure!(
         b.len() >= 16 && &b[..6] == b"PADAWT",
         "not a pada weights file (bad magic)"
+    );
+    anyhow::ensure!(
+        &b[..8] != b"PADAWTS1",
+        "weights file version 1: a table without claim tags, from before the claim table \
+         (this pada reads version 2; save the weights again with --save-weights)"
     );
     anyhow::ensure!(
         &b[..8] == MAGIC,
@@ -149,16 +192,13 @@ pub fn decode(b: &[u8]) -> anyhow::Result<(WeightsHeader, Vec<Q16>)> {
     let header: WeightsHeader = serde_json::from_slice(&body[12..12 + n])?;
     let payload = &body[12 + n..];
     anyhow::ensure!(
-        payload.len() == 4 * header.weights,
-        "weights file holds {} bytes of weights, its header says {} weights",
+        matches!(header.entry_bytes, 4 | 8) && Some(payload.len()) == header.weights.checked_mul(header.entry_bytes),
+        "weights file holds {} bytes of entries, its header says {} entries of {} bytes (4 or 8)",
         payload.len(),
-        header.weights
+        header.weights,
+        header.entry_bytes
     );
-    let weights = payload
-        .chunks_exact(4)
-        .map(|c| Q16(i32::from_le_bytes(c.try_into().expect("4 bytes"))))
-        .collect();
-    Ok((header, weights))
+    Ok((header, payload))
 }
 
 /// Saves `agent`'s weights for `spec`.
@@ -170,7 +210,12 @@ pub fn save(
     agent: &HostAgent,
 ) -> anyhow::Result<()> {
     let w = agent.weights();
-    let header = WeightsHeader::new(spec, policy, switched, w.len());
+    let state = agent.state();
+    let header = WeightsHeader {
+        table_seed: state.table_seed,
+        claims_refused: state.stats.claims_refused,
+        ..WeightsHeader::new(spec, policy, switched, w.len())
+    };
     crate::output::write_atomic(path, &encode(&header, w)?)
 }
 
@@ -180,7 +225,7 @@ pub fn save(
 pub fn load(path: &Path, spec: &TaskSpec) -> anyhow::Result<(WeightsHeader, HostAgent)> {
     let bytes =
         std::fs::read(path).map_err(|e| anyhow::anyhow!("cannot read {}: {e}", path.display()))?;
-    let (header, weights) =
+    let (header, entries) =
         decode(&bytes).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let mut agent = crate::experiment::build_agent(spec, header.policy)?;
     let expected = WeightsHeader::new(spec, header.policy, header.switched, agent.weights().len());
@@ -190,8 +235,17 @@ pub fn load(path: &Path, spec: &TaskSpec) -> anyhow::Result<(WeightsHeader, Host
             path.display()
         );
     }
-    agent.weights_mut().copy_from_slice(&weights);
+    let eb = header.entry_bytes;
+    for (i, src) in entries.chunks_exact(eb).enumerate() {
+        agent.weights_mut().load_le(i, src);
+    }
     agent.rehash();
+    // A claim table counts its claimed slots and takes its initial
+    // weights' seed back.
+    let mut state = agent.state();
+    state.table_seed = header.table_seed;
+    state.stats.claims_refused = header.claims_refused;
+    agent.restore_state(&state).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     if header.switched {
         agent
             .switch_to_sarsa()

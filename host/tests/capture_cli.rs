@@ -4,7 +4,7 @@
 //! mixed in; and the same stream from a file.
 //!
 //! `tests/data/sil-pendulum-3s.bin` (repository root) is the raw USART2 stream of
-//! `pada sil --seconds 3` (telemetry.bin; wire protocol 6). Regenerate it
+//! `pada sil --seconds 3` (telemetry.bin; wire protocol 7). Regenerate it
 //! with that command when the wire format changes.
 
 mod common;

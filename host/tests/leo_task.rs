@@ -6,7 +6,9 @@ use pada::experiment::build_agent;
 use pada::leo::rl::{leo_params, LeoTask};
 use pada::experiment::task::Task;
 use pada::weights::{decode, encode, load, save, WeightsHeader};
+use pada_core::claim_table::{Claim, Occupancy};
 use pada_core::fixed::Q16;
+use pada_core::weights::WeightStore;
 use pada_core::policy::PolicyKind;
 use std::process::Command;
 
@@ -110,16 +112,28 @@ fn weights_round_trip_and_refusals() {
     let spec = task.spec();
     let policy = PolicyKind::Pada { delta: 1.0 / 3.0 };
     let mut agent = build_agent(spec, policy).unwrap();
-    for (i, w) in agent.weights_mut().iter_mut().enumerate().step_by(4097) {
-        *w = Q16(i as i32 * 7 - 100_000);
+    agent.reset_weights(&mut rand_pcg::Pcg64::new(0xcafe_f00d_d15e_a5e5, 0x0a02_bdbf_7bb3_c0a7));
+    // LEO's table is a claim table: claim some features and move their
+    // weights; the rest read their initial weights.
+    let keys: Vec<u32> = (0..500u32).map(|i| i.wrapping_mul(0x9E37_79B1)).collect();
+    for (i, &k) in keys.iter().enumerate() {
+        if let Claim::Slot { slot, .. } = agent.weights_mut().claim(k) {
+            agent.weights_mut().add(slot as usize, Q16(i as i32 * 7 - 100_000), 0);
+        }
     }
+    agent.rehash();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("w.pdw");
     save(&path, spec, policy, true, &agent).unwrap();
     let (h, loaded) = load(&path, spec).unwrap();
     assert_eq!(h.policy, policy);
     assert!(h.switched);
-    assert_eq!(loaded.weights(), agent.weights());
+    assert_eq!(loaded.weights_checksum(), agent.weights_checksum());
+    assert_eq!(loaded.weights().occupancy(), Some(Occupancy { longest_probe: 0, ..agent.weights().occupancy().unwrap() }));
+    assert_eq!(loaded.state().table_seed, agent.state().table_seed);
+    for k in keys.iter().copied().chain([1, 2, 3]) {
+        assert_eq!(loaded.weights().read(k), agent.weights().read(k), "feature {k:#x}");
+    }
 
     // Another configuration: γ differs.
     let other = LeoTask::new(pada_core::agent::SarsaParams {
@@ -148,9 +162,13 @@ fn weights_round_trip_and_refusals() {
         .unwrap_err()
         .to_string()
         .contains("magic"));
-    let header = WeightsHeader::new(spec, policy, false, 2);
-    let mut b = encode(&header, &[Q16(1), Q16(2)]).unwrap();
-    assert_eq!(decode(&b).unwrap().1, vec![Q16(1), Q16(2)]);
+    let header = WeightsHeader { entry_bytes: 4, ..WeightsHeader::new(spec, policy, false, 2) };
+    let mut b = encode(&header, &[Q16(1), Q16(2)][..]).unwrap();
+    assert_eq!(decode(&b).unwrap().1, &[1, 0, 0, 0, 2, 0, 0, 0][..]);
     b[7] = b'9';
     assert!(decode(&b).unwrap_err().to_string().contains("version"));
+    // A file of the layout before the claim table: one line that says so.
+    b[7] = b'1';
+    let e = decode(&b).unwrap_err().to_string();
+    assert!(e.contains("version 1") && e.contains("without claim tags"), "{e}");
 }

@@ -251,3 +251,26 @@ fn pada_run_records_the_same_file_as_a_capture_of_its_stream() {
         &["--mcap", "not available with --board"],
     );
 }
+
+#[test]
+fn a_claim_tables_occupancy_has_its_channel_and_reads_back() {
+    use pada_core::wire::{FrameEncoder, Health, Hello, ToHost, MAX_FRAME_LEN, PROTOCOL_VERSION};
+    let mut enc = FrameEncoder::new();
+    let mut stream = Vec::new();
+    let hello = Hello { protocol: PROTOCOL_VERSION, config_hash: 0xfeed, weight_count: 1 << 21, period_us: 33_333, state_dims: 10, joints: 3 };
+    let mut msgs = vec![ToHost::Hello(hello)];
+    for k in 1..=3u32 {
+        msgs.push(ToHost::Health(Health { uptime_ms: 1000 * k, table_claimed: 100 * k, table_slots: 1000, claims_refused: k - 1, ..Health::default() }));
+    }
+    for m in &msgs {
+        let mut buf = [0u8; MAX_FRAME_LEN];
+        stream.extend_from_slice(enc.encode(m, &mut buf).unwrap());
+    }
+    let (live, back, mcap, _dir) = round_trip(&stream, "claims");
+    assert_eq!(live["latest"]["table"]["claimed"], 300, "{live}");
+    assert_eq!(comparable(&live), comparable(&back));
+    let out = pada(&["capture", "--file", mcap.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&ok(&out).into_bytes()).into_owned() + &String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("/claims: 3 messages"), "{stderr}");
+    assert!(String::from_utf8_lossy(&std::fs::read(&mcap).unwrap()).contains("0000feed"), "config hash in the metadata");
+}

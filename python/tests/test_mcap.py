@@ -106,7 +106,11 @@ def test_counts_per_channel_equal_the_capture_summary(recordings, name, gearboxe
         assert counts[topic] == n, (topic, counts)
     # Policy reports and the other events make the summary's "other".
     assert counts["/policy"] + counts["/event"] == summary["messages"]["other"]
-    assert set(counts) <= set(want) | {"/policy", "/event", "/governor"}, counts
+    assert set(counts) <= set(want) | {"/policy", "/event", "/governor", "/claims"}, counts
+    # The claim table's occupancy beside each health report of a claim table.
+    assert counts["/claims"] in (0, summary["messages"]["health"])
+    if summary["latest"].get("table"):
+        assert counts["/claims"] == summary["messages"]["health"]
     # The file's own statistics agree with what was read.
     stats = file_summary.statistics
     by_id = {c.id: c.topic for c in file_summary.channels.values()}

@@ -7,6 +7,9 @@
 //! - [`fixed`]: the fixed-point formats of weights, rates and trace weights;
 //! - [`tile_coding`]: state → integer tile coordinates → feature indices
 //!   (hashed or exact layout);
+//! - [`claim_table`]: the collision-free table of hashed features (a
+//!   learning update claims a slot, a read never does, an unclaimed
+//!   feature reads its initial weight, a full table refuses and counts);
 //! - [`action_space`]: discrete multi-dimensional actions and joint indices;
 //! - [`action_tiles`]: optional generalisation over actions (their values
 //!   tile-coded, as the paper's LEO learner does);
@@ -54,6 +57,7 @@ pub mod action_space;
 pub mod action_tiles;
 pub mod agent;
 pub mod checkpoint;
+pub mod claim_table;
 pub mod crc;
 pub mod dynamixel;
 pub mod episodes;

@@ -9,9 +9,9 @@
 //!
 //! | board | memory for the table | pendulum | LEO |
 //! |---|---|---|---|
-//! | `f405` | 64 KB CCM + 128 KB SRAM (STM32F405) | exact, 24 960 Q16 weights (CCM, then SRAM) | hashed, see [`Board::profile`] |
-//! | `f429-sdram` | 8 MB SDRAM on the FMC (STM32F429I-DISC1) | exact, in SRAM | hashed, 2^21 Q16 weights (8 MiB) |
-//! | `host` | the heap | exact, as large as the policy needs | hashed, 2^24 Q16 weights (64 MiB) |
+//! | `f405` | 64 KB CCM + 128 KB SRAM (STM32F405) | exact, 24 960 Q16 weights (CCM, then SRAM) | claim table, 2^14 slots of 16-bit weight + 16-bit tag (64 KiB of CCM) |
+//! | `f429-sdram` | 8 MB SDRAM on the FMC (STM32F429I-DISC1) | exact, in SRAM | claim table, 2^21 slots of 16-bit weight + 16-bit tag (8 MiB) |
+//! | `host` | the heap | exact, as large as the policy needs | claim table, 2^23 slots of Q16 weight + 32-bit tag (64 MiB) |
 //!
 //! [`config_hash`] covers the profile: a checkpoint saved under one
 //! profile is refused by another.
@@ -73,7 +73,7 @@ impl Board {
     /// This board's learner for `robot`.
     pub const fn profile(self, robot: Robot) -> LearnerProfile {
         let pendulum = matches!(robot, Robot::Pendulum33 | Robot::Pendulum20);
-        let (layout, size, format, memory) = match (self, pendulum) {
+        let (layout, size, format, memory, tag_bytes) = match (self, pendulum) {
             // The pendulum's exact table (20 × 26 tiles × 16 tilings × 3
             // actions) is 97.5 KB: all 64 KB of CCM and 33.5 KB of SRAM.
             (Board::F405, true) => (
@@ -81,35 +81,44 @@ impl Board {
                 TableSize::Weights(PENDULUM_EXACT_WEIGHTS),
                 WeightFormat::Q16,
                 Memory::CcmThenSram { ccm_weights: CCM_BYTES / 4 },
+                0,
             ),
-            // LEO in the 64 KB of CCM, hashed: 2^14 Q16 weights.
-            (Board::F405, false) => (Layout::Hashed, TableSize::Weights(1 << 14), WeightFormat::Q16, Memory::Ccm),
+            // LEO in the 64 KB of CCM: a claim table of 2^14 slots, each
+            // a 16-bit weight and a 16-bit tag.
+            (Board::F405, false) => (Layout::Claimed, TableSize::Weights(1 << 14), LEO_CHIP_FORMAT, Memory::Ccm, 2),
             (Board::F429Sdram, true) => {
-                (Layout::Exact, TableSize::Weights(PENDULUM_EXACT_WEIGHTS), WeightFormat::Q16, Memory::Sram)
+                (Layout::Exact, TableSize::Weights(PENDULUM_EXACT_WEIGHTS), WeightFormat::Q16, Memory::Sram, 0)
             }
-            // All 8 MiB of the SDRAM: 2^21 Q16 weights.
+            // All 8 MiB of the SDRAM: a claim table of 2^21 slots, each a
+            // 16-bit weight and a 16-bit tag (docs/board.md measures what a
+            // trial claims and what the 16 bits cost).
             (Board::F429Sdram, false) => {
-                (Layout::Hashed, TableSize::Weights(1 << 21), WeightFormat::Q16, Memory::Sdram)
+                (Layout::Claimed, TableSize::Weights(1 << 21), LEO_CHIP_FORMAT, Memory::Sdram, 2)
             }
-            (Board::Host, true) => (Layout::Exact, TableSize::FitExact, WeightFormat::Q16, Memory::Heap),
-            // 2^24 Q16 weights (64 MiB per agent), the size of the
-            // framework's own LEO table (docs/reference/grl.md §3.9).
-            // The framework's table is collision-free (a feature claims a
-            // slot when it is first written, and an unwritten feature
-            // reads its initial weight); a hashed table behaves alike only
-            // while few features share a slot. A 14 666 s trial writes
-            // enough features that 2^22 slots do not: there the greedy
-            // choice over 343 actions reads other features' learned
-            // weights for actions it never tried, and SARSA(λ) never got
-            // past one footstep (learning episodes ≈ 50 steps to the end).
-            // With 2^24 slots its episodes pass 100 steps after
-            // 40 000 learning steps and its test runs walk, as the
-            // framework's do (docs/leo/framework.md).
-            (Board::Host, false) => (Layout::Hashed, TableSize::Weights(1 << 24), WeightFormat::Q16, Memory::Heap),
+            (Board::Host, true) => (Layout::Exact, TableSize::FitExact, WeightFormat::Q16, Memory::Heap, 0),
+            // A claim table as the framework keeps its LEO table
+            // (docs/reference/grl.md §3.9 and §5.1, `safe: 1`): Q16 weights
+            // and 32-bit tags, so two features share a slot only if their
+            // 32-bit hashes are equal. A hashed table of 2^22 slots held
+            // SARSA(λ) below one footstep (its greedy choice over 343
+            // actions read other features' learned weights), and 2^24 let
+            // it walk; a claim table needs only the slots a trial writes.
+            (Board::Host, false) => {
+                (Layout::Claimed, TableSize::Weights(1 << HOST_LEO_LOG2), WeightFormat::Q16, Memory::Heap, 4)
+            }
         };
-        LearnerProfile { board: self, robot, layout, size, format, memory }
+        LearnerProfile { board: self, robot, layout, size, format, memory, tag_bytes }
     }
 }
+
+/// The chips' LEO weights: 16 bits, Q16 shifted right by LEO's
+/// [`crate::robot::leo::HALF_SHIFT`] (±2048 in steps of 1/16, rounded
+/// stochastically).
+pub const LEO_CHIP_FORMAT: WeightFormat = WeightFormat::Half { shift: crate::robot::leo::HALF_SHIFT };
+
+/// log2 of the host's LEO claim table: Q16 weights with 32-bit tags, the
+/// framework's semantics (docs/board.md: what a trial claims).
+pub const HOST_LEO_LOG2: u32 = 23;
 
 /// Bytes of the F405's core-coupled RAM.
 pub const CCM_BYTES: usize = 64 * 1024;
@@ -178,6 +187,9 @@ pub struct LearnerProfile {
     pub format: WeightFormat,
     /// Where the table lives.
     pub memory: Memory,
+    /// Bytes of a claim tag beside each weight ([`Layout::Claimed`]: 2 or
+    /// 4; 0 for the other layouts).
+    pub tag_bytes: usize,
 }
 
 impl LearnerProfile {
@@ -189,37 +201,50 @@ impl LearnerProfile {
         }
     }
 
+    /// Bytes of one table entry: its weight and its claim tag.
+    pub const fn entry_bytes(&self) -> usize {
+        self.format.bytes() + self.tag_bytes
+    }
+
     /// The table's bytes when its length is fixed.
     pub const fn table_bytes(&self) -> Option<usize> {
         match self.weights() {
-            Some(n) => Some(n * self.format.bytes()),
+            Some(n) => Some(n * self.entry_bytes()),
             None => None,
         }
     }
 }
 
 impl LearnerProfile {
-    /// The same board with another hashed table of `2^log2_weights`
-    /// weights in `format`, placed as a chip would place it: in CCM if it
-    /// fits, else CCM first and the rest in SRAM (the F405), the SDRAM
-    /// (the F429) or the heap (the host). For exploring what a board could
-    /// learn with more or less memory; the firmware builds only the
-    /// profiles of [`Board::profile`].
-    pub const fn with_hashed_table(self, log2_weights: u32, format: WeightFormat) -> LearnerProfile {
+    /// The same board with another table of `2^log2_weights` entries in
+    /// `layout` (hashed, or claimed with tags of `tag_bytes`), weights in
+    /// `format`, placed as a chip would place it: in CCM if it fits, else
+    /// CCM first and the rest in SRAM (the F405), the SDRAM (the F429) or
+    /// the heap (the host). For exploring what a board could learn with
+    /// more or less memory; the firmware builds only the profiles of
+    /// [`Board::profile`].
+    pub const fn with_hashed_table(
+        self,
+        layout: Layout,
+        log2_weights: u32,
+        format: WeightFormat,
+        tag_bytes: usize,
+    ) -> LearnerProfile {
+        let tag_bytes = if matches!(layout, Layout::Claimed) { tag_bytes } else { 0 };
         let weights = 1usize << log2_weights;
-        let bytes = weights * format.bytes();
+        let bytes = weights * (format.bytes() + tag_bytes);
         let memory = match self.board {
             Board::Host => Memory::Heap,
             Board::F429Sdram => Memory::Sdram,
             Board::F405 if bytes <= CCM_BYTES => Memory::Ccm,
             Board::F405 => Memory::CcmThenSram { ccm_weights: CCM_BYTES / format.bytes() },
         };
-        LearnerProfile { layout: Layout::Hashed, size: TableSize::Weights(weights), format, memory, ..self }
+        LearnerProfile { layout, size: TableSize::Weights(weights), format, memory, tag_bytes, ..self }
     }
 }
 
 /// Version of what [`config_hash`] covers; bump when its meaning changes.
-pub const CONFIG_HASH_VERSION: u32 = 2;
+pub const CONFIG_HASH_VERSION: u32 = 3;
 
 /// The hash of everything that gives a learner's weights their meaning
 /// (FNV-1a, stored in checkpoints and sent in `Hello`): the robot, the
@@ -243,7 +268,8 @@ pub fn config_hash<W: WeightStore, const TILINGS_: usize, const TRACE_: usize>(
         .write_str(profile.board.name())
         .write_u32(profile.layout.code())
         .write_u32(agent.weights().len() as u32)
-        .write_u32(agent.weights().format().code());
+        .write_u32(agent.weights().format().code())
+        .write_u32(agent.weights().tag_bytes() as u32);
     agent.write_config(&mut h);
     h.finish()
 }

@@ -110,7 +110,7 @@ impl StateDim {
     }
 }
 
-/// How (tiling, tile, action) coordinates become weight indices.
+/// How (tiling, tile, action) coordinates become weight indices (or keys).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -119,6 +119,10 @@ pub enum Layout {
     Hashed,
     /// One weight per (tiling, tile, action); the table must hold them all.
     Exact,
+    /// Hashed as [`Hashed`](Self::Hashed), but the feature is the whole
+    /// 32-bit hash, a key that a [`crate::claim_table::ClaimTable`] of a
+    /// power-of-two size places without collisions.
+    Claimed,
 }
 
 impl Layout {
@@ -127,7 +131,22 @@ impl Layout {
         match self {
             Layout::Hashed => 1,
             Layout::Exact => 2,
+            Layout::Claimed => 3,
         }
+    }
+
+    /// The name for reports and errors.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Layout::Hashed => "hashed",
+            Layout::Exact => "exact",
+            Layout::Claimed => "claim",
+        }
+    }
+
+    /// Whether features are hashed (hashed or claimed).
+    pub const fn is_hashed(self) -> bool {
+        matches!(self, Layout::Hashed | Layout::Claimed)
     }
 }
 
@@ -165,6 +184,9 @@ pub struct TileCoder<const TILINGS: usize> {
     layout: Layout,
     actions: u32,
     table_size: u32,
+    /// What a hash is masked with: the table's index bits (hashed), all 32
+    /// bits (claimed: the key).
+    mask: u32,
     /// Tiles per tiling in the exact layout (0 when hashed).
     tiles_per_tiling: u32,
     /// The action tiling, when actions are generalised over.
@@ -219,7 +241,7 @@ impl<const TILINGS: usize> TileCoder<TILINGS> {
         }
         let mut tiles_per_tiling = 0u32;
         match layout {
-            Layout::Hashed => {
+            Layout::Hashed | Layout::Claimed => {
                 if !table_size.is_power_of_two() {
                     return Err(ConfigError::new(
                         "table_size",
@@ -248,7 +270,19 @@ impl<const TILINGS: usize> TileCoder<TILINGS> {
                 tiles_per_tiling = stride as u32;
             }
         }
-        Ok(TileCoder { dims: prepared, layout, actions, table_size: table_size as u32, tiles_per_tiling, action_tiles: None })
+        let mask = match layout {
+            Layout::Claimed => u32::MAX,
+            _ => (table_size - 1) as u32,
+        };
+        Ok(TileCoder {
+            dims: prepared,
+            layout,
+            actions,
+            table_size: table_size as u32,
+            mask,
+            tiles_per_tiling,
+            action_tiles: None,
+        })
     }
 
     /// The same coder, generalising over actions: the values of `space`
@@ -258,8 +292,8 @@ impl<const TILINGS: usize> TileCoder<TILINGS> {
     /// Errors: the exact layout (action tiles are hashed only); a space with
     /// another number of joint actions; the errors of [`ActionTiles::new`].
     pub fn with_action_tiles(mut self, space: &ActionSpace, widths: &[f32]) -> Result<Self, ConfigError> {
-        if self.layout != Layout::Hashed {
-            return Err(ConfigError::new("layout", 0.0, "the hashed layout when actions are tile-coded"));
+        if !self.layout.is_hashed() {
+            return Err(ConfigError::new("layout", 0.0, "a hashed or claim layout when actions are tile-coded"));
         }
         if space.joint_count() != self.actions {
             return Err(ConfigError::new(
@@ -281,7 +315,7 @@ impl<const TILINGS: usize> TileCoder<TILINGS> {
     /// (only meaningful with [`with_action_tiles`](Self::with_action_tiles)).
     #[inline]
     pub fn combo_feature(&self, code: &StateCode<TILINGS>, tiling: usize, combo: u32) -> u32 {
-        murmur_finish(murmur_mix(code.per_tiling[tiling], combo)) & (self.table_size - 1)
+        murmur_finish(murmur_mix(code.per_tiling[tiling], combo)) & self.mask
     }
 
     /// Writes what gives this coder's features their meaning into a
@@ -328,7 +362,7 @@ impl<const TILINGS: usize> TileCoder<TILINGS> {
     pub fn exact_size(&self) -> Option<usize> {
         match self.layout {
             Layout::Exact => Some(self.tiles_per_tiling as usize * TILINGS * self.actions as usize),
-            Layout::Hashed => None,
+            Layout::Hashed | Layout::Claimed => None,
         }
     }
 
@@ -360,7 +394,7 @@ impl<const TILINGS: usize> TileCoder<TILINGS> {
         let mut per_tiling = [0u32; TILINGS];
         for (j, slot) in per_tiling.iter_mut().enumerate() {
             match self.layout {
-                Layout::Hashed => {
+                Layout::Hashed | Layout::Claimed => {
                     // Words hashed per (state, action): d coordinates, the
                     // tiling and the action.
                     let words = self.dims.len() as u32 + 2;
@@ -401,7 +435,9 @@ impl<const TILINGS: usize> TileCoder<TILINGS> {
     #[inline(always)]
     pub fn action_feature(&self, code: &StateCode<TILINGS>, tiling: usize, action: u32) -> u32 {
         match self.layout {
-            Layout::Hashed => murmur_finish(murmur_mix(code.per_tiling[tiling], action)) & (self.table_size - 1),
+            Layout::Hashed | Layout::Claimed => {
+                murmur_finish(murmur_mix(code.per_tiling[tiling], action)) & self.mask
+            }
             Layout::Exact => code.per_tiling[tiling] + action,
         }
     }

@@ -20,6 +20,7 @@
 //! nothing (the tile coder never produces one; this keeps the chip free of
 //! panics).
 
+use crate::claim_table::{Claim, InitialWeights, Occupancy};
 use crate::fixed::Q16;
 
 /// How weights are stored: part of a board's learner profile and of the
@@ -70,6 +71,7 @@ pub trait WeightStore {
     /// tables draw exactly what they always drew).
     const DITHERED: bool = false;
 
+
     /// Number of weights.
     fn len(&self) -> usize;
 
@@ -103,6 +105,60 @@ pub trait WeightStore {
     /// The stored bits of weight `i` (the `i32` of a full-width weight, the
     /// `i16` of a 16-bit one, sign-extended), 0 outside the table.
     fn raw(&self, i: usize) -> u32;
+
+    /// Whether features claim their slots ([`crate::claim_table`]): then
+    /// the agent reads through [`read`](Self::read), claims through
+    /// [`claim`](Self::claim) before it writes, and the features it hands
+    /// in are full 32-bit keys, not slots. A plain table (`false`) reads
+    /// and writes the feature's index directly. (A method, not a constant,
+    /// so that one host type can hold either kind of table.)
+    #[inline]
+    fn claims(&self) -> bool {
+        false
+    }
+
+    /// Bytes of a claim tag stored after each weight (0: no tags).
+    fn tag_bytes(&self) -> usize {
+        0
+    }
+
+    /// Bytes per stored entry: the weight's, then its tag's
+    /// ([`stored_le`](Self::stored_le) writes both).
+    fn entry_bytes(&self) -> usize {
+        self.format().bytes() + self.tag_bytes()
+    }
+
+    /// The weight of `feature`: the weight at that index in a plain table,
+    /// the feature's slot's (or its initial weight) in a claim table.
+    #[inline]
+    fn read(&self, feature: u32) -> Q16 {
+        self.get(feature as usize)
+    }
+
+    /// The slot a learning update of `feature` writes: the index itself in
+    /// a plain table (never fresh), the claimed slot in a claim table.
+    #[inline]
+    fn claim(&mut self, feature: u32) -> Claim {
+        Claim::Slot { slot: feature, fresh: false }
+    }
+
+    /// Frees every slot of a claim table and sets its unclaimed features'
+    /// initial weights (nothing in a plain table).
+    fn reset_claims(&mut self, _init: InitialWeights) {}
+
+    /// After a claim table's slots were loaded: its initial weights and the
+    /// refusals saved with it (nothing in a plain table).
+    fn restore_claims(&mut self, _init: InitialWeights, _refused: u32) {}
+
+    /// A claim table's occupancy; `None` for a plain table.
+    fn occupancy(&self) -> Option<Occupancy> {
+        None
+    }
+
+    /// A claim table's seed of its initial weights (0 for a plain table).
+    fn table_seed(&self) -> u64 {
+        0
+    }
 
     /// The table's checksum, `Σ raw(i) · entry_factor(i)` (wrapping,
     /// [`entry_factor`]): equal on every machine for equal tables, and cheap

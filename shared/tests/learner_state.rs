@@ -359,8 +359,11 @@ fn agent_state() -> impl Strategy<Value = AgentState> {
         0.0f32..=1.0,
         any::<bool>(),
         policy_state(),
+        // The learner these states go into has a plain table, which holds
+        // no claims (a claim table's are tested in claim_table's tests).
+        Just((0u64, 0u32)),
     )
-        .prop_map(|(steps, u, e, (episodes, saturations, trace_drops, td), epsilon, testing, policy)| AgentState {
+        .prop_map(|(steps, u, e, (episodes, saturations, trace_drops, td), epsilon, testing, policy, (table_seed, claims_refused))| AgentState {
             stats: AgentStats {
                 steps,
                 updates: if steps == 0 { 0 } else { u % (steps.saturating_add(1)) },
@@ -368,11 +371,13 @@ fn agent_state() -> impl Strategy<Value = AgentState> {
                 episodes,
                 saturations,
                 trace_drops,
+                claims_refused,
                 last_td_error: Q16(td),
             },
             epsilon,
             mode: if testing { Mode::Testing } else { Mode::Learning },
             policy,
+            table_seed,
         })
 }
 
@@ -629,7 +634,7 @@ fn records_that_cannot_be_decoded_are_refused_by_name() {
     });
     let bytes = governed.to_bytes();
     assert_eq!(LearnerState::from_bytes(&bytes).unwrap(), governed);
-    for (offset, value, field) in [(513, 2, "governor.restricts"), (518, 1, "governor.reserved"), (1000, 1, "governor.reserved")] {
+    for (offset, value, field) in [(513, 2, "governor.restricts"), (518, 1, "governor.reserved"), (1000, 1, "state.reserved")] {
         let mut record = bytes;
         record[offset] = value;
         assert_eq!(LearnerState::from_bytes(&record).map(|_| ()).unwrap_err().param, field, "byte {offset}");

@@ -56,6 +56,9 @@ fn full_health() -> Health {
         telemetry_drops: u32::MAX,
         checkpoint_erases: u32::MAX,
         saves_refused: u32::MAX,
+        table_claimed: u32::MAX,
+        table_slots: u32::MAX,
+        claims_refused: u32::MAX,
     }
 }
 
@@ -268,13 +271,13 @@ fn the_protocol_version_changes_with_the_layout() {
     // A change of any message's layout changes this fingerprint: then bump
     // PROTOCOL_VERSION and put the new pair here (with the docs that name
     // the version: docs/sil.md, docs/core.md, firmware/README.md).
-    assert_eq!((PROTOCOL_VERSION, layout_fingerprint()), (6, EXPECTED_FINGERPRINT), "{:#010x}", layout_fingerprint());
+    assert_eq!((PROTOCOL_VERSION, layout_fingerprint()), (7, EXPECTED_FINGERPRINT), "{:#010x}", layout_fingerprint());
 }
 
-/// [`layout_fingerprint`] of protocol 6 (the gentle explorations in
-/// `PolicyKind`, the governor in `PolicyReport`, `SetMtbfBudget`; 5 added
-/// `Step::footstep`).
-const EXPECTED_FINGERPRINT: u32 = 0x9109_396b;
+/// [`layout_fingerprint`] of protocol 7 (the claim table's occupancy in
+/// `Health`; 6 added the gentle explorations in `PolicyKind`, the governor
+/// in `PolicyReport`, `SetMtbfBudget`; 5 `Step::footstep`).
+const EXPECTED_FINGERPRINT: u32 = 0xff2d_4ef2;
 
 #[test]
 fn every_chip_message_round_trips() {

@@ -6,19 +6,21 @@
 //! computed from what each built agent knows of itself (its tile coder as
 //! prepared, its actions and their tiles, its parameters, its table), so
 //! any drift between the two — a state range, a tile width, a level, a
-//! parameter, a table size — makes it fail. The episodes' rules (length,
+//! parameter, a table size, a claim table's weight or tag width — makes it
+//! fail. The episodes' rules (length,
 //! test cadence, footstep remap), the control period and the counted
 //! gearboxes are compared directly.
 
 use pada::experiment::algo::{algo_of, policy_kind_of, Algo, PolicyFlags};
 use pada::experiment::build_agent;
+use pada::experiment::table::HostTable;
 use pada::experiment::task::Task;
 use pada::leo::rl::{leo_params, LeoTask};
 use pada::pendulum::{PhysicalPendulumParams, PhysicalPendulumTask};
-use pada_core::fixed::Q16;
 use pada_core::policy::PolicyKind;
 use pada_core::profile::{config_hash, Board, LearnerProfile};
 use pada_core::robot::Robot;
+use pada_core::tile_coding::Layout;
 use pada_core::weights::WeightStore;
 use pada_firmware::control::Controller;
 use pada_firmware::leo::Leo;
@@ -48,10 +50,19 @@ fn every_policy_every_robot_and_every_board_is_checked() {
     assert_eq!(kinds.len(), Algo::ALL.len(), "one policy of every algorithm");
 }
 
+/// A table of `weights` entries laid out as `profile` says: a claim table
+/// of the profile's weight and tag widths, or a plain one.
+fn table_of(profile: LearnerProfile, weights: usize) -> HostTable {
+    match profile.layout {
+        Layout::Claimed => HostTable::claimed(weights, profile.format, profile.tag_bytes).unwrap(),
+        Layout::Exact | Layout::Hashed => HostTable::plain(weights),
+    }
+}
+
 /// The firmware controller's hash for `profile` and `policy` on a table of
 /// `weights` weights.
 fn firmware_hash<R: RobotAdapter>(profile: LearnerProfile, policy: PolicyKind, weights: usize) -> u32 {
-    let table = vec![Q16::ZERO; weights].into_boxed_slice();
+    let table = table_of(profile, weights);
     let ctl = Controller::<_, R>::new(profile, policy, table, 1)
         .unwrap_or_else(|e| panic!("{} on {}: {e}", profile.robot.name(), profile.board.name()));
     ctl.config_hash()
@@ -75,8 +86,7 @@ fn check<T: Task, R: RobotAdapter>(task: &T, profile: LearnerProfile) -> usize {
         let host = match build_agent(spec, policy) {
             Ok(host) => host,
             Err(host_error) => {
-                let n = profile.weights().unwrap_or(1 << 10);
-                let table = vec![Q16::ZERO; n].into_boxed_slice();
+                let table = table_of(profile, profile.weights().unwrap_or(1 << 10));
                 assert!(
                     Controller::<_, R>::new(profile, policy, table, 1).is_err(),
                     "{robot} on {board}: the host refuses {policy:?} ({host_error}) but the firmware builds it"
@@ -87,6 +97,11 @@ fn check<T: Task, R: RobotAdapter>(task: &T, profile: LearnerProfile) -> usize {
         };
         let host_hash = config_hash(&profile, &host);
         let fw = firmware_hash::<R>(profile, policy, host.weights().len());
+        assert_eq!(
+            (host.weights().claims(), host.weights().format(), host.weights().tag_bytes()),
+            (profile.layout == Layout::Claimed, profile.format, profile.tag_bytes),
+            "{robot} on {board}: the host's table is not the profile's"
+        );
         assert_eq!(
             host_hash, fw,
             "{robot} on {board} with {policy:?}: the host's learner and the firmware's differ"
@@ -121,7 +136,8 @@ fn host_and_firmware_build_the_same_leo_learner_on_every_board() {
     for board in Board::ALL {
         let profile = board.profile(Robot::Leo);
         let task = LeoTask::with_profile(profile, leo_params());
-        assert_eq!(check::<_, Leo>(&task, profile), 0, "LEO's hashed tables hold every learner");
+        assert_eq!(profile.layout, Layout::Claimed, "LEO learns on a claim table on every board");
+        assert_eq!(check::<_, Leo>(&task, profile), 0, "LEO's claim tables hold every learner");
     }
 }
 
@@ -145,6 +161,12 @@ fn the_hash_tells_boards_robots_and_learners_apart() {
     assert_eq!(leo(PolicyKind::Sarsa), leo(PolicyKind::Pada { delta: 0.5 }));
     assert_eq!(leo(PolicyKind::Sarsa), leo(PolicyKind::LowPass { alpha: 0.2 }));
     assert_ne!(leo(PolicyKind::Sarsa), leo(PolicyKind::Integrator { delta: 0.5 }));
+    // The F429's claim table with Q16 weights and 32-bit tags instead of
+    // 16-bit ones: another learner (what it stores and what a feature may
+    // share differ).
+    let f429 = Board::F429Sdram.profile(Robot::Leo);
+    let wide = f429.with_hashed_table(Layout::Claimed, 21, pada_core::weights::WeightFormat::Q16, 4);
+    assert_ne!(firmware_hash::<Leo>(wide, PolicyKind::Sarsa, 1 << 21), firmware_hash::<Leo>(f429, PolicyKind::Sarsa, 1 << 21));
     // Other learning parameters: another learner.
     let mut params = leo_params();
     params.lambda = 0.9;

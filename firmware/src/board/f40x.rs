@@ -132,6 +132,6 @@ pub fn split(p: Peripherals) -> (Resources, TableMemoryPins) {
 }
 
 /// The table's memory (CCM and SRAM) works from reset.
-pub fn start_table_memory(_: TableMemoryPins) -> Result<TableMemory, MemoryFault> {
+pub fn start_table_memory(_: TableMemoryPins, _table: pada_core::profile::Memory) -> Result<TableMemory, MemoryFault> {
     Ok(TableMemory::ready())
 }

@@ -163,10 +163,12 @@ pub fn split(p: Peripherals) -> (Resources, TableMemoryPins) {
     (resources, sdram)
 }
 
-/// Starts and checks the SDRAM if this image's table lives there (LEO);
-/// the pendulum's table is in SRAM and leaves the SDRAM off.
-pub fn start_table_memory(sdram: TableMemoryPins) -> Result<TableMemory, MemoryFault> {
-    if matches!(crate::table::PROFILE.memory, Memory::Sdram) {
+/// Starts and checks the SDRAM if the image's table lives there
+/// (`table`, its profile's memory: LEO); the pendulum's table is in SRAM
+/// and leaves the SDRAM off. (The caller names the memory, so the board
+/// layer needs nothing of the table's module.)
+pub fn start_table_memory(sdram: TableMemoryPins, table: Memory) -> Result<TableMemory, MemoryFault> {
+    if matches!(table, Memory::Sdram) {
         sdram::start(sdram)?;
     }
     Ok(TableMemory::ready())

@@ -46,8 +46,9 @@ const TELEMETRY_RX_BUF: usize = 512;
 pub type Board = Parts<ServoPort, TelemetryTx, TelemetryRx, BoardSensors, FlashStore, Watchdog, Cycles, Led>;
 
 impl Board {
-    /// Clocks, pins and peripherals, and the table's memory. Call once.
-    pub fn init() -> Board {
+    /// Clocks, pins and peripherals, and the memory `table` of the image's
+    /// weight table (its profile's). Call once.
+    pub fn init(table: pada_core::profile::Memory) -> Board {
         // The reset cause, before anything clears it.
         let csr = embassy_stm32::pac::RCC.csr().read();
         let watchdog_reset = csr.wdgrstf();
@@ -56,7 +57,7 @@ impl Board {
         let p = embassy_stm32::init(chip::clock_config());
         let (r, table_memory_pins): (Resources, chip::TableMemoryPins) = chip::split(p);
         // Before anything else may touch the table (it needs the token).
-        let table_memory = chip::start_table_memory(table_memory_pins);
+        let table_memory = chip::start_table_memory(table_memory_pins, table);
 
         // Servo bus: 1 Mbps, RX pulled up (the transceiver's
         // receiver is off while the driver is on).

@@ -191,7 +191,7 @@ where
     /// Bytes a checkpoint of this learner takes in a slot: header, learner
     /// state and the whole table.
     pub fn checkpoint_bytes(&self) -> usize {
-        checkpoint::slot_len(self.weights().len(), self.weights().format().bytes())
+        checkpoint::slot_len(self.weights().len(), self.weights().entry_bytes())
     }
 
     /// Saves that failed since boot (too large for a slot, the store
@@ -516,11 +516,12 @@ mod tests {
 
     #[test]
     fn the_f429s_leo_table_is_refused_as_too_large_and_counted_and_its_pendulum_saves() {
-        // LEO on the F429: 2^21 Q16 weights, 8 MiB, all of the SDRAM.
+        // LEO on the F429: a claim table of 2^21 slots, a 16-bit weight and
+        // a 16-bit tag each: 8 MiB, all of the SDRAM.
         let f429_leo = Board::F429Sdram.profile(Robot::Leo);
         let weights = f429_leo.weights().unwrap();
         assert_eq!(weights, 1 << 21);
-        let mut leo = Controller::<_, Leo>::new(f429_leo, PolicyKind::Sarsa, vec![Q16::ZERO; weights].into_boxed_slice(), 1).unwrap();
+        let mut leo = Controller::<_, Leo>::new(f429_leo, PolicyKind::Sarsa, leo_table_of(weights), 1).unwrap();
         let needed = checkpoint::HEADER_LEN + checkpoint::STATE_LEN + 8 * 1024 * 1024;
         assert_eq!(leo.checkpoint_bytes(), needed);
         let mut store = Box::new(pada_core::checkpoint::RamStore::<FLASH_SLOT>::new());
@@ -550,8 +551,7 @@ mod tests {
     /// `weights` weights is the controlled time to the period (10^6
     /// periods are whole seconds), and after 17 more the whole seconds of
     /// it, rounded down.
-    fn operating_time_is_the_controlled_time<R: RobotAdapter>(weights: usize) {
-        let table = vec![Q16::ZERO; weights].into_boxed_slice();
+    fn operating_time_is_the_controlled_time<R: RobotAdapter, W: WeightStore>(table: W) {
         let mut c = Controller::<_, R>::new(profile(R::ROBOT), PolicyKind::Sarsa, table, 1).unwrap();
         let mut store = Box::new(pada_core::checkpoint::RamStore::<FLASH_SLOT>::new());
         let (clock, mut out) = (Clock(Cell::new(0)), PeriodOutput::default());
@@ -573,9 +573,10 @@ mod tests {
     fn a_checkpoints_operating_time_is_the_controlled_time() {
         // 30 000 s of the 33 Hz pendulum, 50 000 s of the 20 Hz one,
         // 33 333 s of LEO (33 333 µs a period).
-        operating_time_is_the_controlled_time::<Pendulum33>(WEIGHTS);
-        operating_time_is_the_controlled_time::<crate::pendulum::Pendulum20>(profile(Robot::Pendulum20).weights().unwrap());
-        operating_time_is_the_controlled_time::<Leo>(profile(Robot::Leo).weights().unwrap());
+        operating_time_is_the_controlled_time::<Pendulum33, _>(table());
+        let n20 = profile(Robot::Pendulum20).weights().unwrap();
+        operating_time_is_the_controlled_time::<crate::pendulum::Pendulum20, _>(vec![Q16::ZERO; n20].into_boxed_slice());
+        operating_time_is_the_controlled_time::<Leo, _>(leo_table());
     }
 
     #[test]

@@ -52,5 +52,9 @@ where
         health.weight_saturations = stats.saturations;
         health.checkpoint_erases = self.flash_wear.most_erases();
         health.saves_refused = self.saves_refused;
+        let table = self.weights().occupancy().unwrap_or_default();
+        health.table_claimed = table.claimed;
+        health.table_slots = table.slots;
+        health.claims_refused = table.refused;
     }
 }

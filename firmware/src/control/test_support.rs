@@ -36,9 +36,23 @@ pub(super) fn table() -> Box<[Q16]> {
     vec![Q16::ZERO; WEIGHTS].into_boxed_slice()
 }
 
+/// A chip's LEO table on the heap: a claim table of 16-bit weights and
+/// 16-bit tags (as `crate::table` lays it out in CCM or SDRAM).
+pub(super) type LeoTable = pada_core::claim_table::ClaimTable<
+    pada_core::weights::Half<Box<[i16]>, { pada_core::robot::leo::HALF_SHIFT as u32 }>,
+    pada_core::claim_table::Tags16<Box<[u16]>>,
+>;
+
+/// A chip's LEO claim table of `n` slots.
+pub(super) fn leo_table_of(n: usize) -> LeoTable {
+    let weights = pada_core::weights::Half::new(vec![0i16; n].into_boxed_slice());
+    pada_core::claim_table::ClaimTable::new(weights, pada_core::claim_table::Tags16(vec![0u16; n].into_boxed_slice()))
+        .unwrap()
+}
+
 /// The F405's LEO table.
-pub(super) fn leo_table() -> Box<[Q16]> {
-    vec![Q16::ZERO; profile(Robot::Leo).weights().unwrap()].into_boxed_slice()
+pub(super) fn leo_table() -> LeoTable {
+    leo_table_of(profile(Robot::Leo).weights().unwrap())
 }
 
 /// A healthy pendulum reading: the servo answers, the encoder at `counts`.
@@ -48,7 +62,7 @@ pub(super) fn pendulum_readings(counts: u16, time_ms: u32) -> Readings {
     r
 }
 
-pub(super) fn start<R: RobotAdapter>(c: &mut Controller<Box<[Q16]>, R>, mode: RunMode) {
+pub(super) fn start<W: pada_core::weights::WeightStore, R: RobotAdapter>(c: &mut Controller<W, R>, mode: RunMode) {
     let (result, t) = c.command(&wire::ToChip::Start(mode));
     assert_eq!(result, Ok(()));
     assert!(t.unwrap().torque_enable);

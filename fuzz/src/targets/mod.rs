@@ -2,6 +2,7 @@
 //! invariants.
 
 mod checkpoint;
+mod claim_table;
 mod dynamixel;
 mod wire;
 
@@ -37,7 +38,8 @@ pub trait Target {
 }
 
 /// Every target: the host's and the chip's frame decoders, the status and
-/// instruction packet decoders, checkpoint loading and torn saves.
+/// instruction packet decoders, checkpoint loading and torn saves, and the
+/// claim table's reads, claims and writes.
 pub fn all(corpus: &Corpus) -> Vec<Box<dyn Target>> {
     vec![
         Box::new(
@@ -51,5 +53,6 @@ pub fn all(corpus: &Corpus) -> Vec<Box<dyn Target>> {
         Box::new(dynamixel::Status::<32>::new("dynamixel-status")),
         Box::new(dynamixel::Instructions::<64>::new("dynamixel-instr")),
         Box::new(checkpoint::Checkpoints::new("checkpoint")),
+        Box::new(claim_table::Claims::new("claim-table")),
     ]
 }

@@ -38,12 +38,14 @@ pub struct ProfileReport {
     pub description: &'static str,
     /// The robot.
     pub robot: &'static str,
-    /// `exact` or `hashed`.
+    /// `exact`, `hashed` or `claim`.
     pub layout: &'static str,
     /// Weights in the table.
     pub weights: usize,
     /// Bits per stored weight.
     pub weight_bits: usize,
+    /// Bits per claim tag (0 without claims).
+    pub tag_bits: usize,
     /// The table's size \[bytes\].
     pub table_bytes: usize,
     /// Where the table lives.
@@ -56,17 +58,15 @@ pub struct ProfileReport {
 impl ProfileReport {
     /// The report of `profile` with a table of `weights` weights.
     pub fn new(profile: &LearnerProfile, weights: usize) -> Self {
-        let bytes = profile.format.bytes();
+        let bytes = profile.entry_bytes();
         ProfileReport {
             board: profile.board.name(),
             description: profile.board.description(),
             robot: profile.robot.name(),
-            layout: match profile.layout {
-                pada_core::tile_coding::Layout::Exact => "exact",
-                pada_core::tile_coding::Layout::Hashed => "hashed",
-            },
+            layout: profile.layout.name(),
             weights,
-            weight_bits: bytes * 8,
+            weight_bits: profile.format.bytes() * 8,
+            tag_bits: profile.tag_bytes * 8,
             table_bytes: weights * bytes,
             memory: profile.memory.name(),
             split_bytes: match profile.memory {

@@ -59,6 +59,9 @@ pub struct EpisodeOutcome {
     pub fell: bool,
     /// Distance walked \[m\] (a walking robot).
     pub walked_m: Option<f64>,
+    /// The claim table's claimed slots when the episode ended (a claim
+    /// table whose occupancy the driver can see).
+    pub claimed_slots: Option<u32>,
 }
 
 impl RunProtocol {
@@ -96,6 +99,7 @@ impl RunProtocol {
                 walked_m: outcome.walked_m,
                 fell: outcome.fell,
                 duration_s: e.length as f64 * self.period_s,
+                claimed_slots: outcome.claimed_slots,
             }),
         }
         let (next, command) = match (self.phase, e.mode) {
@@ -161,7 +165,7 @@ mod tests {
 
     #[test]
     fn first_test_learning_until_the_budget_then_a_final_test() {
-        let none = EpisodeOutcome { fell: false, walked_m: None };
+        let none = EpisodeOutcome { fell: false, walked_m: None, claimed_slots: None };
         // 1 s at 30 ms: a budget of 33 steps.
         let mut p = RunProtocol::new(1.0, 30_000);
         assert_eq!(p.budget_steps(), 33);
@@ -172,7 +176,7 @@ mod tests {
         assert_eq!(p.phase(), Phase::Learning);
         assert_eq!(p.on_episode(&episode(RunMode::Learning, 13), none), Some(ToChip::Start(RunMode::Testing)));
         assert!((p.learning_time_s() - 0.99).abs() < 1e-12);
-        let fell = EpisodeOutcome { fell: true, walked_m: Some(0.5) };
+        let fell = EpisodeOutcome { fell: true, walked_m: Some(0.5), claimed_slots: None };
         assert_eq!(p.on_episode(&episode(RunMode::Testing, 5), fell), None);
         assert!(p.done());
         let curve = p.into_curve();

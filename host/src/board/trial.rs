@@ -44,6 +44,8 @@ use pada_core::policy::PolicyKind;
 use pada_core::episodes::is_learning_action;
 use pada_core::profile::{LearnerProfile, TILINGS};
 use pada_core::robot::Robot;
+use pada_core::claim_table::{ClaimTable, Tags16, Tags32};
+use pada_core::tile_coding::Layout;
 use pada_core::weights::{Half, WeightFormat, WeightStore};
 use pada_core::wire::{Episode, RunMode, StepKind, ToChip};
 use pada_firmware::config::hardware;
@@ -131,7 +133,37 @@ pub fn run_board_trial_on(
     let seed = trial_seed(cfg.seed, trial);
     // On the host a table split over CCM and SRAM is one slice: `Split`
     // addresses the same weights in the same order.
+    let claimed = profile.layout == Layout::Claimed;
+    let half = |n: usize| vec![0i16; n].into_boxed_slice();
+    let claim_err = |e: pada_core::claim_table::ClaimTableError| anyhow!("{e}");
+    const LEO_SHIFT: u32 = pada_core::robot::leo::HALF_SHIFT as u32;
     match (profile.robot, profile.format) {
+        (Robot::Leo, WeightFormat::Half { shift: pada_core::robot::leo::HALF_SHIFT }) if claimed => {
+            let weights = Half::<_, LEO_SHIFT>::new(half(n));
+            match profile.tag_bytes {
+                2 => {
+                    let table = ClaimTable::new(weights, Tags16(vec![0u16; n].into_boxed_slice())).map_err(claim_err)?;
+                    run::<Leo, _>(profile, table, rig, cfg, trial, seed, progress)
+                }
+                _ => {
+                    let table = ClaimTable::new(weights, Tags32(vec![0u32; n].into_boxed_slice())).map_err(claim_err)?;
+                    run::<Leo, _>(profile, table, rig, cfg, trial, seed, progress)
+                }
+            }
+        }
+        (Robot::Leo, WeightFormat::Q16) if claimed => {
+            let weights = vec![Q16::ZERO; n].into_boxed_slice();
+            match profile.tag_bytes {
+                2 => {
+                    let table = ClaimTable::new(weights, Tags16(vec![0u16; n].into_boxed_slice())).map_err(claim_err)?;
+                    run::<Leo, _>(profile, table, rig, cfg, trial, seed, progress)
+                }
+                _ => {
+                    let table = ClaimTable::new(weights, Tags32(vec![0u32; n].into_boxed_slice())).map_err(claim_err)?;
+                    run::<Leo, _>(profile, table, rig, cfg, trial, seed, progress)
+                }
+            }
+        }
         (Robot::Pendulum33, WeightFormat::Q16) => {
             run::<Pendulum33, _>(profile, vec![Q16::ZERO; n].into_boxed_slice(), rig, cfg, trial, seed, progress)
         }
@@ -235,7 +267,11 @@ fn run<R: RobotAdapter, W: WeightStore>(
         // The operator hears of an episode's end in its period, before the
         // next boundary, as in the SIL run; the distance is the plant's.
         let ended = out.episode.map(|e| {
-            let outcome = EpisodeOutcome { fell: last_kind == StepKind::Absorbing, walked_m: rig.walked_m() };
+            let outcome = EpisodeOutcome {
+                fell: last_kind == StepKind::Absorbing,
+                walked_m: rig.walked_m(),
+                claimed_slots: ctl.weights().occupancy().map(|o| o.claimed),
+            };
             rig.episode_ended(t);
             (e, outcome)
         });
@@ -307,6 +343,7 @@ fn run<R: RobotAdapter, W: WeightStore>(
         end_speed_m_s: walked.map(|w| w / tail.iter().map(|p| p.duration_s).sum::<f64>()),
         saturations: stats.saturations,
         trace_drops: stats.trace_drops,
+        table: ctl.weights().occupancy(),
         governor: ctl.governor().map(|g| {
             governed.finish(
                 g,

@@ -1,6 +1,7 @@
 //! One module per subcommand of `pada`.
 
 pub mod capture;
+pub mod claims;
 pub mod demo;
 pub mod leo;
 pub mod mtbf;

@@ -100,16 +100,21 @@ pub struct RunArgs {
     /// board will learn.
     #[arg(long, value_name = "NAME", value_parser = crate::robots::board_parser())]
     pub board: Option<pada_core::profile::Board>,
-    /// With --board: a hashed table of 2^N weights instead of the board's
-    /// (placed in CCM, then SRAM on an F405), to see what a board would
-    /// learn with more or less memory. The firmware builds only the boards'
-    /// own profiles.
+    /// With --board: a table of 2^N entries instead of the board's, in the
+    /// board's layout (a claim table for LEO; placed in CCM, then SRAM on
+    /// an F405), to see what a board would learn with more or less memory.
+    /// The firmware builds only the boards' own profiles.
     #[arg(long, value_name = "N", requires = "board", value_parser = clap::value_parser!(u32).range(8..=26))]
     pub table_log2: Option<u32>,
     /// With --board: store weights in 16 or 32 bits (16: stochastic
     /// rounding, the robot's range; see pada_core::weights).
     #[arg(long, value_name = "BITS", requires = "board", value_parser = ["16", "32"])]
     pub weight_bits: Option<String>,
+    /// With --board: a claim table's tags in 16 or 32 bits (16: features
+    /// whose homes lie within one probe run share a slot with probability
+    /// 2^-16; 32: only features with equal 32-bit hashes share one).
+    #[arg(long, value_name = "BITS", requires = "board", value_parser = ["16", "32"])]
+    pub tag_bits: Option<String>,
     /// Seed and threads.
     #[command(flatten)]
     pub trial: TrialOptions,
@@ -154,17 +159,31 @@ fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
         Some(_) => WeightFormat::Q16,
         None => profile.format,
     };
-    if args.table_log2.is_some() || format != profile.format {
+    let tag_bytes = match args.tag_bits.as_deref() {
+        Some("16") => 2,
+        Some(_) => 4,
+        None => profile.tag_bytes,
+    };
+    if args.tag_bits.is_some() && profile.layout != Layout::Claimed {
+        return Err(usage(format!(
+            "--tag-bits needs a claim table; {} has a {} one for {}",
+            board.name(),
+            profile.layout.name(),
+            robot.name()
+        )));
+    }
+    if args.table_log2.is_some() || format != profile.format || tag_bytes != profile.tag_bytes {
         let log2 = match (args.table_log2, profile.layout, profile.weights()) {
             (Some(n), _, _) => n,
-            (None, Layout::Hashed, Some(n)) => n.trailing_zeros(),
+            (None, Layout::Hashed | Layout::Claimed, Some(n)) => n.trailing_zeros(),
             _ => return Err(usage(format!(
                 "--weight-bits without --table-log2 needs a hashed board table; {} has an exact one for {}",
                 board.name(),
                 robot.name()
             ))),
         };
-        profile = profile.with_hashed_table(log2, format);
+        let layout = if profile.layout == Layout::Exact { Layout::Hashed } else { profile.layout };
+        profile = profile.with_hashed_table(layout, log2, format, tag_bytes);
     }
     let policy = policy_of(&args)?;
     // The task as the runner describes it, with the board's table: the
@@ -178,10 +197,7 @@ fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
             board.name(),
             robot.name(),
             weights,
-            match profile.layout {
-                Layout::Exact => "exact",
-                Layout::Hashed => "hashed",
-            }
+            profile.layout.name()
         )));
     }
     let cfg = run_config(&args, &task_spec, policy)?;
@@ -203,14 +219,16 @@ fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
         outln!("{}", summary.to_json())?;
     } else {
         print_summary(&summary.run, &run_label(&policy, cfg.mtbf_budget_s))?;
+        let p = &summary.profile;
         outln!(
-            "  board                {}: {} {} weights ({} KiB, {}-bit) in {}",
+            "  board                {}: {} table of {} entries ({} KiB: {}-bit weights{}) in {}",
             board.name(),
-            summary.profile.layout,
-            summary.profile.weights,
-            summary.profile.table_bytes / 1024,
-            summary.profile.weight_bits,
-            summary.profile.memory
+            p.layout,
+            p.weights,
+            p.table_bytes / 1024,
+            p.weight_bits,
+            if p.tag_bits > 0 { format!(", {}-bit tags", p.tag_bits) } else { String::new() },
+            p.memory
         )?;
         outln!("wrote {}", out.path().display())?;
     }
@@ -312,7 +330,7 @@ impl TaskVisitor for RunVisitor {
             let results = if telemetry.is_none() && mcap.is_none() && args.save_weights.is_none() {
                 run_trials(task, &cfg, &|n| bar.inc(n))?
             } else {
-                let weight_count = build_agent(spec, policy)?.weights().len() as u32;
+                let weight_count = pada_core::weights::WeightStore::len(build_agent(spec, policy)?.weights()) as u32;
                 let (mut sink, mut tee) = (telemetry.as_mut(), mcap.as_mut());
                 let streaming = sink.is_some() || tee.is_some();
                 let mut observer = streaming.then(|| {
@@ -462,6 +480,17 @@ pub fn print_summary(s: &RunSummary, label: &str) -> Result<(), CliError> {
         "  falls                {:.1} learning, {:.1} test runs per trial",
         s.learning_falls.mean, s.test_falls.mean
     )?;
+    let tables: Vec<_> = s.per_trial.iter().filter_map(|t| t.table).collect();
+    if let Some(most) = tables.iter().max_by_key(|o| o.claimed) {
+        outln!(
+            "  claim table          {} of {} slots claimed ({:.1} %, the fullest trial), {} claims refused in all, longest probe {}",
+            most.claimed,
+            most.slots,
+            100.0 * most.fraction(),
+            tables.iter().map(|o| o.refused as u64).sum::<u64>(),
+            tables.iter().map(|o| o.longest_probe).max().unwrap_or(0)
+        )?;
+    }
     outln!(
         "  wall {:.1} s, {:.0} env steps/s on {} threads",
         s.wall_s, s.env_steps_per_s, s.threads

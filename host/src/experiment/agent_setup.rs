@@ -5,16 +5,17 @@
 //! entries, which the paper's γλ = 0.99·0.92 never fills), and a weight
 //! table laid out as the task asks ([`WeightTable`]).
 
+use crate::experiment::table::HostTable;
 use crate::experiment::task::{TaskSpec, WeightTable};
 use pada_core::agent::Agent;
-use pada_core::fixed::Q16;
 use pada_core::policy::PolicyKind;
 use pada_core::tile_coding::Layout;
 
 pub use pada_core::profile::{TILINGS, TRACE};
 
-/// The agent the host runs: weights in a boxed slice.
-pub type HostAgent = Agent<Box<[Q16]>, TILINGS, TRACE>;
+/// The agent the host runs: weights on the heap, in a plain slice or a
+/// claim table ([`HostTable`]).
+pub type HostAgent = Agent<HostTable, TILINGS, TRACE>;
 
 /// An agent for `spec` driving its motor through `policy`, with the task's
 /// learning parameters; the weights still need
@@ -23,6 +24,7 @@ pub fn build_agent(spec: &TaskSpec, policy: PolicyKind) -> anyhow::Result<HostAg
     let err = |e: pada_core::error::ConfigError| anyhow::anyhow!("{e}");
     let (layout, size) = match spec.table {
         WeightTable::Hashed { log2_size } => (Layout::Hashed, 1usize << log2_size),
+        WeightTable::Claimed { log2_size, .. } => (Layout::Claimed, 1usize << log2_size),
         WeightTable::ExactOf { weights } => (Layout::Exact, weights),
         // The exact size depends on the policy's state extension and its
         // learner actions.
@@ -30,7 +32,10 @@ pub fn build_agent(spec: &TaskSpec, policy: PolicyKind) -> anyhow::Result<HostAg
             (Layout::Exact, pada_core::agent::exact_table_len::<TILINGS>(&spec.state, spec.motor.clone(), policy).map_err(err)?)
         }
     };
-    let weights = vec![Q16::ZERO; size].into_boxed_slice();
+    let weights = match spec.table {
+        WeightTable::Claimed { format, tag_bytes, .. } => HostTable::claimed(size, format, tag_bytes)?,
+        _ => HostTable::plain(size),
+    };
     let mut agent = Agent::new(
         &spec.state,
         spec.motor.clone(),

@@ -23,6 +23,7 @@ pub mod config;
 pub mod governed;
 pub mod metrics;
 pub mod runner;
+pub mod table;
 pub mod task;
 pub mod tasks;
 pub mod trial;

@@ -84,6 +84,17 @@ pub enum WeightTable {
         /// Base-2 logarithm of the table size.
         log2_size: u32,
     },
+    /// A claim table of `2^log2_size` slots ([`pada_core::claim_table`]):
+    /// hashed features without collisions; Q16 weights with 32-bit tags on
+    /// the host, 16-bit weights and tags on the chips.
+    Claimed {
+        /// Base-2 logarithm of the table size.
+        log2_size: u32,
+        /// How each weight is stored.
+        format: pada_core::weights::WeightFormat,
+        /// Bytes per tag (2 or 4).
+        tag_bytes: usize,
+    },
 }
 
 /// The fixed description of a task.
@@ -150,6 +161,14 @@ impl WeightTable {
             // coder); FitExact is an exact-layout size only.
             (Layout::Hashed, TableSize::Weights(n)) => WeightTable::Hashed { log2_size: n.trailing_zeros() },
             (Layout::Hashed, TableSize::FitExact) => WeightTable::Hashed { log2_size: 0 },
+            (Layout::Claimed, TableSize::Weights(n)) => WeightTable::Claimed {
+                log2_size: n.trailing_zeros(),
+                format: profile.format,
+                tag_bytes: profile.tag_bytes,
+            },
+            (Layout::Claimed, TableSize::FitExact) => {
+                WeightTable::Claimed { log2_size: 0, format: profile.format, tag_bytes: profile.tag_bytes }
+            }
         }
     }
 }

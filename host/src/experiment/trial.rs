@@ -53,6 +53,10 @@ pub struct TestPoint {
     pub fell: bool,
     /// Duration of the test run \[s\].
     pub duration_s: f64,
+    /// Slots of the claim table claimed before this test run (claim
+    /// tables only: what the learning so far has written).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub claimed_slots: Option<u32>,
 }
 
 /// Everything measured in one trial.
@@ -102,6 +106,9 @@ pub struct TrialResult {
     pub saturations: u32,
     /// Trace entries dropped for capacity (should be 0).
     pub trace_drops: u32,
+    /// The claim table's occupancy at the end (claim tables only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub table: Option<pada_core::claim_table::Occupancy>,
     /// What the wear governor did, when one ran (`--mtbf-budget`).
     pub governor: Option<GovernorTrial>,
     /// The learning curve.
@@ -247,6 +254,7 @@ pub fn run_trial_observed<T: Task>(
         end_speed_m_s,
         saturations: stats.saturations,
         trace_drops: stats.trace_drops,
+        table: pada_core::weights::WeightStore::occupancy(t.agent.weights()),
         governor: t.governor.as_ref().map(|g| g.finish(mtbf_s, physical_mtbf_s)),
         curve: t.curve,
     };
@@ -394,6 +402,7 @@ impl<P: Plant> Trial<'_, '_, '_, P> {
                 walked_m: self.plant.walked_distance_m(),
                 fell: t.kind == StepKind::Absorbing,
                 duration_s: report.length as f64 * spec.control_period_s,
+                claimed_slots: pada_core::weights::WeightStore::occupancy(self.agent.weights()).map(|o| o.claimed),
             });
             self.test_steps += report.length as u64;
         }

@@ -11,6 +11,7 @@
 //! | `/fatigue/<k>` | `Step`, for gearbox k | `pada.Fatigue` |
 //! | `/episode` | `Episode` | `pada.Episode` |
 //! | `/health` | `Health` | `pada.Health` |
+//! | `/claims` | `Health` of a claim table | `pada.Claims` |
 //! | `/safety/state` | `State` | `pada.StateChange` |
 //! | `/safety/fault` | `Fault` | `pada.Fault` |
 //! | `/policy` | `Policy` | `pada.Policy` |
@@ -19,9 +20,9 @@
 //! | `/link` | lost frame, sequence gap, `Health`, the end | `pada.Link` |
 //! | `/scene` | `Step` of a known robot | `foxglove.SceneUpdate` |
 //!
-//! A new record kind (the claim table's occupancy in `Health`, say) is one
-//! [`Topic`] variant, its view struct, its schema in [`super::schemas`] and
-//! one line in [`Channelizer::frame`].
+//! A new record kind is one [`Topic`] variant, its view, its schema in
+//! [`super::schemas`] and a line in [`Channelizer::frame`], as `/claims`
+//! (the claim table's occupancy, from `Health`) shows.
 
 use super::scene::SceneBuilder;
 use super::schemas;
@@ -42,6 +43,9 @@ pub enum Topic {
     Episode,
     /// `Health`: the periodic health report.
     Health,
+    /// The claim table's occupancy, from each `Health` of a board whose
+    /// table is a claim table.
+    Claims,
     /// `State`: a safety state change.
     SafetyState,
     /// `Fault`: entering Fault.
@@ -68,6 +72,7 @@ impl Topic {
         v.extend([
             Topic::Episode,
             Topic::Health,
+            Topic::Claims,
             Topic::SafetyState,
             Topic::SafetyFault,
             Topic::Policy,
@@ -92,6 +97,7 @@ impl Topic {
             Topic::Fatigue(k) => format!("/fatigue/{k}"),
             Topic::Episode => "/episode".into(),
             Topic::Health => "/health".into(),
+            Topic::Claims => "/claims".into(),
             Topic::SafetyState => "/safety/state".into(),
             Topic::SafetyFault => "/safety/fault".into(),
             Topic::Policy => "/policy".into(),
@@ -443,6 +449,9 @@ impl Channelizer {
                     health: h,
                     max_servo_temp_c: h.servo_temps_c.iter().copied().max().unwrap_or(0),
                 }));
+                if let Some(occupancy) = crate::capture::TableOccupancy::of(h) {
+                    push(Topic::Claims, t, json(&occupancy));
+                }
             }
             ToHost::State(s) => push(Topic::SafetyState, self.clock.now(), json(&StateView {
                 step: s.step,

@@ -79,7 +79,12 @@ pub fn replay(bytes: &[u8]) -> Result<Replayed, String> {
                     latest.learning_return = Some(e.total_reward);
                 }
             }
-            Some(Topic::Health) => messages.health += 1,
+            Some(Topic::Health) => {
+                // The wire's own record (the view adds the hottest servo).
+                let h: pada_core::wire::Health = parse(name, data)?;
+                messages.health += 1;
+                latest.table = crate::capture::TableOccupancy::of(&h);
+            }
             Some(Topic::SafetyState) => {
                 let s: StateView = parse(name, data)?;
                 messages.state += 1;
@@ -95,7 +100,7 @@ pub fn replay(bytes: &[u8]) -> Result<Replayed, String> {
             }
             Some(Topic::Policy | Topic::Event) => messages.other += 1,
             Some(Topic::Link) => link = Some(parse::<LinkView>(name, data)?.stats),
-            Some(Topic::Governor | Topic::Scene) | None => {}
+            Some(Topic::Governor | Topic::Claims | Topic::Scene) | None => {}
         }
     }
     let mut metadata = BTreeMap::new();

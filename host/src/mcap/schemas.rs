@@ -91,6 +91,10 @@ fn build(topic: Topic) -> (&'static str, String) {
             ("bus_errors", T::Int), ("checksum_errors", T::Int), ("timeouts", T::Int), ("trace_drops", T::Int),
             ("weight_saturations", T::Int), ("overruns", T::Int), ("max_loop_us", T::Int), ("telemetry_drops", T::Int),
             ("checkpoint_erases", T::Int), ("saves_refused", T::Int),
+            ("table_claimed", T::Int), ("table_slots", T::Int), ("claims_refused", T::Int),
+        ])),
+        Topic::Claims => ("pada.Claims", object("pada.Claims", "The claim table's occupancy", &[
+            ("claimed", T::Int), ("slots", T::Int), ("fraction", T::Num), ("claims_refused", T::Int),
         ])),
         Topic::SafetyState => ("pada.StateChange", object("pada.StateChange", "A safety state change", &[
             ("step", T::Int), ("from", T::Str), ("to", T::Str), ("to_fault", T::Bool),

@@ -119,6 +119,7 @@ mod tests {
                 walked_m: None,
                 fell: false,
                 duration_s: 0.0,
+                claimed_slots: None,
             })
             .collect()
     }

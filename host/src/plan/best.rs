@@ -141,6 +141,7 @@ mod tests {
                     end_speed_m_s: None,
                     saturations: 0,
                     trace_drops: 0,
+                    table: None,
                     curve: vec![],
                 };
                 let t = TrialTiming {

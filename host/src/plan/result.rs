@@ -109,6 +109,8 @@ struct StoredTrial {
     end_speed_m_s: Option<f64>,
     saturations: u32,
     trace_drops: u32,
+    #[serde(default)]
+    table: Option<pada_core::claim_table::Occupancy>,
     curve: Vec<StoredPoint>,
 }
 
@@ -129,6 +131,8 @@ struct StoredPoint {
     fell: bool,
     #[serde(with = "super::exact::f64")]
     duration_s: f64,
+    #[serde(default)]
+    claimed_slots: Option<u32>,
 }
 
 impl From<&TrialResult> for StoredTrial {
@@ -153,6 +157,7 @@ impl From<&TrialResult> for StoredTrial {
             end_speed_m_s: r.end_speed_m_s,
             saturations: r.saturations,
             trace_drops: r.trace_drops,
+            table: r.table,
             curve: r
                 .curve
                 .iter()
@@ -163,6 +168,7 @@ impl From<&TrialResult> for StoredTrial {
                     walked_m: p.walked_m,
                     fell: p.fell,
                     duration_s: p.duration_s,
+                    claimed_slots: p.claimed_slots,
                 })
                 .collect(),
         }
@@ -191,6 +197,7 @@ impl From<StoredTrial> for TrialResult {
             end_speed_m_s: r.end_speed_m_s,
             saturations: r.saturations,
             trace_drops: r.trace_drops,
+            table: r.table,
             curve: r
                 .curve
                 .into_iter()
@@ -201,6 +208,7 @@ impl From<StoredTrial> for TrialResult {
                     walked_m: p.walked_m,
                     fell: p.fell,
                     duration_s: p.duration_s,
+                    claimed_slots: p.claimed_slots,
                 })
                 .collect(),
         }
@@ -395,6 +403,7 @@ mod tests {
             end_speed_m_s: None,
             saturations: 0,
             trace_drops: 0,
+            table: Some(pada_core::claim_table::Occupancy { claimed: 3, slots: 8, refused: 1, longest_probe: 2 }),
             curve: (0..50)
                 .map(|i| TestPoint {
                     learning_time_s: i as f64 / 30.0,
@@ -403,6 +412,7 @@ mod tests {
                     walked_m: (i % 2 == 0).then_some(i as f64 * 1e-3),
                     fell: i % 3 == 0,
                     duration_s: 25.0 - i as f64 / 7.0,
+                    claimed_slots: Some(i * 3),
                 })
                 .collect(),
         }

@@ -2,6 +2,7 @@
 //! SVG and rasterised to PNG with resvg. Text in the PNGs uses DejaVu Sans
 //! embedded in the binary, so no system font is needed.
 
+pub mod claims;
 pub mod compare;
 pub mod figures;
 pub mod legend;

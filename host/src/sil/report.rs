@@ -598,7 +598,15 @@ mod tests {
     use pada_core::wire::RunMode;
 
     fn point(walked: Option<f64>) -> TestPoint {
-        TestPoint { learning_time_s: 0.0, learning_episodes: 0, test_return: 0.0, walked_m: walked, fell: false, duration_s: 1.0 }
+        TestPoint {
+            learning_time_s: 0.0,
+            learning_episodes: 0,
+            test_return: 0.0,
+            walked_m: walked,
+            fell: false,
+            duration_s: 1.0,
+            claimed_slots: None,
+        }
     }
 
     #[test]

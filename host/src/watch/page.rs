@@ -216,7 +216,8 @@ fn tables(h: &mut String, s: &WatchState, state_name: &str) {
 <tr><th>last test return</th><td class=\"n\">{}</td></tr>\
 <tr><th>end performance (last {} runs)</th><td class=\"n\">{}</td></tr>\
 <tr><th>rise time</th><td class=\"n\">{} s</td></tr>\
-<tr><th>control period</th><td class=\"n\">{}</td></tr></table>",
+<tr><th>control period</th><td class=\"n\">{}</td></tr>\
+<tr><th>claim table</th><td class=\"n\" id=\"table\">{}</td></tr></table>",
         escape(
             &s.policy
                 .as_ref()
@@ -232,6 +233,13 @@ fn tables(h: &mut String, s: &WatchState, state_name: &str) {
         s.period_s
             .map(|p| format!("{:.1} ms ({})", p * 1e3, s.period_from.unwrap_or("")))
             .unwrap_or_else(|| "unknown".into()),
+        s.latest.table.map_or("no claim table reported".into(), |t| format!(
+            "{} of {} slots ({:.1} %), {} claims refused",
+            t.claimed,
+            t.slots,
+            t.fraction * 100.0,
+            t.claims_refused
+        )),
     );
     // Fatigue and the MTBF.
     let f = &s.fatigue;

@@ -24,6 +24,7 @@
 
 use crate::action_space::{ActionSpace, Levels, Output, MAX_ACTION_DIMS};
 use crate::action_tiles::{ActionTiles, MAX_ACTION_COMBOS};
+use crate::claim_table::{Claim, InitialWeights};
 use crate::error::{check_range, ConfigError, StepError};
 use crate::fixed::{Frac, Q16};
 use crate::policy::{uniform_below, Candidates, Exploration, Policy, PolicyKind, PolicyState};
@@ -90,6 +91,9 @@ pub struct AgentStats {
     pub saturations: u32,
     /// Trace entries dropped for lack of capacity.
     pub trace_drops: u32,
+    /// Claims a full claim table refused ([`crate::claim_table`]): each
+    /// is one feature's update dropped. 0 for plain tables.
+    pub claims_refused: u32,
     /// The last TD error δ.
     pub last_td_error: Q16,
 }
@@ -116,6 +120,9 @@ pub struct AgentState {
     /// The policy: its kind with Δ or α, the switch back to SARSA, the
     /// previous action and the filter's or integrator's memory.
     pub policy: PolicyState,
+    /// A claim table's seed of its unclaimed features' initial weights
+    /// ([`crate::claim_table::InitialWeights`]); 0 for plain tables.
+    pub table_seed: u64,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -172,6 +179,13 @@ where
         if TRACE == 0 {
             return Err(ConfigError::new("trace capacity", 0.0, "at least 1 entry"));
         }
+        if (layout == Layout::Claimed) != weights.claims() {
+            return Err(ConfigError::new(
+                "layout",
+                layout.code() as f32,
+                "a claim table (pada_core::claim_table) for the claim layout, a plain table for the others",
+            ));
+        }
         let policy = Policy::new(policy, motor)?;
         let coder = coder_for(obs, &policy, layout, weights.len())?;
         let decay = Frac::from_f32(params.gamma).times(Frac::from_f32(params.lambda));
@@ -205,7 +219,15 @@ where
     }
 
     /// Sets every weight from `params.init` (draws from `rng` if uniform).
+    /// A claim table is emptied instead, and one draw from `rng` seeds the
+    /// initial weights its unclaimed features read.
     pub fn reset_weights<R: RngCore + ?Sized>(&mut self, rng: &mut R) {
+        if self.weights.claims() {
+            let init = self.initial_weights(rng.next_u64());
+            self.weights.reset_claims(init);
+            self.rehash();
+            return;
+        }
         match self.params.init {
             WeightInit::Constant(c) => {
                 for i in 0..self.weights.len() {
@@ -222,6 +244,18 @@ where
             }
         }
         self.rehash();
+    }
+
+    /// The initial weights of a claim table's unclaimed features under
+    /// `seed`: `params.init`'s constant or uniform range.
+    fn initial_weights(&self, seed: u64) -> InitialWeights {
+        match self.params.init {
+            WeightInit::Constant(c) => InitialWeights { seed, lo: Q16::from_f32(c).0, span: 1 },
+            WeightInit::Uniform { min, max } => {
+                let (lo, hi) = (Q16::from_f32(min).0 as i64, Q16::from_f32(max).0 as i64);
+                InitialWeights { seed, lo: lo as i32, span: (hi - lo + 1) as u64 }
+            }
+        }
     }
 
     /// Starts an episode in observation `obs`: clears the trace, puts the
@@ -331,7 +365,13 @@ where
     /// The agent's state besides its weights, as plain data
     /// ([`AgentState`]).
     pub fn state(&self) -> AgentState {
-        AgentState { stats: self.stats(), epsilon: self.params.epsilon, mode: self.mode, policy: self.policy.state() }
+        AgentState {
+            stats: self.stats(),
+            epsilon: self.params.epsilon,
+            mode: self.mode,
+            policy: self.policy.state(),
+            table_seed: self.weights.table_seed(),
+        }
     }
 
     /// Checks that `state` can be restored into this agent; the error names
@@ -340,6 +380,8 @@ where
     /// - `epsilon`: finite, `0 ≤ ε ≤ 1`;
     /// - `stats.explorations`, `stats.updates`: at most `stats.steps` (each
     ///   is counted with a decision);
+    /// - `table_seed` and `stats.claims_refused`: 0 unless the table is a
+    ///   claim table;
     /// - the policy ([`Policy::check_state`]): its kind's Δ or α in range
     ///   ([`PolicyKind::validate`]: `delta`, `lowpass alpha`), a kind whose
     ///   learner means the same as the running one (`policy.kind`), the
@@ -357,6 +399,13 @@ where
         if s.updates > s.steps {
             return Err(ConfigError::new("stats.updates", s.updates as f32, "updates <= steps"));
         }
+        if !self.weights.claims() && (state.table_seed != 0 || s.claims_refused != 0) {
+            return Err(ConfigError::new(
+                "table_seed",
+                state.table_seed as f32,
+                "0 with no claims refused: this learner's table is not a claim table",
+            ));
+        }
         self.policy.check_state(&state.policy)
     }
 
@@ -368,13 +417,17 @@ where
     /// saved (they only matter within an episode, and an episode cut by a
     /// reset cannot be continued anyway), so the trace is cleared and the
     /// next call must be [`start_episode`](Self::start_episode), which also
-    /// puts the policy back at rest. The weights are not touched here.
+    /// puts the policy back at rest. The weights are not touched here, but a
+    /// claim table (whose slots must be loaded first) gets its initial
+    /// weights' seed and its refusals back and counts its claimed slots.
     pub fn restore_state(&mut self, state: &AgentState) -> Result<(), ConfigError> {
         self.check_state(state)?;
         self.policy.restore(&state.policy)?;
         self.set_epsilon(state.epsilon)?;
         self.mode = state.mode;
         self.stats = state.stats;
+        let init = self.initial_weights(state.table_seed);
+        self.weights.restore_claims(init, state.stats.claims_refused);
         self.trace.set_drops(state.stats.trace_drops);
         self.current = None;
         self.trace.clear();
@@ -423,7 +476,8 @@ where
 
     /// Counters.
     pub fn stats(&self) -> AgentStats {
-        AgentStats { trace_drops: self.trace.drops(), ..self.stats }
+        let claims_refused = self.weights.occupancy().map_or(0, |o| o.refused);
+        AgentStats { trace_drops: self.trace.drops(), claims_refused, ..self.stats }
     }
 
     /// The weights.
@@ -496,12 +550,12 @@ where
         match self.coder.action_tiles() {
             None => {
                 for j in 0..TILINGS {
-                    sum += w.get(self.coder.action_feature(code, j, action) as usize).0 as i64;
+                    sum += w.read(self.coder.action_feature(code, j, action)).0 as i64;
                 }
             }
             Some(at) => {
                 for j in 0..TILINGS {
-                    sum += w.get(self.coder.combo_feature(code, j, at.combo_of_action(j, action)) as usize).0 as i64;
+                    sum += w.read(self.coder.combo_feature(code, j, at.combo_of_action(j, action))).0 as i64;
                 }
             }
         }
@@ -510,7 +564,7 @@ where
 
     /// `Q` of a feature set: the mean of its weights.
     fn q_of(&self, features: &[u32; TILINGS]) -> Q16 {
-        let sum: i64 = features.iter().map(|&f| self.weights.get(f as usize).0 as i64).sum();
+        let sum: i64 = features.iter().map(|&f| self.weights.read(f).0 as i64).sum();
         Q16::from_wide(sum / TILINGS as i64)
     }
 
@@ -606,7 +660,7 @@ where
         let mut table = [[0i32; MAX_ACTION_COMBOS]; TILINGS];
         for (j, row) in table.iter_mut().enumerate() {
             for (c, slot) in row.iter_mut().enumerate().take(at.combos() as usize) {
-                *slot = self.weights.get(self.coder.combo_feature(code, j, c as u32) as usize).0;
+                *slot = self.weights.read(self.coder.combo_feature(code, j, c as u32)).0;
             }
         }
         // Unused dimensions have lo = hi = 0 and contribute 0.
@@ -645,6 +699,31 @@ where
         best
     }
 
+    /// The slots a learning update of `features` writes. A plain table's
+    /// features are its slots. A claim table claims each feature's slot now
+    /// (a fresh claim enters the running checksum); a refused claim gets
+    /// `u32::MAX`, outside the table, so its update is dropped (and the
+    /// table counts it).
+    #[inline]
+    fn claim_slots(&mut self, features: &[u32; TILINGS]) -> [u32; TILINGS] {
+        if !self.weights.claims() {
+            return *features;
+        }
+        let mut slots = [u32::MAX; TILINGS];
+        for (slot, &f) in slots.iter_mut().zip(features) {
+            if let Claim::Slot { slot: s, fresh } = self.weights.claim(f) {
+                *slot = s;
+                if fresh {
+                    if let Some(c) = self.checksum.as_mut() {
+                        let i = s as usize;
+                        *c = c.wrapping_add(self.weights.raw(i).wrapping_mul(entry_factor(i)));
+                    }
+                }
+            }
+        }
+        slots
+    }
+
     fn commit(&mut self, mut decision: Decision, features: [u32; TILINGS]) -> Decision {
         decision.output = self.policy.apply(&decision.levels);
         self.current = Some(Current { features });
@@ -673,7 +752,8 @@ where
         let delta = Q16::from_wide(delta);
         self.stats.last_td_error = delta;
         let step = delta.mul_frac(self.alpha);
-        self.trace.push(&current.features);
+        let slots = self.claim_slots(&current.features);
+        self.trace.push(&slots);
         let weights = &mut self.weights;
         let checksum = &mut self.checksum;
         let mut saturations = 0u32;

@@ -3,25 +3,26 @@
 //! last good checkpoint, and a board that resets continues learning where it
 //! was.
 //!
-//! # Slot layout (format 3, little endian)
+//! # Slot layout (format 4, little endian)
 //!
 //! | offset | size | field |
 //! |---|---|---|
 //! | 0 | 4 | magic `"PDCK"` |
-//! | 4 | 2 | format version ([`FORMAT_VERSION`], 3) |
+//! | 4 | 2 | format version ([`FORMAT_VERSION`], 4) |
 //! | 6 | 2 | header length (32) |
 //! | 8 | 4 | configuration hash ([`config_hash`] of the caller's description) |
 //! | 12 | 4 | weight count `n` |
 //! | 16 | 4 | generation (1 for the first save, +1 per save, wrapping: compared in serial-number arithmetic, [`is_newer`]) |
 //! | 20 | 4 | CRC-32 of the payload: the state record and the weights |
 //! | 24 | 2 | length `s` of the learner-state record ([`STATE_LEN`], 1024) |
-//! | 26 | 2 | bytes `b` per stored weight (4: [`Q16`] as `i32`, 2: 16-bit; [`crate::weights::WeightFormat`]) |
+//! | 26 | 2 | bytes `b` per stored entry: the weight's (4: [`Q16`] as `i32`, 2: 16-bit; [`crate::weights::WeightFormat`]) plus a claim table's tag (2 or 4; [`crate::claim_table`]): 2, 4 or 8 |
 //! | 28 | 4 | CRC-32 of bytes 0–27 |
 //! | 32 | s | the learner-state record (below) |
-//! | 32 + s | b·n | the weights as the table stores them ([`crate::weights::WeightStore::stored_le`]), little endian |
+//! | 32 + s | b·n | the entries as the table stores them, each its weight then its tag ([`crate::weights::WeightStore::stored_le`]), little endian |
 //! | 32 + s + b·n | 0–3 | zeros up to a multiple of 4 bytes |
 //!
-//! Format 2 (4-byte weights only, a 4-byte state length at 24) and format 1
+//! Format 3 (tables without claim tags, a record of version 3), format 2
+//! (4-byte weights only, a 4-byte state length at 24) and format 1
 //! (weights without the learner's state) are refused as
 //! [`LoadOutcome::UnsupportedVersion`]. The weight format is part of the
 //! configuration hash too, so a table saved in another format is refused as

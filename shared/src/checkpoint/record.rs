@@ -2,7 +2,7 @@
 //! weights, as a fixed-size little-endian record of [`STATE_LEN`] bytes at
 //! slot offset 32 ([`crate::checkpoint`] has the slot around it).
 //!
-//! # Layout (record version [`STATE_VERSION`], 3)
+//! # Layout (record version [`STATE_VERSION`], 4)
 //!
 //! Offsets from the record's start; the third column names the offset's
 //! constant in this file, and a test checks every row against it (offset,
@@ -50,16 +50,18 @@
 //! | 544 | 8 | `GOV_OVER` | actions after which the window was over budget, `u64` |
 //! | 552 | 4 × 12 × 8 | `GOV_BUCKETS` | damage per governed gearbox and bucket, Q16.48, [`GOVERNED_JOINTS`] × [`WINDOW_BUCKETS`] × `u64`, gearbox-major |
 //! | 936 | 8 | `GOV_HEADROOM_AT_MOVE` | the headroom right after the last move, Q16.48 as `i64` |
-//! | 944 | 80 | `GOV_END` | reserved, up to [`STATE_LEN`] = 1024 |
+//! | 944 | 8 | `TABLE_SEED` | a claim table's seed of its initial weights, `u64` (0 for plain tables; [`crate::claim_table::InitialWeights`]) |
+//! | 952 | 4 | `CLAIMS_REFUSED` | claims the claim table refused, `u32` |
+//! | 956 | 68 | `TABLE_END` | reserved, up to [`STATE_LEN`] = 1024 |
 //!
 //! Each fatigue entry: +0 last sign (`i8`: −1, 0, +1), +1 seven reserved
 //! bytes, +8 steps, +16 re-engagements, +24 damage (Q16.48), +32 window
 //! re-engagements, +40 window damage (Q16.48), each a `u64`.
 //!
-//! Records of version 1 (496 bytes, before the flash wear) and 2 (512
-//! bytes, before the governor) are refused; the flash wear sits at the
-//! same offsets in versions 2 and 3, so a version-2 record's wear is still
-//! read (`WEAR_END`).
+//! Records of version 1 (496 bytes, before the flash wear), 2 (512
+//! bytes, before the governor) and 3 (before the claim table) are refused;
+//! the flash wear sits at the same offsets in versions 2 to 4, so an older
+//! record's wear is still read (`WEAR_END`).
 //!
 //! The record holds what a learner carries between episodes
 //! ([`AgentState`]), not the eligibility trace: restoring ends the episode
@@ -89,8 +91,9 @@ use heapless::Vec;
 
 /// Version of the learner-state record this code writes and reads (2 added
 /// the flash wear at offset 496; 3 the policy's second parameter at offset
-/// 76, the policy codes 6–9 and the wear governor's block from offset 512).
-pub const STATE_VERSION: u16 = 3;
+/// 76, the policy codes 6–9 and the wear governor's block from offset 512;
+/// 4 the claim table's seed and refusals at offset 944).
+pub const STATE_VERSION: u16 = 4;
 /// Bytes of the learner-state record (a multiple of 4).
 pub const STATE_LEN: usize = 1024;
 /// Fatigue counters the state record has room for: one per servo. A layout
@@ -144,12 +147,15 @@ pub(super) mod at {
     pub const GOV_OVER: usize = 544;
     pub const GOV_BUCKETS: usize = 552;
     pub const GOV_HEADROOM_AT_MOVE: usize = GOV_BUCKETS + 8 * super::GOVERNED_JOINTS * super::WINDOW_BUCKETS;
-    pub const GOV_END: usize = GOV_HEADROOM_AT_MOVE + 8;
+    pub const TABLE_SEED: usize = GOV_HEADROOM_AT_MOVE + 8;
+    pub const CLAIMS_REFUSED: usize = 952;
+    pub const TABLE_END: usize = 956;
 }
 
 const _: () = assert!(at::FATIGUE + RECORD_JOINTS * at::JOINT_LEN == at::ERASES);
 const _: () = assert!(at::OPERATING_S + 8 == at::GOVERNOR);
-const _: () = assert!(at::GOV_END == 944 && at::GOV_END <= STATE_LEN);
+const _: () = assert!(at::TABLE_SEED == 944);
+const _: () = assert!(at::TABLE_END == 956 && at::TABLE_END <= STATE_LEN);
 // The record has four action dimensions: previous levels and outputs.
 const _: () = assert!(MAX_ACTION_DIMS == 4 && at::PREVIOUS + MAX_ACTION_DIMS <= at::RESERVED_A);
 const _: () = assert!(at::OUTPUT + 4 * MAX_ACTION_DIMS == at::EPSILON);
@@ -199,6 +205,7 @@ impl Default for LearnerState {
                     previous: [0; MAX_ACTION_DIMS],
                     output: [0.0; MAX_ACTION_DIMS],
                 },
+                table_seed: 0,
             },
             rng: RngState::default(),
             joints: Vec::new(),
@@ -264,6 +271,8 @@ impl LearnerState {
         put(&mut b, at::EPISODES, &a.stats.episodes.to_le_bytes());
         put(&mut b, at::SATURATIONS, &a.stats.saturations.to_le_bytes());
         put(&mut b, at::TRACE_DROPS, &a.stats.trace_drops.to_le_bytes());
+        put(&mut b, at::TABLE_SEED, &a.table_seed.to_le_bytes());
+        put(&mut b, at::CLAIMS_REFUSED, &a.stats.claims_refused.to_le_bytes());
         put(&mut b, at::PARAMETER_2, &kind_second_parameter(&p.kind).to_le_bytes());
         put(&mut b, at::RNG_STATE, &self.rng.state.to_le_bytes());
         put(&mut b, at::RNG_INCREMENT, &self.rng.increment.to_le_bytes());
@@ -311,7 +320,7 @@ impl LearnerState {
         let r = Record(bytes);
         let version = r.u16(at::VERSION);
         if version != STATE_VERSION {
-            return Err(ConfigError::new("state.version", version as f32, "3"));
+            return Err(ConfigError::new("state.version", version as f32, "4"));
         }
         let mode = match r.u8(at::MODE) {
             0 => Mode::Learning,
@@ -339,7 +348,7 @@ impl LearnerState {
         if joints > RECORD_JOINTS {
             return Err(ConfigError::new("joints", joints as f32, "0 ..= 8 fatigue joints"));
         }
-        if !r.zero(at::RESERVED_A, 2) {
+        if !r.zero(at::RESERVED_A, 2) || !r.zero(at::TABLE_END, STATE_LEN - at::TABLE_END) {
             return Err(ConfigError::new("state.reserved", 0.0, "reserved bytes 0"));
         }
         let mut previous = [0u8; MAX_ACTION_DIMS];
@@ -352,6 +361,7 @@ impl LearnerState {
             episodes: r.u32(at::EPISODES),
             saturations: r.u32(at::SATURATIONS),
             trace_drops: r.u32(at::TRACE_DROPS),
+            claims_refused: r.u32(at::CLAIMS_REFUSED),
             last_td_error: Q16(r.u32(at::TD_ERROR) as i32),
         };
         let mut fatigue = Vec::new();
@@ -383,6 +393,7 @@ impl LearnerState {
                 epsilon: r.f32(at::EPSILON),
                 mode,
                 policy: PolicyState { kind, switched, previous, output },
+                table_seed: r.u64(at::TABLE_SEED),
             },
             rng: RngState { state: r.u64(at::RNG_STATE), increment: r.u64(at::RNG_INCREMENT) },
             joints: fatigue,
@@ -398,7 +409,7 @@ impl LearnerState {
 fn governor_of(r: &Record<'_>) -> Result<Option<GovernorState>, ConfigError> {
     match r.u8(at::GOVERNOR) {
         0 => {
-            return if r.zero(at::GOVERNOR, STATE_LEN - at::GOVERNOR) {
+            return if r.zero(at::GOVERNOR, at::TABLE_SEED - at::GOVERNOR) {
                 Ok(None)
             } else {
                 Err(ConfigError::new("governor", 0.0, "all bytes 0 without a governor"))
@@ -410,7 +421,7 @@ fn governor_of(r: &Record<'_>) -> Result<Option<GovernorState>, ConfigError> {
     let code = r.u8(at::GOV_RESTRICTS);
     let restricts = Restricts::from_code(code)
         .ok_or(ConfigError::new("governor.restricts", code as f32, "0 (pada delta) or 1 (lowpass alpha)"))?;
-    if !r.zero(at::GOV_RESERVED_A, 2) || !r.zero(at::GOV_END, STATE_LEN - at::GOV_END) {
+    if !r.zero(at::GOV_RESERVED_A, 2) {
         return Err(ConfigError::new("governor.reserved", 0.0, "reserved bytes 0"));
     }
     let mut buckets = [[0u64; WINDOW_BUCKETS]; GOVERNED_JOINTS];
@@ -501,7 +512,9 @@ mod layout_doc {
         ("GOV_OVER", at::GOV_OVER),
         ("GOV_BUCKETS", at::GOV_BUCKETS),
         ("GOV_HEADROOM_AT_MOVE", at::GOV_HEADROOM_AT_MOVE),
-        ("GOV_END", at::GOV_END),
+        ("TABLE_SEED", at::TABLE_SEED),
+        ("CLAIMS_REFUSED", at::CLAIMS_REFUSED),
+        ("TABLE_END", at::TABLE_END),
     ];
 
     /// A size cell: a number or a product such as `4 × 12 × 8`.

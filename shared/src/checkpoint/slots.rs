@@ -10,8 +10,9 @@ use crate::weights::WeightStore;
 /// `"PDCK"` read as a little-endian `u32`.
 pub const MAGIC: u32 = u32::from_le_bytes(*b"PDCK");
 /// The format version this code writes and reads (1 held weights only, 2
-/// only 4-byte weights).
-pub const FORMAT_VERSION: u16 = 3;
+/// only 4-byte weights, 3 no claim tags; 4 stores each table entry as its
+/// weight and its claim tag, if any, and a record of version 4).
+pub const FORMAT_VERSION: u16 = 4;
 /// Bytes of the header.
 pub const HEADER_LEN: usize = 32;
 /// Number of slots.
@@ -48,7 +49,9 @@ pub struct Header {
     pub payload_crc: u32,
     /// Bytes of the learner-state record ([`STATE_LEN`]).
     pub state_len: u32,
-    /// Bytes per stored weight (4 or 2, [`crate::weights::WeightFormat`]).
+    /// Bytes per stored table entry: the weight's (4 or 2,
+    /// [`crate::weights::WeightFormat`]) and a claim table's tag (0, 2 or
+    /// 4; [`WeightStore::entry_bytes`]): 2, 4 or 8 in all.
     pub weight_bytes: u16,
 }
 
@@ -114,7 +117,7 @@ impl Header {
 
     /// Bytes of the slot this header describes, if that fits a `usize`.
     fn slot_bytes(&self) -> Option<usize> {
-        if !matches!(self.weight_bytes, 2 | 4) {
+        if !matches!(self.weight_bytes, 2 | 4 | 8) {
             return None;
         }
         (self.weight_count as usize)
@@ -335,7 +338,7 @@ fn save_checked<S: CheckpointStore, W: WeightStore + ?Sized>(
     weights: &W,
     budget: Option<&WearBudget>,
 ) -> Result<Saved, SaveError<S::Error>> {
-    let bytes = weights.format().bytes();
+    let bytes = weights.entry_bytes();
     let needed = slot_len(weights.len(), bytes);
     if needed > store.capacity() || weights.len() > u32::MAX as usize {
         return Err(SaveError::TooLarge { needed, capacity: store.capacity() });
@@ -455,7 +458,7 @@ pub fn read_weights<S: CheckpointStore, W: WeightStore + ?Sized>(
     weights: &mut W,
 ) -> Result<LoadOutcome, S::Error> {
     let header = &found.header;
-    let bytes = weights.format().bytes();
+    let bytes = weights.entry_bytes();
     if header.weight_count as usize != weights.len() || header.weight_bytes as usize != bytes {
         return Ok(LoadOutcome::SizeMismatch { expected: weights.len() as u32, found: header.weight_count });
     }
@@ -530,9 +533,13 @@ mod tests {
         assert_eq!(Header::parse(&h1.to_bytes()), Err(HeaderError::UnsupportedVersion { found: 1 }));
         let h2 = Header { version: 2, ..h };
         assert_eq!(Header::parse(&h2.to_bytes()), Err(HeaderError::UnsupportedVersion { found: 2 }));
-        let h4 = Header { version: 4, ..h };
-        assert_eq!(Header::parse(&h4.to_bytes()), Err(HeaderError::UnsupportedVersion { found: 4 }));
-        // A weight width other than 2 or 4 bytes describes no slot.
+        let h3 = Header { version: 3, ..h };
+        assert_eq!(Header::parse(&h3.to_bytes()), Err(HeaderError::UnsupportedVersion { found: 3 }));
+        let h5 = Header { version: 5, ..h };
+        assert_eq!(Header::parse(&h5.to_bytes()), Err(HeaderError::UnsupportedVersion { found: 5 }));
+        // An entry of 8 bytes (a Q16 weight and a 32-bit tag) is a slot;
+        // a width other than 2, 4 or 8 bytes describes none.
+        assert_eq!(Header { weight_bytes: 8, ..h }.slot_bytes(), Some(HEADER_LEN + STATE_LEN + 24));
         let mut store = super::super::store::RamStore::<{ slot_len(3, 4) }>::new();
         let odd = Header { weight_bytes: 3, ..h };
         let _ = store.write(0, 0, &odd.to_bytes());

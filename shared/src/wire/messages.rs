@@ -18,8 +18,9 @@ pub use crate::safety::RunMode;
 /// [`ToHost::Policy`] report and [`CheckpointReport::TooLarge`], appended
 /// last; 5: `Step::footstep`; 6: the gentle explorations appended to
 /// [`PolicyKind`], the wear governor's status in [`PolicyReport`] and
-/// [`ToChip::SetMtbfBudget`]).
-pub const PROTOCOL_VERSION: u16 = 6;
+/// [`ToChip::SetMtbfBudget`]; 7: the claim table's occupancy at the end
+/// of [`Health`]).
+pub const PROTOCOL_VERSION: u16 = 7;
 /// The capacities of a [`Step`] (state dimensions, motor outputs and
 /// counted gearboxes) and of a [`Health`] report (servos): pada-core's own
 /// ([`crate::limits`]).
@@ -190,6 +191,13 @@ pub struct Health {
     /// Saves refused since boot because they would wear the sector out
     /// before its stated lifetime ([`crate::checkpoint::WearBudget`]).
     pub saves_refused: u32,
+    /// Slots of the claim table claimed ([`crate::claim_table`]; 0 for a
+    /// plain table).
+    pub table_claimed: u32,
+    /// Slots of the claim table (0 for a plain table).
+    pub table_slots: u32,
+    /// Claims the full claim table refused: updates dropped.
+    pub claims_refused: u32,
 }
 
 /// A safety state change.

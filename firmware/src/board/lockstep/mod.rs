@@ -71,8 +71,9 @@ pub type Board = Parts<ServoPort, TelemetryTx, TelemetryRx, BoardSensors, FlashS
 
 impl Board {
     /// Counter, clock link, the Boot message and the host's configuration.
-    /// Call once.
-    pub fn init() -> Board {
+    /// Call once. (`_table`, the weight table's memory, is the real boards'
+    /// concern: emulated memory works from reset.)
+    pub fn init(_table: pada_core::profile::Memory) -> Board {
         // Before anything writes RAM the record lives in.
         let reset = super::watchdog::reset_cause();
         machine::start_counter();

@@ -459,7 +459,11 @@ impl<'a> Session<'a> {
             ToHost::Episode(e) => {
                 // The firmware reports the episode's end and waits: the
                 // operator sets the robot up again (rig::leo).
-                let outcome = EpisodeOutcome { fell: self.last_step_kind == StepKind::Absorbing, walked_m: self.rig.walked_m() };
+                let outcome = EpisodeOutcome {
+                    fell: self.last_step_kind == StepKind::Absorbing,
+                    walked_m: self.rig.walked_m(),
+                    claimed_slots: None,
+                };
                 self.rig.episode_ended(at_us);
                 // (After the final test episode the run ends at the board's
                 // next report; the firmware stays idle with torque off.)

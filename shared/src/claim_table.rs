@@ -1,0 +1,496 @@
+//! The claim table: a collision-free home for hashed tile-coding features,
+//! the memory of the paper's framework with `safe: 1`
+//! (`docs/reference/grl.md` §5.1, step 4).
+//!
+//! A hashed table ([`crate::tile_coding::Layout::Hashed`]) lets features
+//! share a slot. That is harmless while few do; once a trial has written a
+//! good part of the table, the greedy choice over LEO's 343 actions reads
+//! other features' learned weights for actions it never tried. The claim
+//! table keeps, beside each slot's weight, a *tag* of the feature that owns
+//! it, and places features by open addressing with linear probing:
+//!
+//! - a feature's key is its full 32-bit hash ([`Layout::Claimed`]); its
+//!   home slot is `key mod slots` (the low bits), and its tag comes from
+//!   the key's other bits ([`tag_of`]);
+//! - a **learning update claims** the feature's slot ([`ClaimTable::claim`]):
+//!   the first slot from home on that holds its tag, or else the first empty
+//!   one, which then gets the tag and the feature's initial weight;
+//! - **reads never claim** ([`ClaimTable::read`]): action selection reads
+//!   every candidate's features, and most of those are never written;
+//! - a feature that holds no slot reads its **initial weight**, a function
+//!   of the trial's seed and its key alone ([`InitialWeights`]), never
+//!   another feature's learned weight;
+//! - the probe is bounded ([`MAX_PROBE`] slots). A claim that finds neither
+//!   its tag nor an empty slot there is **refused**: the update for that
+//!   feature is dropped and counted, and lands in no other feature's slot.
+//!
+//! # Where pada differs from the framework
+//!
+//! The framework (`base/include/grl/projectors/tile_coding.h`) keeps a
+//! side table of 32-bit hashes and probes without a bound; the weights of
+//! `base/src/representations/linear.cpp` are all drawn uniformly at start.
+//! A feature it has not claimed reads the weight of the empty slot where
+//! its probe stopped, so two unclaimed features that stop at the same slot
+//! read the same initial weight, and what an unclaimed feature reads changes
+//! when another feature claims that slot. pada draws the initial weight
+//! from the feature's key instead, so it is the same value however full the
+//! table is, and a claim starts from the value the feature read before. The
+//! probe bound and the refusal keep a full table from looping or writing
+//! into a stranger's slot.
+//!
+//! # Tags
+//!
+//! A [`Tags32`] table stores a tag that is a bijection of the whole key
+//! (except that keys whose tag would be 0, the empty mark, share tag 1):
+//! two features share a slot only if their 32-bit hashes are equal, as in
+//! the framework. A [`Tags16`] table halves the tag memory: features with
+//! the same home never share a slot (the tag then differs, below), and two
+//! features whose homes lie within one probe run share one with
+//! probability 2⁻¹⁶ per occupied slot they both pass.
+//!
+//! Why the tag is a remix and not the key's top bits: in a table of 2²¹
+//! slots the home takes bits 0–20, so a 16-bit tag from bits 16–31 would
+//! repeat five of the home's bits, and features whose homes lie close
+//! together (exactly those that meet on a probe run) would be told apart by
+//! 11 bits only. Multiplying by an odd constant first spreads every key bit
+//! over the tag's bits; for two keys with the same home the product's top
+//! bits differ whenever the keys do.
+//!
+//! Capacities are in the types: the slots are the stores' lengths (a power
+//! of two, fixed at compile time on the chip), the probe bound a constant.
+
+use crate::fixed::Q16;
+use crate::weights::WeightStore;
+
+/// The longest probe: slots looked at from a feature's home on. At a load
+/// of ½ a linear probe that misses looks at 2.5 slots on average, at 0.9
+/// about 50 (Knuth's ½(1 + 1/(1 − α)²)), so claims begin to be refused as
+/// a table passes about nine tenths full. (The framework warns from 8.)
+pub const MAX_PROBE: u32 = 64;
+
+/// The tag of an empty slot.
+pub const EMPTY: u32 = 0;
+
+/// Odd multiplier that spreads a key's bits over its tag (the 32-bit
+/// golden-ratio fraction).
+const TAG_MIX: u32 = 0x9E37_79B1;
+
+/// The `bits`-bit tag of `key` (1 ..= 32 bits): never [`EMPTY`].
+#[inline]
+pub const fn tag_of(key: u32, bits: u32) -> u32 {
+    let t = key.wrapping_mul(TAG_MIX) >> (32 - bits);
+    if t == EMPTY {
+        1
+    } else {
+        t
+    }
+}
+
+/// Where a table keeps its tags: one per slot, [`EMPTY`] for a free one.
+pub trait TagStore {
+    /// Bits per tag (16 or 32).
+    const BITS: u32;
+
+    /// Number of tags (= slots).
+    fn len(&self) -> usize;
+
+    /// Whether there are none.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Tag `i` ([`EMPTY`] outside the table).
+    fn get(&self, i: usize) -> u32;
+
+    /// Sets tag `i` (nothing outside the table).
+    fn set(&mut self, i: usize, tag: u32);
+}
+
+/// 16-bit tags in any `[u16]` (an array, a boxed slice, a `&'static mut`
+/// table in a chosen memory).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Tags16<T>(pub T);
+
+/// 32-bit tags in any `[u32]`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Tags32<T>(pub T);
+
+impl<T: AsRef<[u16]> + AsMut<[u16]>> TagStore for Tags16<T> {
+    const BITS: u32 = 16;
+
+    fn len(&self) -> usize {
+        self.0.as_ref().len()
+    }
+
+    #[inline]
+    fn get(&self, i: usize) -> u32 {
+        self.0.as_ref().get(i).copied().unwrap_or(0) as u32
+    }
+
+    #[inline]
+    fn set(&mut self, i: usize, tag: u32) {
+        if let Some(t) = self.0.as_mut().get_mut(i) {
+            *t = tag as u16;
+        }
+    }
+}
+
+impl<T: AsRef<[u32]> + AsMut<[u32]>> TagStore for Tags32<T> {
+    const BITS: u32 = 32;
+
+    fn len(&self) -> usize {
+        self.0.as_ref().len()
+    }
+
+    #[inline]
+    fn get(&self, i: usize) -> u32 {
+        self.0.as_ref().get(i).copied().unwrap_or(0)
+    }
+
+    #[inline]
+    fn set(&mut self, i: usize, tag: u32) {
+        if let Some(t) = self.0.as_mut().get_mut(i) {
+            *t = tag;
+        }
+    }
+}
+
+/// The initial weight of a feature that holds no slot: uniform in
+/// `[lo, lo + span)` (raw Q16), drawn from the feature's key and the
+/// trial's `seed` by a SplitMix64 finaliser, so it is the same on every
+/// read, on every machine, and however full the table is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct InitialWeights {
+    /// The trial's seed for the initial weights (saved in checkpoints).
+    pub seed: u64,
+    /// Lowest initial weight, raw Q16.
+    pub lo: i32,
+    /// Number of raw values above `lo` that can be drawn (1: a constant).
+    pub span: u64,
+}
+
+impl InitialWeights {
+    /// The initial weight of `key`.
+    #[inline]
+    pub fn of(&self, key: u32) -> Q16 {
+        let mut z = self.seed ^ (key as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        let r = ((z as u128 * self.span as u128) >> 64) as i64;
+        Q16((self.lo as i64 + r) as i32)
+    }
+}
+
+/// What [`ClaimTable::claim`] found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Claim {
+    /// The feature's slot: it held it already (`fresh` false) or took it
+    /// now (`fresh` true: tag and initial weight were just written).
+    Slot {
+        /// The slot.
+        slot: u32,
+        /// Whether this claim took it.
+        fresh: bool,
+    },
+    /// Neither its tag nor a free slot within [`MAX_PROBE`]: refused.
+    Refused,
+}
+
+/// Occupancy of a claim table, for reports and telemetry.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Occupancy {
+    /// Slots claimed.
+    pub claimed: u32,
+    /// Slots in the table.
+    pub slots: u32,
+    /// Claims refused since the table was reset (a full probe run).
+    pub refused: u32,
+    /// The longest probe a claim or read has needed (the framework's
+    /// "memory pressure").
+    pub longest_probe: u32,
+}
+
+impl Occupancy {
+    /// The claimed fraction of the table, 0 ..= 1.
+    pub fn fraction(&self) -> f32 {
+        if self.slots == 0 {
+            0.0
+        } else {
+            self.claimed as f32 / self.slots as f32
+        }
+    }
+}
+
+/// What a probe from a key's home found.
+enum Probe {
+    Found(u32),
+    Free(u32),
+    Exhausted,
+}
+
+/// A claim table over a weight store `W` and a tag store `T` of the same
+/// length, a power of two. See the [module documentation](self).
+#[derive(Debug, Clone)]
+pub struct ClaimTable<W, T> {
+    weights: W,
+    tags: T,
+    mask: u32,
+    init: InitialWeights,
+    claimed: u32,
+    refused: u32,
+    longest_probe: u32,
+}
+
+/// Why a claim table could not be made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ClaimTableError {
+    /// The weight and tag stores differ in length.
+    LengthMismatch {
+        /// Weights.
+        weights: usize,
+        /// Tags.
+        tags: usize,
+    },
+    /// The length is not a power of two in 2 ..= 2³¹.
+    NotPowerOfTwo(usize),
+}
+
+impl core::fmt::Display for ClaimTableError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            ClaimTableError::LengthMismatch { weights, tags } => {
+                write!(f, "claim table: {weights} weights but {tags} tags (they must be equal)")
+            }
+            ClaimTableError::NotPowerOfTwo(n) => {
+                write!(f, "claim table: {n} slots, expected a power of two from 2 to 2^31")
+            }
+        }
+    }
+}
+
+impl<W: WeightStore, T: TagStore> ClaimTable<W, T> {
+    /// A table over `weights` and `tags`; every tag is cleared (all slots
+    /// free) and unclaimed features read 0 until
+    /// [`reset`](Self::reset) sets their initial weights.
+    pub fn new(weights: W, tags: T) -> Result<Self, ClaimTableError> {
+        let n = weights.len();
+        if tags.len() != n {
+            return Err(ClaimTableError::LengthMismatch { weights: n, tags: tags.len() });
+        }
+        if n < 2 || !n.is_power_of_two() || n > 1 << 31 {
+            return Err(ClaimTableError::NotPowerOfTwo(n));
+        }
+        let mut t = ClaimTable {
+            weights,
+            tags,
+            mask: (n - 1) as u32,
+            init: InitialWeights { seed: 0, lo: 0, span: 1 },
+            claimed: 0,
+            refused: 0,
+            longest_probe: 0,
+        };
+        t.reset(t.init);
+        Ok(t)
+    }
+
+    /// Frees every slot and sets the initial weights of unclaimed features.
+    pub fn reset(&mut self, init: InitialWeights) {
+        for i in 0..self.tags.len() {
+            self.tags.set(i, EMPTY);
+            self.weights.set(i, Q16::ZERO);
+        }
+        self.init = init;
+        self.claimed = 0;
+        self.refused = 0;
+        self.longest_probe = 0;
+    }
+
+    /// The initial weights of unclaimed features.
+    pub fn initial_weights(&self) -> InitialWeights {
+        self.init
+    }
+
+    /// Counts the claimed slots again (after the tags were loaded from a
+    /// checkpoint), and sets the refusals to `refused`.
+    pub fn recount(&mut self, refused: u32) {
+        self.claimed = (0..self.tags.len()).filter(|&i| self.tags.get(i) != EMPTY).count() as u32;
+        self.refused = refused;
+    }
+
+    /// Occupancy: slots claimed, slots, refusals, the longest probe.
+    pub fn occupancy(&self) -> Occupancy {
+        Occupancy {
+            claimed: self.claimed,
+            slots: self.mask + 1,
+            refused: self.refused,
+            longest_probe: self.longest_probe,
+        }
+    }
+
+    /// The tag stored in slot `i` ([`EMPTY`] if free).
+    pub fn tag(&self, i: usize) -> u32 {
+        self.tags.get(i)
+    }
+
+    /// The weight store.
+    pub fn weight_store(&self) -> &W {
+        &self.weights
+    }
+
+    #[inline]
+    fn probe(&self, key: u32) -> (Probe, u32) {
+        let tag = tag_of(key, T::BITS);
+        let mut i = key & self.mask;
+        for n in 0..MAX_PROBE {
+            let t = self.tags.get(i as usize);
+            if t == tag {
+                return (Probe::Found(i), n);
+            }
+            if t == EMPTY {
+                return (Probe::Free(i), n);
+            }
+            i = (i + 1) & self.mask;
+        }
+        (Probe::Exhausted, MAX_PROBE)
+    }
+
+    /// The weight of the feature `key`: its slot's, or its initial weight
+    /// if it holds none. Claims nothing.
+    #[inline]
+    pub fn read(&self, key: u32) -> Q16 {
+        match self.probe(key).0 {
+            Probe::Found(i) => self.weights.get(i as usize),
+            Probe::Free(_) | Probe::Exhausted => self.init.of(key),
+        }
+    }
+
+    /// The slot of the feature `key`, claimed now if it held none (its
+    /// weight then starts at the initial weight it read before); refused
+    /// and counted if the probe finds neither its tag nor a free slot.
+    pub fn claim(&mut self, key: u32) -> Claim {
+        let (found, probed) = self.probe(key);
+        if probed > self.longest_probe {
+            self.longest_probe = probed;
+        }
+        match found {
+            Probe::Found(i) => Claim::Slot { slot: i, fresh: false },
+            Probe::Free(i) => {
+                self.tags.set(i as usize, tag_of(key, T::BITS));
+                self.weights.set(i as usize, self.init.of(key));
+                self.claimed += 1;
+                Claim::Slot { slot: i, fresh: true }
+            }
+            Probe::Exhausted => {
+                self.refused = self.refused.saturating_add(1);
+                Claim::Refused
+            }
+        }
+    }
+}
+
+/// Multiplier of a slot's tag in [`ClaimTable`]'s raw value, so that the
+/// table checksum sees a tag change as well as a weight change.
+const TAG_CHECK: u32 = 0x85EB_CA6B;
+
+impl<W: WeightStore, T: TagStore> WeightStore for ClaimTable<W, T> {
+    const DITHERED: bool = W::DITHERED;
+
+    #[inline]
+    fn claims(&self) -> bool {
+        true
+    }
+
+    fn len(&self) -> usize {
+        self.weights.len()
+    }
+
+    #[inline]
+    fn get(&self, i: usize) -> Q16 {
+        self.weights.get(i)
+    }
+
+    #[inline]
+    fn set(&mut self, i: usize, w: Q16) {
+        self.weights.set(i, w)
+    }
+
+    #[inline]
+    fn add(&mut self, i: usize, inc: Q16, dither: u32) -> bool {
+        self.weights.add(i, inc, dither)
+    }
+
+    fn format(&self) -> crate::weights::WeightFormat {
+        self.weights.format()
+    }
+
+    fn tag_bytes(&self) -> usize {
+        T::BITS as usize / 8
+    }
+
+    /// The weight's bytes, then the tag's.
+    fn stored_le(&self, i: usize, out: &mut [u8]) {
+        let wb = self.weights.format().bytes();
+        self.weights.stored_le(i, out);
+        let tag = self.tags.get(i).to_le_bytes();
+        let tb = T::BITS as usize / 8;
+        if let Some(dst) = out.get_mut(wb..wb + tb) {
+            dst.copy_from_slice(&tag[..tb]);
+        }
+    }
+
+    fn load_le(&mut self, i: usize, bytes: &[u8]) {
+        let wb = self.weights.format().bytes();
+        self.weights.load_le(i, bytes);
+        let tb = T::BITS as usize / 8;
+        if let Some(src) = bytes.get(wb..wb + tb) {
+            let mut tag = [0u8; 4];
+            tag[..tb].copy_from_slice(src);
+            self.tags.set(i, u32::from_le_bytes(tag));
+        }
+    }
+
+    /// 0 for a free slot, else the weight's raw bits plus a multiple of
+    /// its tag.
+    #[inline]
+    fn raw(&self, i: usize) -> u32 {
+        let tag = self.tags.get(i);
+        if tag == EMPTY {
+            0
+        } else {
+            self.weights.raw(i).wrapping_add(tag.wrapping_mul(TAG_CHECK))
+        }
+    }
+
+    #[inline]
+    fn read(&self, feature: u32) -> Q16 {
+        ClaimTable::read(self, feature)
+    }
+
+    #[inline]
+    fn claim(&mut self, feature: u32) -> Claim {
+        ClaimTable::claim(self, feature)
+    }
+
+    fn reset_claims(&mut self, init: InitialWeights) {
+        self.reset(init)
+    }
+
+    fn occupancy(&self) -> Option<Occupancy> {
+        Some(ClaimTable::occupancy(self))
+    }
+
+    fn table_seed(&self) -> u64 {
+        self.init.seed
+    }
+
+    fn restore_claims(&mut self, init: InitialWeights, refused: u32) {
+        self.init = init;
+        self.recount(refused);
+    }
+}
+
+#[cfg(test)]
+mod tests;

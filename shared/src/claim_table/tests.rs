@@ -1,0 +1,191 @@
+extern crate std;
+
+use super::*;
+use crate::weights::{Half, WeightStore};
+use proptest::prelude::*;
+use std::collections::HashMap;
+use std::vec;
+use std::vec::Vec;
+
+fn table(slots: usize) -> ClaimTable<Vec<Q16>, Tags32<Vec<u32>>> {
+    let mut t = ClaimTable::new(vec![Q16::ZERO; slots], Tags32(vec![0u32; slots])).unwrap();
+    t.reset(InitialWeights { seed: 7, lo: 0, span: 1 << 16 });
+    t
+}
+
+/// A key whose home is `home` in a table of `slots` and whose high bits
+/// are `n` (distinct keys with one home).
+fn key_at(home: u32, n: u32, slots: u32) -> u32 {
+    home | (n * slots)
+}
+
+/// What the table must behave like: a map from key to weight, where a key
+/// absent from the map reads its initial weight, and a full table refuses.
+struct Model {
+    weights: HashMap<u32, i32>,
+    init: InitialWeights,
+}
+
+#[test]
+fn an_unwritten_feature_reads_its_initial_weight_and_a_claim_starts_from_it() {
+    let mut t = table(64);
+    let key = 0xDEAD_BEEF;
+    let before = t.read(key);
+    assert_eq!(before, t.initial_weights().of(key));
+    assert_eq!(t.occupancy().claimed, 0, "reading claims nothing");
+    let Claim::Slot { slot, fresh: true } = t.claim(key) else { panic!("claim refused") };
+    assert_eq!(t.get(slot as usize), before, "the claimed weight starts where the read was");
+    assert_eq!(t.claim(key), Claim::Slot { slot, fresh: false }, "a second claim finds the slot");
+    t.add(slot as usize, Q16(5), 0);
+    assert_eq!(t.read(key), Q16(before.0 + 5));
+    // Another seed, other initial weights; a constant init is constant.
+    let other = InitialWeights { seed: 8, ..t.initial_weights() };
+    assert_ne!(other.of(key), t.initial_weights().of(key));
+    let c = InitialWeights { seed: 1, lo: 42, span: 1 };
+    assert_eq!((c.of(1), c.of(2)), (Q16(42), Q16(42)));
+}
+
+#[test]
+fn features_with_one_home_get_their_own_slots_across_the_end() {
+    let mut t = table(16);
+    // Five keys whose home is the last slot: their probes wrap to 0..3.
+    let keys: Vec<u32> = (1..=5).map(|n| key_at(15, n, 16)).collect();
+    let mut slots = Vec::new();
+    for (i, &k) in keys.iter().enumerate() {
+        let Claim::Slot { slot, fresh: true } = t.claim(k) else { panic!("refused") };
+        t.set(slot as usize, Q16(100 + i as i32));
+        slots.push(slot);
+    }
+    assert_eq!(slots, [15, 0, 1, 2, 3]);
+    for (i, &k) in keys.iter().enumerate() {
+        assert_eq!(t.read(k), Q16(100 + i as i32), "key {i} reads its own weight");
+    }
+    assert_eq!(t.occupancy().longest_probe, 4);
+}
+
+#[test]
+fn a_full_table_refuses_and_counts_and_writes_nothing() {
+    let mut t = table(8);
+    for n in 0..8 {
+        assert!(matches!(t.claim(key_at(n, 1, 8)), Claim::Slot { fresh: true, .. }));
+    }
+    let snapshot: Vec<(u32, Q16)> = (0..8).map(|i| (t.tag(i), t.get(i))).collect();
+    let stranger = key_at(3, 99, 8);
+    assert_eq!(t.claim(stranger), Claim::Refused);
+    assert_eq!(t.claim(stranger), Claim::Refused);
+    assert_eq!(t.read(stranger), t.initial_weights().of(stranger), "a refused feature reads its initial weight");
+    let after: Vec<(u32, Q16)> = (0..8).map(|i| (t.tag(i), t.get(i))).collect();
+    assert_eq!(snapshot, after, "a refusal changes no slot");
+    let o = t.occupancy();
+    assert_eq!((o.claimed, o.slots, o.refused), (8, 8, 2));
+    assert_eq!(o.fraction(), 1.0);
+}
+
+#[test]
+fn the_probe_is_bounded_before_the_table_is_full() {
+    // MAX_PROBE + 1 keys with one home in a table much larger than that:
+    // the last is refused although most slots are free.
+    let slots = 4 * MAX_PROBE as usize;
+    let mut t = table(slots);
+    for n in 1..=MAX_PROBE {
+        assert!(matches!(t.claim(key_at(5, n, slots as u32)), Claim::Slot { .. }));
+    }
+    assert_eq!(t.claim(key_at(5, MAX_PROBE + 1, slots as u32)), Claim::Refused);
+    assert_eq!(t.occupancy().claimed, MAX_PROBE);
+}
+
+#[test]
+fn sixteen_bit_tags_tell_apart_every_key_of_one_home() {
+    // 2^21 slots: keys with one home differ only in their top 11 bits,
+    // and every one of the 2048 gets a tag of its own.
+    let slots = 1u32 << 21;
+    let tags: std::collections::BTreeSet<u32> = (0..2048).map(|n| tag_of(key_at(77, n, slots), 16)).collect();
+    assert_eq!(tags.len(), 2048);
+    assert!(!tags.contains(&EMPTY));
+    // 32-bit tags are a bijection of the key (but for the empty mark).
+    assert_ne!(tag_of(1, 32), tag_of(2, 32));
+    assert_ne!(tag_of(0, 32), EMPTY);
+}
+
+#[test]
+fn tags_and_weights_round_trip_through_their_stored_bytes() {
+    let mut t = ClaimTable::new(Half::<_, 12>::new(vec![0i16; 32]), Tags16(vec![0u16; 32])).unwrap();
+    t.reset(InitialWeights { seed: 3, lo: 0, span: 1 << 12 });
+    assert_eq!(t.entry_bytes(), 4);
+    for k in [11u32, 0xFFFF_0000, 12345678] {
+        if let Claim::Slot { slot, .. } = t.claim(k) {
+            t.add(slot as usize, Q16(3 << 12), 0);
+        }
+    }
+    let mut bytes = vec![0u8; 32 * 4];
+    for i in 0..32 {
+        t.stored_le(i, &mut bytes[4 * i..4 * i + 4]);
+    }
+    let mut u = ClaimTable::new(Half::<_, 12>::new(vec![0i16; 32]), Tags16(vec![0u16; 32])).unwrap();
+    for i in 0..32 {
+        u.load_le(i, &bytes[4 * i..4 * i + 4]);
+    }
+    u.restore_claims(t.initial_weights(), 0);
+    assert_eq!(u.occupancy().claimed, 3);
+    for k in [11u32, 0xFFFF_0000, 12345678, 999] {
+        assert_eq!(u.read(k), t.read(k), "key {k}");
+    }
+    assert_eq!(u.checksum(), t.checksum());
+}
+
+#[test]
+fn construction_errors_name_the_lengths() {
+    let e = ClaimTable::new(vec![Q16::ZERO; 8], Tags32(vec![0u32; 4])).unwrap_err();
+    assert_eq!(e, ClaimTableError::LengthMismatch { weights: 8, tags: 4 });
+    let e = ClaimTable::new(vec![Q16::ZERO; 12], Tags32(vec![0u32; 12])).unwrap_err();
+    assert!(std::format!("{e}").contains("power of two"));
+}
+
+#[derive(Debug, Clone)]
+enum Op {
+    Read(u32),
+    Claim(u32, i32),
+}
+
+/// Keys drawn from few homes and few high parts, so that probe runs meet,
+/// wrap the end and fill the table.
+fn op(slots: u32) -> impl Strategy<Value = Op> {
+    let key = (0..slots, 0u32..6).prop_map(move |(h, n)| key_at(h, n, slots));
+    prop_oneof![
+        key.clone().prop_map(Op::Read),
+        (key, -1000i32..1000).prop_map(|(k, inc)| Op::Claim(k, inc)),
+    ]
+}
+
+proptest! {
+    /// Against a map from key to weight: a claimed key reads what was
+    /// written to it, an unclaimed one its initial weight, and a claim is
+    /// refused only when no slot is free within the probe bound (here: the
+    /// table is full, since it is smaller than the bound).
+    #[test]
+    fn behaves_as_a_map(ops in prop::collection::vec(op(16), 1..200)) {
+        let mut t = table(16);
+        let mut m = Model { weights: HashMap::new(), init: t.initial_weights() };
+        for op in ops {
+            match op {
+                Op::Read(k) => {
+                    let want = m.weights.get(&k).copied().unwrap_or(m.init.of(k).0);
+                    prop_assert_eq!(t.read(k).0, want);
+                }
+                Op::Claim(k, inc) => match t.claim(k) {
+                    Claim::Slot { slot, fresh } => {
+                        prop_assert_eq!(fresh, !m.weights.contains_key(&k));
+                        t.add(slot as usize, Q16(inc), 0);
+                        let w = m.weights.entry(k).or_insert(m.init.of(k).0);
+                        *w = w.saturating_add(inc);
+                    }
+                    Claim::Refused => {
+                        prop_assert!(!m.weights.contains_key(&k), "a claimed key was refused");
+                        prop_assert_eq!(m.weights.len(), 16, "refused with free slots");
+                    }
+                },
+            }
+            prop_assert_eq!(t.occupancy().claimed as usize, m.weights.len());
+        }
+    }
+}
