@@ -95,13 +95,7 @@ fn model(sub: u32, it: usize, f: impl FnOnce(&mut ModelOptions)) -> LeoModel {
 /// Energy drift (J, max |E − E0|) of the torso-welded robot swinging its
 /// limbs under gravity for 10 s, contacts/friction/back-EMF/stop damping off.
 fn energy_drift(sub: u32, it: usize) -> (f32, f32) {
-    let mut m = model(sub, it, |o| {
-        o.contacts = false;
-        o.dry_friction = false;
-        o.back_emf = false;
-        o.joint_stops = false;
-        o.fixed_torso = true;
-    });
+    let mut m = model(sub, it, pada::model_presets::lossless_fixed_torso);
     m.set_velocities([3.0, 2.0, -2.0, -3.0, 3.0, 4.0, -4.0], [0.0; 3]);
     let e0 = m.energy().total();
     let mut worst = 0.0f32;
@@ -193,12 +187,7 @@ fn motor_response(sub: u32, it: usize) -> f32 {
     let u = pada_core::rx28::LEO_MAX_VOLTAGE;
     let expect = servo.voltage_torque(u) / servo.damping
         * (1.0 - (-CONTROL_PERIOD * servo.damping / j).exp());
-    let mut m = model(sub, it, |o| {
-        o.fixed_torso = true;
-        o.gravity = false;
-        o.contacts = false;
-        o.dry_friction = false;
-    });
+    let mut m = model(sub, it, pada::model_presets::servo_bench);
     let mut v = [0.0; NUM_JOINTS];
     v[Joint::Shoulder as usize] = u;
     m.set_voltages(v);

@@ -118,6 +118,8 @@ pub struct Recorder {
     csv: Option<csv::Writer<Box<dyn Write + Send>>>,
     counts: MessageCounts,
     latest: Latest,
+    /// The channels of an MCAP file or a live Foxglove view, when asked for.
+    tap: Option<crate::mcap::Tap>,
 }
 
 impl Recorder {
@@ -136,7 +138,24 @@ impl Recorder {
             csv,
             counts: MessageCounts::default(),
             latest: Latest::default(),
+            tap: None,
         })
+    }
+
+    /// Also hands every frame, lost frame and gap to `tap` (`--mcap`,
+    /// `--foxglove`); [`Recorder::close_tap`] ends it.
+    pub fn set_tap(&mut self, tap: crate::mcap::Tap) {
+        self.tap = Some(tap);
+    }
+
+    /// Ends the tap, if any: the final link counters, then its sinks close
+    /// (the MCAP file's summary and metadata are written).
+    pub fn close_tap(&mut self) -> std::io::Result<()> {
+        let stats = self.stats();
+        match self.tap.take() {
+            Some(mut tap) => tap.finish(stats),
+            None => Ok(()),
+        }
     }
 
     /// Feeds received bytes at `time_s` (the caller's clock); every decoded
@@ -171,9 +190,17 @@ impl Recorder {
                     }
                     self.note(&frame.msg);
                     self.row(time_s, &frame)?;
+                    if let Some(tap) = self.tap.as_mut() {
+                        tap.frame(&frame, self.decoder.stats())?;
+                    }
                     frames.push(frame);
                 }
-                Err(e) => self.row_other(time_s, None, "lost", &loss_name(&e))?,
+                Err(e) => {
+                    self.row_other(time_s, None, "lost", &loss_name(&e))?;
+                    if let Some(tap) = self.tap.as_mut() {
+                        tap.lost(&e, self.decoder.stats())?;
+                    }
+                }
             }
         }
         Ok(())
@@ -187,6 +214,9 @@ impl Recorder {
         match self.decoder.finish() {
             Some(e) => {
                 self.row_other(time_s, None, "lost", &loss_name(&e))?;
+                if let Some(tap) = self.tap.as_mut() {
+                    tap.lost(&e, self.decoder.stats())?;
+                }
                 Ok(true)
             }
             None => Ok(false),
@@ -198,7 +228,16 @@ impl Recorder {
     /// frame is not a gap; a frame cut short by the restart counts as lost.
     /// Returns whether there was one.
     pub fn restarted(&mut self) -> bool {
-        let cut = self.decoder.finish().is_some();
+        let cut = match self.decoder.finish() {
+            Some(e) => {
+                if let Some(tap) = self.tap.as_mut() {
+                    // A sink's write error shows again at close_tap.
+                    let _ = tap.lost(&e, self.decoder.stats());
+                }
+                true
+            }
+            None => false,
+        };
         self.decoder.resync_seq();
         cut
     }

@@ -86,15 +86,20 @@ impl TelemetrySink {
                 (Box::new(std::io::BufWriter::new(s)), format!("tcp:{a}"))
             }
         };
-        Ok(TelemetrySink {
+        Ok(TelemetrySink::to_writer(out, name))
+    }
+
+    /// A stream into `out`, named `target` in its totals and errors.
+    pub fn to_writer(out: Box<dyn Write + Send>, target: String) -> TelemetrySink {
+        TelemetrySink {
             last_flush: std::time::Instant::now(),
             out,
             encoder: FrameEncoder::new(),
             frames: 0,
             bytes: 0,
             error: None,
-            target: name,
-        })
+            target,
+        }
     }
 
     /// Frames one message (numbered as the firmware numbers its frames).

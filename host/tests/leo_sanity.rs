@@ -138,12 +138,7 @@ fn motion_stays_planar() {
 #[test]
 fn servo_reproduces_stall_torque_and_no_load_speed() {
     let u = LEO_MAX_VOLTAGE;
-    let mut m = model(|o| {
-        o.fixed_torso = true;
-        o.gravity = false;
-        o.contacts = false;
-        o.dry_friction = false;
-    });
+    let mut m = model(pada::model_presets::servo_bench);
     let mut v = [0.0; NUM_JOINTS];
     v[Joint::Shoulder as usize] = u;
     v[Joint::KneeLeft as usize] = u;
@@ -181,12 +176,7 @@ fn servo_response_over_one_control_period() {
     let j = ARM_IYY + ARM_MASS * r2 + servo.armature;
     let v_inf = servo.voltage_torque(LEO_MAX_VOLTAGE) / servo.damping;
     let expect = v_inf * (1.0 - (-CONTROL_PERIOD * servo.damping / j).exp());
-    let mut m = model(|o| {
-        o.fixed_torso = true;
-        o.gravity = false;
-        o.contacts = false;
-        o.dry_friction = false;
-    });
+    let mut m = model(pada::model_presets::servo_bench);
     let mut v = [0.0; NUM_JOINTS];
     v[Joint::Shoulder as usize] = LEO_MAX_VOLTAGE;
     m.set_voltages(v);
@@ -232,13 +222,7 @@ fn passive_robot_falls_and_comes_to_rest() {
 /// Also free-floating without gravity: kinetic energy within 2%.
 #[test]
 fn energy_is_conserved_without_contacts_and_friction() {
-    let mut m = model(|o| {
-        o.fixed_torso = true;
-        o.contacts = false;
-        o.dry_friction = false;
-        o.back_emf = false;
-        o.joint_stops = false;
-    });
+    let mut m = model(pada::model_presets::lossless_fixed_torso);
     m.set_velocities([3.0, 2.0, -2.0, -3.0, 3.0, 4.0, -4.0], [0.0; 3]);
     let e0 = m.energy().total();
     let mut worst = 0.0f32;

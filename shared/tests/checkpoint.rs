@@ -308,7 +308,7 @@ fn erases_are_counted_in_the_record_across_configurations() {
 
 #[test]
 fn a_save_beyond_the_wear_budget_is_refused_before_anything_is_erased() {
-    let budget = WearBudget { endurance: 6, reserve: 2, lifetime_s: 4000 };
+    let budget = WearBudget::new(6, 2, 4000).unwrap();
     let mut store = Store::new();
     let mut s = state(1);
     // The reserve: two erases per slot at operating time 0.

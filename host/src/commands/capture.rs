@@ -35,6 +35,11 @@ pub struct CaptureArgs {
     /// What is kept of it.
     #[command(flatten)]
     pub record: StreamRecord,
+    /// With --file X.mcap: draw 8 frames over 3 s of its /scene (the robot
+    /// from its joint angles; the start of the last test episode that
+    /// long, else the end) side by side as a PNG, side view.
+    #[arg(long, value_name = "FILE.png")]
+    pub scene_png: Option<std::path::PathBuf>,
 }
 
 /// The end of a capture.
@@ -56,6 +61,9 @@ pub struct CaptureSummary {
     pub latest: crate::capture::Latest,
     /// Times the serial port went away (and was waited for).
     pub disconnects: u32,
+    /// What the `--foxglove` live server served, when it ran.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub foxglove: Option<crate::foxglove::server::LiveStats>,
 }
 
 impl CaptureSummary {
@@ -71,21 +79,96 @@ impl CaptureSummary {
             messages: rec.counts(),
             latest: rec.latest().clone(),
             disconnects,
+            foxglove: None,
         }
     }
+}
+
+/// `pada capture --file X.mcap`: the summary of a recording, rebuilt from
+/// its channels ([`crate::mcap::read`]).
+fn replay_mcap(args: &CaptureArgs, path: &std::path::Path) -> Result<(), CliError> {
+    let r = &args.record;
+    if r.out.is_some() || r.mcap.is_some() || r.foxglove.is_some() || r.seconds.is_some() {
+        return Err(usage(format!(
+            "--file {}: an MCAP recording is read back for its summary only; \
+             --out, --mcap, --foxglove and --seconds take a telemetry stream",
+            path.display()
+        )));
+    }
+    let started = Instant::now();
+    let bytes = std::fs::read(path).map_err(|e| usage(format!("--file {}: cannot read: {e}", path.display())))?;
+    let rep = crate::mcap::read::replay(&bytes).map_err(|e| usage(format!("--file {}: {e}", path.display())))?;
+    if let Some(png) = &args.scene_png {
+        let name = path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned());
+        let title = format!(
+            "{name}: /scene (foxglove.SceneUpdate lines) drawn by pada, side view. Blue left leg, orange right leg, grey torso, purple arm, green floor"
+        );
+        // 90 messages: 3 s of LEO (30 Hz) or of the pendulum (33 Hz).
+        let picture = crate::mcap::picture::scene_strip_png(&bytes, 8, 90, &title)
+            .map_err(|e| usage(format!("--scene-png: {e}")))?;
+        std::fs::write(png, picture).map_err(|e| usage(format!("--scene-png {}: cannot write: {e}", png.display())))?;
+    }
+    let summary = CaptureSummary {
+        source: path.display().to_string(),
+        ended: "end of file".to_string(),
+        wall_s: started.elapsed().as_secs_f64(),
+        link: rep.link,
+        bad_frames: rep.link.bad_frames(),
+        messages: rep.messages,
+        latest: rep.latest,
+        disconnects: 0,
+        foxglove: None,
+    };
+    if r.json {
+        outln!("{}", serde_json::to_string_pretty(&summary).map_err(|e| CliError::Runtime(e.into()))?)?;
+    } else {
+        let meta = rep.metadata.get(crate::mcap::writer::META_PADA);
+        errln!(
+            "recording {} (pada {}, configuration {}): {} frames, {} lost, {} sequence gaps ({} frames missing)",
+            summary.source,
+            meta.and_then(|m| m.get("version")).map_or("?", String::as_str),
+            meta.and_then(|m| m.get("config_hash")).map_or("?", String::as_str),
+            summary.link.frames,
+            summary.bad_frames,
+            summary.link.seq_gaps,
+            summary.link.frames_missed
+        );
+        for (topic, n) in &rep.per_topic {
+            errln!("  {topic}: {n} messages");
+        }
+    }
+    Ok(())
+}
+
+/// Whether `path` is a file that starts as an MCAP file does.
+fn is_mcap_file(path: &std::path::Path) -> bool {
+    let mut head = [0u8; 8];
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut head))
+        .is_ok_and(|()| crate::mcap::read::is_mcap(&head))
 }
 
 /// Runs `pada capture`.
 pub fn run(args: CaptureArgs) -> Result<(), CliError> {
     args.record.check()?;
     args.input.check()?;
+    if args.scene_png.is_some() && !args.input.file.as_deref().is_some_and(is_mcap_file) {
+        return Err(usage("--scene-png draws a recording: give --file X.mcap (an MCAP file written by --mcap)"));
+    }
+    if let Some(file) = args.input.file.as_deref().filter(|f| f.as_os_str() != "-" && is_mcap_file(f)) {
+        return replay_mcap(&args, file);
+    }
     let Some((mut source, name)) = args.input.open()? else {
         return Err(usage("give --port DEVICE or --file FILE"));
     };
     let csv = args.record.csv()?;
+    let mut taps = args.record.taps("capture")?;
     let mut rec = Recorder::new(csv)
         .context("cannot write the CSV header")
         .map_err(CliError::Runtime)?;
+    if let Some(tap) = taps.tap.take() {
+        rec.set_tap(tap);
+    }
 
     let stop = Arc::new(AtomicBool::new(false));
     {
@@ -138,7 +221,7 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
         };
         frames.clear();
         rec.feed(&buf[..n], started.elapsed().as_secs_f64(), &mut frames)
-            .context("cannot write the CSV")
+            .context("cannot write the CSV or the MCAP file")
             .map_err(CliError::Runtime)?;
         let every = if tty {
             Duration::from_millis(100)
@@ -158,12 +241,18 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
     rec.flush()
         .context("cannot write the CSV")
         .map_err(CliError::Runtime)?;
+    let closed = rec.close_tap();
+    let live = taps.close("capture");
+    closed
+        .with_context(|| format!("cannot write the MCAP file {}", args.record.mcap.as_deref().unwrap_or(std::path::Path::new("")).display()))
+        .map_err(CliError::Runtime)?;
     status_line(&rec.status_line(), tty, true);
     let disconnects = match &source {
         Opened::Port(p) => p.disconnects(),
         Opened::Reader(_) => 0,
     };
-    let summary = CaptureSummary::of(&rec, name, ended, started, disconnects);
+    let mut summary = CaptureSummary::of(&rec, name, ended, started, disconnects);
+    summary.foxglove = live;
     if args.record.json {
         outln!(
             "{}",

@@ -200,20 +200,15 @@ fn configs_csv(cs: &[ConfigResult]) -> anyhow::Result<Vec<u8>> {
     ])?;
     for c in cs {
         let m = &c.summary;
-        w.write_record([
-            c.algo().name().to_string(),
-            parameter_of(&c.policy)
-                .map(|p| p.to_string())
-                .unwrap_or_default(),
-            m.trials.to_string(),
-            m.mtbf_s.mean.to_string(),
-            m.mtbf_s.ci95.to_string(),
-            m.end_performance.mean.to_string(),
-            m.end_performance.ci95.to_string(),
-            m.rise_time_s.mean.to_string(),
-            m.rise_time_s.ci95.to_string(),
-            m.window_reengagements.mean.to_string(),
-        ])?;
+        let row = crate::paper::csv_row::CsvRow::new()
+            .cell(c.algo().name())
+            .opt(parameter_of(&c.policy))
+            .cell(m.trials)
+            .estimate(&m.mtbf_s)
+            .estimate(&m.end_performance)
+            .estimate(&m.rise_time_s)
+            .cell(m.window_reengagements.mean);
+        w.write_record(row.cells())?;
     }
     w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))
 }

@@ -172,27 +172,22 @@ fn configs_csv(r: &WearResults) -> anyhow::Result<Vec<u8>> {
         let m = &c.summary;
         let names = c.algo.parameter_names().len();
         let p = c.policy.parameters();
-        let opt = |o: Option<f64>| o.map(|v| v.to_string()).unwrap_or_default();
-        w.write_record([
-            c.label.clone(),
-            c.algo.name().to_string(),
-            opt((names > 0).then_some(p[0] as f64)),
-            opt((names > 1).then_some(p[1] as f64)),
-            opt(c.budget_s.map(f64::from)),
-            m.trials.to_string(),
-            m.mtbf_s.mean.to_string(),
-            m.mtbf_s.ci95.to_string(),
-            m.physical_mtbf_s.mean.to_string(),
-            m.physical_mtbf_s.ci95.to_string(),
-            m.end_performance.mean.to_string(),
-            m.end_performance.ci95.to_string(),
-            m.rise_time_s.mean.to_string(),
-            m.rise_time_s.ci95.to_string(),
-            opt(m.governor.as_ref().map(|g| g.held_fraction)),
-            opt(m.governor.as_ref().map(|g| g.mean_parameter.mean)),
-            c.pareto.to_string(),
-            c.pareto_physical.to_string(),
-        ])?;
+        let row = crate::paper::csv_row::CsvRow::new()
+            .cell(&c.label)
+            .cell(c.algo.name())
+            .opt((names > 0).then_some(p[0] as f64))
+            .opt((names > 1).then_some(p[1] as f64))
+            .opt(c.budget_s.map(f64::from))
+            .cell(m.trials)
+            .estimate(&m.mtbf_s)
+            .estimate(&m.physical_mtbf_s)
+            .estimate(&m.end_performance)
+            .estimate(&m.rise_time_s)
+            .opt(m.governor.as_ref().map(|g| g.held_fraction))
+            .opt(m.governor.as_ref().map(|g| g.mean_parameter.mean))
+            .cell(c.pareto)
+            .cell(c.pareto_physical);
+        w.write_record(row.cells())?;
     }
     w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))
 }

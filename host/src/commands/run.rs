@@ -83,6 +83,11 @@ pub struct RunArgs {
     /// tcp:HOST:PORT (loopback only); `pada capture --file` reads them.
     #[arg(long, value_name = "FILE|tcp:HOST:PORT")]
     pub telemetry: Option<String>,
+    /// Record trial 0's telemetry as an MCAP file: the channels of `pada
+    /// capture --mcap` (every record kind, the robot on /scene), to open
+    /// in Foxglove; with or without --telemetry.
+    #[arg(long, value_name = "FILE.mcap")]
+    pub mcap: Option<PathBuf>,
     /// Save the first trial's learned weights to this file (versioned, with
     /// a checksum; read by `pada render`).
     #[arg(long, value_name = "FILE")]
@@ -129,10 +134,15 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
 /// `pada run --board`: the board's own learner ([`crate::board`]).
 fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
     let robot = robot_of_task(args.task).map_err(usage)?;
-    for (flag, given) in [("--telemetry", args.telemetry.is_some()), ("--save-weights", args.save_weights.is_some())] {
+    for (flag, given) in [
+        ("--telemetry", args.telemetry.is_some()),
+        ("--mcap", args.mcap.is_some()),
+        ("--save-weights", args.save_weights.is_some()),
+    ] {
         if given {
             return Err(usage(format!(
-                "{flag} is not available with --board (the board streams its own telemetry: `pada sil --telemetry`)"
+                "{flag} is not available with --board (the board streams its own telemetry: `pada sil --telemetry`, \
+                 whose output directory holds telemetry.mcap)"
             )));
         }
     }
@@ -289,13 +299,17 @@ impl TaskVisitor for RunVisitor {
             .unwrap_or_else(|| PathBuf::from(format!("pada-out/run-{}-{}", spec.name, args.algo)));
         let out = OutDir::check(&out_path)?;
         let mode = args.cluster.mode(out.path())?;
-        if mode != Mode::Local && (args.telemetry.is_some() || args.save_weights.is_some()) {
+        if mode != Mode::Local && (args.telemetry.is_some() || args.mcap.is_some() || args.save_weights.is_some()) {
             return Err(usage(
-                "--telemetry and --save-weights need the trials in this process: they do not combine with --plan, --merge or --slurm",
+                "--telemetry, --mcap and --save-weights need the trials in this process: they do not combine with --plan, --merge or --slurm",
             ));
         }
         let mut telemetry = match &args.telemetry {
             Some(t) => Some(TelemetrySink::open(&parse_target(t)?)?),
+            None => None,
+        };
+        let mut mcap = match &args.mcap {
+            Some(p) => Some(crate::mcap::tee::McapTee::create(p, "--mcap")?),
             None => None,
         };
         set_threads(args.trial.threads)?;
@@ -313,12 +327,14 @@ impl TaskVisitor for RunVisitor {
                     spec.test_interval,
                 );
             let bar = steps_bar(total, &format!("{} {}", spec.name, label(&policy)));
-            let results = if telemetry.is_none() && args.save_weights.is_none() {
+            let results = if telemetry.is_none() && mcap.is_none() && args.save_weights.is_none() {
                 run_trials(task, &cfg, &|n| bar.inc(n))?
             } else {
                 let weight_count = pada_core::weights::WeightStore::len(build_agent(spec, policy)?.weights()) as u32;
-                let mut observer = telemetry.as_mut().map(|sink| {
-                    sink.send(&ToHost::Hello(wire::Hello {
+                let (mut sink, mut tee) = (telemetry.as_mut(), mcap.as_mut());
+                let streaming = sink.is_some() || tee.is_some();
+                let mut observer = streaming.then(|| {
+                    let hello = ToHost::Hello(wire::Hello {
                         protocol: wire::PROTOCOL_VERSION,
                         // 0: a host run, not a firmware configuration.
                         config_hash: 0,
@@ -326,8 +342,17 @@ impl TaskVisitor for RunVisitor {
                         period_us: (spec.control_period_s * 1e6).round() as u32,
                         state_dims: spec.state.len() as u8,
                         joints: spec.motor.dims() as u8,
-                    }));
-                    move |msg: ToHost| sink.send(&msg)
+                    });
+                    let mut send = move |msg: ToHost| {
+                        if let Some(s) = sink.as_mut() {
+                            s.send(&msg);
+                        }
+                        if let Some(t) = tee.as_mut() {
+                            t.send(&msg);
+                        }
+                    };
+                    send(hello);
+                    send
                 });
                 let (results, agent, switched) = run_trials_observed(
                     task,
@@ -360,6 +385,12 @@ impl TaskVisitor for RunVisitor {
             files.push(("timing.json".to_string(), timing.to_json()));
         }
         out.write_all(&files)?;
+        if let Some(tee) = mcap {
+            let (frames, path) = tee.finish()?;
+            if !args.json {
+                outln!("mcap: trial 0, {frames} frames recorded in {}", path.display())?;
+            }
+        }
         if let Some(sink) = telemetry {
             let totals = sink.finish()?;
             if !args.json {

@@ -85,7 +85,8 @@ pub struct SilArgs {
     #[arg(long, value_name = "PROGRAM", default_value = "qemu-system-arm")]
     pub qemu: PathBuf,
     /// Output directory: telemetry.bin (the raw stream), telemetry.csv,
-    /// episodes.csv, summary.json, the firmware's log (default:
+    /// telemetry.mcap (the channels of `pada capture --mcap`, for
+    /// Foxglove), episodes.csv, summary.json, the firmware's log (default:
     /// pada-out/sil-<task>-<algo>-<board>).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,

@@ -79,6 +79,42 @@ pub struct StreamRecord {
     /// Print the final summary as JSON on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Also record the stream as an MCAP file: every record kind on a
+    /// channel of its own with its JSON Schema, the board's clock as log
+    /// time, the robot drawn on /scene, pada's version and the
+    /// configuration hash in its metadata (open it in Foxglove).
+    #[arg(long, value_name = "FILE.mcap")]
+    pub mcap: Option<PathBuf>,
+    /// Serve the stream live in Foxglove's WebSocket protocol on this
+    /// address (the channels of --mcap); connect the Foxglove app to
+    /// ws://HOST:PORT. Port 0 picks a free one.
+    #[arg(long, value_name = "tcp:HOST:PORT")]
+    pub foxglove: Option<String>,
+}
+
+/// The `--mcap` file and the `--foxglove` server of a stream, opened.
+pub struct Taps {
+    /// The tap for the recorder, when either was asked for.
+    pub tap: Option<crate::mcap::Tap>,
+    /// The live server.
+    pub server: Option<crate::foxglove::server::FoxgloveServer>,
+}
+
+impl Taps {
+    /// Ends the live server (after the recorder closed its tap) and says
+    /// on stderr what it served.
+    pub fn close(self, command: &str) -> Option<crate::foxglove::server::LiveStats> {
+        let server = self.server?;
+        let addr = server.addr;
+        let stats = server.close();
+        crate::console::errln!(
+            "{command}: foxglove server ws://{addr}: {} clients, {} messages sent, {} dropped",
+            stats.clients,
+            stats.sent,
+            stats.dropped
+        );
+        Some(stats)
+    }
 }
 
 impl StreamRecord {
@@ -88,6 +124,37 @@ impl StreamRecord {
             Some(s) if !(s.is_finite() && s > 0.0) => Err(usage(format!("--seconds {s} is out of range: valid is > 0"))),
             _ => Ok(()),
         }
+    }
+
+    /// Creates the `--mcap` file and starts the `--foxglove` server, if
+    /// asked for (a bad path or address is a usage error).
+    pub fn taps(&self, command: &str) -> Result<Taps, CliError> {
+        let mut sinks: Vec<Box<dyn crate::mcap::ChannelSink>> = Vec::new();
+        if let Some(p) = &self.mcap {
+            if p.is_dir() {
+                return Err(usage(format!("--mcap {}: is a directory; valid is a file to create", p.display())));
+            }
+            let f = crate::mcap::writer::McapFile::create(p)
+                .map_err(|e| usage(format!("--mcap {}: cannot create: {e}", p.display())))?;
+            sinks.push(Box::new(f));
+        }
+        let mut server = None;
+        if let Some(spec) = &self.foxglove {
+            let addr = crate::foxglove::parse_addr(spec)?;
+            let s = crate::foxglove::server::FoxgloveServer::start(addr)
+                .map_err(|e| usage(format!("--foxglove {spec}: cannot listen: {e}")))?;
+            crate::console::errln!("{command}: foxglove: ws://{} (Foxglove: Open connection, Foxglove WebSocket)", s.addr);
+            if !s.addr.ip().is_loopback() {
+                crate::console::errln!(
+                    "{command}: warning: the live view is served on {} beyond this machine, without authentication",
+                    s.addr.ip()
+                );
+            }
+            sinks.push(s.sink());
+            server = Some(s);
+        }
+        let tap = (!sinks.is_empty()).then(|| crate::mcap::Tap::new(sinks));
+        Ok(Taps { tap, server })
     }
 
     /// Creates the `--out` CSV, if one was asked for.

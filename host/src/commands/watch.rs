@@ -89,11 +89,14 @@ pub fn run(args: WatchArgs) -> Result<(), CliError> {
     let serve = parse_serve(&args.serve)?;
     let (source, name) = open(&args)?;
     let csv = args.record.csv()?;
-    let recorder = Arc::new(Mutex::new(
-        Recorder::new(csv)
-            .context("cannot write the CSV header")
-            .map_err(CliError::Runtime)?,
-    ));
+    let mut taps = args.record.taps("watch")?;
+    let mut rec = Recorder::new(csv)
+        .context("cannot write the CSV header")
+        .map_err(CliError::Runtime)?;
+    if let Some(tap) = taps.tap.take() {
+        rec.set_tap(tap);
+    }
+    let recorder = Arc::new(Mutex::new(rec));
     let shared = Arc::new(Shared::new(WatchState::new(name.clone())));
     let server = server::start(serve, shared.clone())
         .map_err(|e| usage(format!("--serve {}: cannot listen: {e:#}", args.serve)))?;
@@ -175,6 +178,11 @@ pub fn run(args: WatchArgs) -> Result<(), CliError> {
     rec.flush()
         .context("cannot write the CSV")
         .map_err(CliError::Runtime)?;
+    let closed = rec.close_tap();
+    let live = taps.close("watch");
+    closed
+        .context("cannot write the MCAP file")
+        .map_err(CliError::Runtime)?;
     if !told_end {
         let line = rec.status_line();
         let mut err = std::io::stderr().lock();
@@ -185,8 +193,10 @@ pub fn run(args: WatchArgs) -> Result<(), CliError> {
         };
     }
     let disconnects = shared.disconnects.load(Ordering::SeqCst);
+    let mut capture = CaptureSummary::of(&rec, name, ended, started, disconnects);
+    capture.foxglove = live;
     let summary = WatchSummary {
-        capture: CaptureSummary::of(&rec, name, ended, started, disconnects),
+        capture,
         url,
         requests: shared.requests.load(Ordering::Relaxed),
     };

@@ -4,6 +4,7 @@
 //! Section VII ([`pendulum`]) and their report ([`report`]), and learning
 //! on a wear budget ([`wear`], `pada paper wear`).
 
+pub mod csv_row;
 pub mod curves;
 pub mod figure_data;
 pub mod leo;

@@ -31,6 +31,8 @@ pub const SECTOR_ENDURANCE: u32 = 10_000;
 /// Seconds in ten years of 365.25 days.
 pub const TEN_YEARS_S: u64 = 10 * 36_525 * 864;
 
+use crate::error::ConfigError;
+
 /// The checkpoint sectors' erase counts, carried in every learner-state
 /// record, and the operating time they were reached in.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -83,15 +85,15 @@ pub enum WearRefusal {
     },
 }
 
-/// An erase budget per sector (module documentation).
+/// An erase budget per sector (module documentation). Made by
+/// [`WearBudget::new`], which refuses a budget that could not be kept: a
+/// lifetime of 0 s (every save would be refused "until 0 s from now") or
+/// an endurance of 0 erases.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct WearBudget {
-    /// Erase cycles a sector is specified for.
-    pub endurance: u32,
-    /// Erases allowed at any pace before the budget applies.
-    pub reserve: u32,
-    /// Operating seconds the endurance must last.
-    pub lifetime_s: u64,
+    endurance: u32,
+    reserve: u32,
+    lifetime_s: u64,
 }
 
 impl WearBudget {
@@ -100,6 +102,37 @@ impl WearBudget {
     /// saves.
     pub const STM32F4: WearBudget =
         WearBudget { endurance: SECTOR_ENDURANCE, reserve: SECTOR_ENDURANCE / 10, lifetime_s: TEN_YEARS_S };
+
+    /// A budget of `endurance` erase cycles per sector over `lifetime_s`
+    /// seconds of operation, `reserve` of them allowed at any pace first.
+    /// Valid: `endurance >= 1`, `reserve <= endurance`, `lifetime_s >= 1`.
+    pub const fn new(endurance: u32, reserve: u32, lifetime_s: u64) -> Result<WearBudget, ConfigError> {
+        if endurance == 0 {
+            return Err(ConfigError::new("endurance", 0.0, "1 <= endurance (erase cycles per sector)"));
+        }
+        if reserve > endurance {
+            return Err(ConfigError::new("reserve", reserve as f32, "0 <= reserve <= endurance"));
+        }
+        if lifetime_s == 0 {
+            return Err(ConfigError::new("lifetime_s", 0.0, "1 <= lifetime_s (seconds of operation)"));
+        }
+        Ok(WearBudget { endurance, reserve, lifetime_s })
+    }
+
+    /// Erase cycles a sector is specified for.
+    pub const fn endurance(&self) -> u32 {
+        self.endurance
+    }
+
+    /// Erases allowed at any pace before the budget applies.
+    pub const fn reserve(&self) -> u32 {
+        self.reserve
+    }
+
+    /// Operating seconds the endurance must last.
+    pub const fn lifetime_s(&self) -> u64 {
+        self.lifetime_s
+    }
 
     /// Erases a sector may have had after `operating_s` seconds of
     /// operation.
@@ -155,7 +188,7 @@ mod tests {
         // Save as fast as allowed, one erase per sector per check, with
         // time advancing by a minute between tries: the count never passes
         // the budget, and reaches the endurance only at the lifetime.
-        let b = WearBudget { endurance: 100, reserve: 10, lifetime_s: 90_000 };
+        let b = WearBudget::new(100, 10, 90_000).unwrap();
         let mut erases = 0u32;
         let mut t = 0u64;
         while t <= 2 * b.lifetime_s {
@@ -176,5 +209,19 @@ mod tests {
             t += 60;
         }
         assert_eq!(erases, 100);
+    }
+
+    #[test]
+    fn a_budget_that_cannot_be_kept_is_refused_where_it_is_made() {
+        // Regression: lifetime 0 said "retry in 0 s" and refused every save.
+        let e = WearBudget::new(100, 10, 0).unwrap_err();
+        assert_eq!(e.param, "lifetime_s");
+        assert!(e.valid.contains("1 <= lifetime_s"));
+        assert_eq!(WearBudget::new(0, 0, 10).unwrap_err().param, "endurance");
+        assert_eq!(WearBudget::new(10, 11, 10).unwrap_err().param, "reserve");
+        let b = WearBudget::new(1, 0, 1).unwrap();
+        assert!(b.check(0, 1).is_ok());
+        assert_eq!((b.endurance(), b.reserve(), b.lifetime_s()), (1, 0, 1));
+        assert_eq!(WearBudget::new(SECTOR_ENDURANCE, SECTOR_ENDURANCE / 10, TEN_YEARS_S), Ok(WearBudget::STM32F4));
     }
 }

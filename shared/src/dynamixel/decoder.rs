@@ -19,7 +19,7 @@
 //! spurious header cannot hold back or swallow the real reply behind it,
 //! and garbage must match ID, LENGTH and checksum to pass.
 
-use super::packet::{checksum, ErrorFlags, InstructionPacket, StatusPacket, BROADCAST_ID, DEFAULT_PACKET_LEN};
+use super::packet::{checksum, ErrorFlags, InstructionPacket, StatusPacket, BROADCAST_ID, DEFAULT_PACKET_LEN, OVERHEAD};
 use core::marker::PhantomData;
 use heapless::Vec;
 
@@ -113,6 +113,20 @@ impl<const N: usize> FromRaw<N> for InstructionPacket<N> {
 /// Incremental decoder of packets `P` of up to `N` bytes (header to
 /// checksum). Feed it bytes with [`push`](Self::push) or
 /// [`feed`](Self::feed).
+///
+/// `N` must hold the smallest packet, [`OVERHEAD`] = 6 bytes (header,
+/// ID, length, instruction or error, checksum): a smaller decoder could
+/// never complete a packet, and one of 0 bytes would drop every byte
+/// without counting it. Such a decoder does not compile:
+///
+/// ```compile_fail
+/// let d = pada_core::dynamixel::StatusDecoder::<0>::new();
+/// ```
+///
+/// ```
+/// let d = pada_core::dynamixel::StatusDecoder::<6>::new();
+/// assert_eq!(d.buffered(), 0);
+/// ```
 #[derive(Debug, Clone)]
 pub struct Decoder<P, const N: usize> {
     buf: [u8; N],
@@ -134,8 +148,15 @@ impl<P: FromRaw<N>, const N: usize> Default for Decoder<P, N> {
 }
 
 impl<P: FromRaw<N>, const N: usize> Decoder<P, N> {
-    /// A decoder that accepts any ID and length.
+    /// A decoder that accepts any ID and length; `N` below [`OVERHEAD`]
+    /// is a compile-time error naming the valid range.
     pub const fn new() -> Self {
+        const {
+            assert!(
+                N >= OVERHEAD,
+                "Decoder capacity N is too small: valid is N >= 6 (OVERHEAD: header, ID, length, instruction or error, checksum)"
+            )
+        };
         Decoder {
             buf: [0; N],
             len: 0,

@@ -93,7 +93,10 @@ impl<'a> Session<'a> {
     ) -> anyhow::Result<Self> {
         let out = |name: &str| cfg.out_dir.join(name);
         let csv_file = std::fs::File::create(out("telemetry.csv")).context("cannot create telemetry.csv")?;
-        let recorder = Recorder::new(Some(Box::new(std::io::BufWriter::new(csv_file))))?;
+        let mut recorder = Recorder::new(Some(Box::new(std::io::BufWriter::new(csv_file))))?;
+        // telemetry.mcap: the stream's channels for Foxglove (crate::mcap).
+        let mcap = crate::mcap::writer::McapFile::create(&out("telemetry.mcap")).context("cannot create telemetry.mcap")?;
+        recorder.set_tap(crate::mcap::Tap::new(vec![Box::new(mcap)]));
         let raw = std::fs::File::create(out("telemetry.bin")).context("cannot create telemetry.bin")?;
         let mut episodes_csv = csv::Writer::from_path(out("episodes.csv")).context("cannot create episodes.csv")?;
         episodes_csv.write_record([
@@ -170,6 +173,7 @@ impl<'a> Session<'a> {
     /// Writes out the recorded files.
     pub fn flush(&mut self) -> anyhow::Result<()> {
         self.recorder.flush()?;
+        self.recorder.close_tap().context("cannot write telemetry.mcap")?;
         self.episodes_csv.flush()?;
         std::io::Write::flush(&mut self.raw)?;
         Ok(())
