@@ -87,6 +87,18 @@ pub struct Latest {
     pub table: Option<TableOccupancy>,
 }
 
+/// What a [`Recorder`] hands every frame to besides its own counters
+/// (`crate::mcap::Tap`: MCAP and the Foxglove server). A trait here, so
+/// that the capture path need not import what it feeds.
+pub trait FrameTap {
+    /// A decoded frame, with the link's counters after it.
+    fn frame(&mut self, frame: &Decoded<ToHost>, stats: LinkStats) -> std::io::Result<()>;
+    /// A lost frame, with the link's counters after it.
+    fn lost(&mut self, e: &FrameError, stats: LinkStats) -> std::io::Result<()>;
+    /// The end of the stream, with the final counters.
+    fn finish(&mut self, stats: LinkStats) -> std::io::Result<()>;
+}
+
 /// A claim table's occupancy as the board's `Health` reports it.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct TableOccupancy {
@@ -119,7 +131,7 @@ pub struct Recorder {
     counts: MessageCounts,
     latest: Latest,
     /// The channels of an MCAP file or a live Foxglove view, when asked for.
-    tap: Option<crate::mcap::Tap>,
+    tap: Option<Box<dyn FrameTap + Send>>,
 }
 
 impl Recorder {
@@ -144,8 +156,8 @@ impl Recorder {
 
     /// Also hands every frame, lost frame and gap to `tap` (`--mcap`,
     /// `--foxglove`); [`Recorder::close_tap`] ends it.
-    pub fn set_tap(&mut self, tap: crate::mcap::Tap) {
-        self.tap = Some(tap);
+    pub fn set_tap(&mut self, tap: impl FrameTap + Send + 'static) {
+        self.tap = Some(Box::new(tap));
     }
 
     /// Ends the tap, if any: the final link counters, then its sinks close

@@ -58,6 +58,7 @@ pub mod action_tiles;
 pub mod agent;
 pub mod checkpoint;
 pub mod claim_table;
+pub mod claims;
 pub mod crc;
 pub mod dynamixel;
 pub mod episodes;

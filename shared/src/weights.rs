@@ -20,7 +20,7 @@
 //! nothing (the tile coder never produces one; this keeps the chip free of
 //! panics).
 
-use crate::claim_table::{Claim, InitialWeights, Occupancy};
+use crate::claims::{Claim, InitialWeights, Occupancy};
 use crate::fixed::Q16;
 
 /// How weights are stored: part of a board's learner profile and of the
@@ -68,8 +68,12 @@ impl WeightFormat {
 pub trait WeightStore {
     /// Whether [`add`](Self::add) rounds stochastically: the agent then
     /// draws one dither per weight write, otherwise none (so full-width
-    /// tables draw exactly what they always drew).
-    const DITHERED: bool = false;
+    /// tables draw exactly what they always drew). A method, not a
+    /// constant, so that one host type can hold either kind of table.
+    #[inline]
+    fn dithered(&self) -> bool {
+        false
+    }
 
 
     /// Number of weights.
@@ -88,7 +92,7 @@ pub trait WeightStore {
 
     /// Adds `inc` to weight `i`, saturating at the format's range; `dither`
     /// is a uniform `u32` for stochastic rounding (ignored unless
-    /// [`DITHERED`](Self::DITHERED)). Returns whether the weight
+    /// [`dithered`](Self::dithered)). Returns whether the weight
     /// saturated.
     fn add(&mut self, i: usize, inc: Q16, dither: u32) -> bool;
 
@@ -245,7 +249,10 @@ pub struct Split<A, B> {
 }
 
 impl<A: WeightStore, B: WeightStore> WeightStore for Split<A, B> {
-    const DITHERED: bool = A::DITHERED || B::DITHERED;
+    #[inline]
+    fn dithered(&self) -> bool {
+        self.first.dithered() || self.second.dithered()
+    }
 
     fn len(&self) -> usize {
         self.first.len() + self.second.len()
@@ -350,7 +357,10 @@ fn to_half(raw: i32, shift: u32) -> i16 {
 }
 
 impl<T: AsRef<[i16]> + AsMut<[i16]>, const SHIFT: u32> WeightStore for Half<T, SHIFT> {
-    const DITHERED: bool = true;
+    #[inline]
+    fn dithered(&self) -> bool {
+        true
+    }
 
     fn len(&self) -> usize {
         self.data.as_ref().len()

@@ -112,6 +112,11 @@ impl WeightStore for HostTable {
     }
 
     #[inline]
+    fn dithered(&self) -> bool {
+        each!(self, t => t.dithered())
+    }
+
+    #[inline]
     fn claims(&self) -> bool {
         !matches!(self, HostTable::Plain(_))
     }

@@ -43,7 +43,7 @@ pub fn advertise(topics: &[Topic]) -> String {
     let channels: Vec<_> = topics
         .iter()
         .map(|t| {
-            let (schema_name, schema) = t.schema();
+            let (schema_name, schema) = crate::mcap::schemas::of(*t);
             json!({
                 "id": t.id(),
                 "topic": t.name(),

@@ -25,7 +25,6 @@
 //! (the claim table's occupancy, from `Health`) shows.
 
 use super::scene::SceneBuilder;
-use super::schemas;
 use crate::capture::{describe, loss_name, mode_name, step_kind_name};
 use pada_core::wire::{Decoded, FrameError, Hello, LinkStats, SeqGap, ToHost, MAX_GEARBOXES};
 use serde::{Deserialize, Serialize};
@@ -111,11 +110,6 @@ impl Topic {
     /// The topic named `name`.
     pub fn from_name(name: &str) -> Option<Topic> {
         Topic::all().into_iter().find(|t| t.name() == name)
-    }
-
-    /// The schema's name and its JSON Schema text.
-    pub fn schema(self) -> (&'static str, &'static str) {
-        schemas::of(self)
     }
 }
 

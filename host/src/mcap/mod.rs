@@ -48,6 +48,20 @@ pub struct Tap {
     out: Vec<ChannelMessage>,
 }
 
+impl crate::capture::FrameTap for Tap {
+    fn frame(&mut self, frame: &Decoded<ToHost>, stats: LinkStats) -> std::io::Result<()> {
+        Tap::frame(self, frame, stats)
+    }
+
+    fn lost(&mut self, e: &FrameError, stats: LinkStats) -> std::io::Result<()> {
+        Tap::lost(self, e, stats)
+    }
+
+    fn finish(&mut self, stats: LinkStats) -> std::io::Result<()> {
+        Tap::finish(self, stats)
+    }
+}
+
 impl Tap {
     /// A tap feeding `sinks`.
     pub fn new(sinks: Vec<Box<dyn ChannelSink>>) -> Self {

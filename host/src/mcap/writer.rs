@@ -47,7 +47,7 @@ impl McapFile {
             return Ok(id);
         }
         let w = self.w.as_mut().ok_or_else(|| std::io::Error::other("the MCAP file is closed"))?;
-        let (name, text) = topic.schema();
+        let (name, text) = super::schemas::of(topic);
         let schema = match self.schemas.get(name) {
             Some(&id) => id,
             None => {

@@ -754,6 +754,7 @@ where
         let step = delta.mul_frac(self.alpha);
         let slots = self.claim_slots(&current.features);
         self.trace.push(&slots);
+        let dithered = self.weights.dithered();
         let weights = &mut self.weights;
         let checksum = &mut self.checksum;
         let mut saturations = 0u32;
@@ -767,7 +768,7 @@ where
                 // store writes nothing (and no dither is drawn for them).
                 let i = f as usize;
                 if i < weights.len() {
-                    let dither = if W::DITHERED { rng.next_u32() } else { 0 };
+                    let dither = if dithered { rng.next_u32() } else { 0 };
                     let old = weights.raw(i);
                     saturations += weights.add(i, inc, dither) as u32;
                     if let Some(c) = checksum.as_mut() {

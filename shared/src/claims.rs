@@ -1,0 +1,77 @@
+//! What a claim table ([`crate::claim_table`]) answers and reports: a
+//! claim's outcome, its occupancy, and the initial weights of the features
+//! that hold no slot. A leaf module, so that the weight-store trait
+//! ([`crate::weights`]) and the claim table can both name these without
+//! importing each other.
+
+use crate::fixed::Q16;
+
+/// The initial weight of a feature that holds no slot: uniform in
+/// `[lo, lo + span)` (raw Q16), drawn from the feature's key and the
+/// trial's `seed` by a SplitMix64 finaliser, so it is the same on every
+/// read, on every machine, and however full the table is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct InitialWeights {
+    /// The trial's seed for the initial weights (saved in checkpoints).
+    pub seed: u64,
+    /// Lowest initial weight, raw Q16.
+    pub lo: i32,
+    /// Number of raw values above `lo` that can be drawn (1: a constant).
+    pub span: u64,
+}
+
+impl InitialWeights {
+    /// The initial weight of `key`.
+    #[inline]
+    pub fn of(&self, key: u32) -> Q16 {
+        let mut z = self.seed ^ (key as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        let r = ((z as u128 * self.span as u128) >> 64) as i64;
+        Q16((self.lo as i64 + r) as i32)
+    }
+}
+
+/// What [`crate::claim_table::ClaimTable::claim`] found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Claim {
+    /// The feature's slot: it held it already (`fresh` false) or took it
+    /// now (`fresh` true: tag and initial weight were just written).
+    Slot {
+        /// The slot.
+        slot: u32,
+        /// Whether this claim took it.
+        fresh: bool,
+    },
+    /// Neither its tag nor a free slot within [`crate::claim_table::MAX_PROBE`]: refused.
+    Refused,
+}
+
+/// Occupancy of a claim table, for reports and telemetry.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Occupancy {
+    /// Slots claimed.
+    pub claimed: u32,
+    /// Slots in the table.
+    pub slots: u32,
+    /// Claims refused since the table was reset (a full probe run).
+    pub refused: u32,
+    /// The longest probe a claim or read has needed (the framework's
+    /// "memory pressure").
+    pub longest_probe: u32,
+}
+
+impl Occupancy {
+    /// The claimed fraction of the table, 0 ..= 1.
+    pub fn fraction(&self) -> f32 {
+        if self.slots == 0 {
+            0.0
+        } else {
+            self.claimed as f32 / self.slots as f32
+        }
+    }
+}
+
