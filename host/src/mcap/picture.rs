@@ -30,14 +30,7 @@ struct Line {
 
 #[derive(Deserialize)]
 struct Entity {
-    timestamp: T,
     lines: Vec<Line>,
-}
-
-#[derive(Deserialize)]
-struct T {
-    sec: u64,
-    nsec: u32,
 }
 
 #[derive(Deserialize)]
@@ -47,7 +40,6 @@ struct Update {
 
 /// One drawn frame: its time, its step and episode, and its lines.
 struct Frame {
-    time_s: f64,
     step: u32,
     episode: (u32, bool),
     lines: Vec<Line>,
@@ -81,7 +73,6 @@ pub fn scene_strip_png(mcap: &[u8], n: usize, span: usize, title: &str) -> Resul
         let u: Update = serde_json::from_slice(&m.data).map_err(|e| format!("a /scene message is not a SceneUpdate ({e})"))?;
         for e in u.entities {
             frames.push(Frame {
-                time_s: e.timestamp.sec as f64 + e.timestamp.nsec as f64 * 1e-9,
                 step: head.step,
                 episode: (head.episode, head.mode == "testing"),
                 lines: e.lines,
@@ -117,8 +108,17 @@ fn draw(picks: &[&Frame], title: &str) -> anyhow::Result<String> {
     // height of all of them.
     let pts = || picks.iter().flat_map(|f| f.lines.iter().flat_map(|l| l.points.iter()));
     let (zmin, zmax) = pts().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.z), b.max(p.z)));
+    // Each panel centred on the robot: the floor (a line at z = 0 that
+    // spans the scene) is left out of the centre and the width, or a
+    // robot far from the floor line's middle is cut off at the edge.
+    let on_floor = |l: &&Line| l.points.iter().all(|p| p.z.abs() < 1e-9);
     let centre = |f: &Frame| {
-        let (lo, hi) = f.lines.iter().flat_map(|l| l.points.iter()).fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.x), b.max(p.x)));
+        let (lo, hi) = f
+            .lines
+            .iter()
+            .filter(|l| !on_floor(l))
+            .flat_map(|l| l.points.iter())
+            .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.x), b.max(p.x)));
         ((lo + hi) / 2.0, (hi - lo) / 2.0)
     };
     let half = picks.iter().map(|f| centre(f).1).fold(0.0, f64::max).max(zmax - zmin) * 0.6;
@@ -134,7 +134,7 @@ fn draw(picks: &[&Frame], title: &str) -> anyhow::Result<String> {
             let (cx, _) = centre(f);
             let mut chart = ChartBuilder::on(panel)
                 .margin(6)
-                .caption(format!("step {}, t = {:.2} s", f.step, f.time_s), (FONT, 13))
+                .caption(format!("step {}", f.step), (FONT, 13))
                 .build_cartesian_2d(cx - half..cx + half, zmin - pad..zmin - pad + 2.0 * half)
                 .map_err(plot_err)?;
             for l in &f.lines {
