@@ -134,36 +134,19 @@ pub fn run_board_trial_on(
     // On the host a table split over CCM and SRAM is one slice: `Split`
     // addresses the same weights in the same order.
     let claimed = profile.layout == Layout::Claimed;
-    let half = |n: usize| vec![0i16; n].into_boxed_slice();
-    let claim_err = |e: pada_core::claim_table::ClaimTableError| anyhow!("{e}");
     const LEO_SHIFT: u32 = pada_core::robot::leo::HALF_SHIFT as u32;
+    // LEO's claim table over `weights`, with the profile's tag width.
+    let leo_claimed = |weights, rig: &mut dyn Rig| -> anyhow::Result<BoardTrial> {
+        match weights {
+            LeoWeights::Half(w) => claim_on::<_>(profile, w, n, rig, cfg, trial, seed, progress),
+            LeoWeights::Full(w) => claim_on::<_>(profile, w, n, rig, cfg, trial, seed, progress),
+        }
+    };
     match (profile.robot, profile.format) {
         (Robot::Leo, WeightFormat::Half { shift: pada_core::robot::leo::HALF_SHIFT }) if claimed => {
-            let weights = Half::<_, LEO_SHIFT>::new(half(n));
-            match profile.tag_bytes {
-                2 => {
-                    let table = ClaimTable::new(weights, Tags16(vec![0u16; n].into_boxed_slice())).map_err(claim_err)?;
-                    run::<Leo, _>(profile, table, rig, cfg, trial, seed, progress)
-                }
-                _ => {
-                    let table = ClaimTable::new(weights, Tags32(vec![0u32; n].into_boxed_slice())).map_err(claim_err)?;
-                    run::<Leo, _>(profile, table, rig, cfg, trial, seed, progress)
-                }
-            }
+            leo_claimed(LeoWeights::Half(Half::<_, LEO_SHIFT>::new(vec![0i16; n].into_boxed_slice())), rig)
         }
-        (Robot::Leo, WeightFormat::Q16) if claimed => {
-            let weights = vec![Q16::ZERO; n].into_boxed_slice();
-            match profile.tag_bytes {
-                2 => {
-                    let table = ClaimTable::new(weights, Tags16(vec![0u16; n].into_boxed_slice())).map_err(claim_err)?;
-                    run::<Leo, _>(profile, table, rig, cfg, trial, seed, progress)
-                }
-                _ => {
-                    let table = ClaimTable::new(weights, Tags32(vec![0u32; n].into_boxed_slice())).map_err(claim_err)?;
-                    run::<Leo, _>(profile, table, rig, cfg, trial, seed, progress)
-                }
-            }
-        }
+        (Robot::Leo, WeightFormat::Q16) if claimed => leo_claimed(LeoWeights::Full(vec![Q16::ZERO; n].into_boxed_slice()), rig),
         (Robot::Pendulum33, WeightFormat::Q16) => {
             run::<Pendulum33, _>(profile, vec![Q16::ZERO; n].into_boxed_slice(), rig, cfg, trial, seed, progress)
         }
@@ -179,6 +162,39 @@ pub fn run_board_trial_on(
             run::<Pendulum33, _>(profile, table, rig, cfg, trial, seed, progress)
         }
         (robot, format) => bail!("no board runner for {} with {format:?} weights", robot.name()),
+    }
+}
+
+/// The weights of LEO's claim table on the host: the chips' 16-bit ones,
+/// or full width (`--weight-bits 32`).
+enum LeoWeights {
+    Half(Half<Box<[i16]>, { pada_core::robot::leo::HALF_SHIFT as u32 }>),
+    Full(Box<[Q16]>),
+}
+
+/// A LEO trial on a claim table over `weights` with the profile's tags
+/// (16 or 32 bits) of `n` slots.
+#[allow(clippy::too_many_arguments)]
+fn claim_on<W: WeightStore>(
+    profile: LearnerProfile,
+    weights: W,
+    n: usize,
+    rig: &mut dyn Rig,
+    cfg: &RunConfig,
+    trial: u32,
+    seed: u64,
+    progress: &(dyn Fn(u64) + Sync),
+) -> anyhow::Result<BoardTrial> {
+    let err = |e: pada_core::claim_table::ClaimTableError| anyhow!("{e}");
+    match profile.tag_bytes {
+        2 => {
+            let table = ClaimTable::new(weights, Tags16(vec![0u16; n].into_boxed_slice())).map_err(err)?;
+            run::<Leo, _>(profile, table, rig, cfg, trial, seed, progress)
+        }
+        _ => {
+            let table = ClaimTable::new(weights, Tags32(vec![0u32; n].into_boxed_slice())).map_err(err)?;
+            run::<Leo, _>(profile, table, rig, cfg, trial, seed, progress)
+        }
     }
 }
 

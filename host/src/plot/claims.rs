@@ -42,28 +42,13 @@ pub struct ClaimsFigure {
 
 const CAPACITY: RGBColor = RGBColor(120, 120, 120);
 
-impl ClaimsFigure {
-    /// Each series' line style: the first of an algorithm solid, the next
-    /// dashed, then dotted, so two series of one colour never look alike.
-    fn marks(&self) -> Vec<Mark> {
-        self.series
-            .iter()
-            .enumerate()
-            .map(|(i, s)| {
-                let before = self.series[..i].iter().filter(|o| o.algo == s.algo).count();
-                Mark::LINES[before % Mark::LINES.len()]
-            })
-            .collect()
-    }
-}
-
 impl Figure for ClaimsFigure {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> anyhow::Result<()>
     where
         DB::ErrorType: 'static,
     {
         root.fill(&WHITE).map_err(plot_err)?;
-        let marks = self.marks();
+        let marks = super::figures::line_marks(self.series.iter().map(|s| s.algo));
         let mut key: Vec<Entry> = self
             .series
             .iter()

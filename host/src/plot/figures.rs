@@ -422,6 +422,19 @@ const LABEL_CHAR_PX: i32 = 7;
 /// Height of a point's label line \[px\].
 const LABEL_LINE_PX: i32 = 13;
 
+/// The line style of each of a figure's series, in order: the first of
+/// an algorithm solid, the next dashed, then dotted, so two series of one
+/// colour never look alike.
+pub fn line_marks(algos: impl Iterator<Item = Algo>) -> Vec<Mark> {
+    let algos: Vec<Algo> = algos.collect();
+    (0..algos.len())
+        .map(|i| {
+            let before = algos[..i].iter().filter(|&&a| a == algos[i]).count();
+            Mark::LINES[before % Mark::LINES.len()]
+        })
+        .collect()
+}
+
 /// One learning curve of [`LearningCurves`].
 #[derive(Debug, Clone)]
 pub struct Curve {
@@ -453,14 +466,7 @@ impl LearningCurves {
     /// Each curve's mark: the first curve of an algorithm solid, the next
     /// dashed, then dotted, so two curves of one colour never look alike.
     fn marks(&self) -> Vec<Mark> {
-        self.curves
-            .iter()
-            .enumerate()
-            .map(|(i, c)| {
-                let before = self.curves[..i].iter().filter(|o| o.algo == c.algo).count();
-                Mark::LINES[before % Mark::LINES.len()]
-            })
-            .collect()
+        line_marks(self.curves.iter().map(|c| c.algo))
     }
 }
 
