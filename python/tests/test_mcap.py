@@ -31,6 +31,9 @@ def need(module):
 
 
 SIL = REPO / "tests" / "data" / "sil-pendulum-3s.bin"
+# LEO on f429-sdram in QEMU: `pada sil --task leo --board f429-sdram --seconds 3`
+# (telemetry.bin; wire protocol 7), a board with a claim table.
+SIL_LEO = REPO / "tests" / "data" / "sil-leo-3s.bin"
 
 
 def damaged(clean):
@@ -62,7 +65,7 @@ def recordings(tmp_path_factory, pada_bin):
              "--seconds", "20", "--out", str(d / "run"), "--telemetry", str(leo))
     (d / "damaged.bin").write_bytes(damaged(SIL.read_bytes()))
     out = {}
-    for name, stream in [("leo", leo), ("sil", SIL), ("damaged", d / "damaged.bin")]:
+    for name, stream in [("leo", leo), ("sil", SIL), ("sil-leo", SIL_LEO), ("damaged", d / "damaged.bin")]:
         mcap = d / f"{name}.mcap"
         summary = json.loads(run_pada(pada_bin, "capture", "--file", str(stream), "--mcap", str(mcap), "--json"))
         out[name] = (mcap, summary)
@@ -96,7 +99,9 @@ def expected_counts(summary, gearboxes, scene):
     return {k: v for k, v in want.items() if v}
 
 
-@pytest.mark.parametrize("name,gearboxes,scene", [("leo", 4, True), ("sil", 1, True), ("damaged", 1, True)])
+@pytest.mark.parametrize(
+    "name,gearboxes,scene", [("leo", 4, True), ("sil", 1, True), ("sil-leo", 4, True), ("damaged", 1, True)]
+)
 def test_counts_per_channel_equal_the_capture_summary(recordings, name, gearboxes, scene):
     path, summary = recordings[name]
     messages, meta, file_summary = read(path)
@@ -111,6 +116,10 @@ def test_counts_per_channel_equal_the_capture_summary(recordings, name, gearboxe
     assert counts["/claims"] in (0, summary["messages"]["health"])
     if summary["latest"].get("table"):
         assert counts["/claims"] == summary["messages"]["health"]
+    if name == "sil-leo":
+        # The board's claim table reports its occupancy with every health.
+        assert summary["latest"]["table"]["slots"] == 1 << 21
+        assert counts["/claims"] == summary["messages"]["health"] > 0
     # The file's own statistics agree with what was read.
     stats = file_summary.statistics
     by_id = {c.id: c.topic for c in file_summary.channels.values()}
@@ -120,7 +129,7 @@ def test_counts_per_channel_equal_the_capture_summary(recordings, name, gearboxe
     assert int(meta["pada.link"]["frames"]) == summary["link"]["frames"]
 
 
-@pytest.mark.parametrize("name", ["leo", "sil", "damaged"])
+@pytest.mark.parametrize("name", ["leo", "sil", "sil-leo", "damaged"])
 def test_every_message_is_valid_against_its_channels_schema(recordings, name):
     jsonschema = need("jsonschema")
     path, _ = recordings[name]

@@ -300,12 +300,16 @@ pub struct LinkView {
 }
 
 /// The robot that a `Hello`'s dimensions belong to: one learned joint is a
-/// pendulum, three are LEO (`pada_core::robot`'s definitions).
+/// pendulum, three learned joints (a host run) or four counted gearboxes
+/// (a board) are LEO (`pada_core::robot`'s definitions).
 pub fn robot_of(hello: &Hello) -> Option<pada_core::robot::Robot> {
     use pada_core::robot::Robot;
     Robot::ALL.into_iter().find(|r| {
         let spec = r.spec();
-        spec.motor_dims == hello.joints && hello.state_dims as usize >= spec.state.len()
+        // A host run's `Hello` counts the learned motor dimensions, a
+        // board's its counted gearboxes (LEO's hips and knees: 4, not 3).
+        (spec.motor_dims == hello.joints || spec.gearboxes == hello.joints)
+            && hello.state_dims as usize >= spec.state.len()
     })
 }
 
