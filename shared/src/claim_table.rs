@@ -26,9 +26,9 @@
 //!
 //! # Where pada differs from the framework
 //!
-//! The framework (`base/include/grl/projectors/tile_coding.h`) keeps a
-//! side table of 32-bit hashes and probes without a bound; the weights of
-//! `base/src/representations/linear.cpp` are all drawn uniformly at start.
+//! The framework (`docs/reference/grl.md` §5.1 and §5.2) keeps a side
+//! table of 32-bit hashes and probes without a bound, and its linear
+//! representation draws every weight uniformly at start.
 //! A feature it has not claimed reads the weight of the empty slot where
 //! its probe stopped, so two unclaimed features that stop at the same slot
 //! read the same initial weight, and what an unclaimed feature reads changes
