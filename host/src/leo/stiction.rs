@@ -139,6 +139,40 @@ impl Stiction {
         -self.stiffness * (q - anchor) - self.damping * rate
     }
 
+    /// The state for the next step when the torque driving a held joint
+    /// changes by `load_change` (N m) at a step's start (a new voltage):
+    /// the tie then has to carry its present torque minus the change, and
+    /// if that exceeds the friction torque the joint breaks away now,
+    /// sliding the way the load pushes it. Without this the break-away is
+    /// seen only after a step held by the tie, and a driven joint loses one
+    /// physics step of motion at every voltage change: a first-order error
+    /// in the step (`host/src/leo/README.md`, the A/B table). A sliding
+    /// joint, or a held one whose tie keeps up, is left as it is.
+    pub fn at_load_change(
+        &self,
+        state: FrictionState,
+        q: f32,
+        rate: f32,
+        load_change: f32,
+    ) -> FrictionState {
+        if !self.is_active() || !(q.is_finite() && rate.is_finite() && load_change.is_finite()) {
+            return state;
+        }
+        match state {
+            FrictionState::Stick { anchor } => {
+                let held = self.holding_torque(anchor, q, rate) - load_change;
+                if held.abs() > self.max_torque {
+                    FrictionState::Slip {
+                        direction: -held.signum(),
+                    }
+                } else {
+                    state
+                }
+            }
+            FrictionState::Slip { .. } => state,
+        }
+    }
+
     /// The state after a step that ended at angle `q` and rate `rate`.
     ///
     /// - held, and the tie carries more than the friction torque: the
@@ -227,6 +261,30 @@ mod tests {
         let u = F.update(FrictionState::Stick { anchor }, q, 0.0);
         assert_eq!(u.state, FrictionState::Slip { direction: -1.0 });
         assert!(!u.stop);
+    }
+
+    #[test]
+    fn a_held_joint_breaks_away_at_a_load_change_beyond_the_friction_torque() {
+        let held = FrictionState::Stick { anchor: 0.0 };
+        // The tie carries nothing; a +0.3 N m drive breaks it, forward.
+        assert_eq!(
+            F.at_load_change(held, 0.0, 0.0, 0.3),
+            FrictionState::Slip { direction: 1.0 }
+        );
+        assert_eq!(
+            F.at_load_change(held, 0.0, 0.0, -0.3),
+            FrictionState::Slip { direction: -1.0 }
+        );
+        // 0.19 N m stays held; so does a change that unloads a loaded tie
+        // (the tie carries +0.15 N m, the drive adds +0.1 N m: 0.05 left).
+        assert_eq!(F.at_load_change(held, 0.0, 0.0, 0.19), held);
+        let loaded_q = -0.15 / STICK_STIFFNESS;
+        assert_eq!(F.at_load_change(held, loaded_q, 0.0, 0.1), held);
+        // A sliding joint is left to its own rule.
+        let sliding = FrictionState::Slip { direction: -1.0 };
+        assert_eq!(F.at_load_change(sliding, 0.0, 0.0, 5.0), sliding);
+        // Non-finite input changes nothing.
+        assert_eq!(F.at_load_change(held, 0.0, 0.0, f32::NAN), held);
     }
 
     #[test]

@@ -13,7 +13,13 @@ impl LeoModel {
     /// Holds these voltages (V, [`Joint`] order) until the next call
     /// (zero-order hold, §1.1). Each passes the supply clip of §2.1;
     /// non-finite values become 0 V.
+    ///
+    /// A joint held by dry friction whose tie cannot carry the change of
+    /// its voltage torque breaks away now ([`Stiction::at_load_change`]).
+    ///
+    /// [`Stiction::at_load_change`]: super::super::stiction::Stiction::at_load_change
     pub fn set_voltages(&mut self, voltages: [f32; NUM_JOINTS]) {
+        let before = self.voltages;
         self.voltages = voltages.map(|u| {
             if u.is_finite() {
                 u.clamp(-SERVO.supply_clip, SERVO.supply_clip)
@@ -21,6 +27,13 @@ impl LeoModel {
                 0.0
             }
         });
+        let (q, qd) = self.joint_state();
+        for k in 0..NUM_JOINTS {
+            let change =
+                self.servo.voltage_torque(self.voltages[k]) - self.servo.voltage_torque(before[k]);
+            self.friction_states[k] =
+                (self.friction).at_load_change(self.friction_states[k], q[k], qd[k], change);
+        }
     }
 
     /// A constant external force (N) at the body's centre of mass and a
