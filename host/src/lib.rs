@@ -7,6 +7,7 @@
 
 pub mod board;
 pub mod capture;
+pub mod checkpoint_keeper;
 pub mod cli;
 pub mod commands;
 pub mod display;

@@ -82,7 +82,8 @@
 //!
 //! [`slots`] (header, slot selection, save and load), [`record`] (the
 //! learner-state record), [`store`] (the medium), [`wear`] (the erase
-//! budget). CRC-32 is [`crate::crc::CRC32`], shared with the telemetry
+//! budget), [`stream`] (a slot's image sent as chunks over a link, for a
+//! table that fits no flash). CRC-32 is [`crate::crc::CRC32`], shared with the telemetry
 //! frames.
 //!
 //! [`Q16`]: crate::fixed::Q16
@@ -90,6 +91,7 @@
 pub mod record;
 pub mod slots;
 pub mod store;
+pub mod stream;
 pub mod wear;
 
 pub use crate::crc::{config_hash, crc32, ConfigHasher, CRC32};

@@ -72,6 +72,19 @@ pub enum HeaderError {
     },
 }
 
+/// One line naming the cause and what is valid (for logs and refusals).
+impl core::fmt::Display for HeaderError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            HeaderError::Erased => write!(f, "header erased (all 0xFF)"),
+            HeaderError::Corrupt => write!(f, "header corrupt: wrong magic, header length or header CRC"),
+            HeaderError::UnsupportedVersion { found } => {
+                write!(f, "header of format version {found}: valid is {FORMAT_VERSION}")
+            }
+        }
+    }
+}
+
 impl Header {
     /// The 32 header bytes, CRC included.
     pub fn to_bytes(&self) -> [u8; HEADER_LEN] {
@@ -115,8 +128,9 @@ impl Header {
         })
     }
 
-    /// Bytes of the slot this header describes, if that fits a `usize`.
-    fn slot_bytes(&self) -> Option<usize> {
+    /// Bytes of the slot this header describes, if that fits a `usize`:
+    /// also the length of a streamed image ([`super::stream`]).
+    pub fn slot_bytes(&self) -> Option<usize> {
         if !matches!(self.weight_bytes, 2 | 4 | 8) {
             return None;
         }
