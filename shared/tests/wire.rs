@@ -3,6 +3,7 @@
 //! streams without ever panicking.
 
 use heapless::{String, Vec as HVec};
+use pada_core::checkpoint::stream::Chunk;
 use pada_core::checkpoint::{LoadOutcome, Saved};
 use pada_core::dynamixel::ErrorFlags;
 use pada_core::policy::{PolicyKind, PolicyName};
@@ -157,7 +158,18 @@ fn all_to_host() -> Vec<ToHost> {
             }),
         }),
         ToHost::Checkpoint(CheckpointReport::TooLarge { needed: 8_389_136, capacity: 131_072 }),
+        ToHost::Checkpoint(CheckpointReport::Streamed { generation: 3, chunks: 65_541, image_len: 8_389_664 }),
+        ToHost::CheckpointChunk(full_chunk()),
+        ToHost::CheckpointChunk(Chunk::zeros(u32::MAX, u32::MAX - 3, u32::MAX - 127, u32::MAX)),
+        ToHost::RestoreWanted(RestoreRequest { config_hash: u32::MAX, image_len: u32::MAX, offset: u32::MAX }),
+        ToHost::Restored(RestoreOutcome::Loaded { generation: u32::MAX, chunks: u32::MAX }),
+        ToHost::Restored(RestoreOutcome::NoAnswer { waited_ms: 2000 }),
+        ToHost::Restored(RestoreOutcome::ChunkRefused { offset: 1056 }),
+        ToHost::Restored(RestoreOutcome::InvalidState),
     ];
+    for d in all_denials() {
+        v.push(ToHost::Restored(RestoreOutcome::Denied(d)));
+    }
     for o in [
         LoadOutcome::Loaded { generation: 9, slot: 1 },
         LoadOutcome::NoCheckpoint,
@@ -224,7 +236,32 @@ fn all_to_chip() -> Vec<ToChip> {
         ToChip::LoadCheckpoint,
         ToChip::ReadWeights { offset: u32::MAX, count: u32::MAX },
         ToChip::ClearFault,
+        ToChip::RestoreChunk(full_chunk()),
+        ToChip::RestoreChunk(Chunk::zeros(1, 8_389_664, 1056, 65_000)),
     ]
+    .into_iter()
+    .chain(all_denials().into_iter().map(ToChip::RestoreNone))
+    .collect()
+}
+
+/// Every reason the host gives for sending no checkpoint.
+fn all_denials() -> [RestoreDenied; 8] {
+    [
+        RestoreDenied::NoCheckpoint,
+        RestoreDenied::Unreadable,
+        RestoreDenied::Truncated,
+        RestoreDenied::Corrupted,
+        RestoreDenied::OtherConfiguration,
+        RestoreDenied::WrongSize,
+        RestoreDenied::Older,
+        RestoreDenied::NotAChunk,
+    ]
+}
+
+/// The largest checkpoint chunk: a whole window of nonzero words, every
+/// field at its largest encoding.
+fn full_chunk() -> Chunk {
+    Chunk::words(u32::MAX, u32::MAX - 3, u32::MAX - 127 - 3, &[0xA5; 128])
 }
 
 fn round_trip<M: serde::Serialize + serde::de::DeserializeOwned + PartialEq + std::fmt::Debug, const N: usize>(
@@ -271,13 +308,15 @@ fn the_protocol_version_changes_with_the_layout() {
     // A change of any message's layout changes this fingerprint: then bump
     // PROTOCOL_VERSION and put the new pair here (with the docs that name
     // the version: docs/sil.md, docs/core.md, firmware/README.md).
-    assert_eq!((PROTOCOL_VERSION, layout_fingerprint()), (7, EXPECTED_FINGERPRINT), "{:#010x}", layout_fingerprint());
+    assert_eq!((PROTOCOL_VERSION, layout_fingerprint()), (8, EXPECTED_FINGERPRINT), "{:#010x}", layout_fingerprint());
 }
 
-/// [`layout_fingerprint`] of protocol 7 (the claim table's occupancy in
+/// [`layout_fingerprint`] of protocol 8 (the checkpoint the host keeps:
+/// `CheckpointChunk`, `RestoreWanted`, `Restored`, `Streamed`,
+/// `RestoreChunk`, `RestoreNone`; 7 the claim table's occupancy in
 /// `Health`; 6 added the gentle explorations in `PolicyKind`, the governor
 /// in `PolicyReport`, `SetMtbfBudget`; 5 `Step::footstep`).
-const EXPECTED_FINGERPRINT: u32 = 0xff2d_4ef2;
+const EXPECTED_FINGERPRINT: u32 = 0xaca4_4e73;
 
 #[test]
 fn every_chip_message_round_trips() {
@@ -286,8 +325,8 @@ fn every_chip_message_round_trips() {
 
 #[test]
 fn every_host_command_round_trips() {
-    // The chip's decoder holds 64 bytes: enough for every command.
-    round_trip::<ToChip, 64>(&all_to_chip());
+    // The chip's decoder holds a whole frame: a restore's chunk needs it.
+    round_trip::<ToChip, MAX_FRAME_LEN>(&all_to_chip());
 }
 
 #[test]
@@ -296,6 +335,15 @@ fn the_largest_messages_fit_the_documented_limits() {
         let b = body(&(u32::MAX, &m));
         assert!(b.len() <= MAX_BODY, "{} body bytes: {m:?}", b.len());
     }
+    for m in all_to_chip() {
+        let b = body(&(u32::MAX, &m));
+        assert!(b.len() <= MAX_BODY, "{} body bytes: {m:?}", b.len());
+    }
+    // A batch of the largest restore chunks fits the board's 512-byte
+    // command buffer (firmware/src/board/lockstep/link.rs).
+    let mut frame = [0u8; MAX_FRAME_LEN];
+    let largest = encode_frame(&ToChip::RestoreChunk(full_chunk()), u32::MAX, &mut frame).unwrap().len();
+    assert!(largest * RESTORE_BATCH <= 512, "{RESTORE_BATCH} x {largest} B");
     let step = body(&(u32::MAX, ToHost::Step(full_step())));
     let weights = body(&(
         u32::MAX,

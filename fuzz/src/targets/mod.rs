@@ -4,6 +4,7 @@
 mod checkpoint;
 mod claim_table;
 mod dynamixel;
+mod stream;
 mod wire;
 
 use crate::gen::Corpus;
@@ -37,22 +38,36 @@ pub trait Target {
     fn check(&self, input: &[u8]) -> Outcome;
 }
 
+/// Variants of [`ToHost`] (protocol 8: `Hello` … `Policy`, `CheckpointChunk`,
+/// `RestoreWanted`, `Restored`), to aim the value generator.
+const TO_HOST_VARIANTS: u8 = 16;
+/// Variants of [`ToChip`] (protocol 8: `Ping` … `SetMtbfBudget`,
+/// `RestoreChunk`, `RestoreNone`).
+const TO_CHIP_VARIANTS: u8 = 14;
+
 /// Every target: the host's and the chip's frame decoders, the status and
-/// instruction packet decoders, checkpoint loading and torn saves, and the
+/// instruction packet decoders, checkpoint loading and torn saves, a
+/// checkpoint streamed back to a board and damaged on the way, and the
 /// claim table's reads, claims and writes.
 pub fn all(corpus: &Corpus) -> Vec<Box<dyn Target>> {
     vec![
         Box::new(
             wire::Frames::<ToHost, { pada_core::wire::MAX_FRAME_LEN }>::new(
                 "wire-host",
-                12,
+                TO_HOST_VARIANTS,
                 corpus.frames.clone(),
             ),
         ),
-        Box::new(wire::Frames::<ToChip, 64>::new("wire-chip", 11, Vec::new())),
+        // The chip's decoder holds a whole frame (a restore's chunks).
+        Box::new(wire::Frames::<ToChip, { pada_core::wire::MAX_FRAME_LEN }>::new(
+            "wire-chip",
+            TO_CHIP_VARIANTS,
+            Vec::new(),
+        )),
         Box::new(dynamixel::Status::<32>::new("dynamixel-status")),
         Box::new(dynamixel::Instructions::<64>::new("dynamixel-instr")),
         Box::new(checkpoint::Checkpoints::new("checkpoint")),
+        Box::new(stream::Stream::new("checkpoint-stream")),
         Box::new(claim_table::Claims::new("claim-table")),
     ]
 }

@@ -474,7 +474,7 @@ impl<M: DeserializeOwned + Serialize, const N: usize> Iterator for FrameFeed<'_,
 /// The host's decoder of chip telemetry.
 pub type HostDecoder = FrameDecoder<ToHost, MAX_FRAME_LEN>;
 /// The chip's decoder of host commands.
-pub type ChipDecoder = FrameDecoder<ToChip, 64>;
+pub type ChipDecoder = FrameDecoder<ToChip, MAX_FRAME_LEN>;
 
 #[cfg(test)]
 mod tests {

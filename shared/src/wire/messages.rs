@@ -2,6 +2,7 @@
 //! documentation ([`crate::wire`]) as types. Framing is in
 //! [`crate::wire::frame`]; nothing here knows about bytes.
 
+use crate::checkpoint::stream::Chunk;
 use crate::checkpoint::{LoadOutcome, Saved};
 use crate::governor::GovernorStatus;
 use crate::policy::PolicyKind;
@@ -19,8 +20,12 @@ pub use crate::safety::RunMode;
 /// last; 5: `Step::footstep`; 6: the gentle explorations appended to
 /// [`PolicyKind`], the wear governor's status in [`PolicyReport`] and
 /// [`ToChip::SetMtbfBudget`]; 7: the claim table's occupancy at the end
-/// of [`Health`]).
-pub const PROTOCOL_VERSION: u16 = 7;
+/// of [`Health`]; 8: the checkpoint the host keeps,
+/// [`ToHost::CheckpointChunk`], [`ToHost::RestoreWanted`],
+/// [`ToHost::Restored`], [`CheckpointReport::Streamed`],
+/// [`ToChip::RestoreChunk`] and [`ToChip::RestoreNone`], all appended
+/// last; `ToChip` is no longer `Copy`).
+pub const PROTOCOL_VERSION: u16 = 8;
 /// The capacities of a [`Step`] (state dimensions, motor outputs and
 /// counted gearboxes) and of a [`Health`] report (servos): pada-core's own
 /// ([`crate::limits`]).
@@ -62,6 +67,15 @@ pub enum ToHost {
     Nack(Nack),
     /// The action policy in force (protocol 4; appended last).
     Policy(PolicyReport),
+    /// One chunk of a checkpoint streamed to the host, which keeps it
+    /// ([`crate::checkpoint::stream`]; protocol 8): the body in ascending
+    /// order, the header last.
+    CheckpointChunk(Chunk),
+    /// The board asks the host for the checkpoint it keeps, from an offset
+    /// on (protocol 8): at boot from 0, then after every batch.
+    RestoreWanted(RestoreRequest),
+    /// What the board's restore from the host came to (protocol 8).
+    Restored(RestoreOutcome),
 }
 
 /// Sent at boot and in answer to [`ToChip::Ping`].
@@ -244,6 +258,93 @@ pub enum CheckpointReport {
         /// Bytes a slot holds.
         capacity: u32,
     },
+    /// A checkpoint streamed to the host, whole (protocol 8): the host keeps
+    /// it once every chunk checked ([`ToHost::CheckpointChunk`]).
+    Streamed {
+        /// Its generation.
+        generation: u32,
+        /// Chunks sent.
+        chunks: u32,
+        /// Bytes of the image.
+        image_len: u32,
+    },
+}
+
+/// The board's request for the checkpoint the host keeps: chunks from
+/// `offset` on, at most [`RESTORE_BATCH`] of them, header first
+/// ([`crate::checkpoint::stream::Order::HeaderFirst`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct RestoreRequest {
+    /// The board's configuration hash: the host refuses a checkpoint of
+    /// another.
+    pub config_hash: u32,
+    /// Bytes of the board's image: the host refuses one of another size.
+    pub image_len: u32,
+    /// The first chunk wanted (0: the header, the stream's start).
+    pub offset: u32,
+}
+
+/// Chunks the host sends per [`RestoreRequest`]: three of the largest
+/// frames (about 170 bytes each) fit the board's 512-byte command buffer,
+/// so a restore never overruns it.
+pub const RESTORE_BATCH: usize = 3;
+
+/// Why the host sends no checkpoint ([`ToChip::RestoreNone`]); the host
+/// logs the file and the values, the board reports the cause.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum RestoreDenied {
+    /// The host keeps no checkpoint (none yet, or no keeper runs).
+    NoCheckpoint,
+    /// The kept file could not be read.
+    Unreadable,
+    /// The kept file is shorter than its header says.
+    Truncated,
+    /// The kept file fails its header or payload check.
+    Corrupted,
+    /// The kept checkpoint is of another configuration (robot, board,
+    /// table or learner).
+    OtherConfiguration,
+    /// The kept checkpoint's image is of another size than the board's.
+    WrongSize,
+    /// The kept checkpoint is older than the board's own.
+    Older,
+    /// The request's offset starts no chunk of the kept stream (or the
+    /// kept file changed in the middle of a restore).
+    NotAChunk,
+}
+
+/// What a restore from the host came to ([`ToHost::Restored`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum RestoreOutcome {
+    /// The weights and the learner's state of this checkpoint are loaded.
+    Loaded {
+        /// Its generation.
+        generation: u32,
+        /// Chunks received.
+        chunks: u32,
+    },
+    /// The board starts fresh: the host sent none, and says why.
+    Denied(RestoreDenied),
+    /// The board starts fresh: no answer from the host within
+    /// `waited_ms`.
+    NoAnswer {
+        /// How long the board waited \[ms\].
+        waited_ms: u32,
+    },
+    /// The board starts fresh: a chunk was refused (out of order, another
+    /// generation or configuration or size, corrupt, a bad header or
+    /// payload CRC: [`crate::checkpoint::stream::AssembleError`]), at
+    /// this image offset.
+    ChunkRefused {
+        /// The image offset the board expected next.
+        offset: u32,
+    },
+    /// The board starts fresh: the image was whole, but its learner state
+    /// is out of range for the running learner.
+    InvalidState,
 }
 
 /// Severity of a [`Log`].
@@ -362,7 +463,7 @@ pub struct PolicyReport {
 // ---------------------------------------------------------------------------
 
 /// Everything the host sends.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum ToChip {
     /// Ask for a [`Hello`].
@@ -401,6 +502,13 @@ pub enum ToChip {
     /// parameter stays where it is). Only with torque off, for a `pada` or
     /// `lowpass` learner, `0 < seconds <= 1e10`.
     SetMtbfBudget(Option<f32>),
+    /// One chunk of the kept checkpoint, in answer to
+    /// [`ToHost::RestoreWanted`] (protocol 8; not acknowledged: the next
+    /// request is the acknowledgement).
+    RestoreChunk(Chunk),
+    /// No checkpoint for the board, and why (protocol 8; in answer to
+    /// [`ToHost::RestoreWanted`], not acknowledged).
+    RestoreNone(RestoreDenied),
 }
 
 /// The policies with their parameters, as sent on the wire: the learning

@@ -22,6 +22,9 @@
 //! | [`ToHost::Ack`] | chip → host | [`Ack`] | a command was carried out |
 //! | [`ToHost::Nack`] | chip → host | [`Nack`] | a command was refused |
 //! | [`ToHost::Policy`] | chip → host | [`PolicyReport`] | after `Hello`, whenever the policy or its α/Δ changes, and after every episode while a wear governor runs |
+//! | [`ToHost::CheckpointChunk`] | chip → host | [`Chunk`](crate::checkpoint::stream::Chunk) | a save of a checkpoint the host keeps (no flash holds it), body first, header last |
+//! | [`ToHost::RestoreWanted`] | chip → host | [`RestoreRequest`] | at boot, and after each batch of a restore |
+//! | [`ToHost::Restored`] | chip → host | [`RestoreOutcome`] | the restore's end: loaded, or fresh and why |
 //! | [`ToChip::Ping`] | host → chip | — | answered by `Hello` |
 //! | [`ToChip::Start`] | host → chip | [`RunMode`] | learn or test, torque on |
 //! | [`ToChip::Stop`] | host → chip | — | to Idle, torque off |
@@ -34,10 +37,14 @@
 //! | [`ToChip::ReadWeights`] | host → chip | offset `u32`, count `u32` | answered by `Weights` chunks |
 //! | [`ToChip::ClearFault`] | host → chip | — | Fault → Idle |
 //! | [`ToChip::SetMtbfBudget`] | host → chip | `Option<f32>` | start (or stop) the wear governor with this MTBF budget \[s\] |
+//! | [`ToChip::RestoreChunk`] | host → chip | [`Chunk`](crate::checkpoint::stream::Chunk) | up to [`RESTORE_BATCH`] per `RestoreWanted`, header first |
+//! | [`ToChip::RestoreNone`] | host → chip | [`RestoreDenied`] | the host keeps no checkpoint for this board |
 //!
 //! Every command is answered by exactly one `Ack` or `Nack` carrying the
 //! command frame's sequence number, after any data it asks for (`Hello`,
-//! `Weights`, `Checkpoint`).
+//! `Weights`, `Checkpoint`); the restore's answers (`RestoreChunk`,
+//! `RestoreNone`) are not commands and are not acknowledged: the board's
+//! next `RestoreWanted` or its `Restored` is the answer.
 //!
 //! # Frames ([`frame`])
 //!

@@ -64,6 +64,21 @@ pub struct Chunk {
     pub body: Body,
 }
 
+/// In the firmware's logs a chunk is where it goes, not its bytes.
+#[cfg(feature = "defmt")]
+impl defmt::Format for Chunk {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(
+            f,
+            "Chunk {{ generation: {=u32}, image_len: {=u32}, offset: {=u32}, covered: {=u64} }}",
+            self.generation,
+            self.image_len,
+            self.offset,
+            self.covered_len()
+        )
+    }
+}
+
 /// Why a chunk's bytes or fields do not form a chunk.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
