@@ -5,7 +5,8 @@
 //! started and checked here), the weight table where the board's learner
 //! profile puts it ([`table`]), the controller for the robot chosen at
 //! build time, the checkpoint (weights and learner state) from flash if its
-//! configuration matches, a fault if the watchdog reset the chip, then the
+//! configuration matches (or, for a table that fits no flash, from the
+//! host: [`host_kept`]), a fault if the watchdog reset the chip, then the
 //! tasks of [`tasks`]. Logs go out over RTT (defmt), telemetry over the
 //! telemetry USART (pada_core::wire frames).
 //!
@@ -17,6 +18,8 @@
 #![no_main]
 
 mod board;
+mod channels;
+mod host_kept;
 mod table;
 mod tasks;
 
@@ -71,7 +74,7 @@ async fn main(spawner: Spawner) {
             let mut text = heapless::String::new();
             // Fits MAX_TEXT (56 characters); cut short if it did not.
             let _ = write!(text, "table memory fault @{:08x} wrote {:08x} read {:08x}", fault.address, fault.wrote, fault.read);
-            tasks::send_reliable(ToHost::Warning(wire::Warning::Text(text))).await;
+            channels::send_reliable(ToHost::Warning(wire::Warning::Text(text))).await;
             loop {
                 core::future::pending::<()>().await;
             }
@@ -94,33 +97,34 @@ async fn main(spawner: Spawner) {
         ctl.config_hash()
     );
 
-    tasks::send_reliable(ToHost::Hello(ctl.hello())).await;
-    // The F429's LEO table (8 MiB) fits no flash sector: say so once, not
-    // only when a save is refused.
-    if ctl.checkpoint_bytes() > board.flash.capacity() {
-        defmt::warn!(
-            "checkpoints off: one needs {=usize} bytes, a flash slot holds {=usize}; SaveCheckpoint will be refused",
+    channels::send_reliable(ToHost::Hello(ctl.hello())).await;
+    // The telemetry link runs from here: a board whose table fits no flash
+    // asks the host for its checkpoint.
+    spawner.spawn(unwrap!(tasks::telemetry_tx(board.telemetry_tx)));
+    spawner.spawn(unwrap!(tasks::telemetry_rx(board.telemetry_rx)));
+    if ctl.host_keeps_checkpoint(board.flash.capacity()) {
+        // The F429's LEO table (8 MiB) fits no flash sector: the host keeps
+        // its checkpoint (host_kept).
+        info!(
+            "checkpoints kept by the host: one is {=usize} bytes, a flash slot holds {=usize}",
             ctl.checkpoint_bytes(),
             board.flash.capacity()
         );
-        let mut text = heapless::String::new();
-        let _ = write!(text, "checkpoints off: {} B > slot {} B", ctl.checkpoint_bytes(), board.flash.capacity());
-        tasks::send_reliable(ToHost::Warning(wire::Warning::Text(text))).await;
+        host_kept::restore_from_host(&mut ctl).await;
+    } else {
+        tasks::boot_checkpoint(&mut ctl, &board.flash).await;
     }
-    tasks::boot_checkpoint(&mut ctl, &board.flash).await;
     // After the checkpoint, which may restore another policy or the switch.
-    tasks::send_reliable(ToHost::Policy(ctl.policy_report())).await;
+    channels::send_reliable(ToHost::Policy(ctl.policy_report())).await;
     if board.watchdog_reset {
         let t = ctl.watchdog_reset();
         defmt::warn!("reset by the independent watchdog: Fault until the host clears it");
-        tasks::send_reliable(ToHost::State(wire::StateChange { step: 0, from: t.from, to: t.to })).await;
+        channels::send_reliable(ToHost::State(wire::StateChange { step: 0, from: t.from, to: t.to })).await;
         if let Some(cause) = t.entered_fault() {
-            tasks::send_reliable(ToHost::Fault(wire::Fault { step: 0, time_ms: 0, cause })).await;
+            channels::send_reliable(ToHost::Fault(wire::Fault { step: 0, time_ms: 0, cause })).await;
         }
     }
 
-    spawner.spawn(unwrap!(tasks::telemetry_tx(board.telemetry_tx)));
-    spawner.spawn(unwrap!(tasks::telemetry_rx(board.telemetry_rx)));
     spawner.spawn(unwrap!(tasks::watchdog(board.watchdog, board.led)));
     spawner.spawn(unwrap!(tasks::control(tasks::ControlLoop {
         ctl,

@@ -15,14 +15,13 @@
 
 use crate::board::{BoardSensors, Cycles, FlashStore, Led, ServoPort, TelemetryRx, TelemetryTx, Watchdog};
 use defmt::{info, warn};
-use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 use embassy_time::{Duration, Instant, Ticker};
 use heapless::Vec;
 use pada_core::checkpoint::{CheckpointStore, LoadOutcome, SaveError};
 use pada_core::safety::Transition;
-use pada_core::wire::{self, FrameDecoder, FrameEncoder, NackReason, ToChip, ToHost, MAX_FRAME_LEN};
+use pada_core::wire::{self, FrameEncoder, NackReason, ToChip, ToHost, MAX_FRAME_LEN};
 use pada_firmware::bus::{BusConfig, BusStats, ServoBus};
 use crate::table::Ctl;
 use pada_firmware::config::MAX_ROBOT_SERVOS;
@@ -32,7 +31,9 @@ use pada_firmware::io::{ByteSink, ByteSource, CycleCounter, Sensors};
 use pada_firmware::servo::Joint;
 use pada_firmware::timing::LoopTiming;
 
-type Mutex = CriticalSectionRawMutex;
+use crate::channels::{
+    send_reliable, set_long_watchdog, Mutex, Outgoing, WatchdogRequest, FROM_HOST, TO_HOST, WATCHDOG, WATCHDOG_DONE,
+};
 
 /// What the control loop asks of the servo bus.
 pub enum BusRequest {
@@ -55,43 +56,13 @@ pub struct BusReply {
     pub stats: BusStats,
 }
 
-/// A message for the host, and how many were dropped before it (the
-/// telemetry task skips that many sequence numbers, so the host sees the
-/// gap).
-pub struct Outgoing {
-    msg: ToHost,
-    skipped: u32,
-}
-
-/// What the watchdog task is told.
-#[derive(Clone, Copy)]
-pub enum WatchdogRequest {
-    /// The control loop completed a period.
-    Alive,
-    /// A flash erase is about to stall the CPU: long timeout (`true`) or back.
-    Extend(bool),
-}
-
 /// Control → servo bus.
 pub static BUS_REQUESTS: Channel<Mutex, BusRequest, 1> = Channel::new();
 /// Servo bus → control.
 pub static BUS_REPLIES: Channel<Mutex, BusReply, 1> = Channel::new();
-/// Anyone → telemetry.
-pub static TO_HOST: Channel<Mutex, Outgoing, 16> = Channel::new();
-/// Telemetry → control: (sequence number, command).
-pub static FROM_HOST: Channel<Mutex, (u32, ToChip), 4> = Channel::new();
-/// Control → watchdog.
-pub static WATCHDOG: Channel<Mutex, WatchdogRequest, 2> = Channel::new();
-/// Watchdog → control: the last `Extend` is in force.
-pub static WATCHDOG_DONE: Signal<Mutex, ()> = Signal::new();
 /// Servo bus → boot: the servos were told torque off (before the weight
 /// table is filled, which takes about 0.7 s on the F429's 8 MiB table).
 pub static SERVOS_OFF: Signal<Mutex, ()> = Signal::new();
-
-/// Sends a message the host must get (waits for room).
-pub async fn send_reliable(msg: ToHost) {
-    TO_HOST.send(Outgoing { msg, skipped: 0 }).await;
-}
 
 /// The servo bus: boot-time set-up, then reads and writes on request.
 #[embassy_executor::task]
@@ -164,7 +135,8 @@ pub async fn telemetry_tx(mut tx: TelemetryTx) -> ! {
 /// Decodes host commands and hands them to the control loop.
 #[embassy_executor::task]
 pub async fn telemetry_rx(mut rx: TelemetryRx) -> ! {
-    let mut decoder: FrameDecoder<ToChip, 64> = FrameDecoder::new();
+    // A whole frame: a restore's chunks are the largest commands.
+    let mut decoder = wire::ChipDecoder::new();
     let mut buf = [0u8; 64];
     loop {
         let n = match rx.read(&mut buf).await {
@@ -425,16 +397,21 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
         ToChip::SaveCheckpoint => {
             if cl.ctl.torque_enabled() {
                 Err(NackReason::Busy)
+            } else if cl.ctl.host_keeps_checkpoint(cl.flash.capacity()) {
+                // No flash slot holds it: streamed to the host, which keeps
+                // it (crate::host_kept). The loop stood still meanwhile.
+                stalled = true;
+                match crate::host_kept::save_to_host(&mut cl.ctl).await {
+                    Ok(report) => {
+                        send_reliable(ToHost::Checkpoint(report)).await;
+                        Ok(())
+                    }
+                    Err(reason) => Err(reason),
+                }
             } else {
-                // A checkpoint larger than a slot is refused before any
-                // erase: no long watchdog, no stalled period.
-                let result = if cl.ctl.checkpoint_bytes() <= cl.flash.capacity() {
-                    stalled = true;
-                    with_long_watchdog(|| cl.ctl.save_checkpoint(&mut cl.flash)).await
-                } else {
-                    cl.ctl.save_checkpoint(&mut cl.flash)
-                };
-                match result {
+                // It fits a slot (the branch above): an erase stalls the loop.
+                stalled = true;
+                match with_long_watchdog(|| cl.ctl.save_checkpoint(&mut cl.flash)).await {
                     Ok(saved) => {
                         info!("checkpoint saved: generation {=u32}, slot {=u8}", saved.generation, saved.slot);
                         send_reliable(ToHost::Checkpoint(wire::CheckpointReport::Saved(saved))).await;
@@ -526,11 +503,9 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
 /// Runs a long operation (flash, a fresh learner) with the watchdog's long
 /// timeout.
 async fn with_long_watchdog<T>(op: impl FnOnce() -> T) -> T {
-    WATCHDOG_DONE.reset();
-    WATCHDOG.send(WatchdogRequest::Extend(true)).await;
-    WATCHDOG_DONE.wait().await;
+    set_long_watchdog(true).await;
     let result = op();
-    WATCHDOG.send(WatchdogRequest::Extend(false)).await;
+    set_long_watchdog(false).await;
     result
 }
 

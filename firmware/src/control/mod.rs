@@ -51,6 +51,7 @@
 //! | `period.rs` | one period, steps 1–6: readings → safety, voltages → Moving Speeds, torques → fatigue; the period's types |
 //! | `episodes.rs` | the chip's side of the shared episode cycle: resets, observations, the step records |
 //! | `persist.rs` | the learner's state, checkpoints and the flash's erase budget |
+//! | `host_kept.rs` | a checkpoint the host keeps (no flash holds the table): the image of a save, the sink of a restore |
 //! | `governor.rs` | the wear governor's budget command and its feed |
 //! | `commands.rs` | the host commands the controller owns |
 //! | `telemetry.rs` | `Hello`, `Policy` and `Health` |
@@ -58,6 +59,7 @@
 mod commands;
 mod episodes;
 mod governor;
+mod host_kept;
 mod period;
 mod persist;
 mod telemetry;
@@ -68,6 +70,7 @@ mod tests;
 
 pub use commands::CommandResult;
 pub use period::{safety_config, PeriodOutput, Readings, ServoRead};
+pub use host_kept::{HostSave, Misaligned, RestoreSink};
 pub use persist::CheckpointError;
 
 use crate::config::{hardware, FirmwareAgent, LearnerProfile, RobotConfig, MAX_ROBOT_SERVOS};
@@ -144,6 +147,9 @@ pub struct Controller<W, R> {
     saves_refused: u32,
     /// The wear governor, after `SetMtbfBudget`.
     governor: Option<Governor>,
+    /// The generation of the last checkpoint saved to or restored from the
+    /// host (a table that fits no flash, [`host_kept`]); 0: none.
+    host_generation: u32,
 }
 
 impl<W, R> Controller<W, R>
@@ -199,6 +205,7 @@ where
             operating_before_s: 0,
             saves_refused: 0,
             governor: None,
+            host_generation: 0,
         };
         controller.build(policy, weights)?;
         Ok(controller)
@@ -207,11 +214,14 @@ where
     /// A fresh agent with `policy` on `weights`: the generator is reseeded
     /// and the weights initialised, as a host build would do.
     fn build(&mut self, policy: PolicyKind, weights: W) -> Result<(), ConfigError> {
-        let mut agent = self.spec.agent(policy, self.profile.layout, weights)?;
-        let hash = config_hash(&self.profile, &agent);
+        // Put in its place at once: the agent is several KiB, and every
+        // move of it is a copy on the boot's stack, which on the F405 ends
+        // where the table's SRAM part begins.
+        self.agent = None;
+        let agent = self.agent.insert(self.spec.agent(policy, self.profile.layout, weights)?);
+        let hash = config_hash(&self.profile, agent);
         self.rng = Pcg32::seed_from_u64(self.seed);
         agent.reset_weights(&mut self.rng);
-        self.agent = Some(agent);
         self.policy = policy;
         self.config_hash = hash;
         Ok(())

@@ -91,7 +91,7 @@ where
     /// Takes in the wear the store's newest checkpoint recorded (whatever
     /// its configuration): erase counts and the operating time before this
     /// boot.
-    fn note_stored_wear(&mut self, stored: FlashWear) {
+    pub(super) fn note_stored_wear(&mut self, stored: FlashWear) {
         self.flash_wear = self.flash_wear.max(&stored);
         let since_boot = self.operating_s() - self.operating_before_s;
         self.operating_before_s = self.operating_before_s.max(stored.operating_s.saturating_sub(since_boot));
@@ -131,7 +131,7 @@ where
     /// only the whole check makes the restore all or nothing). The agent's
     /// episode ends (traces are not saved); the next Start brings the robot
     /// to its start and begins a new one.
-    fn restore_learner_state(&mut self, state: &LearnerState) -> Result<(), ConfigError> {
+    pub(super) fn restore_learner_state(&mut self, state: &LearnerState) -> Result<(), ConfigError> {
         let rng = Pcg32::from_state(state.rng)?;
         let governor = match &state.governor {
             Some(g) => {
@@ -258,7 +258,7 @@ where
 
     /// A fresh learner with the running policy (generator reseeded, weights
     /// initialised).
-    fn rebuild(&mut self) {
+    pub(super) fn rebuild(&mut self) {
         if let Some(agent) = self.agent.take() {
             // The running policy built before, so it builds again.
             let _ = self.build(self.policy, agent.into_weights());

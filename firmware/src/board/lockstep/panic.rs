@@ -22,6 +22,16 @@ fn defmt_panic() -> ! {
 
 #[cortex_m_rt::exception]
 unsafe fn HardFault(frame: &cortex_m_rt::ExceptionFrame) -> ! {
-    defmt::error!("HardFault at pc {=u32:#x}", frame.pc());
+    let scb = &*cortex_m::peripheral::SCB::PTR;
+    defmt::error!(
+        "HardFault at pc {=u32:#x} (lr {=u32:#x}, sp {=u32:#x}); HFSR {=u32:#x} CFSR {=u32:#x} MMFAR {=u32:#x} BFAR {=u32:#x}",
+        frame.pc(),
+        frame.lr(),
+        frame as *const _ as u32,
+        scb.hfsr.read(),
+        scb.cfsr.read(),
+        scb.mmfar.read(),
+        scb.bfar.read()
+    );
     exit_failure()
 }
