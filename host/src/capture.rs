@@ -517,6 +517,15 @@ pub fn describe(msg: &ToHost) -> (&'static str, String) {
                 None => format!("{:?} switched {} at step {}", p.built, p.switched_to_sarsa, p.step),
             },
         ),
+        ToHost::CheckpointChunk(c) => (
+            "checkpoint-chunk",
+            format!("generation {} offset {} covers {} of {} bytes", c.generation, c.offset, c.covered_len(), c.image_len),
+        ),
+        ToHost::RestoreWanted(r) => (
+            "restore-wanted",
+            format!("config {:08x} image {} bytes from offset {}", r.config_hash, r.image_len, r.offset),
+        ),
+        ToHost::Restored(o) => ("restored", format!("{o:?}")),
         ToHost::Step(_) => ("step", String::new()),
         ToHost::Episode(_) => ("episode", String::new()),
     }

@@ -11,9 +11,13 @@
 //! generation interrupts, never touches `PATH`.
 
 mod file_sink;
+mod link;
 mod restore;
+mod serve;
 
+pub use link::KeeperLink;
 pub use restore::{read_kept, restore_for, Restore, RestoreRefusal};
+pub use serve::{denial, Answer, RestoreServer};
 
 use std::ffi::OsString;
 use std::io;
@@ -123,16 +127,20 @@ impl CheckpointKeeper {
         &self.kept
     }
 
-    /// Takes one chunk of a board's stream. A chunk of another generation
-    /// at a stream's start (offset 32: a save, header last; offset 0:
-    /// header first) begins a new stream and abandons the one in flight;
-    /// any other chunk continues the stream in flight. Returns the
-    /// checkpoint when this chunk completed it and it was kept.
+    /// Takes one chunk of a board's stream. A chunk at a stream's start
+    /// (offset 32: a save, header last; offset 0: header first) that the
+    /// stream in flight does not expect begins a new stream and abandons
+    /// the one in flight (of another generation, or of the same one: a
+    /// board cut off in mid-save, restored from the kept checkpoint, saves
+    /// the generation it was saving again); any other chunk continues the
+    /// stream in flight. Returns the checkpoint when this chunk completed
+    /// it and it was kept.
     pub fn feed(&mut self, chunk: &Chunk) -> Result<Option<Kept>, KeepError> {
-        let continues = self
-            .stream
-            .as_ref()
-            .is_some_and(|s| !s.assembler.is_complete() && s.assembler.generation() == Some(chunk.generation));
+        let continues = self.stream.as_ref().is_some_and(|s| {
+            !s.assembler.is_complete()
+                && s.assembler.generation() == Some(chunk.generation)
+                && s.assembler.expected_offset() == chunk.offset
+        });
         let starts = chunk.offset == 0 || chunk.offset == HEADER_LEN as u32;
         let progress = if continues || !starts { self.continue_stream(chunk)? } else { self.start_stream(chunk)? };
         let Progress::Complete(header) = progress else {

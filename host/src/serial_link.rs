@@ -7,9 +7,10 @@
 //! [`RETRY`], count the disconnect, and read on once it is back. What the
 //! board sent while nothing was connected is lost; the decoder counts the
 //! frame the disconnect cut short as lost, and the frames that never came
-//! as a sequence gap.
+//! as a sequence gap. [`SerialLink::write_all`] answers the board on the
+//! same port (a restore's chunks).
 
-use std::io::Read;
+use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -59,6 +60,20 @@ impl SerialLink {
     /// Whether the device is open now.
     pub fn connected(&self) -> bool {
         self.port.is_some()
+    }
+
+    /// Writes `bytes` to the board, waiting at most about [`POLL`] for room
+    /// at a time. A port that is not open now (gone, not back yet) is an
+    /// error of kind `NotConnected`; a failed write leaves the port as it
+    /// is: the next [`read`](Self::read) notices that it went away.
+    pub fn write_all(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+        let Some(port) = self.port.as_mut() else {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::NotConnected,
+                format!("{} is not connected", self.path.display()),
+            ));
+        };
+        port.write_all(bytes)
     }
 
     /// Reads what is there, waits at most about [`POLL`].

@@ -134,6 +134,72 @@ mod checkpoint_keeper {
     }
 
     #[test]
+    fn a_save_cut_off_and_made_again_with_its_generation_is_kept() {
+        // The board is cut off in the middle of generation 2, restores 1
+        // from the keeper, learns on and saves generation 2 again, with
+        // other contents: the new stream replaces the torn one.
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("leo.ckpt");
+        let mut keeper = CheckpointKeeper::new(&path).unwrap();
+        let (one, chunks1) = checkpoint(1, 1);
+        feed_all(&mut keeper, &chunks1).unwrap();
+        let (_, torn) = checkpoint(2, 2);
+        for c in &torn[..torn.len() / 2] {
+            assert_eq!(keeper.feed(c).unwrap(), None);
+        }
+        assert_eq!(read(&path), one);
+        let (again, chunks2) = checkpoint(2, 5);
+        assert_eq!(feed_all(&mut keeper, &chunks2).map(|k| k.generation), Some(2));
+        assert_eq!(read(&path), again);
+    }
+
+    #[test]
+    fn a_board_restores_batch_by_batch_from_the_server() {
+        use pada::checkpoint_keeper::RestoreServer;
+        use pada_core::wire::{RestoreDenied, RestoreRequest, ToChip, RESTORE_BATCH};
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("leo.ckpt");
+        let mut server = RestoreServer::new(&path);
+        let ask = |offset| RestoreRequest { config_hash: HASH, image_len: LEN as u32, offset };
+        // Nothing kept yet.
+        let none = server.answer(&ask(0));
+        assert_eq!(none.messages, [ToChip::RestoreNone(RestoreDenied::NoCheckpoint)]);
+        assert!(none.note.unwrap().contains("no checkpoint kept at"));
+
+        let mut keeper = CheckpointKeeper::new(&path).unwrap();
+        let (image, chunks) = checkpoint(7, 7);
+        feed_all(&mut keeper, &chunks).unwrap();
+        // Another configuration or size: refused by name.
+        let other = RestoreRequest { config_hash: HASH ^ 1, ..ask(0) };
+        assert_eq!(server.answer(&other).messages, [ToChip::RestoreNone(RestoreDenied::OtherConfiguration)]);
+        let larger = RestoreRequest { image_len: LEN as u32 + 4, ..ask(0) };
+        assert_eq!(server.answer(&larger).messages, [ToChip::RestoreNone(RestoreDenied::WrongSize)]);
+
+        // The board asks from 0, then from where each batch ended.
+        let expect = Expect { config_hash: Some(HASH), image_len: Some(LEN as u32), newer_than: None };
+        let mut restored = vec![0u8; LEN];
+        let mut board = Assembler::new(&mut restored[..], Order::HeaderFirst, expect);
+        let mut offset = 0;
+        let (mut batches, mut done) = (0, false);
+        while !done {
+            let answer = server.answer(&ask(offset));
+            assert!(answer.note.is_some() == (offset == 0));
+            assert!((1..=RESTORE_BATCH).contains(&answer.messages.len()));
+            batches += 1;
+            for m in answer.messages {
+                let ToChip::RestoreChunk(c) = m else { panic!("{m:?}") };
+                done = matches!(board.accept(&c).unwrap(), Progress::Complete(_));
+            }
+            offset = board.expected_offset();
+        }
+        drop(board);
+        assert_eq!(restored, image);
+        assert_eq!(batches, chunks.len().div_ceil(RESTORE_BATCH));
+        // An offset that starts no chunk.
+        assert_eq!(server.answer(&ask(33)).messages, [ToChip::RestoreNone(RestoreDenied::NotAChunk)]);
+    }
+
+    #[test]
     fn an_older_or_equal_generation_is_refused_and_the_file_stays() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("leo.ckpt");

@@ -11,6 +11,11 @@
 //! off is counted as lost too (a capture stopped by Ctrl-C or `--seconds`
 //! cut it itself, so it is not). A read error ends the capture with its
 //! summary and exit code 1.
+//!
+//! With `--checkpoint PATH` the board's streamed checkpoint is kept at
+//! PATH and, with `--port`, sent back when the board asks
+//! ([`crate::checkpoint_keeper::KeeperLink`]); a refused chunk or a failed
+//! answer is a line on stderr, never the capture's end.
 
 use crate::console::{errln, outln, status_line};
 use crate::capture::Recorder;
@@ -88,10 +93,10 @@ impl CaptureSummary {
 /// its channels ([`crate::mcap::read`]).
 fn replay_mcap(args: &CaptureArgs, path: &std::path::Path) -> Result<(), CliError> {
     let r = &args.record;
-    if r.out.is_some() || r.mcap.is_some() || r.foxglove.is_some() || r.seconds.is_some() {
+    if r.out.is_some() || r.mcap.is_some() || r.foxglove.is_some() || r.seconds.is_some() || r.checkpoint.is_some() {
         return Err(usage(format!(
             "--file {}: an MCAP recording is read back for its summary only; \
-             --out, --mcap, --foxglove and --seconds take a telemetry stream",
+             --out, --mcap, --foxglove, --seconds and --checkpoint take a telemetry stream",
             path.display()
         )));
     }
@@ -161,6 +166,10 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
     let Some((mut source, name)) = args.input.open()? else {
         return Err(usage("give --port DEVICE or --file FILE"));
     };
+    let mut keeper = args.record.keeper()?;
+    if let Some(k) = &keeper {
+        errln!("capture: {}", k.describe());
+    }
     let csv = args.record.csv()?;
     let mut taps = args.record.taps("capture")?;
     let mut rec = Recorder::new(csv)
@@ -223,6 +232,15 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
         rec.feed(&buf[..n], started.elapsed().as_secs_f64(), &mut frames)
             .context("cannot write the CSV or the MCAP file")
             .map_err(CliError::Runtime)?;
+        if let Some(k) = keeper.as_mut().filter(|_| !frames.is_empty()) {
+            let port = match &mut source {
+                Opened::Port(p) => Some(p),
+                Opened::Reader(_) => None,
+            };
+            for line in k.frames(&frames, port) {
+                errln!("capture: {line}");
+            }
+        }
         let every = if tty {
             Duration::from_millis(100)
         } else {
@@ -241,6 +259,9 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
     rec.flush()
         .context("cannot write the CSV")
         .map_err(CliError::Runtime)?;
+    for line in keeper.as_mut().map(|k| k.finish()).unwrap_or_default() {
+        errln!("capture: {line}");
+    }
     let closed = rec.close_tap();
     let live = taps.close("capture");
     closed

@@ -90,6 +90,12 @@ pub struct StreamRecord {
     /// ws://HOST:PORT. Port 0 picks a free one.
     #[arg(long, value_name = "tcp:HOST:PORT")]
     pub foxglove: Option<String>,
+    /// Keep the board's streamed checkpoint at PATH (for a board whose
+    /// table fits no flash: LEO on f429-sdram) and send it back when the
+    /// board asks at boot (with --port; a recording only feeds the file).
+    /// Only a complete checkpoint replaces the file, by an atomic rename.
+    #[arg(long, value_name = "PATH")]
+    pub checkpoint: Option<PathBuf>,
 }
 
 /// The `--mcap` file and the `--foxglove` server of a stream, opened.
@@ -155,6 +161,22 @@ impl StreamRecord {
         }
         let tap = (!sinks.is_empty()).then(|| crate::mcap::Tap::new(sinks));
         Ok(Taps { tap, server })
+    }
+
+    /// The keeper of `--checkpoint`, if asked for (a directory, or a path
+    /// in a directory that does not exist, is a usage error).
+    pub fn keeper(&self) -> Result<Option<crate::checkpoint_keeper::KeeperLink>, CliError> {
+        let Some(p) = &self.checkpoint else { return Ok(None) };
+        if p.is_dir() {
+            return Err(usage(format!("--checkpoint {}: is a directory; valid is a file to keep", p.display())));
+        }
+        let parent = p.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+        if !parent.is_dir() {
+            return Err(usage(format!("--checkpoint {}: no directory {}", p.display(), parent.display())));
+        }
+        let link = crate::checkpoint_keeper::KeeperLink::new(p)
+            .map_err(|e| usage(format!("--checkpoint {}: cannot use: {e}", p.display())))?;
+        Ok(Some(link))
     }
 
     /// Creates the `--out` CSV, if one was asked for.

@@ -5,6 +5,10 @@
 //! The stream's end (end of file, the sender gone) does not end the
 //! command: the page keeps showing the final state until Ctrl-C or
 //! `--seconds`, which print the summary as `pada capture` does.
+//!
+//! `--checkpoint PATH` keeps the board's streamed checkpoint and answers
+//! its restore requests as `pada capture --checkpoint` does, on the
+//! decoder thread.
 
 use super::capture::CaptureSummary;
 use super::stream_args::{Opened, StreamInput, StreamRecord};
@@ -88,6 +92,10 @@ pub fn run(args: WatchArgs) -> Result<(), CliError> {
     args.input.check()?;
     let serve = parse_serve(&args.serve)?;
     let (source, name) = open(&args)?;
+    let keeper = args.record.keeper()?;
+    if let Some(k) = &keeper {
+        eprintln!("watch: {}", k.describe());
+    }
     let csv = args.record.csv()?;
     let mut taps = args.record.taps("watch")?;
     let mut rec = Recorder::new(csv)
@@ -122,6 +130,7 @@ pub fn run(args: WatchArgs) -> Result<(), CliError> {
         recorder.clone(),
         shared.clone(),
         decoder_stop.clone(),
+        keeper,
     )
     .context("cannot start the decoder thread")
     .map_err(CliError::Runtime)?;

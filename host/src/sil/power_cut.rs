@@ -117,18 +117,29 @@ pub struct CutPlan {
     /// \[µs\]; sorted by instant.
     pub learning: Vec<(f64, u64)>,
     /// Cuts inside saves: (save attempt, 1-based; bytes of the save written
-    /// before the cut), sorted by attempt.
+    /// before the cut), sorted by attempt. For a checkpoint the host keeps,
+    /// the bytes are of the image the stream had covered.
     pub in_save: Vec<(u32, u32)>,
+    /// For a checkpoint the host keeps: the cuts (1-based, in the order
+    /// made) whose next boot is cut again inside its restore.
+    pub in_restore: Vec<u32>,
 }
 
 impl CutPlan {
     /// Resolves `specs` for a run of `seconds` saving every `save_every_s`
     /// of learning a checkpoint of `checkpoint_bytes` into slots of
     /// `slot_bytes` (a larger one is never written: its cuts are timed).
+    ///
+    /// A checkpoint larger than a slot is the host's to keep, streamed over
+    /// the telemetry link: a cut inside a save falls at a uniform byte of
+    /// the image the stream has covered, and of the cuts inside transfers
+    /// half (rounded down) fall inside a restore instead (at the boot after
+    /// one of the other cuts, chosen at random).
     pub fn new(specs: &[CutSpec], seconds: f64, save_every_s: f64, checkpoint_bytes: usize, slot_bytes: usize) -> CutPlan {
         let mut plan = CutPlan::default();
-        let fits = checkpoint_bytes <= slot_bytes;
-        let save_bytes = (slot_bytes + checkpoint_bytes) as u32;
+        let host_kept = checkpoint_bytes > slot_bytes;
+        // A flash save erases the slot, then writes the checkpoint.
+        let save_bytes = if host_kept { checkpoint_bytes as u32 } else { (slot_bytes + checkpoint_bytes) as u32 };
         for spec in specs {
             match *spec {
                 CutSpec::At(t) => plan.at_us.push((t * 1e6).round() as u64),
@@ -138,7 +149,17 @@ impl CutPlan {
                     let mut uniform = move || rng.next_u32() as f64 / (u32::MAX as f64 + 1.0);
                     let attempts = (seconds / save_every_s).floor() as u32;
                     let third = (n as f64 / 3.0).round() as u32;
-                    let n_save = if fits { in_save.unwrap_or(third).min(attempts) } else { 0 };
+                    let n_transfer = in_save.unwrap_or(third).min(attempts);
+                    let n_restore = if host_kept { n_transfer / 2 } else { 0 };
+                    let n_save = n_transfer - n_restore;
+                    // The boots after distinct cuts among the others.
+                    let mut after: Vec<u32> = (1..=n - n_restore).collect();
+                    for i in 0..n_restore as usize {
+                        let last = after.len() - 1;
+                        let j = i + (uniform() * (after.len() - i) as f64) as usize;
+                        after.swap(i, j.min(last));
+                        plan.in_restore.push(after[i]);
+                    }
                     // Distinct attempts: a partial Fisher-Yates over 1..=attempts.
                     let mut pool: Vec<u32> = (1..=attempts).collect();
                     for i in 0..n_save as usize {
@@ -147,7 +168,7 @@ impl CutPlan {
                         pool.swap(i, j.min(last));
                         plan.in_save.push((pool[i], (uniform() * save_bytes as f64) as u32));
                     }
-                    for _ in n_save..n {
+                    for _ in n_transfer..n {
                         plan.learning.push((uniform() * seconds, (uniform() * RANDOM_DELAY_US as f64) as u64));
                     }
                 }
@@ -156,6 +177,7 @@ impl CutPlan {
         plan.at_us.sort_unstable();
         plan.learning.sort_by(|a, b| a.0.total_cmp(&b.0));
         plan.in_save.sort_unstable();
+        plan.in_restore.sort_unstable();
         // Two cuts asked for the same save: the second takes the next one.
         for i in 1..plan.in_save.len() {
             if plan.in_save[i].0 <= plan.in_save[i - 1].0 {
@@ -167,7 +189,7 @@ impl CutPlan {
 
     /// Cuts planned.
     pub fn len(&self) -> usize {
-        self.at_us.len() + self.learning.len() + self.in_save.len()
+        self.at_us.len() + self.learning.len() + self.in_save.len() + self.in_restore.len()
     }
 
     /// No cut planned.
@@ -199,13 +221,21 @@ pub struct CutRecord {
     pub loaded: Option<Option<u32>>,
     /// The boot refused a checkpoint (`CheckpointIgnored`): lost or corrupt.
     pub refused: Option<String>,
+    /// Inside the restore at boot from the host, as the board asked for
+    /// the batch from this image offset.
+    pub in_restore: Option<u32>,
+    /// The boot after this cut was itself cut, inside its restore, before
+    /// it reported what it loaded: the next cut's record answers for it
+    /// (the same last save).
+    pub boot_cut_off: bool,
 }
 
 impl CutRecord {
     /// The boot loaded exactly the last completed save (or, with none,
-    /// found no checkpoint).
+    /// found no checkpoint); a boot cut off in its restore is answered for
+    /// by the next.
     pub fn loaded_last_save(&self) -> bool {
-        self.refused.is_none() && self.loaded == Some(self.last_save)
+        self.boot_cut_off || (self.refused.is_none() && self.loaded == Some(self.last_save))
     }
 }
 
@@ -271,12 +301,32 @@ pub struct PowerReport {
     pub cuts: Vec<CutRecord>,
     /// Every hang.
     pub hangs: Vec<HangRecord>,
+    /// Restores the board asked the host for (a checkpoint the host keeps).
+    pub restores_asked: u32,
+    /// Bytes of the last image the host kept.
+    pub kept_bytes: u64,
+    /// The most chunks a kept checkpoint took.
+    pub kept_chunks: u32,
+    /// Encoded chunk bytes of every kept checkpoint (what the link carried
+    /// for them, before framing).
+    pub streamed_bytes: u64,
+    /// Chunks the keeper refused (out of order, corrupt, stale, …).
+    pub chunks_refused: u32,
+    /// The first refusal, in one line.
+    pub first_chunk_refusal: Option<String>,
+    /// `Streamed` reports whose checkpoint the host did not keep.
+    pub streams_not_kept: u32,
 }
 
 impl PowerReport {
     /// Cuts inside a save.
     pub fn cuts_in_save(&self) -> usize {
         self.cuts.iter().filter(|c| c.in_save.is_some()).count()
+    }
+
+    /// Cuts inside a restore from the host.
+    pub fn cuts_in_restore(&self) -> usize {
+        self.cuts.iter().filter(|c| c.in_restore.is_some()).count()
     }
 
     /// Boots that loaded the last completed save.
@@ -320,11 +370,19 @@ mod tests {
         assert!(p.learning.iter().all(|&(t, d)| (0.0..600.0).contains(&t) && d < RANDOM_DELAY_US));
         let again = CutPlan::new(&specs, 600.0, 20.0, 100_368, 131_072);
         assert_eq!((p.learning.clone(), p.in_save.clone()), (again.learning, again.in_save));
-        // A checkpoint that no slot holds is never written: every cut timed.
+        // A checkpoint that no slot holds is the host's: of the cuts inside
+        // transfers, half fall inside a restore, after a distinct other cut.
         let leo = CutPlan::new(&[CutSpec::Random { n: 5, in_save: None, seed: 1 }], 60.0, 20.0, 8_389_136, 131_072);
         let five = CutPlan::new(&[CutSpec::Random { n: 30, in_save: Some(5), seed: 1 }], 600.0, 20.0, 100_368, 131_072);
-        assert_eq!((five.learning.len(), five.in_save.len()), (25, 5));
-        assert_eq!((leo.learning.len(), leo.in_save.len()), (5, 0));
+        assert_eq!((five.learning.len(), five.in_save.len(), five.in_restore.len()), (25, 5, 0));
+        assert_eq!((leo.learning.len(), leo.in_save.len(), leo.in_restore.len()), (3, 1, 1));
+        assert!(leo.in_save.iter().all(|&(k, b)| (1..=3).contains(&k) && b < 8_389_136));
+        assert!(leo.in_restore.iter().all(|&c| (1..=4).contains(&c)));
+        let many = CutPlan::new(&[CutSpec::Random { n: 20, in_save: Some(8), seed: 4 }], 7333.0, 300.0, 8_389_664, 131_072);
+        assert_eq!((many.learning.len(), many.in_save.len(), many.in_restore.len(), many.len()), (12, 4, 4, 20));
+        let mut distinct = many.in_restore.clone();
+        distinct.dedup();
+        assert_eq!(distinct, many.in_restore);
     }
 }
 
@@ -341,10 +399,11 @@ pub fn checks(p: &mut PowerReport, period_ms: f64, emulated_s: f64, checkpoint_f
             name: "power cuts: every planned cut made, every boot loaded the last completed save",
             ok: p.cuts.len() == p.cuts_planned && p.boots_ok() == p.cuts.len(),
             detail: format!(
-                "{} of {} cuts made ({} inside a save); {} of {} boots loaded the last completed save; {} refused a checkpoint (lost or corrupt){}",
+                "{} of {} cuts made ({} inside a save, {} inside a restore from the host); {} of {} boots loaded the last completed save; {} refused a checkpoint (lost or corrupt){}",
                 p.cuts.len(),
                 p.cuts_planned,
                 p.cuts_in_save(),
+                p.cuts_in_restore(),
                 p.boots_ok(),
                 p.cuts.len(),
                 refused,
@@ -355,27 +414,39 @@ pub fn checks(p: &mut PowerReport, period_ms: f64, emulated_s: f64, checkpoint_f
                     .unwrap_or_default()
             ),
         });
-        match (checkpoint_fits, p.save_every_s) {
-            (true, Some(every)) => checks.push(Check {
+        if let Some(every) = p.save_every_s {
+            checks.push(Check {
                 name: "power cuts: learning lost per cut at most one save interval",
                 ok: p.max_learning_lost_s() <= every + 1e-9,
-                detail: format!("mean {mean_lost:.2} s, max {:.2} s of learning lost per cut; saves every {every} s", p.max_learning_lost_s()),
-            }),
-            (false, _) => checks.push(Check {
-                name: "power cuts: no checkpoint fits a slot, so every save is refused and a cut costs all learning since the boot",
-                ok: p.saves == 0 && p.saves_too_large == p.save_attempts && p.cuts.iter().all(|c| c.loaded == Some(None)),
                 detail: format!(
-                    "{} save attempts, {} refused as too large, {} saved; learning lost per cut: mean {mean_lost:.2} s, max {:.2} s",
-                    p.save_attempts,
-                    p.saves_too_large,
-                    p.saves,
-                    p.max_learning_lost_s()
+                    "mean {mean_lost:.2} s, max {:.2} s of learning lost per cut; saves every {every} s{}",
+                    p.max_learning_lost_s(),
+                    if checkpoint_fits { "" } else { " (streamed to the host, which keeps them)" }
                 ),
-            }),
-            (true, None) => {}
+            });
         }
     }
-    if p.saves > 0 {
+    if !checkpoint_fits && (p.save_attempts > 0 || p.restores_asked > 0) {
+        checks.push(Check {
+            name: "checkpoints kept by the host: every save streamed whole was kept, no chunk refused",
+            ok: p.chunks_refused == 0 && p.streams_not_kept == 0 && p.saves_too_large == 0,
+            detail: format!(
+                "{} of {} save attempts kept ({} cut off inside), last image {} bytes in up to {} chunks, {} encoded bytes streamed for them ({:.1} s of a 921,600-baud link); {} restores asked; {} chunks refused{}; {} streams reported but not kept",
+                p.saves,
+                p.save_attempts,
+                p.cuts_in_save(),
+                p.kept_bytes,
+                p.kept_chunks,
+                p.streamed_bytes,
+                p.streamed_bytes as f64 * 10.0 / 921_600.0,
+                p.restores_asked,
+                p.chunks_refused,
+                p.first_chunk_refusal.as_deref().map(|r| format!(" (first: {r})")).unwrap_or_default(),
+                p.streams_not_kept
+            ),
+        });
+    }
+    if p.saves > 0 && checkpoint_fits {
         checks.push(Check {
             name: "flash: erases within the ten-year wear budget, no save failed",
             ok: (p.max_erases as f64) <= p.erases_allowed && p.saves_failed == 0,

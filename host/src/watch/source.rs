@@ -2,10 +2,12 @@
 //! stream, or one sender on a loopback TCP port (`pada run --telemetry
 //! tcp:…`, `pada sil --telemetry tcp:…`) — and the decoder thread that
 //! feeds [`Recorder`] (the decoder and CSV of `pada capture`) and the
-//! page's state.
+//! page's state, and with `--checkpoint` the board's checkpoint keeper
+//! (answering its restore requests on a serial port).
 
 use super::server::Shared;
 use crate::capture::Recorder;
+use crate::checkpoint_keeper::KeeperLink;
 use crate::serial_link::LinkEvent;
 use std::io::Read;
 use std::net::{SocketAddr, TcpListener, TcpStream};
@@ -60,11 +62,14 @@ fn failed(reason: String) -> End {
 
 /// Reads `source` until it ends or `stop` is set, recording every frame
 /// and updating the shared state after every chunk; returns why it ended.
+/// `keeper` takes the checkpoint's chunks and, on a port, answers restore
+/// requests.
 pub fn decode(
     source: Source,
     recorder: &Mutex<Recorder>,
     shared: &Shared,
     stop: &AtomicBool,
+    keeper: &mut Option<KeeperLink>,
 ) -> End {
     let mut buf = vec![0u8; 4096];
     let mut frames = Vec::new();
@@ -149,6 +154,15 @@ pub fn decode(
         let (link, counts) = (rec.stats(), rec.counts());
         let latest = rec.latest().clone();
         drop(rec);
+        if let Some(k) = keeper.as_mut().filter(|_| !frames.is_empty()) {
+            let port = match &mut source {
+                Source::Port(p) => Some(p),
+                _ => None,
+            };
+            for line in k.frames(&frames, port) {
+                eprintln!("watch: {line}");
+            }
+        }
         shared
             .state
             .lock()
@@ -163,11 +177,16 @@ pub fn spawn(
     recorder: Arc<Mutex<Recorder>>,
     shared: Arc<Shared>,
     stop: Arc<AtomicBool>,
+    keeper: Option<KeeperLink>,
 ) -> std::io::Result<std::thread::JoinHandle<()>> {
     std::thread::Builder::new()
         .name("watch-decoder".into())
         .spawn(move || {
-            let end = decode(source, &recorder, &shared, &stop);
+            let mut keeper = keeper;
+            let end = decode(source, &recorder, &shared, &stop, &mut keeper);
+            for line in keeper.as_mut().map(KeeperLink::finish).unwrap_or_default() {
+                eprintln!("watch: {line}");
+            }
             // The stream ended by itself (not Ctrl-C, which cuts the frame
             // in progress itself): a frame cut off by the end counts as lost,
             // as `pada capture` counts it.

@@ -22,13 +22,17 @@ use super::config::SilConfig;
 use super::wall::{Account, WallClock};
 use crate::board::{EpisodeOutcome, Phase, RunProtocol};
 use crate::capture::{mode_name, Recorder};
+use crate::checkpoint_keeper::{CheckpointKeeper, RestoreServer};
 use crate::rig::Rig;
 use anyhow::{anyhow, bail, Context};
 use pada_core::checkpoint::LoadOutcome;
 use pada_core::safety::FaultCause;
-use pada_core::wire::{self, CheckpointReport, Decoded, FrameEncoder, RunMode, StepKind, ToChip, ToHost, Warning, MAX_FRAME_LEN};
+use pada_core::wire::{
+    self, CheckpointReport, Decoded, FrameEncoder, RestoreDenied, RestoreOutcome, RunMode, StepKind, ToChip, ToHost, Warning,
+    MAX_FRAME_LEN,
+};
 use pada_firmware::config::Robot;
-use power::{LastSave, Power, Reboot};
+use power::{LastSave, Power, Reboot, TransferCut};
 use pada_firmware::sil::{
     Channel, FromBoard, ToBoard, CALIBRATION_INSTRUCTIONS, CHUNK_LEN, CLOCK_FRAME_LEN, CLOCK_PROTOCOL,
     CHECKPOINT_SLOT_LEN, NEVER,
@@ -40,6 +44,10 @@ use std::time::Instant;
 /// When the run sets the policy and starts the first test episode, after
 /// boot \[µs\] (the board's servo set-up is long done).
 const FIRST_COMMAND_US: u64 = 100_000;
+
+/// The file in the run's directory where the host keeps a checkpoint that
+/// fits no flash slot (it survives every power cut of the board).
+pub const KEPT_CHECKPOINT: &str = "checkpoint.bin";
 
 /// The state of one run.
 pub struct Session<'a> {
@@ -80,6 +88,17 @@ pub struct Session<'a> {
     sink: Option<crate::telemetry::TelemetrySink>,
     bar: Option<indicatif::ProgressBar>,
     power: Power,
+    /// The host's copy of a checkpoint no flash slot holds (LEO on
+    /// `f429-sdram`): the board streams its saves to it and restores from
+    /// it at boot ([`crate::checkpoint_keeper`]); `None` when the board's
+    /// checkpoint fits its flash.
+    kept: Option<HostKept>,
+}
+
+/// The checkpoint the host keeps for the board, in the run's directory.
+struct HostKept {
+    keeper: CheckpointKeeper,
+    server: RestoreServer,
 }
 
 impl<'a> Session<'a> {
@@ -116,6 +135,22 @@ impl<'a> Session<'a> {
         hangs_us.sort_unstable();
         let protocol = RunProtocol::new(cfg.seconds, cfg.task.robot().spec().period_us);
         let power = Power::new(plan, hangs_us, cfg.save_every_s, protocol.clone());
+        let kept = if ckpt > CHECKPOINT_SLOT_LEN {
+            let path = out(KEPT_CHECKPOINT);
+            // A run starts with a fresh board: a checkpoint an earlier run
+            // left in this directory is not this run's (it is replaced, as
+            // telemetry.csv is).
+            match std::fs::remove_file(&path) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                    return Err(e).with_context(|| format!("cannot remove the earlier run's {}", path.display()))
+                }
+                _ => {}
+            }
+            let keeper = CheckpointKeeper::new(&path).with_context(|| format!("cannot keep a checkpoint at {}", path.display()))?;
+            Some(HostKept { keeper, server: RestoreServer::new(&path) })
+        } else {
+            None
+        };
         let bar = cfg
             .progress
             .then(|| crate::progress::steps_bar((cfg.seconds * 1000.0).round() as u64, "sil: learning ms"));
@@ -153,6 +188,7 @@ impl<'a> Session<'a> {
             sink,
             bar,
             power,
+            kept,
         })
     }
 
@@ -318,14 +354,26 @@ impl<'a> Session<'a> {
 
     fn on_telemetry(&mut self, at_us: u64, bytes: &[u8]) -> anyhow::Result<()> {
         let t0 = Instant::now();
-        std::io::Write::write_all(&mut self.raw, bytes)?;
-        if let Some(sink) = self.sink.as_mut() {
-            sink.forward(bytes);
-        }
-        let mut frames = Vec::new();
-        self.recorder.feed(bytes, at_us as f64 * 1e-6, &mut frames)?;
-        for f in frames {
-            self.on_frame(at_us, f)?;
+        let mut rest = bytes;
+        while !rest.is_empty() {
+            // A frame at a time (up to its 0x00): a cut decided at a frame
+            // falls right after it, and what follows never arrived.
+            let end = rest.iter().position(|&b| b == 0).map_or(rest.len(), |i| i + 1);
+            let (piece, after) = rest.split_at(end);
+            rest = after;
+            std::io::Write::write_all(&mut self.raw, piece)?;
+            if let Some(sink) = self.sink.as_mut() {
+                sink.forward(piece);
+            }
+            let mut frames = Vec::new();
+            self.recorder.feed(piece, at_us as f64 * 1e-6, &mut frames)?;
+            for f in frames {
+                self.on_frame(at_us, f)?;
+            }
+            if let Some(cut) = self.power.cut_now.take() {
+                self.wall.add(Account::Telemetry, t0.elapsed());
+                return self.transfer_cut(at_us.max(self.now_us), cut);
+            }
         }
         self.wall.add(Account::Telemetry, t0.elapsed());
         Ok(())
@@ -405,8 +453,14 @@ impl<'a> Session<'a> {
         let mut tele_in = Vec::new();
         if self.commands[..due].iter().any(|c| c.1 == ToChip::SaveCheckpoint) {
             if let Some((k, after_bytes)) = self.power.arm_next_save.take() {
-                self.power.armed = Some((k, after_bytes));
-                self.queue(&ToBoard::CutInSave { after_bytes })?;
+                if self.kept.is_some() {
+                    // Streamed to the host: cut when the stream has covered
+                    // that many bytes of the image (on_checkpoint_chunk).
+                    self.power.stream_armed = Some((k, after_bytes));
+                } else {
+                    self.power.armed = Some((k, after_bytes));
+                    self.queue(&ToBoard::CutInSave { after_bytes })?;
+                }
             }
         }
         for (_, cmd) in self.commands.drain(..due).collect::<Vec<_>>() {
@@ -508,6 +562,41 @@ impl<'a> Session<'a> {
                 self.records.push(Record::Saved);
             }
             ToHost::Checkpoint(CheckpointReport::TooLarge { .. }) => self.power.report.saves_too_large += 1,
+            ToHost::Checkpoint(CheckpointReport::Streamed { generation, .. }) => {
+                let kept = self.kept.as_ref().and_then(|k| k.keeper.kept_generation());
+                if kept != Some(generation) {
+                    self.power.report.streams_not_kept += 1;
+                }
+            }
+            ToHost::CheckpointChunk(chunk) => self.on_checkpoint_chunk(&chunk)?,
+            ToHost::RestoreWanted(request) => {
+                if request.offset == 0 {
+                    self.power.report.restores_asked += 1;
+                    self.power.restore_requests = 0;
+                }
+                self.power.restore_requests += 1;
+                if self.power.restore_cut_due() {
+                    // The power fails while the board asks for this batch.
+                    self.power.cut_now = Some(TransferCut::Restore { offset: request.offset });
+                    return Ok(());
+                }
+                let Some(kept) = self.kept.as_mut() else {
+                    bail!("the board asked the host for its checkpoint, but its checkpoint fits its flash");
+                };
+                for m in kept.server.answer(&request).messages {
+                    self.command_at(at_us, m);
+                }
+            }
+            ToHost::Restored(outcome) => {
+                match outcome {
+                    RestoreOutcome::Loaded { generation, .. } => self.boot_loaded(Some(generation), None),
+                    RestoreOutcome::Denied(RestoreDenied::NoCheckpoint) => self.boot_loaded(None, None),
+                    other => self.boot_loaded(None, Some(format!("{other:?}"))),
+                }
+                if std::mem::take(&mut self.power.start_after_restore) {
+                    self.command_at(at_us + FIRST_COMMAND_US, ToChip::Start(RunMode::Learning));
+                }
+            }
             ToHost::Checkpoint(CheckpointReport::SaveFailed) => self.power.report.saves_failed += 1,
             ToHost::Checkpoint(CheckpointReport::Load(LoadOutcome::Loaded { generation, .. })) => {
                 self.boot_loaded(Some(generation), None)
@@ -547,6 +636,45 @@ impl<'a> Session<'a> {
                 self.command_at(resume_from + 200_000, ToChip::Start(mode));
             }
             _ => {}
+        }
+        Ok(())
+    }
+
+    /// A chunk of a save streamed to the host: kept (a complete
+    /// checkpoint is the save completed), or the armed cut inside this
+    /// save falls on it (the board dies sending it).
+    fn on_checkpoint_chunk(&mut self, chunk: &pada_core::checkpoint::stream::Chunk) -> anyhow::Result<()> {
+        let Some(kept) = self.kept.as_mut() else {
+            bail!("the board streamed a checkpoint chunk, but its checkpoint fits its flash");
+        };
+        if let Some((k, after_bytes)) = self.power.stream_armed {
+            // The body goes in ascending order, the header last: the body
+            // chunk that covers the image up to `after_bytes` is the last
+            // that arrives (the last body chunk covers it all, so the cut
+            // always falls before the header).
+            let covered = chunk.offset as u64 + chunk.covered_len();
+            if chunk.offset != 0 && covered >= after_bytes as u64 {
+                self.power.stream_armed = None;
+                self.power.cut_now = Some(TransferCut::Save { attempt: k, after_bytes });
+            }
+        }
+        match kept.keeper.feed(chunk) {
+            Ok(Some(k)) => {
+                let p = &mut self.power;
+                p.report.saves += 1;
+                p.report.kept_bytes = k.bytes;
+                p.report.kept_chunks = p.report.kept_chunks.max(k.chunks);
+                p.report.streamed_bytes += k.encoded_bytes;
+                p.last_save = Some(LastSave { generation: k.generation, protocol: self.protocol.clone() });
+                self.records.push(Record::Saved);
+            }
+            Ok(None) => {}
+            Err(e) => {
+                self.power.report.chunks_refused += 1;
+                if self.power.report.first_chunk_refusal.is_none() {
+                    self.power.report.first_chunk_refusal = Some(e.to_string());
+                }
+            }
         }
         Ok(())
     }

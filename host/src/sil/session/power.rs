@@ -20,6 +20,27 @@ pub(super) struct LastSave {
     pub(super) protocol: RunProtocol,
 }
 
+/// A cut inside a checkpoint transfer with the host (a board whose
+/// checkpoint fits no flash): decided while a telemetry frame is taken,
+/// made once the frame is done.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum TransferCut {
+    /// Inside save attempt `attempt`, at the chunk that reached
+    /// `after_bytes` of the image (that chunk and the rest never arrive).
+    Save {
+        /// The save attempt (1-based).
+        attempt: u32,
+        /// Image bytes the stream had covered.
+        after_bytes: u32,
+    },
+    /// Inside the restore at boot, as the board asked for the batch from
+    /// `offset`.
+    Restore {
+        /// The offset asked for.
+        offset: u32,
+    },
+}
+
 /// A reboot the host caused, whose boot is to be checked.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum Reboot {
@@ -61,7 +82,24 @@ pub(super) struct Power {
     pub(super) awaiting_load: Option<Reboot>,
     /// The watchdog's period on this board \[ms\] (0: none).
     pub(super) watchdog_ms: u32,
+    /// A cut inside a save streamed to the host, armed for the stream of
+    /// this save attempt: (attempt, image bytes covered).
+    pub(super) stream_armed: Option<(u32, u32)>,
+    /// A transfer cut to make once the frame being taken is done.
+    pub(super) cut_now: Option<TransferCut>,
+    /// The boot's restore is to be cut at its [`RESTORE_CUT_REQUEST`]-th
+    /// request.
+    pub(super) restore_cut_armed: bool,
+    /// Requests of the restore in progress.
+    pub(super) restore_requests: u32,
+    /// The run goes on (`Start`) once the board reports its restore.
+    pub(super) start_after_restore: bool,
 }
+
+/// The request of a restore at which an armed restore cut falls: the
+/// second, when the header and the first body chunks have arrived and
+/// some of the table is written.
+pub(super) const RESTORE_CUT_REQUEST: u32 = 2;
 
 impl Power {
     /// Nothing happened yet: cuts as `plan` says, hangs at `hangs_us`
@@ -86,11 +124,42 @@ impl Power {
         awaiting_boot: None,
         awaiting_load: None,
         watchdog_ms: 0,
+        stream_armed: None,
+        cut_now: None,
+        restore_cut_armed: false,
+        restore_requests: 0,
+        start_after_restore: false,
         }
     }
 }
 
+impl Power {
+    /// Whether the restore request just counted is where the armed restore
+    /// cut falls (then it is disarmed).
+    pub(super) fn restore_cut_due(&mut self) -> bool {
+        let due = self.restore_cut_armed && self.restore_requests == RESTORE_CUT_REQUEST;
+        if due {
+            self.restore_cut_armed = false;
+        }
+        due
+    }
+}
+
 impl Session<'_> {
+    /// Cuts the power inside a checkpoint transfer with the host.
+    pub(super) fn transfer_cut(&mut self, at_us: u64, cut: TransferCut) -> anyhow::Result<()> {
+        match cut {
+            TransferCut::Save { attempt, after_bytes } => self.power_cut(at_us, Some((attempt, after_bytes))),
+            TransferCut::Restore { offset } => {
+                self.power_cut(at_us, None)?;
+                if let Some(c) = self.power.report.cuts.last_mut() {
+                    c.in_restore = Some(offset);
+                }
+                Ok(())
+            }
+        }
+    }
+
     /// After a Boot's checks: configure the board and start (or resume) the
     /// run; a reboot the host did not cause ends the run.
     pub(super) fn after_boot(&mut self, reset: ResetCause) -> anyhow::Result<()> {
@@ -125,9 +194,15 @@ impl Session<'_> {
         self.send_queued()?;
         if !first && self.power.last_save.is_some() {
             // The board loads the last save and waits, torque off (after a
-            // watchdog reset in Fault, which the Fault report clears).
+            // watchdog reset in Fault, which the Fault report clears). A
+            // board restoring from the host goes on once it reports the
+            // restore (which takes as long as its table is large).
             if matches!(reboot, Some(Reboot::Cut(_))) {
-                self.command_at(self.now_us + FIRST_COMMAND_US, ToChip::Start(RunMode::Learning));
+                if self.kept.is_some() {
+                    self.power.start_after_restore = true;
+                } else {
+                    self.command_at(self.now_us + FIRST_COMMAND_US, ToChip::Start(RunMode::Learning));
+                }
             }
             return Ok(());
         }
@@ -182,6 +257,13 @@ impl Session<'_> {
     /// bytes it wrote) and boots the board again after [`OFF_US`].
     pub(super) fn power_cut(&mut self, at_us: u64, in_save: Option<(u32, u32)>) -> anyhow::Result<()> {
         self.wall.time(Account::Board, || self.emu.power_cycle())?;
+        // A boot cut off before it reported what it loaded: the next boot,
+        // which finds the same last save, answers for it.
+        if let Some(Reboot::Cut(i)) = self.power.awaiting_load.take() {
+            self.power.report.cuts[i].boot_cut_off = true;
+        }
+        self.power.stream_armed = None;
+        self.power.start_after_restore = false;
         let saved_s = self.power.last_save.as_ref().map_or(0.0, |s| s.protocol.learning_time_s());
         self.power.report.cuts.push(CutRecord {
             at_s: at_us as f64 * 1e-6,
@@ -190,7 +272,12 @@ impl Session<'_> {
             learning_lost_s: self.protocol.learning_time_s() - saved_s,
             loaded: None,
             refused: None,
+            in_restore: None,
+            boot_cut_off: false,
         });
+        // The restore at the boot after this cut is to be cut too.
+        let made = self.power.report.cuts.len() as u32;
+        self.power.restore_cut_armed = self.power.plan.in_restore.contains(&made);
         let (rig, bus) = (self.rig.as_mut(), &mut self.bus);
         self.wall.time(Account::Plant, || {
             rig.advance_to(at_us);
