@@ -47,6 +47,8 @@
 
 mod anatomy;
 mod build;
+#[cfg(test)]
+mod mass_matrix_check;
 mod motor_lag;
 mod options;
 mod state;
