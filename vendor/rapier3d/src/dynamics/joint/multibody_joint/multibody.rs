@@ -7,7 +7,7 @@ use crate::dynamics::{
     IntegrationParameters, RigidBodyHandle, RigidBodySet, RigidBodyType, RigidBodyVelocity,
 };
 use crate::math::{
-    ANG_DIM, AngDim, AngVector, DIM, DVector, Dim, Jacobian, Pose, Real, SPATIAL_DIM, Vector,
+    ANG_DIM, AngDim, AngVector, DIM, DVector, Dim, Jacobian, Pose, Real, SPATIAL_DIM, Vector, SimdAngVector,
 };
 use crate::prelude::MultibodyJoint;
 #[cfg(feature = "dim3")]
@@ -48,6 +48,22 @@ struct MassColumn {
     m_j_w: na::Vector3<Real>,
     acc_j_v: na::Vector3<Real>,
     acc_j_w: na::Vector3<Real>,
+}
+
+/// Upstream's helper, used by the oracle `update_mass_matrix_upstream` only.
+#[cfg(feature = "dim3")]
+fn concat_rb_mass_matrix(
+    mass: Vector,
+    inertia: na::Matrix3<Real>,
+) -> SMatrix<Real, SPATIAL_DIM, SPATIAL_DIM> {
+    let mut result = SMatrix::<Real, SPATIAL_DIM, SPATIAL_DIM>::zeros();
+    result[(0, 0)] = mass.x;
+    result[(1, 1)] = mass.y;
+    result[(2, 2)] = mass.z;
+    result
+        .fixed_view_mut::<ANG_DIM, ANG_DIM>(DIM, DIM)
+        .copy_from(&inertia);
+    result
 }
 
 /// Column `c` of a column-major `3 × n` matrix.
@@ -1122,6 +1138,297 @@ impl Multibody {
         };
         self.acc_inv_augmented_mass = LU::new(owned(&self.acc_augmented_mass));
         self.inv_augmented_mass = LU::new(owned(&self.augmented_mass));
+    }
+
+    /// Upstream 0.36.1's `update_mass_matrix`, unchanged but for a local `i_coriolis_dt`:
+    /// the oracle of [`Self::mass_matrices_against_upstream`].
+    fn update_mass_matrix_upstream(&mut self, dt: Real, bodies: &RigidBodySet) {
+        if self.ndofs == 0 {
+            return; // Nothing to do.
+        }
+
+        if self.augmented_mass.ncols() != self.ndofs {
+            // TODO: do a resize instead of a full reallocation.
+            self.augmented_mass = DMatrix::zeros(self.ndofs, self.ndofs);
+            self.acc_augmented_mass = DMatrix::zeros(self.ndofs, self.ndofs);
+        } else {
+            self.augmented_mass.fill(0.0);
+            self.acc_augmented_mass.fill(0.0);
+        }
+
+        self.augmented_mass_indices.clear();
+
+        // Resize coriolis workspaces if the link count or number of DOFs change.
+        let coriolis_ndofs = self.coriolis_v.first().map(|m| m.ncols());
+        if self.coriolis_v.len() != self.links.len() || coriolis_ndofs != Some(self.ndofs) {
+            self.coriolis_v = vec![OMatrix::<Real, Dim, Dyn>::zeros(self.ndofs); self.links.len()];
+            self.coriolis_w =
+                vec![OMatrix::<Real, AngDim, Dyn>::zeros(self.ndofs); self.links.len()];
+        }
+
+        let mut i_coriolis_dt: Jacobian<Real> = Jacobian::zeros(self.ndofs);
+        let mut curr_assembly_id = 0;
+
+        for i in 0..self.links.len() {
+            let link = &self.links[i];
+            let rb = &bodies[link.rigid_body];
+            let rb_mass = rb.mprops.effective_mass();
+            let rb_inertia = rb.mprops.effective_angular_inertia().into_matrix();
+            let body_jacobian = &self.body_jacobians[i];
+
+            // NOTE: the mass matrix index reordering operates on the assumption that the assembly
+            //       ids are traversed in order. This assert is here to ensure the assumption always
+            //       hold.
+            assert_eq!(
+                curr_assembly_id, link.assembly_id,
+                "Internal error: contiguity assumption on assembly_id does not hold."
+            );
+            curr_assembly_id += link.joint.ndofs();
+
+            if link.joint.kinematic {
+                for k in link.assembly_id..link.assembly_id + link.joint.ndofs() {
+                    self.augmented_mass_indices.remove(k);
+                }
+            } else {
+                for k in link.assembly_id..link.assembly_id + link.joint.ndofs() {
+                    self.augmented_mass_indices.keep(k);
+                }
+            }
+
+            #[allow(unused_mut)] // mut is needed for 3D but not for 2D.
+            let mut augmented_inertia = rb_inertia;
+
+            #[cfg(feature = "dim3")]
+            {
+                // Derivative of gyroscopic forces.
+                let gyroscopic_matrix = rb.vels.angvel.gcross_matrix() * rb_inertia
+                    - (rb_inertia * rb.vels.angvel).gcross_matrix();
+
+                augmented_inertia += gyroscopic_matrix * dt;
+            }
+
+            // TODO: optimize that (knowing the structure of the augmented inertia matrix).
+            // TODO: this could be better optimized in 2D.
+            #[allow(clippy::useless_conversion)] // Needed in 3D, no-op in 2D
+            let rb_mass_matrix_wo_gyro = concat_rb_mass_matrix(rb_mass, rb_inertia.into());
+            #[allow(clippy::useless_conversion)] // Needed in 3D, no-op in 2D
+            let rb_mass_matrix = concat_rb_mass_matrix(rb_mass, augmented_inertia.into());
+            self.augmented_mass
+                .quadform(1.0, &rb_mass_matrix_wo_gyro, body_jacobian, 1.0);
+            self.acc_augmented_mass
+                .quadform(1.0, &rb_mass_matrix, body_jacobian, 1.0);
+
+            /*
+             *
+             * Coriolis matrix.
+             *
+             */
+            let rb_j = &self.body_jacobians[i];
+            let rb_j_w = rb_j.fixed_rows::<ANG_DIM>(DIM);
+
+            let ndofs = link.joint.ndofs();
+
+            if i != 0 {
+                let parent_id = link.parent_internal_id;
+                let parent_link = &self.links[parent_id];
+                let parent_rb = &bodies[parent_link.rigid_body];
+                let parent_j = &self.body_jacobians[parent_id];
+                let parent_j_w = parent_j.fixed_rows::<ANG_DIM>(DIM);
+                let parent_w = SimdAngVector::<Real>::from(parent_rb.vels.angvel).gcross_matrix();
+
+                let (coriolis_v, parent_coriolis_v) = self.coriolis_v.index_mut2(i, parent_id);
+                let (coriolis_w, parent_coriolis_w) = self.coriolis_w.index_mut2(i, parent_id);
+
+                coriolis_v.copy_from(parent_coriolis_v);
+                coriolis_w.copy_from(parent_coriolis_w);
+
+                // [c1 - c0].gcross() * (JDot + JDot/u * qdot)"
+                let shift_cross_tr = vect_to_na(link.shift02).gcross_matrix_tr();
+                coriolis_v.gemm(1.0, &shift_cross_tr, parent_coriolis_w, 1.0);
+
+                // JDot (but the 2.0 originates from the sum of two identical terms in JDot and JDot/u * gdot)
+                let dvel_cross = vect_to_na(
+                    rb.vels.angvel.gcross(link.shift02) + 2.0 * link.joint_velocity.linvel,
+                )
+                .gcross_matrix_tr();
+                coriolis_v.gemm(1.0, &dvel_cross, &parent_j_w, 1.0);
+
+                // JDot/u * qdot
+                coriolis_v.gemm(
+                    1.0,
+                    &vect_to_na(link.joint_velocity.linvel).gcross_matrix_tr(),
+                    &parent_j_w,
+                    1.0,
+                );
+                coriolis_v.gemm(1.0, &(parent_w * shift_cross_tr), &parent_j_w, 1.0);
+
+                #[cfg(feature = "dim3")]
+                {
+                    let vel_wrt_joint_w = vect_to_na(link.joint_velocity.angvel).gcross_matrix();
+                    coriolis_w.gemm(-1.0, &vel_wrt_joint_w, &parent_j_w, 1.0);
+                }
+
+                // JDot (but the 2.0 originates from the sum of two identical terms in JDot and JDot/u * gdot)
+                if !link.joint.kinematic {
+                    let mut coriolis_v_part = coriolis_v.columns_mut(link.assembly_id, ndofs);
+
+                    let mut tmp1 = SMatrix::<Real, SPATIAL_DIM, SPATIAL_DIM>::zeros();
+                    let mut rb_joint_j = tmp1.columns_mut(0, ndofs);
+                    link.joint.jacobian(
+                        &(parent_link.local_to_world.rotation
+                            * link.joint.data.local_frame1.rotation),
+                        &mut rb_joint_j,
+                    );
+
+                    let rb_joint_j_v = rb_joint_j.fixed_rows::<DIM>(0);
+                    coriolis_v_part.gemm(2.0, &parent_w, &rb_joint_j_v, 1.0);
+
+                    #[cfg(feature = "dim3")]
+                    {
+                        let rb_joint_j_w = rb_joint_j.fixed_rows::<ANG_DIM>(DIM);
+                        let mut coriolis_w_part = coriolis_w.columns_mut(link.assembly_id, ndofs);
+                        coriolis_w_part.gemm(1.0, &parent_w, &rb_joint_j_w, 1.0);
+                    }
+                }
+            } else {
+                self.coriolis_v[i].fill(0.0);
+                self.coriolis_w[i].fill(0.0);
+            }
+
+            let coriolis_v = &mut self.coriolis_v[i];
+            let coriolis_w = &mut self.coriolis_w[i];
+
+            {
+                // [c3 - c2].gcross() * (JDot + JDot/u * qdot)
+                let shift_cross_tr = vect_to_na(link.shift23).gcross_matrix_tr();
+                coriolis_v.gemm(1.0, &shift_cross_tr, coriolis_w, 1.0);
+
+                // JDot
+                let dvel_cross = vect_to_na(rb.vels.angvel.gcross(link.shift23)).gcross_matrix_tr();
+                coriolis_v.gemm(1.0, &dvel_cross, &rb_j_w, 1.0);
+
+                // JDot/u * qdot
+                coriolis_v.gemm(
+                    1.0,
+                    &(SimdAngVector::<Real>::from(rb.vels.angvel).gcross_matrix() * shift_cross_tr),
+                    &rb_j_w,
+                    1.0,
+                );
+            }
+
+            let coriolis_v = &mut self.coriolis_v[i];
+            let coriolis_w = &mut self.coriolis_w[i];
+
+            /*
+             * Meld with the mass matrix.
+             */
+            {
+                let mut i_coriolis_dt_v = i_coriolis_dt.fixed_rows_mut::<DIM>(0);
+                i_coriolis_dt_v.copy_from(coriolis_v);
+                let rb_mass_dt = vect_to_na(rb_mass * dt);
+                i_coriolis_dt_v
+                    .column_iter_mut()
+                    .for_each(|mut c| c.component_mul_assign(&rb_mass_dt));
+            }
+
+            #[cfg(feature = "dim2")]
+            {
+                let mut i_coriolis_dt_w = i_coriolis_dt.fixed_rows_mut::<ANG_DIM>(DIM);
+                // NOTE: this is just an axpy, but on row columns.
+                i_coriolis_dt_w.zip_apply(coriolis_w, |o, x| *o = x * dt * rb_inertia);
+            }
+            #[cfg(feature = "dim3")]
+            {
+                let mut i_coriolis_dt_w = i_coriolis_dt.fixed_rows_mut::<ANG_DIM>(DIM);
+                i_coriolis_dt_w.gemm(dt, &mat_to_na(rb_inertia), coriolis_w, 0.0);
+            }
+
+            self.acc_augmented_mass
+                .gemm_tr(1.0, rb_j, &i_coriolis_dt, 1.0);
+        }
+
+        /*
+         * Damping and armature.
+         *
+         * Damping is a velocity-proportional force made implicit, so it adds
+         * `dt · d` to the mass-matrix diagonal. Armature is a "reflected
+         * rotor inertia" (additional inertia to account for the joint’s
+         * mass and geometry itself): it adds to the diagonal directly.
+         */
+        for i in 0..self.ndofs {
+            let diag = self.damping[i] * dt + self.armature[i];
+            self.acc_augmented_mass[(i, i)] += diag;
+            self.augmented_mass[(i, i)] += diag;
+        }
+
+        // Implicit joint springs: `dt²·k` on the mass-matrix diagonal (force term in `update_acceleration`)
+        // keeps a stiff spring on a low-inertia link stable where an explicit position motor injects energy.
+        // The spring lives on the link's `MultibodyJoint` so it travels with the link through topology changes.
+        let dt2 = dt * dt;
+        for li in 0..self.links.len() {
+            let mut idx = self.links[li].assembly_id;
+            let locked = self.links[li].joint.data.locked_axes.bits();
+            for a in 0..SPATIAL_DIM {
+                if (locked >> a) & 1 == 0 {
+                    let k = self.links[li].joint.spring_stiffness[a];
+                    if k != 0.0 {
+                        let d = k * dt2;
+                        self.acc_augmented_mass[(idx, idx)] += d;
+                        self.augmented_mass[(idx, idx)] += d;
+                    }
+                    idx += 1;
+                }
+            }
+        }
+
+        let effective_dim = self
+            .augmented_mass_indices
+            .dim_after_removal(self.acc_augmented_mass.nrows());
+
+        // PERF: since we clone the matrix anyway for LU, should be directly output
+        //       a new matrix instead of applying permutations?
+        self.augmented_mass_indices
+            .rearrange_columns(&mut self.acc_augmented_mass, true);
+        self.augmented_mass_indices
+            .rearrange_columns(&mut self.augmented_mass, true);
+
+        self.augmented_mass_indices
+            .rearrange_rows(&mut self.acc_augmented_mass, true);
+        self.augmented_mass_indices
+            .rearrange_rows(&mut self.augmented_mass, true);
+
+        // TODO: avoid allocation inside LU at each timestep.
+        self.acc_inv_augmented_mass = LU::new(
+            self.acc_augmented_mass
+                .view((0, 0), (effective_dim, effective_dim))
+                .into_owned(),
+        );
+        self.inv_augmented_mass = LU::new(
+            self.augmented_mass
+                .view((0, 0), (effective_dim, effective_dim))
+                .into_owned(),
+        );
+    }
+
+
+    /// Test oracle for this vendored patch (`PATCH.md`): assembles the mass matrices with the
+    /// patched `update_mass_matrix` and with upstream's, at the current state, and returns the
+    /// largest absolute differences of the two `augmented_mass` and of the two
+    /// `acc_augmented_mass`, the largest absolute entry, and the largest absolute entry of
+    /// the gyroscopic and Coriolis part (`acc_augmented_mass - augmented_mass`). Leaves
+    /// upstream's (equal up to rounding) in place.
+    #[doc(hidden)]
+    pub fn mass_matrices_against_upstream(&mut self, dt: Real, bodies: &RigidBodySet) -> [Real; 4] {
+        self.update_mass_matrix(dt, bodies);
+        let (augmented, acc_augmented) =
+            (self.augmented_mass.clone(), self.acc_augmented_mass.clone());
+        self.update_mass_matrix_upstream(dt, bodies);
+        [
+            (&augmented - &self.augmented_mass).abs().max(),
+            (&acc_augmented - &self.acc_augmented_mass).abs().max(),
+            self.augmented_mass.abs().max(),
+            (&self.acc_augmented_mass - &self.augmented_mass).abs().max(),
+        ]
     }
 
     /// Per-DoF inverse joint-space inertia `diag(M⁻¹)` at the current configuration, where `M`
