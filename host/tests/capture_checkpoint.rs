@@ -66,6 +66,14 @@ struct Board {
 }
 
 impl Board {
+    /// A board at `link`, plugged in.
+    fn plugged_at(link: PathBuf) -> Board {
+        let mut board =
+            Board { link, master: None, encoder: FrameEncoder::new(), decoder: ChipDecoder::new(), host_seq: None };
+        board.plug();
+        board
+    }
+
     fn plug(&mut self) {
         let m = plug_at(&self.link);
         // Non-blocking: the test waits for the host's answers with a deadline.
@@ -248,14 +256,7 @@ fn interrupt(child: Child, err: Stderr) -> Vec<String> {
 fn capture_keeps_the_checkpoint_through_ten_unplugs_mid_save_and_sends_it_back_at_every_boot() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("leo.ckpt");
-    let mut board = Board {
-        link: dir.path().join("ttyUSB-leo"),
-        master: None,
-        encoder: FrameEncoder::new(),
-        decoder: ChipDecoder::new(),
-        host_seq: None,
-    };
-    board.plug();
+    let mut board = Board::plugged_at(dir.path().join("ttyUSB-leo"));
     let mut child = Command::new(env!("CARGO_BIN_EXE_pada"))
         .args(["capture", "--port"])
         .arg(&board.link)
@@ -396,14 +397,7 @@ fn a_recording_only_feeds_the_keeper() {
 fn watch_keeps_the_checkpoint_and_sends_it_back_on_its_port() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("leo.ckpt");
-    let mut board = Board {
-        link: dir.path().join("ttyACM-leo"),
-        master: None,
-        encoder: FrameEncoder::new(),
-        decoder: ChipDecoder::new(),
-        host_seq: None,
-    };
-    board.plug();
+    let mut board = Board::plugged_at(dir.path().join("ttyACM-leo"));
     let mut child = Command::new(env!("CARGO_BIN_EXE_pada"))
         .args(["watch", "--serve", "127.0.0.1:0", "--port"])
         .arg(&board.link)

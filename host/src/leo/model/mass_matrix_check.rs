@@ -9,6 +9,11 @@ use rapier3d::na::{DMatrix, DVector, Matrix3};
 use super::anatomy::InitialPose;
 use super::{LeoModel, ModelOptions, NUM_JOINTS};
 
+/// Every servo at a voltage drawn uniformly from ±10 V.
+fn random_voltages(rng: &mut rand_pcg::Pcg32) -> [f32; NUM_JOINTS] {
+    std::array::from_fn(|_| (rng.next_u32() as f32 / u32::MAX as f32) * 20.0 - 10.0)
+}
+
 #[test]
 fn rapier_factorises_the_dense_joint_space_mass_matrix() {
     let mut model = LeoModel::new(ModelOptions::default(), &InitialPose::REFERENCE).unwrap();
@@ -16,9 +21,7 @@ fn rapier_factorises_the_dense_joint_space_mass_matrix() {
     // Random voltages for a few control periods: bent joints, a pitched
     // torso, every body moving, so that no Jacobian column is trivial.
     for _ in 0..6 {
-        let voltages: [f32; NUM_JOINTS] =
-            std::array::from_fn(|_| (rng.next_u32() as f32 / u32::MAX as f32) * 20.0 - 10.0);
-        model.set_voltages(voltages);
+        model.set_voltages(random_voltages(&mut rng));
         model.control_step().unwrap();
     }
     let world = &mut model.world;
@@ -74,9 +77,7 @@ fn the_patched_mass_matrices_equal_upstreams() {
     let dt = model.options.dt();
     let mut largest_coriolis = 0.0f32;
     for step in 0..60 {
-        let voltages: [f32; NUM_JOINTS] =
-            std::array::from_fn(|_| (rng.next_u32() as f32 / u32::MAX as f32) * 20.0 - 10.0);
-        model.set_voltages(voltages);
+        model.set_voltages(random_voltages(&mut rng));
         if model.control_step().is_err() {
             break;
         }
