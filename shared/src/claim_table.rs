@@ -405,6 +405,13 @@ impl<W: WeightStore, T: TagStore> WeightStore for ClaimTable<W, T> {
         ClaimTable::read(self, feature)
     }
 
+    /// The key's home slot: its tag, and the weight beside it.
+    #[inline]
+    fn touch(&self, feature: u32) -> u32 {
+        let home = (feature & self.mask) as usize;
+        self.tags.get(home) ^ self.weights.raw(home)
+    }
+
     #[inline]
     fn claim(&mut self, feature: u32) -> Claim {
         ClaimTable::claim(self, feature)

@@ -132,6 +132,27 @@ pub trait WeightStore {
         self.format().bytes() + self.tag_bytes()
     }
 
+    /// Whether a reader of many features should [`touch`](Self::touch)
+    /// them all before it reads them: a table in cached memory far larger
+    /// than the cache (the host's LEO table), where a read's branches wait
+    /// on its cache miss, so misses taken one read at a time do not
+    /// overlap. `false` by default: the chips' tables sit in memory with
+    /// no data cache to fill, where touching is only extra reads.
+    #[inline]
+    fn touches_before_reading(&self) -> bool {
+        false
+    }
+
+    /// Loads the memory that [`read`](Self::read) of `feature` looks at
+    /// first and returns its bits (for `core::hint::black_box`). A batch of
+    /// touches are independent loads that the processor issues together;
+    /// the reads after them then find their lines in the cache. Changes
+    /// nothing and reads nothing outside the table.
+    #[inline]
+    fn touch(&self, feature: u32) -> u32 {
+        self.raw(feature as usize)
+    }
+
     /// The weight of `feature`: the weight at that index in a plain table,
     /// the feature's slot's (or its initial weight) in a claim table.
     #[inline]

@@ -130,6 +130,18 @@ impl WeightStore for HostTable {
         each!(self, t => WeightStore::read(t, feature))
     }
 
+    /// Every host table is in cached memory, and LEO's are far larger
+    /// than the cache.
+    #[inline]
+    fn touches_before_reading(&self) -> bool {
+        true
+    }
+
+    #[inline]
+    fn touch(&self, feature: u32) -> u32 {
+        each!(self, t => t.touch(feature))
+    }
+
     #[inline]
     fn claim(&mut self, feature: u32) -> Claim {
         each!(self, t => WeightStore::claim(t, feature))

@@ -657,10 +657,28 @@ where
         rng: &mut R,
     ) -> Levels {
         const MASK: usize = MAX_ACTION_COMBOS - 1;
+        let combos = at.combos() as usize;
+        // The features first (their bits), then, where the table is larger
+        // than a cache, one load of each (independent loads, whose misses
+        // overlap), then the reads, whose probes now hit the cache.
         let mut table = [[0i32; MAX_ACTION_COMBOS]; TILINGS];
         for (j, row) in table.iter_mut().enumerate() {
-            for (c, slot) in row.iter_mut().enumerate().take(at.combos() as usize) {
-                *slot = self.weights.read(self.coder.combo_feature(code, j, c as u32)).0;
+            for (c, slot) in row.iter_mut().enumerate().take(combos) {
+                *slot = self.coder.combo_feature(code, j, c as u32) as i32;
+            }
+        }
+        if self.weights.touches_before_reading() {
+            let mut touched = 0u32;
+            for row in &table {
+                for &feature in row.iter().take(combos) {
+                    touched ^= self.weights.touch(feature as u32);
+                }
+            }
+            core::hint::black_box(touched);
+        }
+        for row in table.iter_mut() {
+            for slot in row.iter_mut().take(combos) {
+                *slot = self.weights.read(*slot as u32).0;
             }
         }
         // Unused dimensions have lo = hi = 0 and contribute 0.
