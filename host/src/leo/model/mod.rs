@@ -48,6 +48,8 @@
 mod anatomy;
 mod build;
 #[cfg(test)]
+mod forward_kinematics_check;
+#[cfg(test)]
 mod mass_matrix_check;
 mod motor_lag;
 mod options;

@@ -436,7 +436,8 @@ impl PhysicsPipeline {
         // TODO: do this only on user-change.
         // TODO: do we want some kind of automatic inverse kinematics?
         for multibody in &mut multibody_joints.multibodies {
-            multibody.1.forward_kinematics(bodies, true);
+            // Vendored: skipped when nothing it reads changed since the last step ended with it.
+            multibody.1.forward_kinematics_if_changed(bodies, true);
             multibody
                 .1
                 .update_rigid_bodies_internal(bodies, true, false, false);

@@ -169,6 +169,10 @@ pub struct Multibody {
     link_dofs_range: Vec<(usize, usize)>,
     /// One link's Jacobian columns and their products with its mass matrices.
     mass_columns: Vec<MassColumn>,
+    /// The bits of everything the last `forward_kinematics` read (see
+    /// `push_kinematic_inputs`), and a workspace to compare them with.
+    kinematic_inputs: Vec<u32>,
+    kinematic_inputs_now: Vec<u32>,
 }
 impl Default for Multibody {
     fn default() -> Self {
@@ -204,6 +208,8 @@ impl Multibody {
             link_dofs: Vec::new(),
             link_dofs_range: Vec::new(),
             mass_columns: Vec::new(),
+            kinematic_inputs: Vec::new(),
+            kinematic_inputs_now: Vec::new(),
             root_is_dynamic: false,
             self_contacts_enabled,
             couplings: Vec::new(),
@@ -1812,6 +1818,76 @@ impl Multibody {
          * Compute body jacobians.
          */
         self.update_body_jacobians();
+
+        let mut inputs = core::mem::take(&mut self.kinematic_inputs);
+        inputs.clear();
+        self.push_kinematic_inputs(bodies, &mut inputs);
+        self.kinematic_inputs = inputs;
+    }
+
+    /// [`Self::forward_kinematics`], unless nothing it reads has changed since it last ran
+    /// (vendored addition): then the link poses and body Jacobians it would compute are,
+    /// bit for bit, the ones already there. Returns whether it ran.
+    ///
+    /// The step starts with forward kinematics for the case the user moved a joint between
+    /// steps; the previous step already ended with it (`integrate_multibody_positions`), so
+    /// without a user change it is repeated work (upstream's "TODO: do this only on
+    /// user-change"). What it reads is compared, not tracked: a change made through any
+    /// accessor, or by rapier itself, is seen.
+    pub fn forward_kinematics_if_changed(
+        &mut self,
+        bodies: &RigidBodySet,
+        read_root_pose_from_rigid_body: bool,
+    ) -> bool {
+        let mut now = core::mem::take(&mut self.kinematic_inputs_now);
+        now.clear();
+        self.push_kinematic_inputs(bodies, &mut now);
+        let unchanged = !self.kinematic_inputs.is_empty() && now == self.kinematic_inputs;
+        self.kinematic_inputs_now = now;
+        if unchanged {
+            return false;
+        }
+        self.forward_kinematics(bodies, read_root_pose_from_rigid_body);
+        true
+    }
+
+    /// Pushes the bits of everything [`Self::forward_kinematics`] reads: the DoF count and
+    /// the root's type (and the root body's, which makes it change the root joint); per link
+    /// its body, place in the tree and in the DoFs, the joint's locked axes, coordinates,
+    /// rotation and frames, and the body's local centre of mass.
+    fn push_kinematic_inputs(&self, bodies: &RigidBodySet, out: &mut Vec<u32>) {
+        fn push_vector(out: &mut Vec<u32>, v: Vector) {
+            out.extend_from_slice(&[v.x.to_bits(), v.y.to_bits(), v.z.to_bits()]);
+        }
+        fn push_rotation(out: &mut Vec<u32>, r: crate::math::Rotation) {
+            out.extend_from_slice(&[r.x.to_bits(), r.y.to_bits(), r.z.to_bits(), r.w.to_bits()]);
+        }
+        out.push(self.ndofs as u32);
+        out.push(self.root_is_dynamic as u32);
+        out.push(self.links.len() as u32);
+        let root_body = self.links.first().and_then(|l| bodies.get(l.rigid_body));
+        out.push(root_body.map_or(2, |rb| rb.is_dynamic() as u32));
+        for link in self.links.iter() {
+            let (index, generation) = link.rigid_body.into_raw_parts();
+            out.extend_from_slice(&[
+                index,
+                generation,
+                link.internal_id as u32,
+                link.parent_internal_id as u32,
+                link.assembly_id as u32,
+                link.joint.data.locked_axes.bits() as u32,
+            ]);
+            out.extend(link.joint.coords.iter().map(|c| c.to_bits()));
+            push_rotation(out, link.joint.joint_rot);
+            for frame in [&link.joint.data.local_frame1, &link.joint.data.local_frame2] {
+                push_vector(out, frame.translation);
+                push_rotation(out, frame.rotation);
+            }
+            match bodies.get(link.rigid_body) {
+                Some(rb) => push_vector(out, rb.mprops.local_mprops.local_com),
+                None => out.push(u32::MAX),
+            }
+        }
     }
 
     /// Computes the ids of all the links between the root and the link identified by `link_id`.
