@@ -5,7 +5,7 @@
 //! applied voltage), at each number of physics steps per control period.
 //!
 //! cargo run --release -p pada --example leo_ab_table [-- 2 4 8 12 48]
-use pada::leo::compare::{compare, Drive, Reference};
+use pada::leo::compare::{compare, references_in, Drive};
 use pada::leo::model::ModelOptions;
 
 /// 0.2 s of control steps: the horizon of the step-size study.
@@ -24,12 +24,10 @@ fn main() {
         }
     };
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/leo-ab");
-    let mut paths: Vec<_> = std::fs::read_dir(dir)
-        .expect("tests/data/leo-ab exists")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().and_then(|e| e.to_str()) == Some("csv"))
-        .collect();
-    paths.sort();
+    let references = references_in(std::path::Path::new(dir)).unwrap_or_else(|e| {
+        eprintln!("error: {e}");
+        std::process::exit(1);
+    });
     print!("| reference |");
     for s in &substeps {
         print!(" {s} steps |");
@@ -41,10 +39,7 @@ fn main() {
     }
     println!();
     let mut worst = vec![0.0f32; substeps.len()];
-    for path in paths {
-        let name = path.file_stem().unwrap().to_string_lossy().into_owned();
-        let text = std::fs::read_to_string(&path).expect("a readable reference");
-        let reference = Reference::parse(&text).expect("a valid reference");
+    for (name, reference) in references {
         print!("| `{name}` |");
         for (i, &s) in substeps.iter().enumerate() {
             let options = ModelOptions {

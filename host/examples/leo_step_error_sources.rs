@@ -8,7 +8,7 @@
 //! difference is one the coarse step integrates badly.
 //!
 //! cargo run --release -p pada --example leo_step_error_sources [-- 4]
-use pada::leo::compare::{compare, Drive, Reference};
+use pada::leo::compare::{compare, references_in, Drive};
 use pada::leo::model::ModelOptions;
 
 /// 0.2 s of control steps: the horizon of the step-size study.
@@ -34,17 +34,10 @@ fn main() {
         ("no joint stops", ModelOptions { joint_stops: false, ..all }),
     ];
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/leo-ab");
-    let mut paths: Vec<_> = match std::fs::read_dir(dir) {
-        Ok(entries) => entries
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.extension().and_then(|e| e.to_str()) == Some("csv"))
-            .collect(),
-        Err(e) => {
-            eprintln!("error: cannot read {dir}: {e}");
-            std::process::exit(1);
-        }
-    };
-    paths.sort();
+    let references = references_in(std::path::Path::new(dir)).unwrap_or_else(|e| {
+        eprintln!("error: {e}");
+        std::process::exit(1);
+    });
     println!("{coarse} physics steps per period against {FINE_SUBSTEPS}, largest angle difference (rad):\n");
     print!("| reference |");
     for (name, _) in &variants {
@@ -53,18 +46,7 @@ fn main() {
     println!();
     println!("|---|{}", "---|".repeat(variants.len()));
     let mut worst = [0.0f32; 5];
-    for path in paths {
-        let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-        let reference = match std::fs::read_to_string(&path)
-            .map_err(|e| e.to_string())
-            .and_then(|t| Reference::parse(&t).map_err(|e| e.to_string()))
-        {
-            Ok(r) => r,
-            Err(e) => {
-                eprintln!("error: {}: {e}", path.display());
-                std::process::exit(1);
-            }
-        };
+    for (name, reference) in references {
         print!("| `{name}` |");
         for (i, (_, options)) in variants.iter().enumerate() {
             let run = |substeps| {

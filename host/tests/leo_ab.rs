@@ -25,7 +25,7 @@
 //!   20 N, which pada's stiff contacts leave out; over a leg of about
 //!   0.2 m that is 0.004 rad.
 
-use pada::leo::compare::{compare, Comparison, Drive, Reference, ANGLE_NAMES};
+use pada::leo::compare::{compare, references_in, Comparison, Drive, Reference, ANGLE_NAMES};
 use pada::leo::model::ModelOptions;
 
 const STEP_TOLERANCE: f32 = 0.02;
@@ -40,18 +40,7 @@ const START_TOLERANCE: f32 = 0.004;
 /// Every reference trajectory, by name.
 fn references() -> Vec<(String, Reference)> {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/leo-ab");
-    let mut out = Vec::new();
-    for entry in std::fs::read_dir(dir).expect("tests/data/leo-ab exists") {
-        let path = entry.expect("a directory entry").path();
-        if path.extension().and_then(|e| e.to_str()) != Some("csv") {
-            continue;
-        }
-        let text = std::fs::read_to_string(&path).expect("a readable reference");
-        let name = path.file_stem().unwrap().to_string_lossy().into_owned();
-        let reference = Reference::parse(&text).unwrap_or_else(|e| panic!("{name}: {e}"));
-        out.push((name, reference));
-    }
-    out.sort_by(|a, b| a.0.cmp(&b.0));
+    let out = references_in(std::path::Path::new(dir)).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(
         out.len(),
         9,

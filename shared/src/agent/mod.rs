@@ -660,7 +660,9 @@ where
         let combos = at.combos() as usize;
         // The features first (their bits), then, where the table is larger
         // than a cache, one load of each (independent loads, whose misses
-        // overlap), then the reads, whose probes now hit the cache.
+        // overlap), then the reads, whose probes now hit the cache. (Three
+        // passes: the touch folded into the hashing loop measured 25·10³
+        // more instructions per choice.)
         let mut table = [[0i32; MAX_ACTION_COMBOS]; TILINGS];
         for (j, row) in table.iter_mut().enumerate() {
             for (c, slot) in row.iter_mut().enumerate().take(combos) {

@@ -19,7 +19,7 @@ use serde::Serialize;
 use crate::leo::model::{ModelOptions, NUM_JOINTS};
 use crate::leo::task::Leg;
 use crate::leo::{LeoConfig, LeoEnv, LeoError, Terminal};
-pub use reference::{LeoState, Reference, ReferenceError, ReferenceStep};
+pub use reference::{references_in, LeoState, Reference, ReferenceError, ReferenceStep};
 
 /// How the reference drives pada's LEO (see the module's documentation).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]

@@ -196,6 +196,26 @@ impl fmt::Display for ReferenceError {
 
 impl std::error::Error for ReferenceError {}
 
+/// Every reference in `dir` (its `*.csv` files, as `tests/data/leo-ab/`
+/// holds them), named by file stem and sorted by name. Errors name the
+/// directory or the file and why it could not be read or parsed.
+pub fn references_in(dir: &std::path::Path) -> Result<Vec<(String, Reference)>, String> {
+    let entries = std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let mut out = Vec::new();
+    for entry in entries {
+        let path = entry.map_err(|e| format!("{}: {e}", dir.display()))?.path();
+        if path.extension().and_then(|e| e.to_str()) != Some("csv") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let reference = Reference::parse(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+        let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        out.push((name, reference));
+    }
+    out.sort_by(|a, b| a.0.cmp(&b.0));
+    Ok(out)
+}
+
 impl Reference {
     /// Parses a reference file's text (see the module's documentation).
     pub fn parse(text: &str) -> Result<Reference, ReferenceError> {

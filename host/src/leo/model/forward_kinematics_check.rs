@@ -5,17 +5,14 @@
 //! kinematics computes; and a joint moved or re-framed between steps makes
 //! it run.
 
-use rand_core::{RngCore, SeedableRng};
+use rand_core::SeedableRng;
 use rapier3d::dynamics::Multibody;
 use rapier3d::math::Vector;
 
 use super::anatomy::InitialPose;
+use super::test_drive::random_voltages;
 use super::{LeoModel, ModelOptions, NUM_JOINTS};
 
-/// Every servo at a voltage drawn uniformly from ±10 V.
-fn random_voltages(rng: &mut rand_pcg::Pcg32) -> [f32; NUM_JOINTS] {
-    std::array::from_fn(|_| (rng.next_u32() as f32 / u32::MAX as f32) * 20.0 - 10.0)
-}
 
 /// Whether two multibodies hold the same link poses and body Jacobians,
 /// bit for bit.

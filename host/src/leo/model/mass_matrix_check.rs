@@ -3,16 +3,13 @@
 //! armature, formed densely here from rapier's public body Jacobians and the
 //! bodies' masses and world inertias, in a pose the robot moved into.
 
-use rand_core::{RngCore, SeedableRng};
+use rand_core::SeedableRng;
 use rapier3d::na::{DMatrix, DVector, Matrix3};
 
 use super::anatomy::InitialPose;
-use super::{LeoModel, ModelOptions, NUM_JOINTS};
+use super::test_drive::random_voltages;
+use super::{LeoModel, ModelOptions};
 
-/// Every servo at a voltage drawn uniformly from ±10 V.
-fn random_voltages(rng: &mut rand_pcg::Pcg32) -> [f32; NUM_JOINTS] {
-    std::array::from_fn(|_| (rng.next_u32() as f32 / u32::MAX as f32) * 20.0 - 10.0)
-}
 
 #[test]
 fn rapier_factorises_the_dense_joint_space_mass_matrix() {

@@ -55,6 +55,8 @@ mod motor_lag;
 mod options;
 mod state;
 mod step;
+#[cfg(test)]
+mod test_drive;
 
 pub use anatomy::{
     assemble, joint_limits, Body, InitialPose, Joint, JOINTS, NUM_BODIES, NUM_JOINTS,
