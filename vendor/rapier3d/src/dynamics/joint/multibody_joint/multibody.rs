@@ -92,6 +92,46 @@ fn jacobian_w(j: &[Real], c: usize) -> na::Vector3<Real> {
     na::Vector3::new(j[6 * c + 3], j[6 * c + 4], j[6 * c + 5])
 }
 
+/// `out[c] += Σᵣ J[r, c]·f[r]` for the columns `c` in `dofs` of a column-major `6 × n` body
+/// Jacobian J that is zero in every other column: upstream's `out.gemv_tr(1.0, J, f, 1.0)`,
+/// bit for bit on those columns (nalgebra sums a 6-row dot product from zero, one row at a time,
+/// then adds the old value), without the products with the zero columns, which leave their
+/// entries as they were (unless `f` is not finite, where upstream writes NaN there as well as in
+/// the link's own columns).
+#[inline]
+fn add_jacobian_tr_times(
+    out: &mut [Real],
+    j: &[Real],
+    dofs: &[usize],
+    f: &SVector<Real, SPATIAL_DIM>,
+) {
+    for &c in dofs {
+        let column = &j[SPATIAL_DIM * c..SPATIAL_DIM * (c + 1)];
+        let mut dot: Real = 0.0;
+        for r in 0..SPATIAL_DIM {
+            dot += column[r] * f[r];
+        }
+        out[c] = dot + out[c];
+    }
+}
+
+/// `J_v[:, c] += S·J_w[:, c]` for the columns `c` in `dofs` of a column-major `6 × n` body
+/// Jacobian whose other columns are zero: upstream's `j_v.gemm(1.0, &s, &j_w, 1.0)`, bit for bit
+/// on those columns (nalgebra's small-matrix gemm adds `S[r, k]·w[k]` to each entry for k = 0, 1,
+/// 2 in turn), without the products with the zero columns, which would leave them zero.
+#[inline]
+fn add_shift_times_angular(j: &mut [Real], s: &na::Matrix3<Real>, dofs: &[usize]) {
+    for &c in dofs {
+        let column = &mut j[SPATIAL_DIM * c..SPATIAL_DIM * (c + 1)];
+        let w = [column[3], column[4], column[5]];
+        for (k, w_k) in w.iter().enumerate() {
+            for r in 0..DIM {
+                column[r] = s[(r, k)] * w_k + column[r];
+            }
+        }
+    }
+}
+
 /// A holonomic coupling between two generalized coordinates of a single
 /// [`Multibody`], `q2 = coeff · q1 + offset`, enforced as a velocity-level
 /// equality constraint. This is how MuJoCo's `<equality><joint>` (a polynomial
@@ -588,6 +628,12 @@ impl Multibody {
             0
         });
 
+        // The DoFs each link's Jacobian depends on, listed by `update_mass_matrix`, which the
+        // solver always calls just before; listed here if it did not.
+        if self.link_dofs_range.len() != self.links.len() {
+            self.update_link_dofs();
+        }
+
         // Eqn 42 to 45
         for i in 0..self.links.len() {
             let link = &self.links[i];
@@ -642,20 +688,24 @@ impl Multibody {
                 rb.forces.force - rb_mass * acc.linvel,
                 rb.forces.torque - gyroscopic - rb_inertia * acc.angvel,
             );
-            self.accelerations.gemv_tr(
-                1.0,
-                &self.body_jacobians[i],
+            // `accelerations += Jᵀ·f` over the link's DoFs only (see `add_jacobian_tr_times`).
+            let (deps_start, deps_end) = self.link_dofs_range[i];
+            let deps = &self.link_dofs[deps_start..deps_end];
+            let rb_j = self.body_jacobians[i].as_slice();
+            add_jacobian_tr_times(
+                self.accelerations.as_mut_slice(),
+                rb_j,
+                deps,
                 external_forces.as_vector(),
-                1.0,
             );
 
             if check_implicit_coriolis_divergence {
                 let applied_forces = Force::new(rb.forces.force, rb.forces.torque);
-                pos_forces.gemv_tr(
-                    1.0,
-                    &self.body_jacobians[i],
+                add_jacobian_tr_times(
+                    pos_forces.as_mut_slice(),
+                    rb_j,
+                    deps,
                     applied_forces.as_vector(),
-                    1.0,
                 );
             }
         }
@@ -809,6 +859,9 @@ impl Multibody {
     }
 
     fn update_body_jacobians(&mut self) {
+        // The shifts below touch only the columns of the DoFs a link's Jacobian depends on
+        // (`add_shift_times_angular`); the others are zero, copied from the parent or filled.
+        self.update_link_dofs();
         for i in 0..self.links.len() {
             let link = &self.links[i];
 
@@ -827,13 +880,15 @@ impl Multibody {
                 let (link_j, parent_j) = self.body_jacobians.index_mut_const(i, parent_id);
                 link_j.copy_from(parent_j);
 
-                {
-                    let mut link_j_v = link_j.fixed_rows_mut::<DIM>(0);
-                    let parent_j_w = parent_j.fixed_rows::<ANG_DIM>(DIM);
-
-                    let shift_tr = vect_to_na(link.shift02).gcross_matrix_tr();
-                    link_j_v.gemm(1.0, &shift_tr, &parent_j_w, 1.0);
-                }
+                // Upstream: `link_j_v.gemm(1.0, &shift_tr, &parent_j_w, 1.0)`; the copy's angular
+                // rows are the parent's, nonzero in the parent's DoFs' columns only.
+                let (parent_start, parent_end) = self.link_dofs_range[parent_id];
+                let shift_tr = vect_to_na(link.shift02).gcross_matrix_tr();
+                add_shift_times_angular(
+                    link_j.as_mut_slice(),
+                    &shift_tr,
+                    &self.link_dofs[parent_start..parent_end],
+                );
             } else {
                 self.body_jacobians[i].fill(0.0);
                 parent_to_world = Pose::IDENTITY;
@@ -849,13 +904,14 @@ impl Multibody {
             );
             link_j_part += link_joint_j;
 
-            {
-                let link_j = &mut self.body_jacobians[i];
-                let (mut link_j_v, link_j_w) =
-                    link_j.rows_range_pair_mut(0..DIM, DIM..DIM + ANG_DIM);
-                let shift_tr = vect_to_na(link.shift23).gcross_matrix_tr();
-                link_j_v.gemm(1.0, &shift_tr, &link_j_w, 1.0);
-            }
+            // Upstream: `link_j_v.gemm(1.0, &shift_tr, &link_j_w, 1.0)` over every column.
+            let (deps_start, deps_end) = self.link_dofs_range[i];
+            let shift_tr = vect_to_na(link.shift23).gcross_matrix_tr();
+            add_shift_times_angular(
+                self.body_jacobians[i].as_mut_slice(),
+                &shift_tr,
+                &self.link_dofs[deps_start..deps_end],
+            );
         }
     }
 
@@ -1435,6 +1491,72 @@ impl Multibody {
             self.augmented_mass.abs().max(),
             (&self.acc_augmented_mass - &self.augmented_mass).abs().max(),
         ]
+    }
+
+    /// Test oracle for this vendored patch (`PATCH.md`): recomputes every link's body Jacobian
+    /// from the link poses now in place with upstream's dense shifts (`gemm` over every column),
+    /// and every link's `Jᵀ·force` added to a nonzero vector with upstream's `gemv_tr`, and
+    /// returns whether both equal the patched ones (`add_shift_times_angular`,
+    /// `add_jacobian_tr_times`) bit for bit.
+    #[doc(hidden)]
+    pub fn jacobian_products_match_upstream(&self, force: [Real; SPATIAL_DIM]) -> bool {
+        let bits = |m: &[Real]| m.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        let mut dense: Vec<Jacobian<Real>> = Vec::with_capacity(self.links.len());
+        for i in 0..self.links.len() {
+            let link = &self.links[i];
+            let mut link_j = Jacobian::zeros(self.ndofs);
+            let parent_to_world;
+            if i != 0 {
+                let parent_id = link.parent_internal_id;
+                parent_to_world = self.links[parent_id].local_to_world;
+                link_j.copy_from(&dense[parent_id]);
+                let parent_j_w = dense[parent_id].fixed_rows::<ANG_DIM>(DIM).into_owned();
+                let shift_tr = vect_to_na(link.shift02).gcross_matrix_tr();
+                link_j
+                    .fixed_rows_mut::<DIM>(0)
+                    .gemm(1.0, &shift_tr, &parent_j_w, 1.0);
+            } else {
+                parent_to_world = Pose::IDENTITY;
+            }
+            let ndofs = link.joint.ndofs();
+            let mut tmp = SMatrix::<Real, SPATIAL_DIM, SPATIAL_DIM>::zeros();
+            let mut link_joint_j = tmp.columns_mut(0, ndofs);
+            link.joint.jacobian(
+                &(parent_to_world.rotation * link.joint.data.local_frame1.rotation),
+                &mut link_joint_j,
+            );
+            let mut link_j_part = link_j.columns_mut(link.assembly_id, ndofs);
+            link_j_part += link_joint_j;
+            {
+                let (mut link_j_v, link_j_w) =
+                    link_j.rows_range_pair_mut(0..DIM, DIM..DIM + ANG_DIM);
+                let shift_tr = vect_to_na(link.shift23).gcross_matrix_tr();
+                link_j_v.gemm(1.0, &shift_tr, &link_j_w, 1.0);
+            }
+            if bits(link_j.as_slice()) != bits(self.body_jacobians[i].as_slice()) {
+                return false;
+            }
+            dense.push(link_j);
+        }
+
+        let force = SVector::<Real, SPATIAL_DIM>::from(force);
+        let start = DVector::from_fn(self.ndofs, |k, _| 0.1 * (k as Real + 1.0));
+        for i in 0..self.links.len() {
+            let mut upstream = start.clone();
+            upstream.gemv_tr(1.0, &self.body_jacobians[i], &force, 1.0);
+            let mut patched = start.clone();
+            let (deps_start, deps_end) = self.link_dofs_range[i];
+            add_jacobian_tr_times(
+                patched.as_mut_slice(),
+                self.body_jacobians[i].as_slice(),
+                &self.link_dofs[deps_start..deps_end],
+                &force,
+            );
+            if bits(upstream.as_slice()) != bits(patched.as_slice()) {
+                return false;
+            }
+        }
+        true
     }
 
     /// Per-DoF inverse joint-space inertia `diag(M⁻¹)` at the current configuration, where `M`
