@@ -204,7 +204,10 @@ pub struct Multibody {
     coriolis_v: Vec<OMatrix<Real, Dim, Dyn>>,
     coriolis_w: Vec<OMatrix<Real, AngDim, Dyn>>,
     /// The DoFs each link's body Jacobian depends on (its own and its ancestors'), link by
-    /// link: link `i`'s are `link_dofs[link_dofs_range[i].0..link_dofs_range[i].1]`.
+    /// link: link `i`'s are `link_dofs[link_dofs_range[i].0..link_dofs_range[i].1]`. Listed by
+    /// forward kinematics with the Jacobians themselves, which every user of either follows
+    /// (the step skips forward kinematics only when nothing it reads, the tree included, has
+    /// changed since it last ran).
     link_dofs: Vec<usize>,
     link_dofs_range: Vec<(usize, usize)>,
     /// One link's Jacobian columns and their products with its mass matrices.
@@ -628,12 +631,6 @@ impl Multibody {
             0
         });
 
-        // The DoFs each link's Jacobian depends on, listed by `update_mass_matrix`, which the
-        // solver always calls just before; listed here if it did not.
-        if self.link_dofs_range.len() != self.links.len() {
-            self.update_link_dofs();
-        }
-
         // Eqn 42 to 45
         for i in 0..self.links.len() {
             let link = &self.links[i];
@@ -965,7 +962,6 @@ impl Multibody {
         // over those columns only, with fixed-size 3×3 and 3-vector arithmetic, where upstream
         // forms full `6 × ndofs` products (`quadform`, `gemm`) over mostly-zero columns.
         // Mathematically the same matrices; only the rounding order differs.
-        self.update_link_dofs();
         let mut curr_assembly_id = 0;
 
         for i in 0..self.links.len() {
