@@ -10,7 +10,7 @@ use super::anatomy::{
     NUM_JOINTS,
 };
 use super::options::{options_servo, ModelError, ModelOptions};
-use super::{LeoModel, Snapshot, LATERAL_TIE, LINEAR_Y, ROOT_DOFS, ROOT_Y};
+use super::{LeoModel, Snapshot, ROOT_DOFS};
 
 impl LeoModel {
     /// Builds LEO in `pose` at rest, voltages 0 (§1.8).
@@ -109,8 +109,9 @@ impl LeoModel {
                 .contacts_enabled(false)
                 .build()
         } else {
-            // y stays a DoF, held by the lateral tie (see `LATERAL_TIE`).
-            GenericJointBuilder::new(JointAxesMask::ANG_X | JointAxesMask::ANG_Z)
+            GenericJointBuilder::new(
+                JointAxesMask::LIN_Y | JointAxesMask::ANG_X | JointAxesMask::ANG_Z,
+            )
                 .contacts_enabled(false)
                 .build()
         };
@@ -195,13 +196,7 @@ impl LeoModel {
             mb.link_mut(root_link)
                 .ok_or(ModelError::Topology)?
                 .joint
-                .apply_displacement(&[torso[0], 0.0, torso[1], pitch[Body::Torso as usize]]);
-            // The lateral tie: a stiff implicit spring and damper at y = 0.
-            mb.link_mut(root_link)
-                .ok_or(ModelError::Topology)?
-                .joint
-                .set_spring(LINEAR_Y, LATERAL_TIE[0], 0.0);
-            mb.damping_mut()[root_dof + ROOT_Y] = LATERAL_TIE[1];
+                .apply_displacement(&[torso[0], torso[1], pitch[Body::Torso as usize]]);
         }
         let angles = pose.joint_angles();
         for k in 0..NUM_JOINTS {
@@ -317,7 +312,6 @@ impl LeoModel {
             let c = root.joint.coords();
             root.joint.apply_displacement(&[
                 root_target[0] - c[0],
-                -c[1],
                 root_target[1] - c[2],
                 root_target[2] - c[4],
             ]);

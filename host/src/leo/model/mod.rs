@@ -5,10 +5,10 @@
 //!
 //! - **Planar motion** (§1.4: GRL keeps LEO planar only by symmetry). Here
 //!   the robot is one reduced-coordinate multibody whose root is a fixed
-//!   anchor and whose first joint is free in x, z and pitch, locked in roll
-//!   and yaw, and held at y = 0 by a stiff implicit spring (the lateral tie,
-//!   [`LATERAL_TIE`]: with y locked outright rapier's contact friction
-//!   fails, see there). Out-of-plane rotation has no coordinate at all.
+//!   anchor and whose first joint is free in x, z and pitch only: the
+//!   lateral translation, roll and yaw have no coordinate at all. (Rapier's
+//!   contact friction needs a patch for that: the floor's lateral friction
+//!   row has no mobility, `vendor/rapier3d/PATCH.md`.)
 //! - **The boom** (§1.4) is folded into the torso's mass, CoM and inertia
 //!   (see the constants) plus the extra vertical force, applied at its torso
 //!   point every physics step. GRL's massless `virtualBoom` body is not
@@ -72,25 +72,6 @@ use super::stiction::{FrictionState, Stiction};
 /// Index of a revolute joint's free axis (rotation about its local x) in
 /// rapier's 6-DoF spatial layout, for the joint springs.
 const ANGULAR_X: usize = 3;
-/// Index of the lateral (y) translation in rapier's spatial layout.
-const LINEAR_Y: usize = 1;
-
-/// The lateral tie of the root: stiffness (N/m) and damping (N s/m) of an
-/// implicit spring that holds the robot at y = 0.
-///
-/// Why y is a DoF at all: with y locked, the contacts' out-of-plane
-/// friction direction has no mobility, and rapier's solver divides by a
-/// rounding error there (1/(J·M⁻¹·Jᵀ) of a row that should be 0 but is
-/// not once the bodies are pitched). The resulting impulses fill the whole
-/// friction cone, which rapier caps as one 2-D vector, so nothing was left
-/// for the in-plane direction: the standing robot slid under a 1 N push as
-/// if the floor had no friction, whatever μ (measured, `README.md`). With y
-/// free and tied, that row has the robot's mass behind it. The tie is the
-/// boom's lateral stiffness in spirit but not a fact of the reference:
-/// 1e7 N/m moves LEO (≈ 2.3 kg) by 0.5 µm under a 5 N side push, and the
-/// damper (≈ 2·√(k·m)) keeps it from ringing; rapier integrates both
-/// implicitly, so they are stable at any step.
-const LATERAL_TIE: [f32; 2] = [1.0e7, 1.0e4];
 
 /// The simulated robot: a rapier world plus the voltages being held.
 pub struct LeoModel {
@@ -139,10 +120,9 @@ pub struct Snapshot {
     friction_states: [FrictionState; NUM_JOINTS],
 }
 
-/// The DoF order of the root joint: x, y (the lateral tie), z, pitch.
+/// The DoF order of the root joint: x, z, pitch.
 const ROOT_X: usize = 0;
-const ROOT_Y: usize = 1;
-const ROOT_Z: usize = 2;
-const ROOT_PITCH: usize = 3;
+const ROOT_Z: usize = 1;
+const ROOT_PITCH: usize = 2;
 /// The root's free DoFs.
-const ROOT_DOFS: usize = 4;
+const ROOT_DOFS: usize = 3;

@@ -8,7 +8,7 @@ use super::super::constants::*;
 use super::super::stiction::FrictionState;
 use super::anatomy::{limits_and_stop, Body, BODY_SPECS, JOINT_SPECS, NUM_JOINTS};
 use super::options::{BlowUp, ModelOptions};
-use super::{LeoModel, LATERAL_TIE, LINEAR_Y, ROOT_PITCH, ROOT_X, ROOT_Y, ROOT_Z};
+use super::{LeoModel, ROOT_PITCH, ROOT_X, ROOT_Z};
 
 /// The raw state the task reads after a step (§3.1).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -131,9 +131,8 @@ impl LeoModel {
         let (angles, rates) = self.joint_state();
         let root = mb.link(self.root_link).map(|l| l.joint.coords());
         let (x, z, pitch) = match (root, self.root_dof) {
-            // Coordinates of the root joint: coords[0] = x, coords[1] = y
-            // (the lateral tie's), coords[2] = z, coords[4] = rotation
-            // about y (not wrapped).
+            // Coordinates of the root joint: coords[0] = x, coords[2] = z,
+            // coords[4] = rotation about y (not wrapped).
             (Some(c), Some(_)) => (c[0], c[2], c[4]),
             _ => {
                 let pose = self.body_pose(Body::Torso);
@@ -177,7 +176,6 @@ impl LeoModel {
             }
             if let Some(r) = root_dof {
                 v[r + ROOT_X] = root[0];
-                v[r + ROOT_Y] = 0.0;
                 v[r + ROOT_Z] = root[1];
                 v[r + ROOT_PITCH] = root[2];
             }
@@ -225,13 +223,7 @@ impl LeoModel {
             let p = self.body_point(Body::Torso, BOOM_FORCE_POINT);
             potential += (-BOOM_EXTRA_FORCE_Z * p[1]) as f64;
         }
-        // The lateral tie's spring and the friction ties' springs.
-        if self.root_dof.is_some() {
-            let y = mb
-                .link(self.root_link)
-                .map_or(0.0, |l| l.joint.coords()[LINEAR_Y]);
-            potential += 0.5 * (LATERAL_TIE[0] * y * y) as f64;
-        }
+        // The friction ties' springs.
         for k in 0..NUM_JOINTS {
             if let (FrictionState::Stick { anchor }, true) =
                 (self.friction_states[k], self.friction.is_active())

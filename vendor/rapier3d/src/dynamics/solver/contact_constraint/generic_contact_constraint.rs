@@ -16,6 +16,10 @@ use crate::prelude::RigidBodyHandle;
 use crate::utils::OrthonormalBasis;
 use parry::math::Vector;
 
+/// A friction row whose mobility J·M⁻¹·Jᵀ is below this fraction of its
+/// contact normal's has none but rounding (see its use).
+const NO_MOBILITY: Real = 1.0e-6;
+
 #[derive(Copy, Clone)]
 pub(crate) struct GenericContactConstraintBuilder {
     infos: [CoulombContactPointInfos<Real>; MAX_MANIFOLD_POINTS],
@@ -179,6 +183,7 @@ impl GenericContactConstraintBuilder {
 
             // Normal part.
             let restitution_seed;
+            let normal_mobility;
             {
                 let torque_dir1 = dp1.gcross(force_dir1);
                 let torque_dir2 = dp2.gcross(-force_dir1);
@@ -218,7 +223,8 @@ impl GenericContactConstraintBuilder {
                     0.0
                 };
 
-                let r = crate::utils::inv(inv_r1 + inv_r2);
+                normal_mobility = inv_r1 + inv_r2;
+                let r = crate::utils::inv(normal_mobility);
 
                 // Warm-start impulses and contact newness come from the manifold
                 // point (they are not duplicated on the solver contacts).
@@ -322,7 +328,21 @@ impl GenericContactConstraintBuilder {
                         0.0
                     };
 
-                    let r = crate::utils::inv(inv_r1 + inv_r2);
+                    // A multibody with a locked DoF (a planar robot: no lateral
+                    // translation, no roll or yaw) cannot move along a tangent in
+                    // that direction, but the row's J·M⁻¹·Jᵀ is a rounding error
+                    // (≈ 1e-13 of the normal's), not zero. Upstream's 1/(that)
+                    // turns noise into impulses that fill the friction cone, which
+                    // is capped as one 2-D vector, so the other, real direction
+                    // loses its friction and the robot slides. Such a row gets no
+                    // impulse; rows with any real mobility are ≥ 1e-1 of the
+                    // normal's for a foot on a floor.
+                    let mobility = inv_r1 + inv_r2;
+                    let r = if mobility <= NO_MOBILITY * normal_mobility {
+                        0.0
+                    } else {
+                        crate::utils::inv(mobility)
+                    };
                     let rhs_wo_bias = manifold_point.tangent_velocity.gdot(tangents1[j]);
 
                     out_constraint.tangent_part[k].rhs_wo_bias[j] = rhs_wo_bias;
