@@ -109,9 +109,8 @@ impl LeoModel {
                 .contacts_enabled(false)
                 .build()
         } else {
-            GenericJointBuilder::new(
-                JointAxesMask::LIN_Y | JointAxesMask::ANG_X | JointAxesMask::ANG_Z,
-            )
+            let locked = JointAxesMask::LIN_Y | JointAxesMask::ANG_X | JointAxesMask::ANG_Z;
+            GenericJointBuilder::new(locked)
                 .contacts_enabled(false)
                 .build()
         };
