@@ -135,7 +135,7 @@ fn the_passive_robot_holds_its_swing_hip_and_slides_its_stance_hip() {
 /// The stance foot stands on the floor (§1.7, rubber μ = 100): with 0 V
 /// on every joint and a 1 N forward push on the torso, the left foot's
 /// heel and toe do not slide while both touch. Bound: 0.2 mm in 0.3 s
-/// (measured: 0.02 mm). The root has no lateral DoF, so the floor's
+/// (measured: 0.015 mm). The root has no lateral DoF, so the floor's
 /// lateral friction row has no mobility; upstream rapier divided by its
 /// rounding error and lost the in-plane friction, and this test then
 /// fails (the foot slid 6.2 mm; `vendor/rapier3d/PATCH.md`).
