@@ -5,8 +5,6 @@
 //! 8 turns of a 1024-line encoder in one 33 ms period), so the signed
 //! 16-bit difference of two samples is the true motion.
 
-use crate::config::EncoderConfig;
-
 /// Tracks whole turns of a wrapping 16-bit counter.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Unwrapper {
@@ -32,22 +30,6 @@ impl Unwrapper {
     /// Counts since the first sample, as of the last update.
     pub fn total(&self) -> i64 {
         self.total
-    }
-}
-
-impl EncoderConfig {
-    /// Angle \[rad\] of `counts` since the reference.
-    pub fn angle(&self, counts: i64) -> f32 {
-        let turns = counts as f64 / self.counts_per_rev as f64;
-        (self.sign as f64 * turns * core::f64::consts::TAU) as f32
-    }
-
-    /// The 16-bit timer count of `angle` \[rad\] from the reference: the
-    /// inverse of [`angle`](Self::angle), wrapping as the timer does. What
-    /// a simulated encoder of this configuration reads.
-    pub fn count_of(&self, angle: f64) -> u16 {
-        let counts = libm::round(self.sign as f64 * angle / core::f64::consts::TAU * self.counts_per_rev as f64) as i64;
-        counts.rem_euclid(1 << 16) as u16
     }
 }
 
@@ -84,30 +66,6 @@ mod tests {
             pos += (k * 7919 % 40_001) - 20_000;
             assert_eq!(u.update(pos.rem_euclid(65_536) as u16), pos - start);
         }
-    }
-
-    #[test]
-    fn angle_of_a_turn() {
-        let e = EncoderConfig { counts_per_rev: 4096, sign: 1 };
-        assert!((e.angle(4096) - 2.0 * PI).abs() < 1e-6);
-        assert!((e.angle(-1024) + PI / 2.0).abs() < 1e-6);
-        let flipped = EncoderConfig { sign: -1, ..e };
-        assert!((flipped.angle(1024) + PI / 2.0).abs() < 1e-6);
-    }
-
-    #[test]
-    fn count_of_inverts_angle_and_wraps_like_the_timer() {
-        use core::f64::consts::TAU;
-        for e in [EncoderConfig { counts_per_rev: 4096, sign: 1 }, EncoderConfig { counts_per_rev: 2000, sign: -1 }] {
-            assert_eq!(e.count_of(0.0), 0);
-            for counts in [1i64, 100, -100, 4095, -30_000] {
-                assert_eq!(e.count_of(e.angle(counts) as f64), counts.rem_euclid(1 << 16) as u16, "{e:?} at {counts}");
-            }
-        }
-        // Sixteen whole turns of 4096 counts are 65 536: the timer's wrap.
-        let e = EncoderConfig { counts_per_rev: 4096, sign: 1 };
-        assert_eq!(e.count_of(16.0 * TAU), 0);
-        assert_eq!(e.count_of(-TAU / 4096.0), 65_535);
     }
 
     #[test]

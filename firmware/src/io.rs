@@ -47,7 +47,7 @@ pub trait Sensors {
     /// tracks whole turns), or `None` if it could not be read.
     async fn encoder_count(&mut self) -> Option<u16>;
 
-    /// Foot contacts as a bit set of [`crate::leo::contact`] bits (toe R,
+    /// Foot contacts as a bit set of `pada_core::robot::leo::contact` bits (toe R,
     /// heel R, toe L, heel L); 0 on a robot without them.
     async fn contacts(&mut self) -> u8;
 }

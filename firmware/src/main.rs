@@ -30,8 +30,7 @@ use pada_core::checkpoint::CheckpointStore;
 use pada_core::policy::PolicyKind;
 use pada_core::weights::WeightStore;
 use pada_core::wire::{self, ToHost};
-use pada_firmware::robot::RobotAdapter;
-use table::{Ctl, ThisRobot, PROFILE};
+use table::{Ctl, PROFILE, ROBOT};
 
 /// The policy at boot; the host chooses another with `SetPolicy`.
 const BOOT_POLICY: PolicyKind = PolicyKind::Sarsa;
@@ -48,7 +47,7 @@ async fn main(spawner: Spawner) {
     info!(
         "pada firmware {}: {} on board profile {}",
         env!("CARGO_PKG_VERSION"),
-        ThisRobot::ROBOT.name(),
+        ROBOT.name,
         PROFILE.board.name()
     );
 
@@ -56,7 +55,7 @@ async fn main(spawner: Spawner) {
     // boot (a watchdog reset leaves them turning at their last Moving
     // Speed), they stop before the weight table is filled — about 0.7 s on
     // the F429's 8 MiB table.
-    let joints = pada_firmware::config::hardware(ThisRobot::ROBOT).joints;
+    let joints = ROBOT.joints;
     spawner.spawn(unwrap!(tasks::servo_bus(board.servo_port, joints)));
     tasks::SERVOS_OFF.wait().await;
 
@@ -82,7 +81,7 @@ async fn main(spawner: Spawner) {
     };
 
     // DEFAULT_SEED on a real board; the emulated boards take the run's.
-    let mut ctl: Ctl = match Ctl::new(PROFILE, BOOT_POLICY, table::take(table_memory), board.seed) {
+    let mut ctl: Ctl = match Ctl::new(table::this_robot(), PROFILE, BOOT_POLICY, table::take(table_memory), board.seed) {
         Ok(ctl) => ctl,
         // The profiles are constants checked by the host tests.
         Err(e) => defmt::panic!("controller configuration: {}", defmt::Debug2Format(&e)),

@@ -73,7 +73,7 @@ use heapless::{String, Vec};
 use serde::{Deserialize, Serialize};
 
 /// Version of the clock protocol; the board sends it in [`FromBoard::Boot`].
-pub const CLOCK_PROTOCOL: u16 = 3;
+pub const CLOCK_PROTOCOL: u16 = 4;
 
 /// Instructions of the calibration loop of [`FromBoard::Boot`].
 pub const CALIBRATION_INSTRUCTIONS: u32 = 20_000;
@@ -106,8 +106,12 @@ pub enum FromBoard {
     Boot {
         /// [`CLOCK_PROTOCOL`].
         protocol: u16,
-        /// The robot the image drives ([`crate::config::Robot::code`]).
-        robot: u8,
+        /// The name of the robot the image drives
+        /// (`pada_core::robot::RobotSpec::name`).
+        robot: String<{ pada_core::robot::MAX_NAME }>,
+        /// Its definition's hash (`RobotSpec::definition_hash`): a robot
+        /// is its name and this, never a number from a closed list.
+        robot_hash: u32,
         /// The board learner profile of the image
         /// (`pada_core::profile::Board::name`).
         board: String<16>,
@@ -301,7 +305,8 @@ mod tests {
         round_trip(&[
             FromBoard::Boot {
                 protocol: CLOCK_PROTOCOL,
-                robot: 3,
+                robot: String::try_from("a-robot-name-of-32-bytes-exactly").unwrap(),
+                robot_hash: u32::MAX,
                 board: String::try_from("f429-sdram-xxxxx").unwrap(),
                 machine: String::try_from("mps2-an386-xxxxx").unwrap(),
                 calibration: u32::MAX,

@@ -1,14 +1,15 @@
-//! The image's learner: the robot chosen at build time, the board's learner
+//! The image's learner: the robot chosen at build time (`PADA_ROBOT`,
+//! written by build.rs into `$OUT_DIR/robot.rs`), the board's learner
 //! profile for it (`pada_core::profile`), and the weight table where that
-//! profile puts it.
+//! profile puts it (build.rs's `cfg(pada_table)`):
 //!
-//! | board (cargo feature) | pendulum | LEO |
+//! | `pada_table` | where | the paper's robots |
 //! |---|---|---|
-//! | F405/F407, and QEMU's netduinoplus2 (`stm32f405`, `stm32f407`, `qemu`) | exact table: all 64 KiB of CCM, then 33.5 KiB of SRAM (`Split`) | claim table of 2^14 slots (16-bit weights and 16-bit tags) in CCM |
-//! | F429I-DISC1 (`stm32f429`), and QEMU's mps2-an386 (`mps2`) | exact table, 97.5 KiB of SRAM | claim table of 2^21 slots (16-bit weights and 16-bit tags), all 8 MiB of the SDRAM (on mps2-an386: its PSRAM, `.sdram` in `memory-mps2.x`) |
-//!
-//! (`profile_f429` is build.rs's cfg for the `stm32f429` and `mps2`
-//! features: the boards of the f429-sdram profile.)
+//! | `exact_ccm` | an exact table of Q16 weights in the 64 KiB of CCM | — |
+//! | `exact_ccm_sram` | an exact table: all 64 KiB of CCM, then SRAM (`Split`) | the pendulum on F405/F407 and QEMU's netduinoplus2 (`stm32f405`, `stm32f407`, `qemu`) |
+//! | `exact_sram` | an exact table in SRAM | the pendulum on the F429I-DISC1 and QEMU's mps2-an386 (`stm32f429`, `mps2`) |
+//! | `claimed_ccm` | a claim table of 2^14 slots (16-bit weights and 16-bit tags) in CCM | LEO on the F405 |
+//! | `claimed_sdram` | a claim table of 2^21 slots, all 8 MiB of the SDRAM (on mps2-an386: its PSRAM, `.sdram` in `memory-mps2.x`) | LEO on the F429 |
 //!
 //! The statics are NOLOAD (CCM, SDRAM) or `.uninit` (SRAM): the startup
 //! code leaves them alone; [`take`] zeroes them once — after the board
@@ -25,18 +26,9 @@ use core::mem::MaybeUninit;
 #[allow(unused_imports)] // the pendulum's tables only
 use pada_core::fixed::Q16;
 use pada_core::profile::{Board, LearnerProfile, Memory};
-use pada_firmware::robot::RobotAdapter;
 
-/// The robot this image drives (cargo features `robot-leo`,
-/// `robot-pendulum-20hz`; the 33 Hz pendulum otherwise).
-#[cfg(feature = "robot-leo")]
-pub type ThisRobot = pada_firmware::leo::Leo;
-/// The robot this image drives.
-#[cfg(all(feature = "robot-pendulum-20hz", not(feature = "robot-leo")))]
-pub type ThisRobot = pada_firmware::pendulum::Pendulum20;
-/// The robot this image drives.
-#[cfg(not(any(feature = "robot-leo", feature = "robot-pendulum-20hz")))]
-pub type ThisRobot = pada_firmware::pendulum::Pendulum33;
+// `ThisRobot`, `this_robot()` and `ROBOT`: the robot build.rs chose.
+include!(concat!(env!("OUT_DIR"), "/robot.rs"));
 
 /// The board's learner profile: F405-class chips (and their emulation).
 #[cfg(not(profile_f429))]
@@ -46,8 +38,12 @@ pub const BOARD: Board = Board::F405;
 #[cfg(profile_f429)]
 pub const BOARD: Board = Board::F429Sdram;
 
-/// The learner of this image.
-pub const PROFILE: LearnerProfile = BOARD.profile(ThisRobot::ROBOT);
+/// The learner of this image. (build.rs has checked that the robot's table
+/// fits the board, and stops the build with the sizes if not.)
+pub const PROFILE: LearnerProfile = match BOARD.profile(ROBOT) {
+    Ok(profile) => profile,
+    Err(_) => panic!("the robot's exact table fits no memory of this board"),
+};
 
 /// Weights in the table.
 pub const WEIGHTS: usize = match PROFILE.weights() {
@@ -98,17 +94,17 @@ macro_rules! one_memory {
 }
 
 // ---------------------------------------------------------------------------
-// The pendulum on an F405: all of CCM, then the rest in SRAM.
+// An exact table over all of CCM, then SRAM (the pendulum on an F405).
 // ---------------------------------------------------------------------------
 
-#[cfg(all(not(profile_f429), not(feature = "robot-leo")))]
+#[cfg(pada_table = "exact_ccm_sram")]
 mod layout {
     use super::*;
     use pada_core::weights::Split;
 
     const CCM: usize = match PROFILE.memory {
         Memory::CcmThenSram { ccm_weights } => ccm_weights,
-        _ => panic!("the F405's pendulum table is split over CCM and SRAM"),
+        _ => panic!("build.rs chose a table split over CCM and SRAM"),
     };
     const REST: usize = WEIGHTS - CCM;
 
@@ -148,7 +144,7 @@ macro_rules! claim_table {
         const _: () = assert!(WEIGHTS >= 2 && WEIGHTS.is_power_of_two(), "a claim table has 2^n slots");
         const SHIFT: u32 = match PROFILE.format {
             pada_core::weights::WeightFormat::Half { shift } => shift as u32,
-            pada_core::weights::WeightFormat::Q16 => panic!("the chips' LEO table has 16-bit weights"),
+            pada_core::weights::WeightFormat::Q16 => panic!("the chips' claim tables have 16-bit weights"),
         };
 
         #[link_section = $section]
@@ -176,20 +172,28 @@ macro_rules! claim_table {
     };
 }
 
-// LEO on an F405: the 64 KiB of CCM, weights and tags.
-#[cfg(all(not(profile_f429), feature = "robot-leo"))]
+// A claim table in the 64 KiB of CCM, weights and tags (LEO on an F405).
+#[cfg(pada_table = "claimed_ccm")]
 mod layout {
     claim_table!(Memory::Ccm, ".ccmram", "PADA_TABLE_CCM", "PADA_TABLE_TAGS_CCM");
 }
 
-// The pendulum on the F429: 97.5 KiB of its 192 KiB SRAM.
-#[cfg(all(profile_f429, not(feature = "robot-leo")))]
+// An exact table in CCM (a small robot's).
+#[cfg(pada_table = "exact_ccm")]
+mod layout {
+    one_memory!(Memory::Ccm, ".ccmram", "PADA_TABLE_CCM");
+}
+
+// An exact table in SRAM (the pendulum on the F429: 97.5 KiB of its 192
+// KiB).
+#[cfg(pada_table = "exact_sram")]
 mod layout {
     one_memory!(Memory::Sram, ".uninit.pada_table", "PADA_TABLE_SRAM");
 }
 
-// LEO on the F429: all 8 MiB of the SDRAM, weights and tags.
-#[cfg(all(profile_f429, feature = "robot-leo"))]
+// A claim table in all 8 MiB of the SDRAM, weights and tags (LEO on the
+// F429).
+#[cfg(pada_table = "claimed_sdram")]
 mod layout {
     claim_table!(Memory::Sdram, ".sdram", "PADA_TABLE_SDRAM", "PADA_TABLE_TAGS_SDRAM");
 }

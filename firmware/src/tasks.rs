@@ -28,7 +28,7 @@ use pada_firmware::config::MAX_ROBOT_SERVOS;
 use pada_core::weights::WeightStore;
 use pada_firmware::control::{CheckpointError, PeriodOutput, Readings, ServoRead};
 use pada_firmware::io::{ByteSink, ByteSource, CycleCounter, Sensors};
-use pada_firmware::servo::Joint;
+use pada_core::robot::JointSpec as Joint;
 use pada_firmware::timing::LoopTiming;
 
 use crate::channels::{
@@ -200,7 +200,7 @@ struct WeightsJob {
 /// The control loop at the robot's rate.
 #[embassy_executor::task]
 pub async fn control(mut cl: ControlLoop) -> ! {
-    let period_us = cl.ctl.config().period_us();
+    let period_us = cl.ctl.spec().period_us;
     let mut timing = LoopTiming::new(cl.cpu_hz, period_us);
     let mut readings = Readings::default();
     let mut out = PeriodOutput::default();
@@ -212,7 +212,7 @@ pub async fn control(mut cl: ControlLoop) -> ! {
     let health_every = (1_000_000 / period_us).max(1);
     let log_every = health_every * 10;
     let mut period: u32 = 0;
-    info!("control loop: {} at {=u32} us, policy {}", cl.ctl.config().name(), period_us, cl.ctl.policy());
+    info!("control loop: {} at {=u32} us, policy {}", cl.ctl.spec().name, period_us, cl.ctl.policy());
 
     // Sends without waiting; a full queue drops the message (counted, and
     // visible to the host as a sequence gap).

@@ -124,6 +124,21 @@ impl TableOccupancy {
     }
 }
 
+/// The error for a stream of another telemetry protocol (a recording or a
+/// board of another pada): one line that says why it is refused.
+fn foreign_protocol(found: u16) -> std::io::Error {
+    let this = pada_core::wire::PROTOCOL_VERSION;
+    let why = if found < this {
+        "an older pada wrote it (protocol 9 names the robot and its definition in `Hello`); read it with that version"
+    } else {
+        "a newer pada wrote it; update this one"
+    };
+    std::io::Error::new(
+        std::io::ErrorKind::InvalidData,
+        format!("the stream speaks telemetry protocol {found}, this pada reads protocol {this}: {why}"),
+    )
+}
+
 /// Decodes a telemetry stream, writes CSV, keeps counts.
 pub struct Recorder {
     decoder: HostDecoder,
@@ -184,6 +199,11 @@ impl Recorder {
             };
             match result {
                 Ok(frame) => {
+                    if let ToHost::Hello(h) = &frame.msg {
+                        if h.protocol != pada_core::wire::PROTOCOL_VERSION {
+                            return Err(foreign_protocol(h.protocol));
+                        }
+                    }
                     if let Some(gap) = frame.gap {
                         let detail = if gap.is_resync() {
                             format!(
@@ -208,6 +228,9 @@ impl Recorder {
                     frames.push(frame);
                 }
                 Err(e) => {
+                    if let Some(found) = self.decoder.foreign_protocol() {
+                        return Err(foreign_protocol(found));
+                    }
                     self.row_other(time_s, None, "lost", &loss_name(&e))?;
                     if let Some(tap) = self.tap.as_mut() {
                         tap.lost(&e, self.decoder.stats())?;
@@ -549,6 +572,8 @@ mod tests {
     fn hello() -> ToHost {
         ToHost::Hello(Hello {
             protocol: PROTOCOL_VERSION,
+            robot: heapless::String::try_from("physical-pendulum").unwrap(),
+            robot_hash: 0,
             config_hash: 1,
             weight_count: 2,
             period_us: 3,

@@ -146,6 +146,8 @@ impl Board {
     fn restore(&mut self) -> Result<(u32, Vec<u8>), RestoreDenied> {
         self.send(&ToHost::Hello(Hello {
             protocol: PROTOCOL_VERSION,
+            robot: "leo".try_into().unwrap(),
+            robot_hash: pada_core::robot::leo::SPEC.definition_hash(),
             config_hash: HASH,
             weight_count: N as u32,
             period_us: 33_333,

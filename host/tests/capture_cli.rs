@@ -4,8 +4,10 @@
 //! mixed in; and the same stream from a file.
 //!
 //! `tests/data/sil-pendulum-3s.bin` (repository root) is the raw USART2 stream of
-//! `pada sil --seconds 3` (telemetry.bin; wire protocol 7). Regenerate it
-//! with that command when the wire format changes.
+//! `pada sil --task pendulum --seconds 3` (telemetry.bin; wire protocol 9).
+//! Regenerate it with that command when the wire format changes.
+//! `tests/data/sil-pendulum-3s-protocol7.bin` is the same run recorded by
+//! an older pada (protocol 7), which a capture refuses in one line.
 
 mod common;
 use common::{capture_json, damaged, frames, plug_at, raw_pty};
@@ -164,6 +166,15 @@ fn capture_from_a_file_counts_the_same() {
     let json = capture_json(&file, None);
     check_summary(&json, &want);
     assert_eq!(json["ended"], "end of file");
+}
+
+#[test]
+fn a_recording_of_an_older_protocol_is_refused_in_one_line() {
+    let old = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/sil-pendulum-3s-protocol7.bin");
+    common::assert_bad_input(
+        &["capture", "--file", old],
+        &["telemetry protocol 7", "this pada reads protocol 9", "an older pada wrote it"],
+    );
 }
 
 #[test]

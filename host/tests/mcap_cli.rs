@@ -257,7 +257,9 @@ fn a_claim_tables_occupancy_has_its_channel_and_reads_back() {
     use pada_core::wire::{FrameEncoder, Health, Hello, ToHost, MAX_FRAME_LEN, PROTOCOL_VERSION};
     let mut enc = FrameEncoder::new();
     let mut stream = Vec::new();
-    let hello = Hello { protocol: PROTOCOL_VERSION, config_hash: 0xfeed, weight_count: 1 << 21, period_us: 33_333, state_dims: 10, joints: 3 };
+    let leo = &pada_core::robot::leo::SPEC;
+    let robot = leo.name.try_into().unwrap();
+    let hello = Hello { protocol: PROTOCOL_VERSION, robot, robot_hash: leo.definition_hash(), config_hash: 0xfeed, weight_count: 1 << 21, period_us: 33_333, state_dims: 10, joints: 3 };
     let mut msgs = vec![ToHost::Hello(hello)];
     for k in 1..=3u32 {
         msgs.push(ToHost::Health(Health { uptime_ms: 1000 * k, table_claimed: 100 * k, table_slots: 1000, claims_refused: k - 1, ..Health::default() }));

@@ -328,6 +328,8 @@ fn a_live_run_over_tcp_and_a_sender_that_stalls() {
     let mut buf = [0u8; pada_core::wire::MAX_FRAME_LEN];
     let hello = pada_core::wire::ToHost::Hello(pada_core::wire::Hello {
         protocol: pada_core::wire::PROTOCOL_VERSION,
+        robot: "physical-pendulum-20hz".try_into().unwrap(),
+        robot_hash: 0,
         config_hash: 0,
         weight_count: 1,
         period_us: 50_000,

@@ -18,7 +18,7 @@
 
 use crate::agent::Agent;
 use crate::checkpoint::ConfigHasher;
-use crate::robot::Robot;
+use crate::robot::{RobotSpec, TableNeed};
 use crate::tile_coding::Layout;
 use crate::weights::{WeightFormat, WeightStore};
 
@@ -70,32 +70,56 @@ impl Board {
         }
     }
 
-    /// This board's learner for `robot`.
-    pub const fn profile(self, robot: Robot) -> LearnerProfile {
-        let pendulum = matches!(robot, Robot::Pendulum33 | Robot::Pendulum20);
-        let (layout, size, format, memory, tag_bytes) = match (self, pendulum) {
+    /// This board's learner for `robot`: an exact table where the robot
+    /// needs one ([`TableNeed::Exact`]), Q16 weights in the board's fastest
+    /// memory that holds them; a claim table otherwise, as large as the
+    /// board's table memory ([`TableNeed::Claimed`]). An exact table that
+    /// fits no memory of the board is an error that names the sizes (the
+    /// firmware's build turns it into a compile-time error).
+    pub const fn profile(self, robot: &'static RobotSpec) -> Result<LearnerProfile, ProfileError> {
+        let (layout, size, format, memory, tag_bytes) = match (self, robot.table) {
             // The pendulum's exact table (20 × 26 tiles × 16 tilings × 3
             // actions) is 97.5 KB: all 64 KB of CCM and 33.5 KB of SRAM.
-            (Board::F405, true) => (
-                Layout::Exact,
-                TableSize::Weights(PENDULUM_EXACT_WEIGHTS),
-                WeightFormat::Q16,
-                Memory::CcmThenSram { ccm_weights: CCM_BYTES / 4 },
-                0,
-            ),
+            (Board::F405, TableNeed::Exact { weights }) => {
+                let bytes = weights * 4;
+                let memory = if bytes <= CCM_BYTES {
+                    Memory::Ccm
+                } else if bytes <= CCM_BYTES + F405_SRAM_TABLE_BYTES {
+                    Memory::CcmThenSram { ccm_weights: CCM_BYTES / 4 }
+                } else {
+                    return Err(ProfileError { board: self, weights, bytes, room: CCM_BYTES + F405_SRAM_TABLE_BYTES });
+                };
+                (Layout::Exact, TableSize::Weights(weights), WeightFormat::Q16, memory, 0)
+            }
             // LEO in the 64 KB of CCM: a claim table of 2^14 slots, each
             // a 16-bit weight and a 16-bit tag.
-            (Board::F405, false) => (Layout::Claimed, TableSize::Weights(1 << 14), LEO_CHIP_FORMAT, Memory::Ccm, 2),
-            (Board::F429Sdram, true) => {
-                (Layout::Exact, TableSize::Weights(PENDULUM_EXACT_WEIGHTS), WeightFormat::Q16, Memory::Sram, 0)
+            (Board::F405, TableNeed::Claimed) => (
+                Layout::Claimed,
+                TableSize::Weights(1 << 14),
+                WeightFormat::Half { shift: robot.half_shift },
+                Memory::Ccm,
+                2,
+            ),
+            (Board::F429Sdram, TableNeed::Exact { weights }) => {
+                let bytes = weights * 4;
+                if bytes > F429_SRAM_TABLE_BYTES {
+                    return Err(ProfileError { board: self, weights, bytes, room: F429_SRAM_TABLE_BYTES });
+                }
+                (Layout::Exact, TableSize::Weights(weights), WeightFormat::Q16, Memory::Sram, 0)
             }
             // All 8 MiB of the SDRAM: a claim table of 2^21 slots, each a
             // 16-bit weight and a 16-bit tag (docs/board.md measures what a
             // trial claims and what the 16 bits cost).
-            (Board::F429Sdram, false) => {
-                (Layout::Claimed, TableSize::Weights(1 << 21), LEO_CHIP_FORMAT, Memory::Sdram, 2)
+            (Board::F429Sdram, TableNeed::Claimed) => (
+                Layout::Claimed,
+                TableSize::Weights(1 << 21),
+                WeightFormat::Half { shift: robot.half_shift },
+                Memory::Sdram,
+                2,
+            ),
+            (Board::Host, TableNeed::Exact { .. }) => {
+                (Layout::Exact, TableSize::FitExact, WeightFormat::Q16, Memory::Heap, 0)
             }
-            (Board::Host, true) => (Layout::Exact, TableSize::FitExact, WeightFormat::Q16, Memory::Heap, 0),
             // A claim table as the framework keeps its LEO table
             // (docs/reference/grl.md §3.9 and §5.1, `safe: 1`): Q16 weights
             // and 32-bit tags, so two features share a slot only if their
@@ -103,34 +127,57 @@ impl Board {
             // SARSA(λ) below one footstep (its greedy choice over 343
             // actions read other features' learned weights), and 2^24 let
             // it walk; a claim table needs only the slots a trial writes.
-            (Board::Host, false) => {
-                (Layout::Claimed, TableSize::Weights(1 << HOST_LEO_LOG2), WeightFormat::Q16, Memory::Heap, 4)
+            (Board::Host, TableNeed::Claimed) => {
+                (Layout::Claimed, TableSize::Weights(1 << HOST_CLAIM_LOG2), WeightFormat::Q16, Memory::Heap, 4)
             }
         };
-        LearnerProfile { board: self, robot, layout, size, format, memory, tag_bytes }
+        Ok(LearnerProfile { board: self, robot, layout, size, format, memory, tag_bytes })
     }
 }
 
-/// The chips' LEO weights: 16 bits, Q16 shifted right by LEO's
-/// [`crate::robot::leo::HALF_SHIFT`] (±2048 in steps of 1/16, rounded
-/// stochastically).
-pub const LEO_CHIP_FORMAT: WeightFormat = WeightFormat::Half { shift: crate::robot::leo::HALF_SHIFT };
+/// A robot's exact table fits no memory of a board.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ProfileError {
+    /// The board.
+    pub board: Board,
+    /// Weights of the robot's exact table.
+    pub weights: usize,
+    /// Their bytes as Q16 weights.
+    pub bytes: usize,
+    /// The bytes the board has for a table.
+    pub room: usize,
+}
 
-/// log2 of the host's LEO claim table: Q16 weights with 32-bit tags, the
+impl core::fmt::Display for ProfileError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "the robot's exact table of {} weights ({} bytes) does not fit board {}: it has room for {} bytes \
+             (fewer observation tiles or actions, or a larger board)",
+            self.weights,
+            self.bytes,
+            self.board.name(),
+            self.room
+        )
+    }
+}
+
+/// log2 of the host's claim table (LEO's): Q16 weights with 32-bit tags, the
 /// framework's semantics. 2^22 slots (32 MiB): the most a measured LEO
 /// trial claimed in 14 666 s is 2.39 M (SARSA(λ), 15 trials, `pada
 /// claims`, docs/board.md), 57 % of it. While no claim is refused a claim
 /// table learns the same whatever its size (a feature's tag and initial
 /// weight depend on its key alone), so this size changes no result.
-pub const HOST_LEO_LOG2: u32 = 22;
+pub const HOST_CLAIM_LOG2: u32 = 22;
 
 /// Bytes of the F405's core-coupled RAM.
 pub const CCM_BYTES: usize = 64 * 1024;
-/// Weights of the physical pendulum's exact table with SARSA, the low-pass
-/// filter, the integrator or PADA: 20 angle tiles × 26 velocity tiles ×
-/// 16 tilings × 3 actions (the Markov variants add a state dimension and
-/// need 4× more).
-pub const PENDULUM_EXACT_WEIGHTS: usize = 24_960;
+/// Bytes of the F405's 128 KB SRAM an exact table may take after all of
+/// CCM: the rest is the firmware's stack, buffers and executor.
+pub const F405_SRAM_TABLE_BYTES: usize = 48 * 1024;
+/// Bytes of the F429's 192 KB SRAM an exact table may take.
+pub const F429_SRAM_TABLE_BYTES: usize = 128 * 1024;
 
 /// How many weights a table has.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -182,7 +229,7 @@ pub struct LearnerProfile {
     /// The board.
     pub board: Board,
     /// The robot.
-    pub robot: Robot,
+    pub robot: &'static RobotSpec,
     /// How features map to weights.
     pub layout: Layout,
     /// How many weights.
@@ -248,7 +295,7 @@ impl LearnerProfile {
 }
 
 /// Version of what [`config_hash`] covers; bump when its meaning changes.
-pub const CONFIG_HASH_VERSION: u32 = 3;
+pub const CONFIG_HASH_VERSION: u32 = 4;
 
 /// The hash of everything that gives a learner's weights their meaning
 /// (FNV-1a, stored in checkpoints and sent in `Hello`): the robot, the
@@ -268,7 +315,8 @@ pub fn config_hash<W: WeightStore, const TILINGS_: usize, const TRACE_: usize>(
 ) -> u32 {
     let mut h = ConfigHasher::new();
     h.write_u32(CONFIG_HASH_VERSION)
-        .write_str(profile.robot.name())
+        .write_str(profile.robot.name)
+        .write_u32(profile.robot.definition_hash())
         .write_str(profile.board.name())
         .write_u32(profile.layout.code())
         .write_u32(agent.weights().len() as u32)
@@ -282,28 +330,66 @@ pub fn config_hash<W: WeightStore, const TILINGS_: usize, const TRACE_: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::robot::{leo, pendulum, registry};
 
     #[test]
     fn chip_tables_fit_their_memory() {
-        for robot in Robot::ALL {
-            let p = Board::F405.profile(robot);
+        for robot in registry::specs() {
+            let p = Board::F405.profile(robot).unwrap();
             let bytes = p.table_bytes().unwrap();
             match p.memory {
-                Memory::Ccm => assert!(bytes <= CCM_BYTES, "{robot:?}"),
+                Memory::Ccm => assert!(bytes <= CCM_BYTES, "{}", robot.name),
                 Memory::CcmThenSram { ccm_weights } => {
                     assert!(ccm_weights * p.format.bytes() <= CCM_BYTES);
                     // The rest must leave most of the 128 KB SRAM to the
                     // firmware's stack, buffers and executor.
-                    assert!(bytes - ccm_weights * p.format.bytes() <= 48 * 1024, "{robot:?}");
+                    assert!(bytes - ccm_weights * p.format.bytes() <= 48 * 1024, "{}", robot.name);
                 }
-                m => panic!("{robot:?}: {m:?} on an F405"),
+                m => panic!("{}: {m:?} on an F405", robot.name),
             }
-            let p = Board::F429Sdram.profile(robot);
+            let p = Board::F429Sdram.profile(robot).unwrap();
             assert!(p.table_bytes().unwrap() <= 8 * 1024 * 1024);
         }
-        assert_eq!(Board::F429Sdram.profile(Robot::Leo).table_bytes(), Some(8 * 1024 * 1024));
+        assert_eq!(Board::F429Sdram.profile(&leo::SPEC).unwrap().table_bytes(), Some(8 * 1024 * 1024));
         for b in Board::ALL {
             assert_eq!(Board::from_name(b.name()), Some(b));
         }
+    }
+
+    #[test]
+    fn the_profiles_of_the_paper_robots_are_the_measured_ones() {
+        // The tables docs/board.md measures: the pendulum's exact 24 960
+        // weights over CCM and SRAM; LEO's claim tables of 2^14 and 2^21
+        // slots with 16-bit weights shifted by 12 and 16-bit tags; the
+        // host's 2^22 slots of Q16 weights with 32-bit tags.
+        let p = Board::F405.profile(&pendulum::SPEC_33HZ).unwrap();
+        assert_eq!((p.layout, p.weights(), p.format), (Layout::Exact, Some(24_960), WeightFormat::Q16));
+        assert_eq!(p.memory, Memory::CcmThenSram { ccm_weights: 16_384 });
+        let l = Board::F405.profile(&leo::SPEC).unwrap();
+        assert_eq!((l.layout, l.weights(), l.format, l.tag_bytes), (Layout::Claimed, Some(1 << 14), WeightFormat::Half { shift: 12 }, 2));
+        let l = Board::F429Sdram.profile(&leo::SPEC).unwrap();
+        assert_eq!((l.weights(), l.memory, l.tag_bytes), (Some(1 << 21), Memory::Sdram, 2));
+        let h = Board::Host.profile(&leo::SPEC).unwrap();
+        assert_eq!((h.weights(), h.format, h.tag_bytes), (Some(1 << 22), WeightFormat::Q16, 4));
+        assert_eq!(Board::Host.profile(&pendulum::SPEC_20HZ).unwrap().size, TableSize::FitExact);
+    }
+
+    #[test]
+    fn an_exact_table_too_large_for_a_board_is_refused_with_its_sizes() {
+        static HUGE: RobotSpec = RobotSpec { table: TableNeed::Exact { weights: 40_000 }, ..pendulum::SPEC_33HZ };
+        let e = Board::F405.profile(&HUGE).unwrap_err();
+        assert_eq!((e.weights, e.bytes, e.room), (40_000, 160_000, 112 * 1024));
+        let text = alloc_free_text(&e);
+        assert!(text.contains("40000 weights") && text.contains("f405"), "{text}");
+        assert!(Board::F429Sdram.profile(&HUGE).is_err());
+        assert!(Board::Host.profile(&HUGE).is_ok());
+    }
+
+    /// `e`'s message in a fixed buffer.
+    fn alloc_free_text(e: &ProfileError) -> heapless::String<256> {
+        use core::fmt::Write;
+        let mut s = heapless::String::new();
+        write!(s, "{e}").unwrap();
+        s
     }
 }

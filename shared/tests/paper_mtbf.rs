@@ -14,8 +14,7 @@
 //! paper's 362 s for SARSA(λ).
 
 use pada_core::fatigue::{FatigueCounter, FatigueModel, GearboxParams, PAPER_WINDOW_STEPS};
-use pada_core::robot::leo::{commanded_gear_torque, ACTION_VOLTAGE_LIMIT, CONTROL_PERIOD_US};
-use pada_core::robot::Robot;
+use pada_core::robot::leo::{commanded_gear_torque, ACTION_VOLTAGE_LIMIT, CONTROL_PERIOD_US, SPEC};
 use rand_core::{RngCore, SeedableRng};
 
 #[test]
@@ -29,7 +28,7 @@ fn random_leo_actions_give_the_hand_calculated_mtbf() {
     let expected_mtbf = 1200.0 * period / (expected_reengagements * mean_damage);
     assert!((250.0..800.0).contains(&expected_mtbf), "hand calculation {expected_mtbf} s");
     assert!((commanded_gear_torque(10.7) - 1.786).abs() < 0.01);
-    assert_eq!(Robot::Leo.commanded_gear_torque(-5.0), commanded_gear_torque(-5.0));
+    assert_eq!(SPEC.paper_torque.torque(0, -5.0), commanded_gear_torque(-5.0));
 
     let mut mtbfs = Vec::new();
     for seed in 0..20 {

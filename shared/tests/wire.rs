@@ -85,6 +85,8 @@ fn all_to_host() -> Vec<ToHost> {
     let mut v = vec![
         ToHost::Hello(Hello {
             protocol: PROTOCOL_VERSION,
+            robot: heapless::String::try_from("a-robot-name-of-32-bytes-exactly").unwrap(),
+            robot_hash: u32::MAX,
             config_hash: 0xDEAD_BEEF,
             weight_count: 1 << 16,
             period_us: 33_333,
@@ -478,6 +480,8 @@ fn each_loss_kind_is_typed_and_counted() {
     let mut hb = [0u8; MAX_FRAME_LEN];
     let hello = ToHost::Hello(Hello {
         protocol: 1,
+        robot: heapless::String::try_from("leo").unwrap(),
+        robot_hash: 7,
         config_hash: 0xFFFF_FFFF,
         weight_count: 0xFFFF_FFFF,
         period_us: 1,
@@ -823,4 +827,51 @@ proptest! {
         // A flip that makes a 0x00 inside splits the frame: two errors.
         prop_assert!(dec.stats().bad_frames() >= 1);
     }
+}
+
+/// A recording of an older pada: its `Hello` (protocol 8, before the robot
+/// was named) does not decode, and the decoder says which protocol it was,
+/// so a reader refuses the file in one line instead of counting damage.
+#[test]
+fn a_hello_of_another_protocol_is_told_apart_from_damage() {
+    #[derive(serde::Serialize)]
+    struct HelloV8 {
+        protocol: u16,
+        config_hash: u32,
+        weight_count: u32,
+        period_us: u32,
+        state_dims: u8,
+        joints: u8,
+    }
+    #[derive(serde::Serialize)]
+    enum ToHostV8 {
+        Hello(HelloV8),
+    }
+    let old = ToHostV8::Hello(HelloV8 { protocol: 8, config_hash: 1, weight_count: 2, period_us: 3, state_dims: 2, joints: 1 });
+    let mut buf = [0u8; MAX_FRAME_LEN];
+    let frame = encode_frame(&old, 0, &mut buf).unwrap().to_vec();
+    let mut dec = HostDecoder::new();
+    assert_eq!(dec.foreign_protocol(), None);
+    assert_eq!(dec.feed(&frame).collect::<Vec<_>>(), vec![Err(FrameError::Decode)]);
+    assert_eq!(dec.foreign_protocol(), Some(8));
+    // Damage is damage: a body that is no Hello at all sets nothing.
+    let mut dec = HostDecoder::new();
+    let junk = encode_frame(&(5u32, 200u32, 7u8), 0, &mut buf).unwrap().to_vec();
+    assert_eq!(dec.feed(&junk).count(), 1);
+    assert_eq!(dec.foreign_protocol(), None);
+    // And this version's own Hello decodes.
+    let hello = ToHost::Hello(Hello {
+        protocol: PROTOCOL_VERSION,
+        robot: heapless::String::try_from("leo").unwrap(),
+        robot_hash: 7,
+        config_hash: 1,
+        weight_count: 2,
+        period_us: 3,
+        state_dims: 2,
+        joints: 1,
+    });
+    let frame = encode_frame(&hello, 0, &mut buf).unwrap().to_vec();
+    let mut dec = HostDecoder::new();
+    assert!(dec.feed(&frame).all(|r| r.is_ok()));
+    assert_eq!(pada_core::wire::hello_protocol(&[0, 0, PROTOCOL_VERSION as u8]), Some(PROTOCOL_VERSION));
 }

@@ -14,18 +14,15 @@
 use pada::experiment::algo::{algo_of, policy_kind_of, Algo, PolicyFlags};
 use pada::experiment::build_agent;
 use pada::experiment::table::HostTable;
-use pada::experiment::task::Task;
+use pada::experiment::task::{Task, TaskSpec};
 use pada::leo::rl::{leo_params, LeoTask};
-use pada::pendulum::{PhysicalPendulumParams, PhysicalPendulumTask};
+use pada::robots::{board_task_spec, host_robot, DynRules};
 use pada_core::policy::PolicyKind;
 use pada_core::profile::{config_hash, Board, LearnerProfile};
-use pada_core::robot::Robot;
+use pada_core::robot::{leo, pendulum, registry, RobotRules};
 use pada_core::tile_coding::Layout;
 use pada_core::weights::WeightStore;
 use pada_firmware::control::Controller;
-use pada_firmware::leo::Leo;
-use pada_firmware::pendulum::{Pendulum20, Pendulum33};
-use pada_firmware::robot::RobotAdapter;
 
 /// Every policy of `--algo`, each with its default parameters (and PADA
 /// with LEO's Δ = 1/6 besides).
@@ -44,7 +41,7 @@ fn policies() -> Vec<PolicyKind> {
 #[test]
 fn every_policy_every_robot_and_every_board_is_checked() {
     assert_eq!(Algo::ALL.len(), 10, "a new policy: it is checked by the loops below");
-    assert_eq!(Robot::ALL.len(), 3, "a new robot needs its own check below");
+    assert_eq!(registry::BUILT_IN.len(), 3, "every robot of the registry is checked by the loop below");
     assert_eq!(Board::ALL.len(), 3);
     let kinds: std::collections::BTreeSet<&str> = policies().iter().map(|p| algo_of(p).name()).collect();
     assert_eq!(kinds.len(), Algo::ALL.len(), "one policy of every algorithm");
@@ -59,12 +56,17 @@ fn table_of(profile: LearnerProfile, weights: usize) -> HostTable {
     }
 }
 
+/// The rules of `profile`'s robot, as the host builds them.
+fn rules(profile: LearnerProfile) -> DynRules {
+    (host_robot(profile.robot).unwrap().rules)()
+}
+
 /// The firmware controller's hash for `profile` and `policy` on a table of
 /// `weights` weights.
-fn firmware_hash<R: RobotAdapter>(profile: LearnerProfile, policy: PolicyKind, weights: usize) -> u32 {
+fn firmware_hash(profile: LearnerProfile, policy: PolicyKind, weights: usize) -> u32 {
     let table = table_of(profile, weights);
-    let ctl = Controller::<_, R>::new(profile, policy, table, 1)
-        .unwrap_or_else(|e| panic!("{} on {}: {e}", profile.robot.name(), profile.board.name()));
+    let ctl = Controller::new(rules(profile), profile, policy, table, 1)
+        .unwrap_or_else(|e| panic!("{} on {}: {e}", profile.robot.name, profile.board.name()));
     ctl.config_hash()
 }
 
@@ -72,15 +74,15 @@ fn firmware_hash<R: RobotAdapter>(profile: LearnerProfile, policy: PolicyKind, w
 /// firmware builds the same one; where the host refuses one (a Markov
 /// filter's learner on a pendulum's exact table, sized for the plain
 /// state), the firmware refuses it too. Returns how many it refused.
-fn check<T: Task, R: RobotAdapter>(task: &T, profile: LearnerProfile) -> usize {
-    let spec = task.spec();
+fn check(spec: &TaskSpec, profile: LearnerProfile) -> usize {
     assert_eq!(spec.profile, Some(profile));
-    let (robot, board) = (profile.robot.name(), profile.board.name());
+    let (robot, board) = (profile.robot.name, profile.board.name());
+    let fw = rules(profile).spec();
     // The episodes: the runner's task and the firmware's robot run the
     // same cycle (`pada_core::episodes`) under the same rules.
-    assert_eq!(spec.episode_rules(), R::spec().episode_rules(), "{robot}: the host's episodes and the firmware's differ");
-    assert_eq!(spec.control_period_s, R::spec().period_s(), "{robot}: control period");
-    assert_eq!(spec.gearboxes, R::spec().gearboxes as usize, "{robot}: counted gearboxes");
+    assert_eq!(spec.episode_rules(), fw.episode_rules(), "{robot}: the host's episodes and the firmware's differ");
+    assert_eq!(spec.control_period_s, fw.period_s(), "{robot}: control period");
+    assert_eq!(spec.gearboxes, fw.gearboxes(), "{robot}: counted gearboxes");
     let mut refused = 0;
     for policy in policies() {
         let host = match build_agent(spec, policy) {
@@ -88,7 +90,7 @@ fn check<T: Task, R: RobotAdapter>(task: &T, profile: LearnerProfile) -> usize {
             Err(host_error) => {
                 let table = table_of(profile, profile.weights().unwrap_or(1 << 10));
                 assert!(
-                    Controller::<_, R>::new(profile, policy, table, 1).is_err(),
+                    Controller::new(rules(profile), profile, policy, table, 1).is_err(),
                     "{robot} on {board}: the host refuses {policy:?} ({host_error}) but the firmware builds it"
                 );
                 refused += 1;
@@ -96,7 +98,7 @@ fn check<T: Task, R: RobotAdapter>(task: &T, profile: LearnerProfile) -> usize {
             }
         };
         let host_hash = config_hash(&profile, &host);
-        let fw = firmware_hash::<R>(profile, policy, host.weights().len());
+        let fw = firmware_hash(profile, policy, host.weights().len());
         assert_eq!(
             (host.weights().claims(), host.weights().format(), host.weights().tag_bytes()),
             (profile.layout == Layout::Claimed, profile.format, profile.tag_bytes),
@@ -114,48 +116,33 @@ fn check<T: Task, R: RobotAdapter>(task: &T, profile: LearnerProfile) -> usize {
 }
 
 #[test]
-fn host_and_firmware_build_the_same_pendulum_learner_on_every_board() {
-    for board in Board::ALL {
-        let profile = board.profile(Robot::Pendulum33);
-        let task = PhysicalPendulumTask::with_profile(PhysicalPendulumParams::default(), profile);
-        assert!(check::<_, Pendulum33>(&task, profile) <= 2, "only the two Markov filters are refused");
-    }
-}
-
-#[test]
-fn host_and_firmware_build_the_same_20_hz_pendulum_learner_on_every_board() {
-    for board in Board::ALL {
-        let profile = board.profile(Robot::Pendulum20);
-        let task = PhysicalPendulumTask::with_profile(PhysicalPendulumParams::default(), profile);
-        assert!(check::<_, Pendulum20>(&task, profile) <= 2, "only the two Markov filters are refused");
-    }
-}
-
-#[test]
-fn host_and_firmware_build_the_same_leo_learner_on_every_board() {
-    for board in Board::ALL {
-        let profile = board.profile(Robot::Leo);
-        let task = LeoTask::with_profile(profile, leo_params());
-        assert_eq!(profile.layout, Layout::Claimed, "LEO learns on a claim table on every board");
-        assert_eq!(check::<_, Leo>(&task, profile), 0, "LEO's claim tables hold every learner");
+fn host_and_firmware_build_the_same_learner_for_every_robot_on_every_board() {
+    for robot in registry::specs() {
+        for board in Board::ALL {
+            let profile = board.profile(robot).unwrap();
+            let task = board_task_spec(profile).unwrap();
+            let refused = check(&task, profile);
+            if robot == &leo::SPEC {
+                assert_eq!(profile.layout, Layout::Claimed, "LEO learns on a claim table on every board");
+                assert_eq!(refused, 0, "LEO's claim tables hold every learner");
+            } else {
+                assert!(refused <= 2, "{}: only the two Markov filters are refused", robot.name);
+            }
+        }
     }
 }
 
 #[test]
 fn the_hash_tells_boards_robots_and_learners_apart() {
     let pendulum = |board: Board| {
-        let p = board.profile(Robot::Pendulum33);
-        let n = PhysicalPendulumTask::with_profile(PhysicalPendulumParams::default(), p)
-            .spec()
-            .profile
-            .and_then(|p| p.weights())
-            .unwrap_or(24_960);
-        firmware_hash::<Pendulum33>(p, PolicyKind::Sarsa, n)
+        let p = board.profile(&pendulum::SPEC_33HZ).unwrap();
+        let n = board_task_spec(p).unwrap().profile.and_then(|p| p.weights()).unwrap_or(24_960);
+        firmware_hash(p, PolicyKind::Sarsa, n)
     };
     // The same exact table on two boards: a checkpoint of one is refused by
     // the other.
     assert_ne!(pendulum(Board::F405), pendulum(Board::F429Sdram));
-    let leo = |policy| firmware_hash::<Leo>(Board::F405.profile(Robot::Leo), policy, 1 << 14);
+    let leo = |policy| firmware_hash(Board::F405.profile(&leo::SPEC).unwrap(), policy, 1 << 14);
     // PADA and the low-pass filter share SARSA's weights (Section VIII's
     // switch); the integrator learns −Δ/0/+Δ and does not.
     assert_eq!(leo(PolicyKind::Sarsa), leo(PolicyKind::Pada { delta: 0.5 }));
@@ -164,13 +151,13 @@ fn the_hash_tells_boards_robots_and_learners_apart() {
     // The F429's claim table with Q16 weights and 32-bit tags instead of
     // 16-bit ones: another learner (what it stores and what a feature may
     // share differ).
-    let f429 = Board::F429Sdram.profile(Robot::Leo);
+    let f429 = Board::F429Sdram.profile(&leo::SPEC).unwrap();
     let wide = f429.with_hashed_table(Layout::Claimed, 21, pada_core::weights::WeightFormat::Q16, 4);
-    assert_ne!(firmware_hash::<Leo>(wide, PolicyKind::Sarsa, 1 << 21), firmware_hash::<Leo>(f429, PolicyKind::Sarsa, 1 << 21));
+    assert_ne!(firmware_hash(wide, PolicyKind::Sarsa, 1 << 21), firmware_hash(f429, PolicyKind::Sarsa, 1 << 21));
     // Other learning parameters: another learner.
     let mut params = leo_params();
     params.lambda = 0.9;
-    let profile = Board::Host.profile(Robot::Leo);
+    let profile = Board::Host.profile(&leo::SPEC).unwrap();
     let task = LeoTask::with_profile(profile, params);
     let other = config_hash(&profile, &build_agent(task.spec(), PolicyKind::Sarsa).unwrap());
     let default = LeoTask::with_profile(profile, leo_params());

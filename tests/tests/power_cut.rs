@@ -15,7 +15,7 @@ use pada::sil::{run, SilConfig, SilSummary, SilTask};
 use pada_core::policy::PolicyKind;
 use pada_core::profile::Board;
 use pada_core::wire::{CheckpointReport, HostDecoder, ToHost};
-use pada_firmware::config::Robot;
+use pada_core::robot::pendulum::SPEC_33HZ;
 use std::path::Path;
 use std::time::Duration;
 
@@ -105,7 +105,7 @@ fn power_cuts_at_random_and_inside_saves_each_boot_loads_the_last_completed_save
     // their Hello; a replay that ignores the boots (the learner going on
     // as if never cut) does not match, so the check has teeth.
     let stream = std::fs::read(dir.path().join("telemetry.bin")).unwrap();
-    let profile = Board::F405.profile(Robot::Pendulum33);
+    let profile = Board::F405.profile(&SPEC_33HZ).unwrap();
     let seed = trial_seed(1, 0);
     let with = replay(&profile, policy, seed, &records(&stream, true));
     assert!(with.identical && with.boots == 8, "{with:?}");

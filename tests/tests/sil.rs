@@ -13,7 +13,7 @@ use pada::sil::{run, SilConfig, SilSummary, SilTask};
 use pada_core::policy::PolicyKind;
 use pada_core::profile::Board;
 use pada_core::wire::{HostDecoder, RunMode, StepKind, ToHost};
-use pada_firmware::config::Robot;
+use pada_core::robot::pendulum::SPEC_33HZ;
 use std::path::Path;
 use std::time::Duration;
 
@@ -135,7 +135,7 @@ fn the_firmware_in_qemu_replays_bit_for_bit_on_the_host_and_its_link_is_clean() 
     let last = policies.last().expect("the firmware sent a Policy frame");
     assert_eq!(last.built, policy, "{policies:?}");
     assert!(!last.switched_to_sarsa);
-    let profile = Board::F405.profile(Robot::Pendulum33);
+    let profile = Board::F405.profile(&SPEC_33HZ).unwrap();
     let seed = trial_seed(SEED, 0);
     let mut recs = records(&stream);
     assert!(replay(&profile, policy, seed, &recs).identical);

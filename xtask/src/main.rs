@@ -20,7 +20,7 @@
 mod elf;
 mod toolchain;
 
-use pada_core::robot::Robot;
+use pada_core::robot::registry::{self, BuiltIn};
 use std::{
     env,
     path::{Path, PathBuf},
@@ -157,41 +157,27 @@ impl Chip {
     }
 }
 
-/// What xtask knows of a robot beyond its one definition
-/// (`pada_core::robot::Robot`): the short name its firmware images carry
-/// and that `--robot` takes beside the full one, and the firmware's cargo
-/// feature that selects it.
-trait FirmwareRobot: Sized {
-    /// The robot `--robot` names: its full name (`physical-pendulum`,
-    /// `physical-pendulum-20hz`, `leo`) or the image's short one.
-    fn parse(s: &str) -> Option<Self>;
-    /// The short name of its images, which `pada sil --task` also takes.
-    fn short_name(self) -> &'static str;
-    /// The firmware's cargo feature that selects this robot, if any.
-    fn feature(self) -> Option<&'static str>;
+/// The robot `--robot` names: a robot of pada's registry
+/// (`pada_core::robot::registry`), by its full name (`physical-pendulum`,
+/// `physical-pendulum-20hz`, `leo`) or the short one its images carry.
+fn parse_robot(s: &str) -> Result<Robot, String> {
+    registry::find(&s.to_ascii_lowercase()).ok_or_else(|| {
+        let names: Vec<&str> = registry::BUILT_IN.iter().map(|b| b.short_name).collect();
+        format!("unknown robot `{s}`: expected {}", names.join(", "))
+    })
 }
 
-impl FirmwareRobot for Robot {
-    fn parse(s: &str) -> Option<Robot> {
-        let s = s.to_ascii_lowercase();
-        Robot::from_name(&s).or_else(|| Robot::ALL.into_iter().find(|r| r.short_name() == s || (s == "pendulum-33hz" && *r == Robot::Pendulum33)))
-    }
+/// A robot of the registry.
+type Robot = &'static BuiltIn;
 
-    fn short_name(self) -> &'static str {
-        match self {
-            Robot::Pendulum33 => "pendulum",
-            Robot::Pendulum20 => "pendulum-20hz",
-            Robot::Leo => "leo",
-        }
-    }
+/// The robot when `--robot` is not given: the 33 Hz pendulum.
+fn pendulum() -> Robot {
+    registry::find("pendulum").expect("the registry has the 33 Hz pendulum (xtask's tests check it)")
+}
 
-    fn feature(self) -> Option<&'static str> {
-        match self {
-            Robot::Pendulum33 => None,
-            Robot::Pendulum20 => Some("robot-pendulum-20hz"),
-            Robot::Leo => Some("robot-leo"),
-        }
-    }
+#[cfg(test)]
+fn leo() -> Robot {
+    registry::find("leo").unwrap()
 }
 
 /// What to build.
@@ -219,7 +205,7 @@ enum Task {
 /// `qemu` and `sil`: release unless `--debug`, a board profile, a robot,
 /// and for `sil` everything after `--`.
 fn parse_emulated(task: &str, rest: &[String]) -> Result<Task, String> {
-    let mut build = Build { release: true, chip: Chip::F405, robot: Robot::Pendulum33 };
+    let mut build = Build { release: true, chip: Chip::F405, robot: pendulum() };
     let (own, passed) = match rest.iter().position(|a| a == "--") {
         Some(i) if task == "sil" => (&rest[..i], rest[i + 1..].to_vec()),
         _ => (rest, Vec::new()),
@@ -233,7 +219,9 @@ fn parse_emulated(task: &str, rest: &[String]) -> Result<Task, String> {
             }
             "-h" | "--help" => return Ok(Task::Help),
             key @ ("--robot" | "--board") => {
-                let choices = if key == "--robot" { "pendulum, pendulum-20hz or leo" } else { PROFILES };
+                let robots: Vec<&str> = registry::BUILT_IN.iter().map(|b| b.short_name).collect();
+                let robots = robots.join(", ");
+                let choices = if key == "--robot" { robots.as_str() } else { PROFILES };
                 (key, own.next().ok_or_else(|| format!("{key} needs a value: {choices}"))?.as_str())
             }
             other => match ["--robot", "--board"]
@@ -247,8 +235,7 @@ fn parse_emulated(task: &str, rest: &[String]) -> Result<Task, String> {
         if key == "--board" {
             build.chip = Chip::for_profile(value).ok_or_else(|| format!("unknown board `{value}`: expected {PROFILES}"))?;
         } else {
-            build.robot = Robot::parse(value)
-                .ok_or_else(|| format!("unknown robot `{value}`: expected pendulum, pendulum-20hz or leo"))?;
+            build.robot = parse_robot(value)?;
         }
     }
     Ok(if task == "sil" { Task::Sil(build, passed) } else { Task::Qemu(build) })
@@ -262,7 +249,7 @@ fn parse_args(args: &[String]) -> Result<Task, String> {
         "help" | "-h" | "--help" => Ok(Task::Help),
         "firmware" | "flash" => {
             let mut release = false;
-            let (mut board, mut chip, mut robot) = (None, None, Robot::Pendulum33);
+            let (mut board, mut chip, mut robot) = (None, None, pendulum());
             let mut rest = rest.iter();
             while let Some(arg) = rest.next() {
                 let (key, value) = match arg.as_str() {
@@ -301,8 +288,7 @@ fn parse_args(args: &[String]) -> Result<Task, String> {
                         )
                     }
                     _ => {
-                        robot = Robot::parse(value)
-                            .ok_or_else(|| format!("unknown robot `{value}`: expected pendulum, pendulum-20hz or leo"))?
+                        robot = parse_robot(value)?
                     }
                 }
             }
@@ -429,17 +415,18 @@ fn firmware(root: &Path, build: Build) -> Result<PathBuf, String> {
         cmd.arg("--no-default-features");
         features.push(chip.feature());
     }
-    features.extend(robot.feature());
     if !features.is_empty() {
         cmd.args(["--features", &features.join(",")]);
     }
+    // The image's robot: firmware/build.rs reads it.
+    cmd.env("PADA_ROBOT", robot.spec.name);
 
     println!(
-        "xtask: building pada-firmware ({profile}, board profile {}: {} on {}, {}) for {TARGET}",
+        "xtask: building pada-firmware ({profile}, board profile {}: {} on {}, robot {}) for {TARGET}",
         chip.profile(),
         chip.feature(),
         chip.board(),
-        robot.feature().unwrap_or("robot-pendulum-33hz (default)")
+        robot.spec.name
     );
     let started = Instant::now();
     let status = cmd
@@ -504,8 +491,7 @@ fn qemu_image(root: &Path, build: Build) -> Result<PathBuf, String> {
     lock.lock().map_err(|e| format!("cannot lock {}: {e}", lock_path.display()))?;
     let profile = if build.release { "release" } else { "debug" };
     let (machine_feature, machine, memory_x) = build.chip.emulated();
-    let mut features = vec![machine_feature];
-    features.extend(build.robot.feature());
+    let features = [machine_feature];
     let mut cmd = toolchain.cargo_build(&firmware_dir);
     cmd.arg("--manifest-path")
         .arg(firmware_dir.join("Cargo.toml"))
@@ -513,14 +499,15 @@ fn qemu_image(root: &Path, build: Build) -> Result<PathBuf, String> {
         .arg(TARGET)
         .arg("--target-dir")
         .arg(&target_dir)
-        .args(["--no-default-features", "--features", &features.join(",")]);
+        .args(["--no-default-features", "--features", &features.join(",")])
+        .env("PADA_ROBOT", build.robot.spec.name);
     if build.release {
         cmd.arg("--release");
     }
     println!(
-        "xtask: building pada-firmware ({profile}, board profile {} emulated on QEMU's {machine}, {}) for {TARGET}",
+        "xtask: building pada-firmware ({profile}, board profile {} emulated on QEMU's {machine}, robot {}) for {TARGET}",
         build.chip.profile(),
-        build.robot.feature().unwrap_or("robot-pendulum-33hz (default)")
+        build.robot.spec.name
     );
     let started = Instant::now();
     let status = cmd
@@ -531,7 +518,7 @@ fn qemu_image(root: &Path, build: Build) -> Result<PathBuf, String> {
     }
     let built = target_dir.join(TARGET).join(profile).join("pada-firmware");
     let debug = if build.release { "" } else { "-debug" };
-    let elf = images.join(format!("{}-{}{debug}.elf", build.chip.profile(), build.robot.short_name()));
+    let elf = images.join(format!("{}-{}{debug}.elf", build.chip.profile(), build.robot.short_name));
     std::fs::copy(&built, &elf).map_err(|e| format!("cannot copy {} to {}: {e}", built.display(), elf.display()))?;
     drop(lock);
     println!("xtask: built in {:.1} s", started.elapsed().as_secs_f64());
@@ -556,7 +543,7 @@ fn sil(root: &Path, elf: &Path, build: Build, args: &[String]) -> Result<(), Str
         .arg(elf);
     let given = |flag: &str| args.iter().any(|a| a == flag || a.starts_with(&format!("{flag}=")));
     if !given("--task") {
-        cmd.args(["--task", build.robot.short_name()]);
+        cmd.args(["--task", build.robot.short_name]);
     }
     if !given("--board") {
         cmd.args(["--board", build.chip.profile()]);
@@ -662,32 +649,32 @@ mod tests {
     fn firmware_defaults_to_debug_f405() {
         assert_eq!(
             parse_args(&args("firmware")),
-            Ok(Task::Firmware(Build { release: false, chip: Chip::F405, robot: Robot::Pendulum33 }))
+            Ok(Task::Firmware(Build { release: false, chip: Chip::F405, robot: pendulum() }))
         );
     }
 
     #[test]
     fn firmware_flags_in_any_order_and_both_chip_spellings() {
-        let want = Ok(Task::Firmware(Build { release: true, chip: Chip::F407, robot: Robot::Pendulum33 }));
+        let want = Ok(Task::Firmware(Build { release: true, chip: Chip::F407, robot: pendulum() }));
         assert_eq!(parse_args(&args("firmware --chip f407 --release")), want);
         assert_eq!(parse_args(&args("firmware --release --chip=stm32F407")), want);
     }
 
     #[test]
     fn a_board_profile_picks_its_chip_and_a_chip_its_profile() {
-        let f429_leo = Ok(Task::Firmware(Build { release: true, chip: Chip::F429, robot: Robot::Leo }));
+        let f429_leo = Ok(Task::Firmware(Build { release: true, chip: Chip::F429, robot: leo() }));
         assert_eq!(parse_args(&args("firmware --release --board f429-sdram --robot leo")), f429_leo);
         assert_eq!(parse_args(&args("firmware --robot=leo --board=F429-SDRAM --release")), f429_leo);
         assert_eq!(parse_args(&args("firmware --release --chip f429 --robot leo")), f429_leo);
         assert_eq!(parse_args(&args("firmware --release --board f429-sdram --chip stm32f429 --robot leo")), f429_leo);
         assert_eq!(
             parse_args(&args("firmware --board f405")),
-            Ok(Task::Firmware(Build { release: false, chip: Chip::F405, robot: Robot::Pendulum33 }))
+            Ok(Task::Firmware(Build { release: false, chip: Chip::F405, robot: pendulum() }))
         );
         // The Discovery's F407 is an f405-profile board.
         assert_eq!(
             parse_args(&args("flash --board f405 --chip f407")),
-            Ok(Task::Flash(Build { release: false, chip: Chip::F407, robot: Robot::Pendulum33 }))
+            Ok(Task::Flash(Build { release: false, chip: Chip::F407, robot: pendulum() }))
         );
         assert_eq!((Chip::F407.profile(), Chip::F429.profile()), ("f405", "f429-sdram"));
         assert_eq!(Chip::F429.memory_x(), "firmware/memory-f429.x");
@@ -704,11 +691,11 @@ mod tests {
     fn flash_robot_and_firmware_test() {
         assert_eq!(
             parse_args(&args("flash --robot leo --release")),
-            Ok(Task::Flash(Build { release: true, chip: Chip::F405, robot: Robot::Leo }))
+            Ok(Task::Flash(Build { release: true, chip: Chip::F405, robot: leo() }))
         );
         assert_eq!(
             parse_args(&args("firmware --robot=pendulum-20hz --chip=f407")),
-            Ok(Task::Firmware(Build { release: false, chip: Chip::F407, robot: Robot::Pendulum20 }))
+            Ok(Task::Firmware(Build { release: false, chip: Chip::F407, robot: registry::find("pendulum-20hz").unwrap() }))
         );
         assert_eq!(parse_args(&args("firmware-test")), Ok(Task::FirmwareTest));
         assert!(parse_args(&args("firmware-test --release")).is_err());
@@ -717,22 +704,22 @@ mod tests {
 
     #[test]
     fn emulated_board_builds_release_by_default_and_passes_sil_options_on() {
-        let release = Build { release: true, chip: Chip::F405, robot: Robot::Pendulum33 };
+        let release = Build { release: true, chip: Chip::F405, robot: pendulum() };
         assert_eq!(parse_args(&args("qemu")), Ok(Task::Qemu(release)));
         assert_eq!(
             parse_args(&args("qemu --debug --robot leo")),
-            Ok(Task::Qemu(Build { release: false, chip: Chip::F405, robot: Robot::Leo }))
+            Ok(Task::Qemu(Build { release: false, chip: Chip::F405, robot: leo() }))
         );
         assert_eq!(
             parse_args(&args("sil -- --seconds 60 --json")),
             Ok(Task::Sil(release, args("--seconds 60 --json")))
         );
-        assert_eq!(parse_args(&args("sil --robot=leo")), Ok(Task::Sil(Build { robot: Robot::Leo, ..release }, vec![])));
+        assert_eq!(parse_args(&args("sil --robot=leo")), Ok(Task::Sil(Build { robot: leo(), ..release }, vec![])));
         assert!(parse_args(&args("qemu --release")).is_err());
         assert!(parse_args(&args("qemu -- --json")).is_err());
         assert!(parse_args(&args("sil --robot")).is_err());
         // The f429-sdram profile is emulated on mps2-an386.
-        let f429_leo = Build { release: true, chip: Chip::F429, robot: Robot::Leo };
+        let f429_leo = Build { release: true, chip: Chip::F429, robot: leo() };
         assert_eq!(parse_args(&args("qemu --board f429-sdram --robot leo")), Ok(Task::Qemu(f429_leo)));
         assert_eq!(parse_args(&args("sil --robot=leo --board=f429-sdram -- --seconds 5")), Ok(Task::Sil(f429_leo, args("--seconds 5"))));
         assert_eq!(Chip::F429.emulated(), ("mps2", "mps2-an386", "firmware/memory-mps2.x"));

@@ -4,7 +4,7 @@
 
 use super::Controller;
 use crate::config::TILINGS;
-use crate::robot::RobotAdapter;
+use pada_core::robot::RobotRules;
 use pada_core::policy::PolicyKind;
 use pada_core::safety::{Command, Event, Transition};
 use pada_core::weights::WeightStore;
@@ -16,7 +16,7 @@ pub type CommandResult = Result<(), NackReason>;
 impl<W, R> Controller<W, R>
 where
     W: WeightStore,
-    R: RobotAdapter,
+    R: RobotRules,
 {
     /// Carries out a host command that the controller owns (start, stop,
     /// pause, clear fault, policy, ε, switch to SARSA); the others
@@ -75,14 +75,12 @@ where
 mod tests {
     use super::*;
     use crate::control::test_support::*;
-    use crate::config::Robot;
-    use crate::pendulum::Pendulum33;
     use pada_core::fixed::Q16;
     use pada_core::safety::RunMode;
 
     #[test]
     fn policy_changes_only_with_torque_off_and_reseed() {
-        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 5).unwrap();
+        let mut c = Controller::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Sarsa, table(), 5).unwrap();
         let fresh = c.agent().weights_checksum();
         c.agent_mut().weights_mut()[0] = Q16(12345);
         assert_eq!(c.command(&wire::ToChip::SetPolicy(PolicyKind::Pada { delta: 0.5 })).0, Ok(()));

@@ -8,7 +8,7 @@
 use super::{Controller, PeriodOutput, Phase, Readings};
 use crate::config::MAX_OBS;
 use crate::io::CycleCounter;
-use crate::robot::RobotAdapter;
+use pada_core::robot::RobotRules;
 use pada_core::episodes::record::Stamp;
 use pada_core::episodes::Transition;
 use pada_core::safety::RunMode;
@@ -17,7 +17,7 @@ use pada_core::weights::WeightStore;
 impl<W, R> Controller<W, R>
 where
     W: WeightStore,
-    R: RobotAdapter,
+    R: RobotRules,
 {
     pub(super) fn begin_reset(&mut self) {
         self.phase = Phase::Resetting;
@@ -82,15 +82,13 @@ where
 mod tests {
     use super::*;
     use crate::control::test_support::*;
-    use crate::config::Robot;
-    use crate::pendulum::Pendulum33;
     use core::cell::Cell;
     use pada_core::policy::PolicyKind;
     use pada_core::wire::StepKind;
 
     #[test]
     fn pendulum_episodes_start_after_hanging_still_and_end_by_time() {
-        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Pada { delta: 0.5 }, table(), 7).unwrap();
+        let mut c = Controller::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Pada { delta: 0.5 }, table(), 7).unwrap();
         start(&mut c, RunMode::Learning);
         let clock = Clock(Cell::new(0));
         let mut out = PeriodOutput::default();
@@ -125,7 +123,7 @@ mod tests {
 
     #[test]
     fn every_tenth_episode_is_a_test() {
-        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 3).unwrap();
+        let mut c = Controller::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Sarsa, table(), 3).unwrap();
         start(&mut c, RunMode::Learning);
         let clock = Clock(Cell::new(0));
         let mut out = PeriodOutput::default();

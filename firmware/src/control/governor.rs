@@ -13,7 +13,7 @@
 
 use super::{CommandResult, Controller, PeriodOutput};
 use crate::config::MAX_ROBOT_SERVOS;
-use crate::robot::RobotAdapter;
+use pada_core::robot::RobotRules;
 use pada_core::episodes::wear;
 use pada_core::error::ConfigError;
 use pada_core::fatigue::GearboxParams;
@@ -25,7 +25,7 @@ use pada_core::wire::NackReason;
 impl<W, R> Controller<W, R>
 where
     W: WeightStore,
-    R: RobotAdapter,
+    R: RobotRules,
 {
     /// A fresh governor for the built `policy` holding `budget_s`,
     /// following the reported joints (at most [`GOVERNED_JOINTS`]).
@@ -84,8 +84,7 @@ where
 mod tests {
     use super::*;
     use crate::control::test_support::*;
-    use crate::config::{Robot, TILINGS, TRACE};
-    use crate::pendulum::Pendulum33;
+    use crate::config::{TILINGS, TRACE};
     use pada_core::agent::{EpisodeEnd, Mode};
     use pada_core::safety::RunMode;
     use pada_core::wire::{self, StepKind};
@@ -93,7 +92,7 @@ mod tests {
 
     #[test]
     fn the_wear_budget_command_starts_a_governor_for_pada_and_lowpass_only() {
-        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Pada { delta: 1.0 }, table(), 3).unwrap();
+        let mut c = Controller::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Pada { delta: 1.0 }, table(), 3).unwrap();
         assert_eq!(c.command(&wire::ToChip::SetMtbfBudget(Some(1.0e3))).0, Ok(()));
         assert_eq!(c.governor().map(|g| g.budget_s()), Some(1.0e3));
         assert_eq!(c.policy(), PolicyKind::Pada { delta: 0.5 }, "starts at the floor, one level");
@@ -126,7 +125,7 @@ mod tests {
         // governor's moves, replayed through a host agent that takes each
         // reported Δ when it arrives, give the same actions and weights.
         let seed = 11;
-        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Pada { delta: 0.5 }, table(), seed).unwrap();
+        let mut c = Controller::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Pada { delta: 0.5 }, table(), seed).unwrap();
         assert_eq!(c.command(&wire::ToChip::SetMtbfBudget(Some(TEST_BUDGET_S))).0, Ok(()));
         start(&mut c, RunMode::Learning);
         let mut angle = 0.0;
@@ -134,9 +133,8 @@ mod tests {
         let moves = c.governor().unwrap().status().moves;
         assert!(moves >= 2, "the governor moved {moves} times: the test needs it to move");
 
-        let robot = Robot::Pendulum33;
-        let mut rng = rand_pcg::Pcg32::seed_from_u64(seed);
-        let mut agent = robot.spec().agent::<_, TILINGS, TRACE>(PolicyKind::Pada { delta: 0.5 }, profile(robot).layout, table()).unwrap();
+            let mut rng = rand_pcg::Pcg32::seed_from_u64(seed);
+        let mut agent = SPEC_33HZ.agent::<_, TILINGS, TRACE>(PolicyKind::Pada { delta: 0.5 }, profile(&SPEC_33HZ).layout, table()).unwrap();
         agent.reset_weights(&mut rng);
         let (mut compared, mut reports) = (0, 0);
         for r in &sent {

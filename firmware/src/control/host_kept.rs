@@ -13,7 +13,7 @@
 
 use super::persist::CheckpointError;
 use super::{Controller, Phase};
-use crate::robot::RobotAdapter;
+use pada_core::robot::RobotRules;
 use pada_core::checkpoint::stream::ImageSink;
 use pada_core::checkpoint::{LearnerState, HEADER_LEN, STATE_LEN};
 use pada_core::weights::WeightStore;
@@ -113,7 +113,7 @@ impl<'a, W: WeightStore + ?Sized> ImageSink for RestoreSink<'a, W> {
 impl<W, R> Controller<W, R>
 where
     W: WeightStore,
-    R: RobotAdapter,
+    R: RobotRules,
 {
     /// Whether this board's checkpoint is the host's to keep: larger than
     /// a flash slot of `slot_bytes`.
@@ -193,18 +193,16 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::Robot;
     use crate::control::test_support::*;
-    use crate::pendulum::Pendulum33;
     use pada_core::checkpoint::stream::{Assembler, Chunk, Chunker, Expect, Order, Progress, TableImage};
     use pada_core::fixed::Q16;
     use pada_core::policy::PolicyKind;
     use pada_core::safety::RunMode;
 
-    type Pendulum = Controller<Box<[Q16]>, Pendulum33>;
+    type PendulumCtl = Controller<Box<[Q16]>, Pendulum>;
 
-    fn learned(seed: u64) -> Pendulum {
-        let mut c = Pendulum::new(profile(Robot::Pendulum33), PolicyKind::Pada { delta: 0.5 }, table(), seed).unwrap();
+    fn learned(seed: u64) -> PendulumCtl {
+        let mut c = PendulumCtl::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Pada { delta: 0.5 }, table(), seed).unwrap();
         start(&mut c, RunMode::Learning);
         let mut angle = 0.0;
         assert!(run_pendulum(&mut c, &mut angle, 0, 1500).len() > 300);
@@ -214,14 +212,14 @@ mod tests {
 
     /// The chunks of `c`'s next save, header first (as the host sends it
     /// back).
-    fn restore_chunks(c: &mut Pendulum) -> (u32, std::vec::Vec<Chunk>) {
+    fn restore_chunks(c: &mut PendulumCtl) -> (u32, std::vec::Vec<Chunk>) {
         let save = c.host_save().unwrap();
         let image = TableImage::new(c.config_hash(), save.generation, &save.record, c.weights()).unwrap();
         (save.generation, Chunker::new(&image, Order::HeaderFirst).unwrap().collect())
     }
 
     /// Feeds `chunks` into `c` as the boot's restore does.
-    fn restore(c: &mut Pendulum, chunks: &[Chunk]) -> RestoreOutcome {
+    fn restore(c: &mut PendulumCtl, chunks: &[Chunk]) -> RestoreOutcome {
         let expect = Expect {
             config_hash: Some(c.config_hash()),
             image_len: Some(c.checkpoint_bytes() as u32),
@@ -261,7 +259,7 @@ mod tests {
         assert!(matches!(a.host_save(), Err(CheckpointError::Busy)));
         stop(&mut a);
 
-        let mut b = Pendulum::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 99).unwrap();
+        let mut b = PendulumCtl::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Sarsa, table(), 99).unwrap();
         assert_ne!(b.weights(), a.weights());
         assert_eq!(restore(&mut b, &chunks), RestoreOutcome::Loaded { generation: 1, chunks: chunks.len() as u32 });
         assert_eq!(b.weights(), a.weights());
@@ -293,11 +291,11 @@ mod tests {
     fn a_restore_that_fails_half_way_leaves_a_fresh_learner() {
         let mut a = learned(5);
         let (_, mut chunks) = restore_chunks(&mut a);
-        let fresh = Pendulum::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 99).unwrap();
+        let fresh = PendulumCtl::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Sarsa, table(), 99).unwrap();
         let fresh_checksum = fresh.agent().weights_checksum();
 
         // Cut short: entries written, never completed.
-        let mut b = Pendulum::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 99).unwrap();
+        let mut b = PendulumCtl::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Sarsa, table(), 99).unwrap();
         assert_eq!(restore(&mut b, &chunks[..chunks.len() / 2]), RestoreOutcome::NoAnswer { waited_ms: 0 });
         assert_eq!(b.agent().weights_checksum(), fresh_checksum);
         assert_eq!(b.weights(), fresh.weights());
@@ -307,7 +305,7 @@ mod tests {
         let k = chunks.len() / 2;
         chunks[k].crc ^= 1;
         let offset = chunks[k].offset;
-        let mut c = Pendulum::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 99).unwrap();
+        let mut c = PendulumCtl::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Sarsa, table(), 99).unwrap();
         assert_eq!(restore(&mut c, &chunks), RestoreOutcome::ChunkRefused { offset });
         assert_eq!(c.weights(), fresh.weights());
 
@@ -318,7 +316,7 @@ mod tests {
         let record = state.to_bytes();
         let image = TableImage::new(a.config_hash(), 9, &record, a.weights()).unwrap();
         let bad: std::vec::Vec<Chunk> = Chunker::new(&image, Order::HeaderFirst).unwrap().collect();
-        let mut d = Pendulum::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 99).unwrap();
+        let mut d = PendulumCtl::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Sarsa, table(), 99).unwrap();
         assert_eq!(restore(&mut d, &bad), RestoreOutcome::InvalidState);
         assert_eq!(d.last_refusal().map(|e| e.param), Some("epsilon"));
         assert_eq!(d.checkpoints_refused(), 1);
@@ -328,7 +326,7 @@ mod tests {
         // written.
         let other = TableImage::new(a.config_hash() ^ 1, 3, &record, a.weights()).unwrap();
         let other: std::vec::Vec<Chunk> = Chunker::new(&other, Order::HeaderFirst).unwrap().collect();
-        let mut e = Pendulum::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 99).unwrap();
+        let mut e = PendulumCtl::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Sarsa, table(), 99).unwrap();
         assert_eq!(restore(&mut e, &other), RestoreOutcome::ChunkRefused { offset: 0 });
         assert_eq!(e.weights(), fresh.weights());
     }

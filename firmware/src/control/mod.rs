@@ -6,9 +6,10 @@
 //! 1. the safety machine sees every servo answer, timeout, checksum error,
 //!    error bit, joint position and the last period's overrun — a fault
 //!    found here switches torque off in **this** period's output;
-//! 2. the robot's adapter ([`RobotAdapter`]: [`crate::pendulum`],
-//!    [`crate::leo`]) turns the readings into the observation and reward of
-//!    the robot's one definition in `pada_core::robot`;
+//! 2. the robot's rules ([`RobotRules`]: `pada_core::robot::pendulum`,
+//!    `pada_core::robot::leo`, or a robot of the user's own) turn the
+//!    readings into the observation and reward of the robot's one
+//!    definition;
 //! 3. while torque is on: between episodes the robot is brought back to
 //!    its start (pendulum hanging still, LEO set upright); in an episode the
 //!    agent takes one step (`start_episode`, `step` or `end_episode` at an
@@ -73,10 +74,9 @@ pub use period::{safety_config, PeriodOutput, Readings, ServoRead};
 pub use host_kept::{HostSave, Misaligned, RestoreSink};
 pub use persist::CheckpointError;
 
-use crate::config::{hardware, FirmwareAgent, LearnerProfile, RobotConfig, MAX_ROBOT_SERVOS};
+use crate::config::{soft_limits, FirmwareAgent, LearnerProfile, MAX_ROBOT_SERVOS};
 use crate::encoder::Unwrapper;
-use crate::robot::RobotAdapter;
-use heapless::Vec;
+use pada_core::robot::RobotRules;
 use pada_core::checkpoint::FlashWear;
 use pada_core::episodes::Episodes;
 use pada_core::error::ConfigError;
@@ -101,12 +101,11 @@ enum Phase {
     Running,
 }
 
-/// The control loop's state for robot `R` on weights `W`: agent, safety
-/// machine, the robot's adapter, fatigue.
+/// The control loop's state for a robot with rules `R` on weights `W`:
+/// agent, safety machine, the robot's rules, fatigue.
 pub struct Controller<W, R> {
     profile: LearnerProfile,
     spec: &'static RobotSpec,
-    config: RobotConfig,
     agent: Option<FirmwareAgent<W>>,
     policy: PolicyKind,
     config_hash: u32,
@@ -155,32 +154,29 @@ pub struct Controller<W, R> {
 impl<W, R> Controller<W, R>
 where
     W: WeightStore,
-    R: RobotAdapter,
+    R: RobotRules,
 {
-    /// A controller for `R` with the board's learner `profile` (whose robot
-    /// must be `R`'s), learning with `policy` on `weights`, initialised from
-    /// `seed` (also the generator of every action).
-    pub fn new(profile: LearnerProfile, policy: PolicyKind, weights: W, seed: u64) -> Result<Self, ConfigError> {
-        if profile.robot != R::ROBOT {
-            return Err(ConfigError::new("profile.robot", profile.robot.code() as f32, "the controller's robot"));
+    /// A controller for `robot` with the board's learner `profile` (whose
+    /// robot must be `robot`'s), learning with `policy` on `weights`,
+    /// initialised from `seed` (also the generator of every action).
+    pub fn new(robot: R, profile: LearnerProfile, policy: PolicyKind, weights: W, seed: u64) -> Result<Self, ConfigError> {
+        let spec = robot.spec();
+        if profile.robot != spec {
+            return Err(ConfigError::new("profile.robot", profile.robot.definition_hash() as f32, "the controller's robot"));
+        }
+        if spec.joints.len() > MAX_ROBOT_SERVOS {
+            return Err(ConfigError::new("joints", spec.joints.len() as f32, "at most MAX_SERVOS (8)"));
         }
         if profile.weights().is_some_and(|n| n != weights.len()) {
             return Err(ConfigError::new("weights", weights.len() as f32, "the profile's table size"));
         }
-        let config = hardware(R::ROBOT);
-        let mut soft_limits = Vec::new();
-        for limit in config.soft_limits.iter().map_while(|l| *l) {
-            let _ = soft_limits.push(limit);
-        }
-        let safety = Safety::new(safety_config(soft_limits))?;
-        let spec = R::spec();
+        let safety = Safety::new(safety_config(soft_limits(spec)))?;
         let fatigue = FatigueCounter::new(GearboxParams::TABLE_I, spec.period_s(), Some(PAPER_WINDOW_STEPS))
             .map_err(|_| ConfigError::new("fatigue", 0.0, "Table I parameters"))?;
         let mut controller = Controller {
             profile,
             spec,
-            robot: R::new(&config),
-            config,
+            robot,
             agent: None,
             policy,
             config_hash: 0,
@@ -236,11 +232,6 @@ where
         self.agent.as_mut().unwrap_or_else(|| unreachable!())
     }
 
-    /// The robot's hardware.
-    pub fn config(&self) -> &RobotConfig {
-        &self.config
-    }
-
     /// The robot's learning task.
     pub fn spec(&self) -> &'static RobotSpec {
         self.spec
@@ -251,7 +242,7 @@ where
         &self.profile
     }
 
-    /// The robot's adapter (for inspection).
+    /// The robot's rules (for inspection).
     pub fn robot(&self) -> &R {
         &self.robot
     }
@@ -303,7 +294,7 @@ where
     /// pendulum's motor; LEO's hips and knees, which take turns as stance
     /// and swing joints).
     pub fn reported_joints(&self) -> core::ops::Range<usize> {
-        R::reported_joints()
+        self.spec.counted.range()
     }
 
     /// Distance walked in the current (or last) episode \[m\], for a

@@ -9,7 +9,7 @@ use super::{Controller, Phase};
 use crate::bus::BusConfig;
 use crate::config::MAX_ROBOT_SERVOS;
 use crate::io::CycleCounter;
-use crate::robot::{RobotAdapter, Sensed};
+use pada_core::robot::{RobotRules, Sensed};
 use heapless::Vec;
 use pada_core::dynamixel::{table::PresentState, ErrorFlags};
 use pada_core::safety::{Event, RunMode, Safety, SafetyConfig, Transition};
@@ -37,7 +37,7 @@ pub struct Readings {
     pub servos: [ServoRead; MAX_ROBOT_SERVOS],
     /// The encoder's counter, if it could be read.
     pub encoder: Option<u16>,
-    /// Foot switches ([`crate::leo::contact`]).
+    /// Foot switches (the robot's own bits, e.g. `pada_core::robot::leo::contact`).
     pub contacts: u8,
     /// Time since boot \[ms\].
     pub time_ms: u32,
@@ -90,7 +90,7 @@ pub fn safety_config(soft_limits: Vec<pada_core::safety::SoftLimit, { pada_core:
 impl<W, R> Controller<W, R>
 where
     W: WeightStore,
-    R: RobotAdapter,
+    R: RobotRules,
 {
     /// One control period (see the module documentation). `cycles` times
     /// the agent call.
@@ -105,7 +105,7 @@ where
         self.steps = self.steps.wrapping_add(1);
         self.periods = self.periods.saturating_add(1);
         let now = readings.time_ms;
-        let joints = self.config.joints;
+        let joints = self.spec.joints;
         let n = joints.len();
 
         // 1. Safety sees everything that was read.
@@ -132,7 +132,7 @@ where
                 self.temps[i] = state.temperature;
                 let angle = joint.angle(state.position);
                 angles[i] = Some(angle);
-                if self.config.soft_limits.get(i).is_some_and(|l| l.is_some()) {
+                if joint.soft_limit.is_some() {
                     let position = Event::JointPosition { joint: i as u8, position: angle };
                     feed(&mut self.safety, &mut out.transitions, position);
                 }
@@ -160,7 +160,10 @@ where
         self.last_state = state;
 
         // 3. Observe.
-        let encoder_angle = readings.encoder.map(|c| self.config.encoder.angle(self.encoder.update(c)));
+        let encoder_angle = match (self.spec.encoder, readings.encoder) {
+            (Some(encoder), Some(count)) => Some(encoder.angle(self.encoder.update(count))),
+            _ => None,
+        };
         self.robot.sense(&Sensed { angles, encoder_angle, contacts: readings.contacts, applied: self.applied });
 
         // 4. The agent's step, and the voltages.
@@ -182,7 +185,7 @@ where
         }
 
         // 5. Voltages → Moving Speeds of the measured supply.
-        let nominal = self.config.supply_nominal_v;
+        let nominal = self.spec.supply_nominal_v;
         for (i, joint) in joints.iter().enumerate() {
             let v = if torque { volts[i] } else { 0.0 };
             let supply = self.supply[i].filter(|s| *s >= 5.0).unwrap_or(nominal);
@@ -216,9 +219,6 @@ where
 mod tests {
     use super::*;
     use crate::control::test_support::*;
-    use crate::config::Robot;
-    use crate::leo::Leo;
-    use crate::pendulum::Pendulum33;
     use core::cell::Cell;
     use pada_core::policy::PolicyKind;
     use pada_core::safety::{FaultCause, State};
@@ -226,7 +226,7 @@ mod tests {
 
     #[test]
     fn idle_means_torque_off_and_zero_speed() {
-        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 1).unwrap();
+        let mut c = Controller::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Sarsa, table(), 1).unwrap();
         let mut out = PeriodOutput::default();
         c.period(&pendulum_readings(0, 0), &Clock(Cell::new(0)), &mut out);
         assert!(!out.torque);
@@ -236,7 +236,7 @@ mod tests {
 
     #[test]
     fn a_silent_servo_faults_and_torque_goes_off_in_the_same_period() {
-        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 1).unwrap();
+        let mut c = Controller::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Sarsa, table(), 1).unwrap();
         start(&mut c, RunMode::Learning);
         let clock = Clock(Cell::new(0));
         let mut out = PeriodOutput::default();
@@ -263,7 +263,7 @@ mod tests {
 
     #[test]
     fn damaged_answers_fault_as_checksum_errors_in_the_period() {
-        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 1).unwrap();
+        let mut c = Controller::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Sarsa, table(), 1).unwrap();
         start(&mut c, RunMode::Learning);
         let clock = Clock(Cell::new(0));
         let mut out = PeriodOutput::default();
@@ -278,7 +278,7 @@ mod tests {
 
     #[test]
     fn servo_error_bits_and_overrun_streaks_fault() {
-        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 1).unwrap();
+        let mut c = Controller::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Sarsa, table(), 1).unwrap();
         start(&mut c, RunMode::Learning);
         let clock = Clock(Cell::new(0));
         let mut out = PeriodOutput::default();
@@ -288,7 +288,7 @@ mod tests {
         assert!(!out.torque);
         assert!(matches!(c.state(), State::Fault(FaultCause::ServoError { servo: 1, .. })));
 
-        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 1).unwrap();
+        let mut c = Controller::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Sarsa, table(), 1).unwrap();
         start(&mut c, RunMode::Learning);
         let mut r = pendulum_readings(0, 0);
         r.last_period_overran = true;
@@ -303,11 +303,11 @@ mod tests {
 
     #[test]
     fn leo_soft_limit_faults() {
-        let mut c = Controller::<_, Leo>::new(profile(Robot::Leo), PolicyKind::Sarsa, leo_table(), 1).unwrap();
+        let mut c = Controller::new(Leo::new(), profile(&leo::SPEC), PolicyKind::Sarsa, leo_table(), 1).unwrap();
         start(&mut c, RunMode::Learning);
         let clock = Clock(Cell::new(0));
         let mut out = PeriodOutput::default();
-        let mut r = Readings { encoder: Some(0), contacts: crate::leo::contact::LEFT, ..Readings::default() };
+        let mut r = Readings { encoder: Some(0), contacts: leo::contact::LEFT, ..Readings::default() };
         for s in r.servos.iter_mut() {
             s.state = Some(PresentState { position: 512, speed: 0, load: 0, voltage: 140, temperature: 30 });
         }

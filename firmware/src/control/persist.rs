@@ -6,7 +6,7 @@
 
 use super::{Controller, Phase};
 use crate::config::MAX_ROBOT_SERVOS;
-use crate::robot::RobotAdapter;
+use pada_core::robot::RobotRules;
 use heapless::Vec;
 use pada_core::checkpoint::{self, CheckpointStore, FlashWear, LearnerState, LoadOutcome, SaveError, Saved, WearBudget};
 use pada_core::error::ConfigError;
@@ -49,7 +49,7 @@ mod user {
 impl<W, R> Controller<W, R>
 where
     W: WeightStore,
-    R: RobotAdapter,
+    R: RobotRules,
 {
     /// The learner's state besides its weights, as a checkpoint saves it:
     /// the agent's ([`pada_core::agent::AgentState`]), the generator, every
@@ -286,22 +286,22 @@ where
 mod tests {
     use super::*;
     use crate::control::test_support::*;
-    use crate::config::{Board, Robot, TILINGS, TRACE};
-    use crate::leo::Leo;
-    use crate::pendulum::Pendulum33;
+    use crate::config::{Board, TILINGS, TRACE};
     use crate::control::{PeriodOutput, Readings};
     use core::cell::Cell;
     use pada_core::agent::{EpisodeEnd, Mode};
     use pada_core::fixed::Q16;
     use pada_core::policy::PolicyKind;
-    use pada_core::profile::{config_hash, PENDULUM_EXACT_WEIGHTS as WEIGHTS};
+    use pada_core::profile::config_hash;
+    use pada_core::robot::pendulum::EXACT_WEIGHTS as WEIGHTS;
+    use pada_core::robot::RobotRules;
     use pada_core::safety::RunMode;
     use pada_core::wire::{self, StepKind};
 
     #[test]
     fn a_checkpoint_carries_the_governor() {
         let mut store = Store::new();
-        let mut a = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Pada { delta: 0.5 }, table(), 5).unwrap();
+        let mut a = Controller::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Pada { delta: 0.5 }, table(), 5).unwrap();
         assert_eq!(a.command(&wire::ToChip::SetMtbfBudget(Some(TEST_BUDGET_S))).0, Ok(()));
         start(&mut a, RunMode::Learning);
         let mut angle = 0.0;
@@ -311,7 +311,7 @@ mod tests {
         assert!(governor.state().steps > 1000);
         a.save_checkpoint(&mut store).unwrap();
 
-        let mut b = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Pada { delta: 0.5 }, table(), 99).unwrap();
+        let mut b = Controller::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Pada { delta: 0.5 }, table(), 99).unwrap();
         assert_eq!(b.load_checkpoint(&store), Ok(LoadOutcome::Loaded { generation: 1, slot: 0 }));
         assert_eq!(b.governor(), Some(&governor));
         assert_eq!(b.policy(), a.policy(), "the governor's rung is the Δ in force");
@@ -333,7 +333,7 @@ mod tests {
     #[test]
     fn a_checkpoint_carries_the_learner_across_a_reset() {
         let mut store = Store::new();
-        let mut a = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Pada { delta: 0.5 }, table(), 11).unwrap();
+        let mut a = Controller::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Pada { delta: 0.5 }, table(), 11).unwrap();
         start(&mut a, RunMode::Learning);
         // Only with torque off.
         assert_eq!(a.save_checkpoint(&mut store), Err(CheckpointError::Busy));
@@ -349,7 +349,7 @@ mod tests {
         assert!(a.episodes.started() >= 3);
 
         // The board resets: it boots with SARSA and another seed, and loads.
-        let mut b = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 99).unwrap();
+        let mut b = Controller::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Sarsa, table(), 99).unwrap();
         assert_ne!(b.agent().weights_checksum(), a.agent().weights_checksum());
         assert_eq!(b.load_checkpoint(&store), Ok(LoadOutcome::Loaded { generation: 1, slot: 0 }));
         assert_eq!(b.checkpoints_refused(), 0);
@@ -371,8 +371,7 @@ mod tests {
         let mut state = LearnerState::default();
         let mut weights = table();
         assert!(matches!(checkpoint::load(&store, b.config_hash(), &mut state, &mut weights), Ok(LoadOutcome::Loaded { .. })));
-        let robot = Robot::Pendulum33;
-        let mut agent = robot.spec().agent::<_, TILINGS, TRACE>(PolicyKind::Sarsa, profile(robot).layout, weights).unwrap();
+        let mut agent = SPEC_33HZ.agent::<_, TILINGS, TRACE>(PolicyKind::Sarsa, profile(&SPEC_33HZ).layout, weights).unwrap();
         agent.restore_state(&state.agent).unwrap();
         let mut rng = Pcg32::from_state(state.rng).unwrap();
         for s in &after {
@@ -389,14 +388,14 @@ mod tests {
         // The next save goes to the other slot and carries on the counters.
         stop(&mut b);
         assert_eq!(b.save_checkpoint(&mut store), Ok(Saved { generation: 2, slot: 1, erases: 1 }));
-        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 5).unwrap();
+        let mut c = Controller::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Sarsa, table(), 5).unwrap();
         assert_eq!(c.load_checkpoint(&store), Ok(LoadOutcome::Loaded { generation: 2, slot: 1 }));
         assert_eq!(c.learner_state(), b.learner_state());
     }
 
     #[test]
     fn saves_beyond_the_flash_budget_are_refused_counted_and_reported() {
-        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 3).unwrap();
+        let mut c = Controller::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Sarsa, table(), 3).unwrap();
         let mut store = Store::new();
         assert_eq!(c.save_checkpoint(&mut store).map(|s| s.erases), Ok(1));
         // A store whose sectors were erased 5000 times in under a minute of
@@ -404,7 +403,7 @@ mod tests {
         let mut worn = c.learner_state();
         worn.wear = FlashWear { erases: [5000, 5000], operating_s: 40 };
         checkpoint::save(&mut store, c.config_hash(), &worn, c.weights()).unwrap();
-        let mut d = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 3).unwrap();
+        let mut d = Controller::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Sarsa, table(), 3).unwrap();
         assert!(matches!(d.load_checkpoint(&store), Ok(LoadOutcome::Loaded { .. })));
         assert_eq!(d.flash_wear().erases, [5000, 5001]);
         assert_eq!(d.operating_s(), 40, "the operating time carried by the checkpoint");
@@ -420,14 +419,14 @@ mod tests {
 
     #[test]
     fn refused_checkpoints_are_counted_and_change_nothing() {
-        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 3).unwrap();
+        let mut c = Controller::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Sarsa, table(), 3).unwrap();
         start(&mut c, RunMode::Learning);
         let mut angle = 0.0;
         run_pendulum(&mut c, &mut angle, 0, 600);
         stop(&mut c);
         let (state, checksum) = (c.learner_state(), c.agent().weights_checksum());
         // The learner is unchanged; the flash wear is the store's to report.
-        let unchanged = |c: &Controller<Box<[Q16]>, Pendulum33>| {
+        let unchanged = |c: &Controller<Box<[Q16]>, Pendulum>| {
             assert_eq!(LearnerState { wear: state.wear, ..c.learner_state() }, state);
             assert_eq!(c.agent().weights_checksum(), checksum);
         };
@@ -438,7 +437,7 @@ mod tests {
         assert_eq!(c.checkpoints_refused(), 0);
 
         // Another robot's checkpoint.
-        let mut leo = Controller::<_, Leo>::new(profile(Robot::Leo), PolicyKind::Sarsa, leo_table(), 1).unwrap();
+        let mut leo = Controller::new(Leo::new(), profile(&leo::SPEC), PolicyKind::Sarsa, leo_table(), 1).unwrap();
         leo.save_checkpoint(&mut store).unwrap();
         let expected = LoadOutcome::ConfigMismatch { expected: c.config_hash(), found: leo.config_hash() };
         assert_eq!(c.load_checkpoint(&store), Ok(expected));
@@ -449,11 +448,10 @@ mod tests {
         // (An integrator with Δ = 0.5 has the pendulum's −3/0/+3 V levels,
         // so the configuration hash matches; the state record tells them
         // apart.)
-        let integrator = Robot::Pendulum33
-            .spec()
-            .agent::<_, TILINGS, TRACE>(PolicyKind::Integrator { delta: 0.5 }, profile(Robot::Pendulum33).layout, table())
+        let integrator = SPEC_33HZ
+            .agent::<_, TILINGS, TRACE>(PolicyKind::Integrator { delta: 0.5 }, profile(&SPEC_33HZ).layout, table())
             .unwrap();
-        assert_eq!(config_hash(&profile(Robot::Pendulum33), &integrator), c.config_hash());
+        assert_eq!(config_hash(&profile(&SPEC_33HZ), &integrator), c.config_hash());
         type Change = fn(&mut LearnerState);
         let cases: [(&str, Change); 6] = [
             ("epsilon", |s| s.agent.epsilon = 2.0),
@@ -518,10 +516,10 @@ mod tests {
     fn the_f429s_leo_table_is_refused_as_too_large_and_counted_and_its_pendulum_saves() {
         // LEO on the F429: a claim table of 2^21 slots, a 16-bit weight and
         // a 16-bit tag each: 8 MiB, all of the SDRAM.
-        let f429_leo = Board::F429Sdram.profile(Robot::Leo);
+        let f429_leo = Board::F429Sdram.profile(&leo::SPEC).unwrap();
         let weights = f429_leo.weights().unwrap();
         assert_eq!(weights, 1 << 21);
-        let mut leo = Controller::<_, Leo>::new(f429_leo, PolicyKind::Sarsa, leo_table_of(weights), 1).unwrap();
+        let mut leo = Controller::new(Leo::new(), f429_leo, PolicyKind::Sarsa, leo_table_of(weights), 1).unwrap();
         let needed = checkpoint::HEADER_LEN + checkpoint::STATE_LEN + 8 * 1024 * 1024;
         assert_eq!(leo.checkpoint_bytes(), needed);
         let mut store = Box::new(pada_core::checkpoint::RamStore::<FLASH_SLOT>::new());
@@ -537,13 +535,13 @@ mod tests {
         assert_eq!(leo.load_checkpoint(&*store), Ok(LoadOutcome::NoCheckpoint));
 
         // The F429's pendulum (exact table in SRAM) fits a sector and saves.
-        let f429_pendulum = Board::F429Sdram.profile(Robot::Pendulum33);
-        let mut pendulum = Controller::<_, Pendulum33>::new(f429_pendulum, PolicyKind::Sarsa, table(), 1).unwrap();
+        let f429_pendulum = Board::F429Sdram.profile(&SPEC_33HZ).unwrap();
+        let mut pendulum = Controller::new(Pendulum::at_33hz(), f429_pendulum, PolicyKind::Sarsa, table(), 1).unwrap();
         assert!(pendulum.checkpoint_bytes() <= FLASH_SLOT, "{}", pendulum.checkpoint_bytes());
         assert_eq!(pendulum.save_checkpoint(&mut *store), Ok(Saved { generation: 1, slot: 0, erases: 1 }));
         assert_eq!(pendulum.saves_failed(), 0);
         // A saved F429 pendulum is not the F405's: the profile is in the hash.
-        let mut f405 = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 1).unwrap();
+        let mut f405 = Controller::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Sarsa, table(), 1).unwrap();
         assert!(matches!(f405.load_checkpoint(&*store), Ok(LoadOutcome::ConfigMismatch { .. })));
     }
 
@@ -551,11 +549,12 @@ mod tests {
     /// `weights` weights is the controlled time to the period (10^6
     /// periods are whole seconds), and after 17 more the whole seconds of
     /// it, rounded down.
-    fn operating_time_is_the_controlled_time<R: RobotAdapter, W: WeightStore>(table: W) {
-        let mut c = Controller::<_, R>::new(profile(R::ROBOT), PolicyKind::Sarsa, table, 1).unwrap();
+    fn operating_time_is_the_controlled_time<R: RobotRules, W: WeightStore>(robot: R, table: W) {
+        let spec = robot.spec();
+        let mut c = Controller::new(robot, profile(spec), PolicyKind::Sarsa, table, 1).unwrap();
         let mut store = Box::new(pada_core::checkpoint::RamStore::<FLASH_SLOT>::new());
         let (clock, mut out) = (Clock(Cell::new(0)), PeriodOutput::default());
-        let period_us = R::spec().period_us as u64;
+        let period_us = spec.period_us as u64;
         let mut periods = 0;
         for more in [1_000_000, 17] {
             for _ in 0..more {
@@ -565,7 +564,7 @@ mod tests {
             c.save_checkpoint(&mut *store).unwrap();
             let operating_s = checkpoint::stored_wear(&*store).unwrap().operating_s;
             let controlled_us = periods * period_us;
-            assert_eq!(operating_s, controlled_us / 1_000_000, "{:?} after {periods} periods of {period_us} µs", R::ROBOT);
+            assert_eq!(operating_s, controlled_us / 1_000_000, "{} after {periods} periods of {period_us} µs", spec.name);
         }
     }
 
@@ -573,18 +572,18 @@ mod tests {
     fn a_checkpoints_operating_time_is_the_controlled_time() {
         // 30 000 s of the 33 Hz pendulum, 50 000 s of the 20 Hz one,
         // 33 333 s of LEO (33 333 µs a period).
-        operating_time_is_the_controlled_time::<Pendulum33, _>(table());
-        let n20 = profile(Robot::Pendulum20).weights().unwrap();
-        operating_time_is_the_controlled_time::<crate::pendulum::Pendulum20, _>(vec![Q16::ZERO; n20].into_boxed_slice());
-        operating_time_is_the_controlled_time::<Leo, _>(leo_table());
+        operating_time_is_the_controlled_time(Pendulum::at_33hz(), table());
+        let n20 = profile(&SPEC_20HZ).weights().unwrap();
+        operating_time_is_the_controlled_time(Pendulum::at_20hz(), vec![Q16::ZERO; n20].into_boxed_slice());
+        operating_time_is_the_controlled_time(Leo::new(), leo_table());
     }
 
     #[test]
     fn every_f405_checkpoint_fits_a_flash_sector() {
-        for robot in Robot::ALL {
+        for robot in pada_core::robot::registry::specs() {
             let p = profile(robot);
             let bytes = checkpoint::slot_len(p.weights().unwrap(), p.entry_bytes());
-            assert!(bytes <= FLASH_SLOT, "{robot:?}: {bytes}");
+            assert!(bytes <= FLASH_SLOT, "{}: {bytes}", robot.name);
         }
     }
 }

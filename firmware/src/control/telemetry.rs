@@ -3,7 +3,7 @@
 //! `Health` record.
 
 use super::Controller;
-use crate::robot::RobotAdapter;
+use pada_core::robot::RobotRules;
 use pada_core::governor::Governor;
 use pada_core::weights::WeightStore;
 use pada_core::wire;
@@ -11,12 +11,16 @@ use pada_core::wire;
 impl<W, R> Controller<W, R>
 where
     W: WeightStore,
-    R: RobotAdapter,
+    R: RobotRules,
 {
     /// The `Hello` of this configuration.
     pub fn hello(&self) -> wire::Hello {
         wire::Hello {
             protocol: wire::PROTOCOL_VERSION,
+            // Robot names are at most MAX_NAME bytes (the definitions'
+            // tests check it; a longer one would be sent empty).
+            robot: heapless::String::try_from(self.spec.name).unwrap_or_default(),
+            robot_hash: self.spec.definition_hash(),
             config_hash: self.config_hash,
             weight_count: self.weights().len() as u32,
             period_us: self.spec.period_us,
@@ -41,7 +45,7 @@ where
     /// link counters.
     pub fn health(&self, health: &mut wire::Health) {
         health.servo_temps_c.clear();
-        let n = self.config.joints.len();
+        let n = self.spec.joints.len();
         for &t in &self.temps[..n] {
             let _ = health.servo_temps_c.push(t);
         }

@@ -3,15 +3,17 @@
 //! crude pendulum that the replay and checkpoint tests run.
 
 use super::*;
-use crate::config::{Board, Robot};
+use crate::config::Board;
 use crate::io::CycleCounter;
-use crate::pendulum::Pendulum33;
+pub(super) use pada_core::robot::leo::{self, Leo};
+pub(super) use pada_core::robot::pendulum::{Pendulum, SPEC_20HZ, SPEC_33HZ};
+use pada_core::robot::RobotSpec;
 use core::cell::Cell;
 use core::f32::consts::PI;
 use pada_core::checkpoint;
 use pada_core::dynamixel::table::PresentState;
 use pada_core::fixed::Q16;
-use pada_core::profile::PENDULUM_EXACT_WEIGHTS as WEIGHTS;
+use pada_core::robot::pendulum::EXACT_WEIGHTS as WEIGHTS;
 use pada_core::safety::RunMode;
 use pada_core::wire;
 
@@ -27,8 +29,8 @@ impl CycleCounter for Clock {
 }
 
 /// The F405's learner for `robot`.
-pub(super) fn profile(robot: Robot) -> LearnerProfile {
-    Board::F405.profile(robot)
+pub(super) fn profile(robot: &'static RobotSpec) -> LearnerProfile {
+    Board::F405.profile(robot).unwrap()
 }
 
 /// The F405's pendulum table (exact).
@@ -52,7 +54,7 @@ pub(super) fn leo_table_of(n: usize) -> LeoTable {
 
 /// The F405's LEO table.
 pub(super) fn leo_table() -> LeoTable {
-    leo_table_of(profile(Robot::Leo).weights().unwrap())
+    leo_table_of(profile(&leo::SPEC).weights().unwrap())
 }
 
 /// A healthy pendulum reading: the servo answers, the encoder at `counts`.
@@ -62,7 +64,7 @@ pub(super) fn pendulum_readings(counts: u16, time_ms: u32) -> Readings {
     r
 }
 
-pub(super) fn start<W: pada_core::weights::WeightStore, R: RobotAdapter>(c: &mut Controller<W, R>, mode: RunMode) {
+pub(super) fn start<W: pada_core::weights::WeightStore, R: RobotRules>(c: &mut Controller<W, R>, mode: RunMode) {
     let (result, t) = c.command(&wire::ToChip::Start(mode));
     assert_eq!(result, Ok(()));
     assert!(t.unwrap().torque_enable);
@@ -76,7 +78,7 @@ pub(super) type Store = pada_core::checkpoint::RamStore<{ checkpoint::slot_len(W
 
 /// `periods` periods of the crude pendulum of the replay test, from
 /// period `k0`; the Step records.
-pub(super) fn run_pendulum(c: &mut Controller<Box<[Q16]>, Pendulum33>, angle: &mut f32, k0: u32, periods: u32) -> std::vec::Vec<wire::Step> {
+pub(super) fn run_pendulum(c: &mut Controller<Box<[Q16]>, Pendulum>, angle: &mut f32, k0: u32, periods: u32) -> std::vec::Vec<wire::Step> {
     let clock = Clock(Cell::new(0));
     let mut out = PeriodOutput::default();
     let mut steps = std::vec::Vec::new();
@@ -92,7 +94,7 @@ pub(super) fn run_pendulum(c: &mut Controller<Box<[Q16]>, Pendulum33>, angle: &m
     steps
 }
 
-pub(super) fn stop(c: &mut Controller<Box<[Q16]>, Pendulum33>) {
+pub(super) fn stop(c: &mut Controller<Box<[Q16]>, Pendulum>) {
     assert_eq!(c.command(&wire::ToChip::Stop).0, Ok(()));
     let mut out = PeriodOutput::default();
     c.period(&pendulum_readings(0, 0), &Clock(Cell::new(0)), &mut out);
@@ -113,7 +115,7 @@ pub(super) enum Sent {
     Policy(wire::PolicyReport),
 }
 
-pub(super) fn run_governed(c: &mut Controller<Box<[Q16]>, Pendulum33>, angle: &mut f32, periods: u32) -> std::vec::Vec<Sent> {
+pub(super) fn run_governed(c: &mut Controller<Box<[Q16]>, Pendulum>, angle: &mut f32, periods: u32) -> std::vec::Vec<Sent> {
     let clock = Clock(Cell::new(0));
     let mut out = PeriodOutput::default();
     let mut sent = std::vec::Vec::new();

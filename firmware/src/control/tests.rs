@@ -3,8 +3,7 @@
 
 use super::*;
 use crate::control::test_support::*;
-use crate::config::{Robot, TILINGS, TRACE};
-use crate::pendulum::Pendulum33;
+use crate::config::{TILINGS, TRACE};
 use core::cell::Cell;
 use core::f32::consts::PI;
 use pada_core::agent::{EpisodeEnd, Mode};
@@ -17,7 +16,7 @@ fn replaying_the_reported_steps_on_a_host_agent_gives_the_same_actions() {
     // pendulum that moves with the commands, the Step records replayed
     // through a plain agent with the same seed.
     let seed = 11;
-    let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Pada { delta: 0.5 }, table(), seed).unwrap();
+    let mut c = Controller::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Pada { delta: 0.5 }, table(), seed).unwrap();
     start(&mut c, RunMode::Learning);
     let clock = Clock(Cell::new(0));
     let mut out = PeriodOutput::default();
@@ -35,10 +34,9 @@ fn replaying_the_reported_steps_on_a_host_agent_gives_the_same_actions() {
     }
     assert!(steps.len() > 300);
 
-    let robot = Robot::Pendulum33;
     // The host's generator: the firmware's own must draw the same.
     let mut rng = rand_pcg::Pcg32::seed_from_u64(seed);
-    let mut agent = robot.spec().agent::<_, TILINGS, TRACE>(PolicyKind::Pada { delta: 0.5 }, profile(robot).layout, table()).unwrap();
+    let mut agent = SPEC_33HZ.agent::<_, TILINGS, TRACE>(PolicyKind::Pada { delta: 0.5 }, profile(&SPEC_33HZ).layout, table()).unwrap();
     agent.reset_weights(&mut rng);
     for s in &steps {
         agent.set_mode(if s.mode == RunMode::Testing { Mode::Testing } else { Mode::Learning });

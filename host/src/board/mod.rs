@@ -22,7 +22,7 @@ pub mod trial;
 use crate::experiment::RunConfig;
 use crate::experiment::TrialResult;
 use pada_core::profile::{LearnerProfile, Memory};
-use pada_core::robot::Robot;
+use pada_core::robot::RobotSpec;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -62,7 +62,7 @@ impl ProfileReport {
         ProfileReport {
             board: profile.board.name(),
             description: profile.board.description(),
-            robot: profile.robot.name(),
+            robot: profile.robot.name,
             layout: profile.layout.name(),
             weights,
             weight_bits: profile.format.bytes() * 8,
@@ -78,7 +78,7 @@ impl ProfileReport {
 }
 
 /// The robot of a `--task` that has a board, or why not.
-pub fn robot_of_task(task: crate::experiment::tasks::TaskName) -> Result<Robot, String> {
+pub fn robot_of_task(task: crate::experiment::tasks::TaskName) -> Result<&'static RobotSpec, String> {
     task.robot().ok_or_else(|| {
         "--board runs a robot that has a board: --task physical-pendulum or --task leo, not pendulum \
          (the simulated pendulum of Section VII is a simulation only)"

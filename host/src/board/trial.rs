@@ -42,18 +42,15 @@ use pada_core::fatigue::{FatigueCounter, GearboxParams, PAPER_WINDOW_STEPS};
 use pada_core::fixed::Q16;
 use pada_core::policy::PolicyKind;
 use pada_core::episodes::is_learning_action;
-use pada_core::profile::{LearnerProfile, TILINGS};
-use pada_core::robot::Robot;
+use crate::robots::{host_robot, DynRules};
 use pada_core::claim_table::{ClaimTable, Tags16, Tags32};
+use pada_core::profile::{LearnerProfile, TILINGS};
+use pada_core::robot::{RobotRules, RobotSpec};
 use pada_core::tile_coding::Layout;
 use pada_core::weights::{Half, WeightFormat, WeightStore};
 use pada_core::wire::{Episode, RunMode, StepKind, ToChip};
-use pada_firmware::config::hardware;
 use pada_firmware::control::{Controller, PeriodOutput, Readings};
 use pada_firmware::io::CycleCounter;
-use pada_firmware::leo::Leo;
-use pada_firmware::pendulum::Pendulum33;
-use pada_firmware::robot::RobotAdapter;
 use serde::Serialize;
 
 /// The most joints whose fatigue a trial counts (LEO's hips and knees).
@@ -99,13 +96,13 @@ pub fn table_len(profile: &LearnerProfile, policy: PolicyKind) -> anyhow::Result
     if let Some(n) = profile.weights() {
         return Ok(n);
     }
-    profile.robot.spec().exact_table_len::<TILINGS>(policy).map_err(|e| anyhow!("{e}"))
+    profile.robot.exact_table_len::<TILINGS>(policy).map_err(|e| anyhow!("{e}"))
 }
 
 /// The rig a board trial of `robot` runs against: the physical pendulum's
 /// model with an operator who stops it between episodes, or the rapier3d
 /// LEO.
-pub fn standard_rig(robot: Robot) -> anyhow::Result<Box<dyn Rig>> {
+pub fn standard_rig(robot: &RobotSpec) -> anyhow::Result<Box<dyn Rig>> {
     crate::robots::board_rig(robot)
 }
 
@@ -121,6 +118,33 @@ pub fn run_board_trial(
     run_board_trial_on(profile, cfg, trial, rig.as_mut(), progress)
 }
 
+/// `$body` applied to `n` 16-bit weights shifted by `$shift`: the shift
+/// is part of the weights' type, so each shift a robot may choose is one
+/// instance (`RobotSpec::half_shift`, 8 to 15: Q-values within ±128 to
+/// ±16384).
+macro_rules! with_half_weights {
+    ($shift:expr, $n:expr, |$w:ident| $body:expr) => {{
+        let n = $n;
+        macro_rules! one {
+            ($s:literal) => {{
+                let $w = Half::<_, $s>::new(vec![0i16; n].into_boxed_slice());
+                $body
+            }};
+        }
+        match $shift {
+            8 => one!(8),
+            9 => one!(9),
+            10 => one!(10),
+            11 => one!(11),
+            12 => one!(12),
+            13 => one!(13),
+            14 => one!(14),
+            15 => one!(15),
+            s => bail!("16-bit weights shifted by {s}: the board runner takes shifts 8 to 15"),
+        }
+    }};
+}
+
 /// Trial `trial` of `cfg` with `profile`'s learner against `rig`.
 pub fn run_board_trial_on(
     profile: LearnerProfile,
@@ -131,54 +155,32 @@ pub fn run_board_trial_on(
 ) -> anyhow::Result<BoardTrial> {
     let n = table_len(&profile, cfg.policy)?;
     let seed = trial_seed(cfg.seed, trial);
+    let rules = (host_robot(profile.robot)?.rules)();
     // On the host a table split over CCM and SRAM is one slice: `Split`
     // addresses the same weights in the same order.
-    let claimed = profile.layout == Layout::Claimed;
-    const LEO_SHIFT: u32 = pada_core::robot::leo::HALF_SHIFT as u32;
-    // LEO's claim table over `weights`, with the profile's tag width.
-    let leo_claimed = |weights, rig: &mut dyn Rig| -> anyhow::Result<BoardTrial> {
-        match weights {
-            LeoWeights::Half(w) => claim_on::<_>(profile, w, n, rig, cfg, trial, seed, progress),
-            LeoWeights::Full(w) => claim_on::<_>(profile, w, n, rig, cfg, trial, seed, progress),
+    match (profile.layout, profile.format) {
+        (Layout::Claimed, WeightFormat::Q16) => {
+            claim_on(profile, vec![Q16::ZERO; n].into_boxed_slice(), n, rules, rig, cfg, trial, seed, progress)
         }
-    };
-    match (profile.robot, profile.format) {
-        (Robot::Leo, WeightFormat::Half { shift: pada_core::robot::leo::HALF_SHIFT }) if claimed => {
-            leo_claimed(LeoWeights::Half(Half::<_, LEO_SHIFT>::new(vec![0i16; n].into_boxed_slice())), rig)
+        (Layout::Claimed, WeightFormat::Half { shift }) => {
+            with_half_weights!(shift, n, |w| claim_on(profile, w, n, rules, rig, cfg, trial, seed, progress))
         }
-        (Robot::Leo, WeightFormat::Q16) if claimed => leo_claimed(LeoWeights::Full(vec![Q16::ZERO; n].into_boxed_slice()), rig),
-        (Robot::Pendulum33, WeightFormat::Q16) => {
-            run::<Pendulum33, _>(profile, vec![Q16::ZERO; n].into_boxed_slice(), rig, cfg, trial, seed, progress)
+        (_, WeightFormat::Q16) => run(profile, vec![Q16::ZERO; n].into_boxed_slice(), rules, rig, cfg, trial, seed, progress),
+        (_, WeightFormat::Half { shift }) => {
+            with_half_weights!(shift, n, |w| run(profile, w, rules, rig, cfg, trial, seed, progress))
         }
-        (Robot::Leo, WeightFormat::Q16) => {
-            run::<Leo, _>(profile, vec![Q16::ZERO; n].into_boxed_slice(), rig, cfg, trial, seed, progress)
-        }
-        (Robot::Leo, WeightFormat::Half { shift: pada_core::robot::leo::HALF_SHIFT }) => {
-            let table = Half::<_, { pada_core::robot::leo::HALF_SHIFT as u32 }>::new(vec![0i16; n].into_boxed_slice());
-            run::<Leo, _>(profile, table, rig, cfg, trial, seed, progress)
-        }
-        (Robot::Pendulum33, WeightFormat::Half { shift: pada_core::robot::pendulum::HALF_SHIFT }) => {
-            let table = Half::<_, { pada_core::robot::pendulum::HALF_SHIFT as u32 }>::new(vec![0i16; n].into_boxed_slice());
-            run::<Pendulum33, _>(profile, table, rig, cfg, trial, seed, progress)
-        }
-        (robot, format) => bail!("no board runner for {} with {format:?} weights", robot.name()),
     }
 }
 
-/// The weights of LEO's claim table on the host: the chips' 16-bit ones,
-/// or full width (`--weight-bits 32`).
-enum LeoWeights {
-    Half(Half<Box<[i16]>, { pada_core::robot::leo::HALF_SHIFT as u32 }>),
-    Full(Box<[Q16]>),
-}
 
-/// A LEO trial on a claim table over `weights` with the profile's tags
-/// (16 or 32 bits) of `n` slots.
+/// A trial on a claim table over `weights` with the profile's tags (16 or
+/// 32 bits) of `n` slots.
 #[allow(clippy::too_many_arguments)]
 fn claim_on<W: WeightStore>(
     profile: LearnerProfile,
     weights: W,
     n: usize,
+    rules: DynRules,
     rig: &mut dyn Rig,
     cfg: &RunConfig,
     trial: u32,
@@ -189,35 +191,37 @@ fn claim_on<W: WeightStore>(
     match profile.tag_bytes {
         2 => {
             let table = ClaimTable::new(weights, Tags16(vec![0u16; n].into_boxed_slice())).map_err(err)?;
-            run::<Leo, _>(profile, table, rig, cfg, trial, seed, progress)
+            run(profile, table, rules, rig, cfg, trial, seed, progress)
         }
         _ => {
             let table = ClaimTable::new(weights, Tags32(vec![0u32; n].into_boxed_slice())).map_err(err)?;
-            run::<Leo, _>(profile, table, rig, cfg, trial, seed, progress)
+            run(profile, table, rules, rig, cfg, trial, seed, progress)
         }
     }
 }
 
-fn command<W: WeightStore, R: RobotAdapter>(ctl: &mut Controller<W, R>, cmd: ToChip) -> anyhow::Result<()> {
+fn command<W: WeightStore, R: RobotRules>(ctl: &mut Controller<W, R>, cmd: ToChip) -> anyhow::Result<()> {
     ctl.command(&cmd).0.map_err(|e| anyhow!("{cmd:?} refused: {e:?}"))
 }
 
-fn run<R: RobotAdapter, W: WeightStore>(
+#[allow(clippy::too_many_arguments)]
+fn run<R: RobotRules, W: WeightStore>(
     profile: LearnerProfile,
     table: W,
+    rules: R,
     rig: &mut dyn Rig,
     cfg: &RunConfig,
     trial: u32,
     seed: u64,
     progress: &(dyn Fn(u64) + Sync),
 ) -> anyhow::Result<BoardTrial> {
-    let spec = R::spec();
+    let spec = rules.spec();
     let period_us = spec.period_us as u64;
     let period_s = spec.period_s();
     let weights = table.len();
     // As the SIL run: the board boots with SARSA, the host sets the policy
     // (a fresh learner from the seed) and starts the first test run.
-    let mut ctl = Controller::<W, R>::new(profile, PolicyKind::Sarsa, table, seed).map_err(|e| anyhow!("{e}"))?;
+    let mut ctl = Controller::new(rules, profile, PolicyKind::Sarsa, table, seed).map_err(|e| anyhow!("{e}"))?;
     for cmd in RunProtocol::start(cfg.policy) {
         let starts = matches!(cmd, ToChip::Start(_));
         if let (true, Some(budget)) = (starts, cfg.mtbf_budget_s) {
@@ -231,9 +235,9 @@ fn run<R: RobotAdapter, W: WeightStore>(
     let mut protocol = RunProtocol::new(cfg.seconds, spec.period_us);
     let mut episodes = Vec::new();
 
-    let hw = hardware(R::ROBOT);
-    let counted = R::reported_joints();
-    let ids: Vec<u8> = counted.clone().map(|j| hw.joints[j].id).collect();
+    let joints = spec.joints;
+    let counted = spec.counted.range();
+    let ids: Vec<u8> = counted.clone().map(|j| joints[j].id).collect();
     anyhow::ensure!(ids.len() <= COUNTED, "at most {COUNTED} counted joints");
     let window = Some(PAPER_WINDOW_STEPS);
     let fatigue = |_: ()| FatigueCounter::<COUNTED>::new(GearboxParams::TABLE_I, period_s, window);
@@ -257,7 +261,7 @@ fn run<R: RobotAdapter, W: WeightStore>(
         }
         // 1. Read.
         let mut readings = Readings { time_ms: (t / 1000) as u32, ..Readings::default() };
-        for (i, joint) in hw.joints.iter().enumerate() {
+        for (i, joint) in joints.iter().enumerate() {
             readings.servos[i].state = Some(rig.present(t, joint.id));
         }
         let (count, contacts) = rig.sensors(t);
@@ -304,7 +308,7 @@ fn run<R: RobotAdapter, W: WeightStore>(
             let mut sim = [0.0f32; COUNTED];
             let mut est = [0.0f32; COUNTED];
             for (c, (j, id)) in counted.clone().zip(&ids).enumerate() {
-                com[c] = R::ROBOT.commanded_gear_torque(volts_of[*id as usize]);
+                com[c] = spec.paper_torque.torque(c, volts_of[*id as usize]);
                 sim[c] = rig.gear_torque(*id);
                 est[c] = out.torques[j];
             }

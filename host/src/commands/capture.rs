@@ -229,9 +229,14 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
             },
         };
         frames.clear();
-        rec.feed(&buf[..n], started.elapsed().as_secs_f64(), &mut frames)
-            .context("cannot write the CSV or the MCAP file")
-            .map_err(CliError::Runtime)?;
+        rec.feed(&buf[..n], started.elapsed().as_secs_f64(), &mut frames).map_err(|e| {
+            if e.kind() == std::io::ErrorKind::InvalidData {
+                // A stream of another pada's protocol: bad input, said once.
+                usage(e.to_string())
+            } else {
+                CliError::Runtime(anyhow::Error::new(e).context("cannot write the CSV or the MCAP file"))
+            }
+        })?;
         if let Some(k) = keeper.as_mut().filter(|_| !frames.is_empty()) {
             let port = match &mut source {
                 Opened::Port(p) => Some(p),

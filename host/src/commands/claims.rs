@@ -12,7 +12,6 @@ use crate::output::OutDir;
 use crate::plot::claims::{Capacity, ClaimSeries, ClaimsFigure};
 use clap::Args;
 use pada_core::profile::Board;
-use pada_core::robot::Robot;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -113,7 +112,7 @@ pub fn run(args: ClaimsArgs) -> Result<(), CliError> {
     }
     let boards: Vec<(String, f64)> = [Board::F405, Board::F429Sdram]
         .into_iter()
-        .filter_map(|b| b.profile(Robot::Leo).weights().map(|n| (b.name().to_string(), n as f64)))
+        .filter_map(|b| b.profile(&pada_core::robot::leo::SPEC).ok()?.weights().map(|n| (b.name().to_string(), n as f64)))
         .collect();
     let mut series = Vec::new();
     let mut results = Vec::new();

@@ -153,9 +153,9 @@ fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
             "--plan, --merge and --slurm run the host's learner: they do not combine with --board yet",
         ));
     }
-    let mut profile = board.profile(robot);
+    let mut profile = board.profile(robot).map_err(|e| usage(e.to_string()))?;
     let format = match args.weight_bits.as_deref() {
-        Some("16") => WeightFormat::Half { shift: robot.spec().half_shift },
+        Some("16") => WeightFormat::Half { shift: robot.half_shift },
         Some(_) => WeightFormat::Q16,
         None => profile.format,
     };
@@ -169,7 +169,7 @@ fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
             "--tag-bits needs a claim table; {} has a {} one for {}",
             board.name(),
             profile.layout.name(),
-            robot.name()
+            robot.name
         )));
     }
     if args.table_log2.is_some() || format != profile.format || tag_bytes != profile.tag_bytes {
@@ -179,7 +179,7 @@ fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
             _ => return Err(usage(format!(
                 "--weight-bits without --table-log2 needs a hashed board table; {} has an exact one for {}",
                 board.name(),
-                robot.name()
+                robot.name
             ))),
         };
         let layout = if profile.layout == Layout::Exact { Layout::Hashed } else { profile.layout };
@@ -188,14 +188,14 @@ fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
     let policy = policy_of(&args)?;
     // The task as the runner describes it, with the board's table: the
     // summary's keys and parameters are `pada run`'s.
-    let task_spec = crate::robots::board_task_spec(robot, profile);
+    let task_spec = crate::robots::board_task_spec(profile).map_err(|e| usage(e.to_string()))?;
     let weights = table_len(&profile, policy).map_err(|e| usage(format!("{e}")))?;
-    if let Err(e) = robot.spec().check::<TILINGS>(policy, profile.layout, weights) {
+    if let Err(e) = robot.check::<TILINGS>(policy, profile.layout, weights) {
         return Err(usage(format!(
             "--algo {} does not fit board {}'s learner for {} ({} {} weights): {e}",
             args.algo,
             board.name(),
-            robot.name(),
+            robot.name,
             weights,
             profile.layout.name()
         )));
@@ -336,6 +336,10 @@ impl TaskVisitor for RunVisitor {
                 let mut observer = streaming.then(|| {
                     let hello = ToHost::Hello(wire::Hello {
                         protocol: wire::PROTOCOL_VERSION,
+                        // The task's robot; the simulated pendulum, which is
+                        // none, by the task's name with hash 0.
+                        robot: heapless::String::try_from(spec.name).unwrap_or_default(),
+                        robot_hash: spec.profile.map_or(0, |p| p.robot.definition_hash()),
                         // 0: a host run, not a firmware configuration.
                         config_hash: 0,
                         weight_count,

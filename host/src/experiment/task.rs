@@ -190,9 +190,9 @@ impl TaskSpec {
     /// profile. Defaults for the runner (learning time, trials) are the
     /// caller's to set.
     pub fn of_robot(profile: LearnerProfile, title: &'static str, torque_note: &'static str) -> TaskSpec {
-        let robot = profile.robot.spec();
+        let robot = profile.robot;
         TaskSpec {
-            name: robot.name(),
+            name: robot.name,
             title,
             control_period_s: robot.period_s(),
             episode_steps: robot.episode_steps,
@@ -206,7 +206,7 @@ impl TaskSpec {
             default_seconds: 1500.0,
             default_trials: 8,
             torque_note,
-            gearboxes: robot.gearboxes as usize,
+            gearboxes: robot.gearboxes(),
             footstep_remap: robot.footstep_remap,
             profile: Some(profile),
             worst_torque_nm: robot.worst_commanded_torque(),

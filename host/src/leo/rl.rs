@@ -22,7 +22,6 @@ use crate::experiment::task::{Plant, Step, Task, TaskSpec};
 use pada_core::action_space::{Output, MAX_ACTION_DIMS};
 use pada_core::agent::SarsaParams;
 use pada_core::profile::{Board, LearnerProfile};
-use pada_core::robot::Robot;
 use rand_core::RngCore;
 
 /// Gearboxes counted: both hips, both knees.
@@ -50,7 +49,7 @@ impl Default for LeoTask {
 impl LeoTask {
     /// The task with the host's learner and these learning parameters.
     pub fn new(params: SarsaParams) -> Self {
-        Self::with_profile(Board::Host.profile(Robot::Leo), params)
+        Self::with_profile(Board::Host.profile(&pada_core::robot::leo::SPEC).expect("the host holds a claim table"), params)
     }
 
     /// The task with a board's learner `profile` (LEO's) and these learning

@@ -299,27 +299,17 @@ pub struct LinkView {
     pub stats: LinkStats,
 }
 
-/// The robot that a `Hello`'s dimensions belong to: one learned joint is a
-/// pendulum, three learned joints (a host run) or four counted gearboxes
-/// (a board) are LEO (`pada_core::robot`'s definitions).
-pub fn robot_of(hello: &Hello) -> Option<pada_core::robot::Robot> {
-    use pada_core::robot::Robot;
-    Robot::ALL.into_iter().find(|r| {
-        let spec = r.spec();
-        // A host run's `Hello` counts the learned motor dimensions, a
-        // board's its counted gearboxes (LEO's hips and knees: 4, not 3).
-        (spec.motor_dims == hello.joints || spec.gearboxes == hello.joints)
-            && hello.state_dims as usize >= spec.state.len()
-    })
+/// The robot a `Hello` names, if it is one of pada's own with the same
+/// definition (its name and definition hash): the robots whose bodies the
+/// scene can draw.
+pub fn robot_of(hello: &Hello) -> Option<&'static pada_core::robot::RobotSpec> {
+    let robot = pada_core::robot::registry::find(&hello.robot)?.spec;
+    (robot.definition_hash() == hello.robot_hash).then_some(robot)
 }
 
-/// The name of [`robot_of`] as `/hello` gives it.
-fn robot_name(hello: &Hello) -> &'static str {
-    match robot_of(hello) {
-        Some(pada_core::robot::Robot::Leo) => "leo",
-        Some(_) => "pendulum",
-        None => "unknown",
-    }
+/// The robot's name as `/hello` gives it.
+fn robot_name(hello: &Hello) -> &str {
+    hello.robot.as_str()
 }
 
 /// One message for a channel.
@@ -390,7 +380,7 @@ impl Channelizer {
         };
         match &frame.msg {
             ToHost::Hello(h) => {
-                self.hellos.push(*h);
+                self.hellos.push(h.clone());
                 self.scene.robot(robot_of(h));
                 push(Topic::Hello, self.clock.now(), json(&HelloView {
                     protocol: h.protocol,

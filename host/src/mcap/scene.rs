@@ -23,7 +23,8 @@ use crate::leo::constants::{
 };
 use crate::leo::model::{assemble, Body, InitialPose};
 use pada_core::robot::leo::Leg;
-use pada_core::robot::Robot;
+use crate::robots::{host_robot, Body as RobotBody};
+use pada_core::robot::RobotSpec;
 use pada_core::wire::{Step, StepKind};
 
 /// A point, written to 0.1 mm in the JSON (far finer than a viewer
@@ -74,7 +75,7 @@ const LEG_Y: f64 = 0.03;
 /// Draws the robot of a stream, step after step.
 #[derive(Debug, Clone, Default)]
 pub struct SceneBuilder {
-    robot: Option<Robot>,
+    robot: Option<(RobotBody, &'static str)>,
     stance: Option<Leg>,
     /// World x of the stance heel.
     anchor_x: f64,
@@ -84,7 +85,8 @@ pub struct SceneBuilder {
 
 impl SceneBuilder {
     /// The robot is now this one (a `Hello`), or unknown.
-    pub fn robot(&mut self, robot: Option<Robot>) {
+    pub fn robot(&mut self, robot: Option<&'static RobotSpec>) {
+        let robot = robot.and_then(|r| Some((host_robot(r).ok()?.body, r.name)));
         *self = SceneBuilder { robot, ..SceneBuilder::default() };
     }
 
@@ -92,15 +94,15 @@ impl SceneBuilder {
     /// `None` for an unknown robot or a state too short for it.
     pub fn step(&mut self, s: &Step, t: u64) -> Option<Vec<u8>> {
         let strips = self.strips(s)?;
-        Some(scene_json(&strips, t, self.robot?))
+        Some(scene_json(&strips, t, self.robot?.1))
     }
 
     /// The strips of one step (also what the documentation's picture
     /// draws).
     pub fn strips(&mut self, s: &Step) -> Option<Vec<Strip>> {
-        match self.robot? {
-            Robot::Leo => self.leo(s),
-            Robot::Pendulum33 | Robot::Pendulum20 => pendulum(s),
+        match self.robot?.0 {
+            RobotBody::Leo => self.leo(s),
+            RobotBody::Pendulum => pendulum(s),
         }
     }
 
@@ -210,11 +212,10 @@ fn pendulum(s: &Step) -> Option<Vec<Strip>> {
 /// recording's bytes, and serde's map serialisation and float formatting
 /// were most of the cost of `--mcap` (docs/foxglove.md, "Costs"). The
 /// Python test validates it against the schema.
-fn scene_json(strips: &[Strip], t: u64, robot: Robot) -> Vec<u8> {
+fn scene_json(strips: &[Strip], t: u64, name: &str) -> Vec<u8> {
     use std::io::Write as _;
     let mut v = Vec::with_capacity(256 + strips.len() * 400);
     let (sec, nsec) = (t / 1_000_000_000, t % 1_000_000_000);
-    let name = robot.name();
     let _ = write!(
         v,
         r#"{{"deletions":[],"entities":[{{"timestamp":{{"sec":{sec},"nsec":{nsec}}},"frame_id":"world","id":"{name}","lifetime":{{"sec":0,"nsec":0}},"frame_locked":false,"metadata":[{{"key":"robot","value":"{name}"}}],"arrows":[],"cubes":[],"spheres":[],"cylinders":[],"lines":["#
@@ -275,7 +276,7 @@ mod tests {
     #[test]
     fn a_leo_step_is_drawn_as_five_strips_of_valid_json() {
         let mut b = SceneBuilder::default();
-        b.robot(Some(Robot::Leo));
+        b.robot(Some(&pada_core::robot::leo::SPEC));
         let mut s = Step {
             step: 0, time_ms: 1500, episode: 0, mode: pada_core::wire::RunMode::Learning, kind: StepKind::Start,
             state: heapless::Vec::new(), action: 0, output: heapless::Vec::new(), reward: 0.0, td_error: 0,

@@ -6,7 +6,7 @@
 //! the protocol, the robot) and `pada.link` (the link's final counters, as
 //! `pada capture`'s summary has them).
 
-use super::channels::{robot_of, ChannelMessage, Topic};
+use super::channels::{ChannelMessage, Topic};
 use super::{ChannelSink, StreamEnd};
 use std::collections::{BTreeMap, HashMap};
 use std::fs::File;
@@ -104,7 +104,8 @@ fn pada_metadata(end: &StreamEnd<'_>) -> BTreeMap<String, String> {
         m.insert("protocol".into(), h.protocol.to_string());
         m.insert("weight_count".into(), h.weight_count.to_string());
         m.insert("period_us".into(), h.period_us.to_string());
-        m.insert("robot".into(), robot_of(h).map_or("unknown", |r| r.name()).into());
+        m.insert("robot".into(), h.robot.as_str().into());
+        m.insert("robot_hash".into(), format!("{:08x}", h.robot_hash));
     }
     m
 }

@@ -21,7 +21,6 @@
 use crate::experiment::task::{Task, TaskSpec};
 use pada_core::profile::{Board, LearnerProfile};
 use pada_core::robot::pendulum::{self as robot, gearbox_torque};
-use pada_core::robot::Robot;
 
 /// Constants of the physical pendulum's model (docs/reference/grl.md §4).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -132,7 +131,7 @@ impl Default for PhysicalPendulumTask {
 impl PhysicalPendulumTask {
     /// The task with these constants on the host's learner.
     pub fn new(params: PhysicalPendulumParams) -> Self {
-        Self::with_profile(params, Board::Host.profile(Robot::Pendulum33))
+        Self::with_profile(params, Board::Host.profile(&pada_core::robot::pendulum::SPEC_33HZ).expect("the host holds any exact table"))
     }
 
     /// The task on a board's learner `profile` (the 33 Hz pendulum's).

@@ -20,7 +20,7 @@
 //!   encoder at 4096 counts per turn (the torso angle φ is minus the
 //!   torso's pitch, so the counter reads the pitch, from vertical: LEO
 //!   powered up upright); the toe and heel switches as
-//!   `pada_firmware::leo::contact` bits.
+//!   `pada_core::robot::leo::contact` bits.
 //! - **Between episodes.** When the firmware reports an episode's end (or a
 //!   fault), the operator puts LEO back into the start pose of §1.8 (the
 //!   state after its first control period, as the simulation's episodes
@@ -39,10 +39,9 @@ use super::{joint_volts, servo_reading, Rig, TEMPERATURE_C};
 use crate::leo::model::{InitialPose, LeoModel, ModelOptions, Snapshot, NUM_JOINTS};
 use pada_core::dynamixel::table::PresentState;
 use pada_core::robot::leo::{ankle_x, Leg, StanceTracker, CONTROL_PERIOD_US, JOINTS};
-use pada_core::robot::Robot;
+use pada_core::robot::{EncoderSpec, RobotSpec};
 use pada_core::rx28::Rx28;
-use pada_firmware::config::RobotConfig;
-use pada_firmware::leo::contact;
+use pada_core::robot::leo::contact;
 
 /// LEO on its boom, behind seven emulated RX-28s.
 pub struct LeoRig {
@@ -52,7 +51,9 @@ pub struct LeoRig {
     start: Snapshot,
     /// The servos' IDs and calibration and the boom's encoder: the robot's
     /// one hardware definition.
-    hw: RobotConfig,
+    hw: &'static RobotSpec,
+    /// The boom's encoder of that definition.
+    encoder: EncoderSpec,
     /// Servo ID of each joint ([`pada_core::robot::leo::Joint`] order).
     ids: [u8; NUM_JOINTS],
     /// Voltage and torque enable per joint.
@@ -76,18 +77,21 @@ impl LeoRig {
     /// LEO held at its start pose at time 0, torque off, with the servos
     /// and encoder of its hardware definition.
     pub fn new(options: ModelOptions) -> anyhow::Result<Self> {
-        Self::with_hardware(options, pada_firmware::config::hardware(Robot::Leo))
+        Self::with_hardware(options, &pada_core::robot::leo::SPEC)
     }
 
     /// The same with another calibration of the same servos (a robot whose
     /// servos are mounted or zeroed differently).
-    pub fn with_hardware(options: ModelOptions, hw: RobotConfig) -> anyhow::Result<Self> {
-        anyhow::ensure!(
-            hw.robot == Robot::Leo && hw.joints.len() == NUM_JOINTS,
-            "LEO's rig needs LEO's {NUM_JOINTS} servos, not {} of {}",
-            hw.joints.len(),
-            hw.robot.name()
-        );
+    pub fn with_hardware(options: ModelOptions, hw: &'static RobotSpec) -> anyhow::Result<Self> {
+        let encoder = match (hw.joints.len(), hw.encoder) {
+            (NUM_JOINTS, Some(encoder)) => encoder,
+            _ => anyhow::bail!(
+                "LEO's rig needs LEO's {NUM_JOINTS} servos and its boom's encoder, not {} servos{} of {}",
+                hw.joints.len(),
+                if hw.encoder.is_some() { "" } else { " and no encoder" },
+                hw.name
+            ),
+        };
         let mut model = LeoModel::new(options, &InitialPose::REFERENCE).map_err(|e| anyhow::anyhow!("{e}"))?;
         model.set_voltages([0.0; NUM_JOINTS]);
         model.control_step().map_err(|b| anyhow::anyhow!("the LEO model blew up settling into its start pose: {b:?}"))?;
@@ -100,6 +104,7 @@ impl LeoRig {
             model,
             start,
             hw,
+            encoder,
             ids,
             volts: [0.0; NUM_JOINTS],
             torque: [false; NUM_JOINTS],
@@ -171,7 +176,7 @@ impl LeoRig {
         let s = self.model.state();
         let bits = [contact::TOE_L, contact::HEEL_L, contact::TOE_R, contact::HEEL_R];
         let contacts = s.contacts.iter().zip(bits).filter(|(on, _)| **on).fold(0, |b, (_, bit)| b | bit);
-        (self.hw.encoder.count_of(s.torso_pitch as f64), contacts)
+        (self.encoder.count_of(s.torso_pitch as f64), contacts)
     }
 
     /// Whether the state at `t_us` is the state now: no period boundary
@@ -239,7 +244,7 @@ impl Rig for LeoRig {
         format!(
             "LEO in rapier3d (docs/reference/grl.md §1-2): {} RX-28s, the boom's {}-count encoder, 4 foot switches, set upright by an operator between episodes",
             self.hw.joints.len(),
-            self.hw.encoder.counts_per_rev
+            self.encoder.counts_per_rev
         )
     }
 
@@ -283,7 +288,7 @@ mod tests {
         assert!((before.0 as f64 - (512.0 + START_JOINT_ANGLES[Joint::HipRight as usize] as f64 / unit)).abs() <= 1.5);
         assert!((before.1 as f64 - (512.0 + START_JOINT_ANGLES[Joint::KneeRight as usize] as f64 / unit)).abs() <= 1.5);
         // (The first control period at 0 V tips the torso by a few mrad.)
-        let pitch = before.2 .0 as i32 - rig.hw.encoder.count_of(-START_PHI as f64) as i32;
+        let pitch = before.2 .0 as i32 - rig.encoder.count_of(-START_PHI as f64) as i32;
         assert!(pitch.abs() <= 5, "{pitch} counts from the start pitch");
         assert_ne!(before.2 .1 & contact::LEFT, 0);
         // Held: a second passes, nothing moves, whatever is commanded.
@@ -310,10 +315,11 @@ mod tests {
 
     #[test]
     fn an_offset_or_flipped_servo_reads_and_drives_in_its_own_frame() {
-        use pada_firmware::servo::Joint as Servo;
-        let stock = pada_firmware::config::hardware(Robot::Leo);
-        let remounted: Vec<Servo> = stock.joints.iter().map(|j| Servo { zero: 400, sign: -j.sign, ..*j }).collect();
-        let remounted = RobotConfig { joints: Box::leak(remounted.into_boxed_slice()), ..stock };
+        use pada_core::robot::JointSpec;
+        let stock: &'static RobotSpec = &pada_core::robot::leo::SPEC;
+        let remounted: Vec<JointSpec> = stock.joints.iter().map(|j| JointSpec { zero: 400, sign: -j.sign, ..*j }).collect();
+        let remounted: &'static RobotSpec =
+            Box::leak(Box::new(RobotSpec { joints: Box::leak(remounted.into_boxed_slice()), ..*stock }));
         let mut rigs = [
             (LeoRig::new(ModelOptions::default()).unwrap(), stock),
             (LeoRig::with_hardware(ModelOptions::default(), remounted).unwrap(), remounted),
@@ -333,10 +339,10 @@ mod tests {
         // The firmware's calibration undoes the mounting: the same joint
         // angles within a count, and the hip moved.
         for (a, b) in angles[0].iter().zip(&angles[1]) {
-            assert!((a - b).abs() <= 1.01 * pada_firmware::servo::POSITION_UNIT_RAD, "{:?} against {:?}", angles[0], angles[1]);
+            assert!((a - b).abs() <= 1.01 * pada_core::robot::hardware::POSITION_UNIT_RAD, "{:?} against {:?}", angles[0], angles[1]);
         }
         assert!(angles[0][Joint::HipRight as usize] > START_JOINT_ANGLES[Joint::HipRight as usize] + 0.01);
         // A rig for another robot's servos is refused.
-        assert!(LeoRig::with_hardware(ModelOptions::default(), pada_firmware::config::hardware(Robot::Pendulum33)).is_err());
+        assert!(LeoRig::with_hardware(ModelOptions::default(), &pada_core::robot::pendulum::SPEC_33HZ).is_err());
     }
 }

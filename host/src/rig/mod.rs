@@ -23,7 +23,7 @@ pub use leo::LeoRig;
 pub use pendulum::PendulumRig;
 
 use pada_core::dynamixel::table::{self, PresentState};
-use pada_firmware::servo::Joint;
+use pada_core::robot::JointSpec as Joint;
 
 /// Present Temperature every emulated servo reports \[°C\].
 pub const TEMPERATURE_C: u8 = 40;
@@ -87,7 +87,7 @@ pub trait Rig: Send {
 /// `rate` \[rad/s\] under `load` (a fraction of the stall torque, in the
 /// joint's direction) on a `supply_v` supply. The rigs read in the servo's
 /// own frame through the robot's one hardware definition
-/// (`pada_firmware::config::hardware`: its zero and sign), so an offset or
+/// (`pada_core::robot::RobotSpec::joints`: its zero and sign), so an offset or
 /// flipped servo of the real robot is the same offset or flip here, and the
 /// firmware's calibration undoes it.
 pub fn servo_reading(joint: &Joint, angle: f64, rate: f64, load: f32, supply_v: f64) -> PresentState {
@@ -114,9 +114,12 @@ mod tests {
 
     #[test]
     fn a_reading_is_in_the_servos_frame_and_the_calibration_undoes_it() {
-        for joint in [Joint { id: 1, zero: 512, sign: 1 }, Joint { id: 4, zero: 300, sign: -1 }] {
+        for joint in [
+            Joint { name: "a", servo: "RX-28", id: 1, zero: 512, sign: 1, soft_limit: None },
+            Joint { name: "b", servo: "RX-28", id: 4, zero: 300, sign: -1, soft_limit: None },
+        ] {
             let r = servo_reading(&joint, 0.4, 2.0, 0.25, 12.0);
-            assert!((joint.angle(r.position) - 0.4).abs() <= 0.5 * pada_firmware::servo::POSITION_UNIT_RAD);
+            assert!((joint.angle(r.position) - 0.4).abs() <= 0.5 * pada_core::robot::hardware::POSITION_UNIT_RAD);
             // Speed and load turn with the servo.
             let speed = table::present_speed_ratio(r.speed);
             let load = table::present_load_ratio(r.load);

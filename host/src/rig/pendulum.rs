@@ -4,8 +4,8 @@ use super::{joint_volts, servo_reading, Rig};
 use crate::pendulum::PhysicalPendulumParams;
 use pada_core::dynamixel::table::PresentState;
 use pada_core::robot::pendulum::gearbox_torque;
-use pada_core::robot::Robot;
-use pada_firmware::config::{hardware, RobotConfig};
+use pada_core::robot::pendulum::{ENCODER, SPEC_33HZ};
+use pada_core::robot::{EncoderSpec, RobotSpec};
 use std::f64::consts::PI;
 
 /// The physical pendulum of Section VII on one RX-28 in wheel mode (ID 1)
@@ -37,7 +37,9 @@ pub struct PendulumRig {
     operator: bool,
     /// Its servo's ID and calibration and the encoder: the robot's one
     /// hardware definition.
-    hw: RobotConfig,
+    hw: &'static RobotSpec,
+    /// The encoder on its axis.
+    encoder: EncoderSpec,
 }
 
 impl PendulumRig {
@@ -53,7 +55,8 @@ impl PendulumRig {
             torque: false,
             volts: 0.0,
             operator: false,
-            hw: hardware(Robot::Pendulum33),
+            hw: &SPEC_33HZ,
+            encoder: ENCODER,
         }
     }
 
@@ -109,7 +112,7 @@ impl PendulumRig {
 
     /// The firmware takes the pose at boot (hanging, θ = π) as count 0.
     fn encoder(&self, x: [f64; 2]) -> (u16, u8) {
-        (self.hw.encoder.count_of(x[0] - PI), 0)
+        (self.encoder.count_of(x[0] - PI), 0)
     }
 }
 
@@ -162,7 +165,7 @@ impl Rig for PendulumRig {
 
     fn describe(&self) -> String {
         let hand = if self.operator { ", stopped by hand between episodes" } else { "" };
-        format!("the physical pendulum of Section VII (GRL constants, one RX-28 in wheel mode, {}-count encoder){hand}", self.hw.encoder.counts_per_rev)
+        format!("the physical pendulum of Section VII (GRL constants, one RX-28 in wheel mode, {}-count encoder){hand}", self.encoder.counts_per_rev)
     }
 
     /// With an operator, the pendulum is stopped hanging at rest: the

@@ -18,10 +18,10 @@ use super::fault::{FaultKind, FaultSpec};
 use crate::rig::Rig;
 use pada_core::dynamixel::table::PresentState;
 use pada_core::dynamixel::{table, ErrorFlags, Instruction, InstructionDecoder, StatusPacket, BROADCAST_ID};
-use pada_core::robot::Robot;
+use pada_core::robot::RobotSpec;
 use pada_core::safety::SoftLimit;
-use pada_firmware::config::hardware;
-use pada_firmware::servo::{Joint, POSITION_UNIT_RAD};
+use pada_core::robot::hardware::POSITION_UNIT_RAD;
+use pada_core::robot::JointSpec as Joint;
 use pada_firmware::sil::{sensor_table, SENSOR_ID};
 use serde::Serialize;
 
@@ -160,25 +160,24 @@ struct Answer {
 }
 
 /// Servos `ids` with the calibration and soft limits of `robot`'s joints.
-fn servos(robot: Robot, ids: &[u8]) -> Vec<Servo> {
-    let hw = hardware(robot);
+fn servos(robot: &RobotSpec, ids: &[u8]) -> Vec<Servo> {
     let joint_of = |id: u8| {
-        let k = hw.joints.iter().position(|j| j.id == id)?;
-        Some((hw.joints[k], hw.soft_limits.get(k).copied().flatten()))
+        let joint = robot.joints.iter().find(|j| j.id == id)?;
+        Some((*joint, joint.soft_limit))
     };
     ids.iter().map(|&id| Servo::new(id, joint_of(id))).collect()
 }
 
 /// Why a fault cannot apply to `servos`: no such servo, or a `past-limit`
 /// fault on a joint without a soft limit.
-fn check_faults_on(servos: &[Servo], robot: Robot, faults: &[FaultSpec]) -> Result<(), String> {
+fn check_faults_on(servos: &[Servo], robot: &RobotSpec, faults: &[FaultSpec]) -> Result<(), String> {
     for f in faults {
         let Some(servo) = servos.iter().find(|s| s.id == f.servo) else {
             let ids: Vec<String> = servos.iter().map(|s| s.id.to_string()).collect();
-            return Err(format!("--fault {f}: no servo {} on {}'s bus (its servos: {})", f.servo, robot.name(), ids.join(", ")));
+            return Err(format!("--fault {f}: no servo {} on {}'s bus (its servos: {})", f.servo, robot.name, ids.join(", ")));
         };
         if f.kind == FaultKind::PastLimit && servo.joint.is_none_or(|(_, l)| l.is_none()) {
-            return Err(format!("--fault {f}: servo {}'s joint has no soft limit on {}", f.servo, robot.name()));
+            return Err(format!("--fault {f}: servo {}'s joint has no soft limit on {}", f.servo, robot.name));
         }
     }
     Ok(())
@@ -187,8 +186,8 @@ fn check_faults_on(servos: &[Servo], robot: Robot, faults: &[FaultSpec]) -> Resu
 /// Checks `faults` against `robot`'s servos (the IDs of its hardware
 /// configuration, which the rigs use) before a run, so that a fault that
 /// cannot apply is bad input, not a failed run.
-pub fn check_faults(robot: Robot, faults: &[FaultSpec]) -> Result<(), String> {
-    let ids: Vec<u8> = hardware(robot).joints.iter().map(|j| j.id).collect();
+pub fn check_faults(robot: &RobotSpec, faults: &[FaultSpec]) -> Result<(), String> {
+    let ids: Vec<u8> = robot.joints.iter().map(|j| j.id).collect();
     check_faults_on(&servos(robot, &ids), robot, faults)
 }
 
@@ -210,7 +209,7 @@ impl BusEmulator {
     /// Servos with the rig's IDs (the calibration and soft limits of
     /// `robot`'s joints), the sensor device, and `faults`; the error says
     /// why a fault cannot apply.
-    pub fn new(rig: &dyn Rig, robot: Robot, faults: Vec<FaultSpec>) -> Result<Self, String> {
+    pub fn new(rig: &dyn Rig, robot: &RobotSpec, faults: Vec<FaultSpec>) -> Result<Self, String> {
         let servos = servos(robot, rig.servo_ids());
         check_faults_on(&servos, robot, &faults)?;
         let mut sensor = [0u8; sensor_table::TABLE_LEN];
@@ -563,7 +562,7 @@ mod tests {
     fn pendulum_bus(faults: &[&str]) -> (PendulumRig, BusEmulator) {
         let rig = PendulumRig::new(PhysicalPendulumParams::default());
         let faults = faults.iter().map(|f| fault::parse(f).unwrap()).collect();
-        let bus = BusEmulator::new(&rig, Robot::Pendulum33, faults).unwrap();
+        let bus = BusEmulator::new(&rig, &pada_core::robot::pendulum::SPEC_33HZ, faults).unwrap();
         (rig, bus)
     }
 
@@ -610,7 +609,7 @@ mod tests {
         assert!(rig.state()[1] > 0.0, "256/1023 of 12 V turns it");
         // LEO's servos run on its 14 V.
         let leo = LeoRig::new(ModelOptions::default()).unwrap();
-        assert_eq!(BusEmulator::new(&leo, Robot::Leo, vec![]).unwrap().supply_v, 14.0);
+        assert_eq!(BusEmulator::new(&leo, &pada_core::robot::leo::SPEC, vec![]).unwrap().supply_v, 14.0);
     }
 
     #[test]
@@ -636,27 +635,27 @@ mod tests {
         assert_eq!(decode(&r[0].bytes).unwrap().error, ErrorFlags::OVERHEATING);
         // Another servo's fault leaves servo 1 alone (LEO has seven).
         let mut leo = LeoRig::new(ModelOptions::default()).unwrap();
-        let mut bus = BusEmulator::new(&leo, Robot::Leo, vec![fault::parse("drop:at=1:servo=4").unwrap()]).unwrap();
+        let mut bus = BusEmulator::new(&leo, &pada_core::robot::leo::SPEC, vec![fault::parse("drop:at=1:servo=4").unwrap()]).unwrap();
         assert_eq!(bus.receive(1_000_000, &req, &mut leo).len(), 1);
         assert!(bus.receive(1_001_000, &read(4, table::PRESENT_BLOCK, table::PRESENT_BLOCK_LEN), &mut leo).is_empty());
         // No servo 9 on LEO's bus; the pendulum's joint has no soft limit.
-        assert!(BusEmulator::new(&leo, Robot::Leo, vec![fault::parse("drop:servo=9").unwrap()]).unwrap_err().contains("no servo 9"));
+        assert!(BusEmulator::new(&leo, &pada_core::robot::leo::SPEC, vec![fault::parse("drop:servo=9").unwrap()]).unwrap_err().contains("no servo 9"));
         let pendulum = PendulumRig::new(PhysicalPendulumParams::default());
-        let e = BusEmulator::new(&pendulum, Robot::Pendulum33, vec![fault::parse("past-limit").unwrap()]).unwrap_err();
+        let e = BusEmulator::new(&pendulum, &pada_core::robot::pendulum::SPEC_33HZ, vec![fault::parse("past-limit").unwrap()]).unwrap_err();
         assert!(e.contains("no soft limit"), "{e}");
     }
 
     #[test]
     fn past_limit_reads_the_joint_beyond_its_soft_limit() {
         let mut leo = LeoRig::new(ModelOptions::default()).unwrap();
-        let mut bus = BusEmulator::new(&leo, Robot::Leo, vec![fault::parse("past-limit:at=1:servo=4").unwrap()]).unwrap();
+        let mut bus = BusEmulator::new(&leo, &pada_core::robot::leo::SPEC, vec![fault::parse("past-limit:at=1:servo=4").unwrap()]).unwrap();
         let req = read(4, table::PRESENT_BLOCK, table::PRESENT_BLOCK_LEN);
         let angle = |bus: &mut BusEmulator, leo: &mut LeoRig, t: u64| {
             let r = bus.receive(t, &req, leo);
             let p = table::PresentState::from_bytes(&decode(&r[0].bytes).unwrap().params).unwrap();
-            let hw = hardware(Robot::Leo);
+            let hw = pada_core::robot::leo::SPEC;
             let k = hw.joints.iter().position(|j| j.id == 4).unwrap();
-            (hw.joints[k].angle(p.position), hw.soft_limits[k].unwrap())
+            (hw.joints[k].angle(p.position), hw.joints[k].soft_limit.unwrap())
         };
         let (before, limit) = angle(&mut bus, &mut leo, 500_000);
         assert!(before < limit.max, "{before} inside {limit:?}");

@@ -138,7 +138,6 @@ mod tests {
     use crate::pendulum::PhysicalPendulumParams;
     use crate::rig::PendulumRig;
     use pada_core::dynamixel::{self, table};
-    use pada_core::robot::Robot;
     use pada_firmware::sil::{sensor_table, SENSOR_ID};
 
     fn read(id: u8, addr: u8, len: u8) -> Vec<u8> {
@@ -149,7 +148,7 @@ mod tests {
     #[test]
     fn learns_the_period_s_reads_and_chains_their_answers() {
         let mut rig = PendulumRig::new(PhysicalPendulumParams::default());
-        let mut bus = BusEmulator::new(&rig, Robot::Pendulum33, vec![]).unwrap();
+        let mut bus = BusEmulator::new(&rig, &pada_core::robot::pendulum::SPEC_33HZ, vec![]).unwrap();
         let servo = read(1, table::PRESENT_BLOCK, table::PRESENT_BLOCK_LEN);
         let sensor = read(SENSOR_ID, sensor_table::ENCODER_COUNT, sensor_table::READ_LEN);
         let mut f = Forecaster::new(true);

@@ -87,7 +87,7 @@ pub fn replay(profile: &LearnerProfile, policy: PolicyKind, seed: u64, records: 
         },
         Layout::Exact | Layout::Hashed => HostTable::plain(weights),
     };
-    let agent = profile.robot.spec().agent::<_, TILINGS, TRACE>(policy, profile.layout, table);
+    let agent = profile.robot.agent::<_, TILINGS, TRACE>(policy, profile.layout, table);
     let mut agent = match agent {
         Ok(a) => a,
         Err(e) => {
@@ -118,7 +118,7 @@ pub fn replay(profile: &LearnerProfile, policy: PolicyKind, seed: u64, records: 
             Record::Step(s) => {
                 report.steps += 1;
                 if s.footstep {
-                    match profile.robot.spec().footstep_remap {
+                    match profile.robot.footstep_remap {
                         Some(map) => agent.remap_memory(&map),
                         None => {
                             report.error = Some(format!("step {}: a footstep on a robot without one", s.step));

@@ -351,7 +351,7 @@ fn compare(cfg: &SilConfig, episodes: &[Episode]) -> anyhow::Result<HostComparis
 /// The summary and checks of a finished run.
 pub fn summarize(cfg: &SilConfig, facts: Facts<'_>) -> SilSummary {
     let profile = cfg.profile();
-    let period_us = cfg.task.robot().spec().period_us;
+    let period_us = cfg.task.robot().period_us;
     let period_ms = period_us as f64 * 1e-3;
     let periods = facts.emulated_s / (period_us as f64 * 1e-6);
     let curve = facts.protocol.curve().to_vec();
@@ -544,7 +544,7 @@ pub fn summarize(cfg: &SilConfig, facts: Facts<'_>) -> SilSummary {
     let [learning, test, start, end_calls] = facts.cycles;
     SilSummary {
         task: cfg.task,
-        robot: cfg.task.robot().name(),
+        robot: cfg.task.robot().name,
         board: cfg.board.name(),
         machine: machine(cfg.board).unwrap_or("none"),
         weights: profile.weights().unwrap_or(0),

@@ -149,7 +149,11 @@ pub fn decode(
         let mut rec = recorder.lock().unwrap_or_else(|e| e.into_inner());
         let t = shared.started.elapsed().as_secs_f64();
         if let Err(e) = rec.feed(&buf[..n], t, &mut frames) {
-            return failed(format!("cannot write the CSV ({e})"));
+            return failed(if e.kind() == std::io::ErrorKind::InvalidData {
+                e.to_string()
+            } else {
+                format!("cannot write the CSV ({e})")
+            });
         }
         let (link, counts) = (rec.stats(), rec.counts());
         let latest = rec.latest().clone();

@@ -332,7 +332,7 @@ impl WatchState {
     fn frame(&mut self, msg: &ToHost) {
         match msg {
             ToHost::Hello(h) => {
-                self.hello = Some(*h);
+                self.hello = Some(h.clone());
                 if h.period_us > 0 {
                     self.period_s = Some(h.period_us as f64 / 1e6);
                     self.period_from = Some("hello");
@@ -617,6 +617,8 @@ mod tests {
             gap: None,
             msg: ToHost::Hello(Hello {
                 protocol: 3,
+                robot: heapless::String::try_from("physical-pendulum-20hz").unwrap(),
+                robot_hash: 0,
                 config_hash: 0,
                 weight_count: 1,
                 period_us: 50_000,

@@ -1,97 +1,84 @@
-//! The robots pada learns on, each defined once, for the simulator and the
-//! chip alike: what the learner observes (dimensions, ranges, tile
-//! widths), its motor's levels, its learning parameters, the control
-//! period, the episode length and the test interval ([`RobotSpec`]), and
-//! the robot's rules (observation, reward, falls, held joints, start pose,
-//! rate filter, gearbox torque) in its module:
+//! A robot, defined once for the simulator and the chip alike: its data
+//! ([`RobotSpec`]: what the learner observes — dimensions, ranges, tile
+//! widths —, its motor's levels, its learning parameters, the control
+//! period, the episode length and the test interval; its joints with their
+//! servos and calibration, the encoder, the gearboxes whose wear counts)
+//! and its rules ([`RobotRules`]: observation, reward, falls, held joints,
+//! start pose, commands between episodes, gearbox torque).
 //!
-//! | module | robot |
+//! | module | what |
 //! |---|---|
+//! | [`rules`] | the trait every robot's rules implement, and what a controller senses |
+//! | [`hardware`] | joints, servos and their calibration, the encoder |
+//! | [`registry`] | the robots pada brings, the one list of them |
 //! | [`pendulum`] | the physical inverted pendulum of Section VII (33 or 20 Hz) |
 //! | [`leo`] | the biped LEO walking on its boom (Section VIII) |
 //! | [`filter`] | GRL's rate filter, used by LEO |
 //!
-//! The host's simulations produce these quantities from physics and the
-//! firmware from servo counts and encoder readings; both build their
-//! learner from the same [`RobotSpec`] and a board's learner profile
-//! ([`crate::profile`]), and [`crate::profile::config_hash`] of the two
-//! agents is the same (a test checks it).
+//! A robot is identified by its name and the hash of its definition
+//! ([`RobotSpec::definition_hash`]), never by a number from a closed list:
+//! a robot of the user's own is a third [`RobotSpec`] and [`RobotRules`]
+//! that live outside pada. The host's simulations produce the rules'
+//! quantities from physics and the firmware from servo counts and encoder
+//! readings; both build their learner from the same [`RobotSpec`] and a
+//! board's learner profile ([`crate::profile`]), and
+//! [`crate::profile::config_hash`] of the two agents is the same (a test
+//! checks it).
 
 pub mod filter;
+pub mod hardware;
 pub mod leo;
 pub mod pendulum;
+pub mod registry;
+pub mod rules;
+
+pub use hardware::{EncoderSpec, JointRange, JointSpec};
+pub use rules::{PerServo, RobotRules, Sensed};
 
 use crate::action_space::{ActionDim, ActionSpace, MAX_ACTION_DIMS};
-use crate::agent::{coder_for, exact_table_len, Agent, SarsaParams};
+use crate::agent::{coder_for, exact_table_len, Agent, SarsaParams, WeightInit};
+use crate::crc::ConfigHasher;
 use crate::error::ConfigError;
 use crate::policy::{Policy, PolicyKind};
 use crate::tile_coding::{Layout, StateDim};
 use crate::weights::WeightStore;
 
-/// A robot with a board.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum Robot {
-    /// The physical pendulum of Section VII at the paper's 33 Hz (30 ms).
-    Pendulum33,
-    /// The same pendulum at 20 Hz (50 ms).
-    Pendulum20,
-    /// LEO at 30 Hz.
-    Leo,
+/// Longest robot name, in bytes: what the wire's `Hello` and the
+/// software-in-the-loop link carry.
+pub const MAX_NAME: usize = 32;
+
+/// How the paper turns a commanded voltage into the gearbox torque of its
+/// MTBF (Section IV: "a linear relationship between voltage and torque").
+#[derive(Debug, Clone, Copy)]
+pub enum TorqueLaw {
+    /// The robot's own law, the same for each of its counted joints (the
+    /// pendulum's K/R, LEO's RX-28 stall torque per volt).
+    Rule(fn(f32) -> f32),
 }
 
-impl Robot {
-    /// Every robot, for iteration.
-    pub const ALL: [Robot; 3] = [Robot::Pendulum33, Robot::Pendulum20, Robot::Leo];
-
-    /// The robot's name as the command line, telemetry and the
-    /// configuration hash spell it.
-    pub const fn name(self) -> &'static str {
+impl TorqueLaw {
+    /// The gearbox torque \[N·m\] of `voltage` on counted joint `joint`.
+    pub fn torque(&self, _joint: usize, voltage: f32) -> f32 {
         match self {
-            Robot::Pendulum33 => "physical-pendulum",
-            Robot::Pendulum20 => "physical-pendulum-20hz",
-            Robot::Leo => "leo",
+            TorqueLaw::Rule(law) => law(voltage),
         }
     }
+}
 
-    /// A stable number for the wire.
-    pub const fn code(self) -> u8 {
-        match self {
-            Robot::Pendulum33 => 1,
-            Robot::Pendulum20 => 2,
-            Robot::Leo => 3,
-        }
-    }
-
-    /// The robot with this [`code`](Self::code).
-    pub fn from_code(code: u8) -> Option<Robot> {
-        Robot::ALL.into_iter().find(|r| r.code() == code)
-    }
-
-    /// The robot with this [`name`](Self::name).
-    pub fn from_name(name: &str) -> Option<Robot> {
-        Robot::ALL.into_iter().find(|r| r.name() == name)
-    }
-
-    /// The gearbox torque \[N·m\] of a commanded voltage as the paper takes
-    /// it (Section IV: "a linear relationship between voltage and
-    /// torque"): the pendulum's K/R, LEO's RX-28 stall torque per volt. The
-    /// input of the paper's MTBF on the host and on the board alike.
-    pub fn commanded_gear_torque(self, voltage: f32) -> f32 {
-        match self {
-            Robot::Pendulum33 | Robot::Pendulum20 => pendulum::gearbox_torque(voltage as f64) as f32,
-            Robot::Leo => leo::commanded_gear_torque(voltage),
-        }
-    }
-
-    /// The learning task's definition.
-    pub const fn spec(self) -> &'static RobotSpec {
-        match self {
-            Robot::Pendulum33 => &pendulum::SPEC_33HZ,
-            Robot::Pendulum20 => &pendulum::SPEC_20HZ,
-            Robot::Leo => &leo::SPEC,
-        }
-    }
+/// What kind of weight table a robot's learner needs; a board's profile
+/// ([`crate::profile::Board::profile`]) sizes it to the board's memory.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TableNeed {
+    /// One weight per (tiling, tile, action): this many for SARSA(λ) and
+    /// every policy without state of its own (a test checks it against the
+    /// tile coder).
+    Exact {
+        /// Weights of the exact table.
+        weights: usize,
+    },
+    /// Too many tiles for an exact table: hashed features in a claim table
+    /// as large as the board's memory allows.
+    Claimed,
 }
 
 /// The levels of each learned motor (every motor dimension has the same).
@@ -111,11 +98,15 @@ pub enum MotorLevels {
     },
 }
 
-/// Everything that defines one robot's learning task.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Everything that defines one robot: its learning task and its hardware.
+///
+/// Two definitions are the same robot ([`PartialEq`]) when their names and
+/// [`definition_hash`](Self::definition_hash)es are equal.
+#[derive(Debug, Clone, Copy)]
 pub struct RobotSpec {
-    /// Which robot.
-    pub robot: Robot,
+    /// The robot's name as the command line, telemetry and the
+    /// configuration hash spell it (at most [`MAX_NAME`] bytes).
+    pub name: &'static str,
     /// Control period \[µs\].
     pub period_us: u32,
     /// Control steps of an episode before its time limit (a non-absorbing
@@ -136,11 +127,22 @@ pub struct RobotSpec {
     pub action_tiles: Option<&'static [f32]>,
     /// SARSA(λ) parameters.
     pub params: SarsaParams,
-    /// Physical gearboxes whose fatigue decides the robot's MTBF: the
+    /// The joints, in the robot's joint order: each one's servo, its ID
+    /// and calibration and its soft limit.
+    pub joints: &'static [JointSpec],
+    /// The joints whose gearboxes' fatigue decides the robot's MTBF: the
     /// pendulum's one; LEO's two hips and two knees (Section VIII), the
     /// joints the learned actions drive as stance and swing roles trade
-    /// legs. Their servos are the firmware's reported joints.
-    pub gearboxes: u8,
+    /// legs. Each `Step` record reports their fatigue.
+    pub counted: JointRange,
+    /// The robot's encoder, if it has one.
+    pub encoder: Option<EncoderSpec>,
+    /// Supply voltage assumed until a servo reports it \[V\].
+    pub supply_nominal_v: f32,
+    /// The paper's law from a commanded voltage to a counted gearbox's
+    /// torque (Section IV), the input of the paper's MTBF on the host and
+    /// on the board alike.
+    pub paper_torque: TorqueLaw,
     /// How the policy's memory (PADA's previous action, the low-pass
     /// filter's output, the integrated command) moves between the motor
     /// dimensions at a footstep, when the joints they drive trade roles
@@ -150,12 +152,111 @@ pub struct RobotSpec {
     /// The shift of 16-bit weights ([`crate::weights::WeightFormat::Half`])
     /// for this robot: its Q-values stay within ±2^(shift − 1).
     pub half_shift: u8,
+    /// The kind of weight table its learner needs.
+    pub table: TableNeed,
+}
+
+impl PartialEq for RobotSpec {
+    fn eq(&self, other: &Self) -> bool {
+        self.name == other.name && self.definition_hash() == other.definition_hash()
+    }
+}
+
+impl Eq for RobotSpec {}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for RobotSpec {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(f, "{=str}", self.name)
+    }
 }
 
 impl RobotSpec {
     /// The robot's name.
     pub const fn name(&self) -> &'static str {
-        self.robot.name()
+        self.name
+    }
+
+    /// Gearboxes whose fatigue is counted.
+    pub const fn gearboxes(&self) -> usize {
+        self.counted.len()
+    }
+
+    /// The hash of everything in the definition (FNV-1a): the name, the
+    /// timing, the observation, the motor, the learning parameters, the
+    /// joints with their servos, IDs, calibration and limits, the encoder,
+    /// the counted gearboxes, the footstep remap, the weight shift and the
+    /// table. It identifies a robot on the wire, in checkpoints and in
+    /// recordings beside its name: a definition changed under the same
+    /// name is another robot. (The rules are code; a change of them that
+    /// changes no data is not seen here.)
+    pub fn definition_hash(&self) -> u32 {
+        let mut h = ConfigHasher::new();
+        h.write_str(self.name).write_u32(self.period_us).write_u32(self.episode_steps).write_u32(self.test_interval);
+        h.write_u32(self.state.len() as u32);
+        for d in self.state {
+            h.write_f32(d.min).write_f32(d.max).write_f32(d.tile_width).write_u32(d.wrap as u32);
+        }
+        h.write_u32(self.motor_dims as u32);
+        match self.levels {
+            MotorLevels::Listed(values) => {
+                h.write_u32(1).write_u32(values.len() as u32);
+                for v in values {
+                    h.write_f32(*v);
+                }
+            }
+            MotorLevels::Uniform { min, max, count } => {
+                h.write_u32(2).write_f32(min).write_f32(max).write_u32(count as u32);
+            }
+        }
+        match self.action_tiles {
+            None => h.write_u32(0),
+            Some(widths) => {
+                h.write_u32(widths.len() as u32 + 1);
+                for w in widths {
+                    h.write_f32(*w);
+                }
+                &mut h
+            }
+        };
+        let p = &self.params;
+        h.write_f32(p.alpha).write_f32(p.gamma).write_f32(p.lambda).write_f32(p.epsilon).write_f32(p.trace_threshold);
+        h.write_u32(p.trace_kind.code());
+        match p.init {
+            WeightInit::Constant(v) => h.write_u32(1).write_f32(v),
+            WeightInit::Uniform { min, max } => h.write_u32(2).write_f32(min).write_f32(max),
+        };
+        h.write_u32(self.joints.len() as u32);
+        for j in self.joints {
+            h.write_str(j.name).write_str(j.servo).write_u32(j.id as u32).write_u32(j.zero as u32);
+            h.write_u32(j.sign as u32);
+            match j.soft_limit {
+                None => h.write_u32(0),
+                Some(l) => h.write_u32(1).write_f32(l.min).write_f32(l.max),
+            };
+        }
+        h.write_u32(self.counted.start as u32).write_u32(self.counted.end as u32);
+        match self.encoder {
+            None => h.write_u32(0),
+            Some(e) => h.write_u32(1).write_u32(e.counts_per_rev).write_u32(e.sign as u32),
+        };
+        h.write_f32(self.supply_nominal_v);
+        match self.footstep_remap {
+            None => h.write_u32(0),
+            Some(remap) => {
+                h.write_u32(1);
+                for r in remap {
+                    h.write_u32(r.map_or(u32::MAX, |d| d as u32));
+                }
+                &mut h
+            }
+        };
+        h.write_u32(self.half_shift as u32);
+        match self.table {
+            TableNeed::Exact { weights } => h.write_u32(1).write_u32(weights as u32),
+            TableNeed::Claimed => h.write_u32(2),
+        };
+        h.finish()
     }
 
     /// The rules of the robot's episodes, for [`crate::episodes::Episodes`].
@@ -186,15 +287,18 @@ impl RobotSpec {
     }
 
     /// The largest gearbox torque one learning action can command \[N·m\]:
-    /// the paper's torque law ([`Robot::commanded_gear_torque`]) at the level
-    /// of largest magnitude. Its re-engagement is the most damage one action
-    /// can do (the wear governor's reserve, [`crate::governor`]).
+    /// the paper's torque law ([`RobotSpec::paper_torque`]) at the level of
+    /// largest magnitude, on the counted joint where it is largest. Its
+    /// re-engagement is the most damage one action can do (the wear
+    /// governor's reserve, [`crate::governor`]).
     pub fn worst_commanded_torque(&self) -> f32 {
         let Ok(motor) = self.motor() else { return 0.0 };
         let mut worst = 0.0f32;
-        for i in 0..motor.dims() {
-            for &v in motor.dim(i).values() {
-                worst = worst.max(self.robot.commanded_gear_torque(v).abs());
+        for joint in 0..self.gearboxes() {
+            for i in 0..motor.dims() {
+                for &v in motor.dim(i).values() {
+                    worst = worst.max(self.paper_torque.torque(joint, v).abs());
+                }
             }
         }
         worst
@@ -249,24 +353,46 @@ impl RobotSpec {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::profile::TILINGS;
 
     #[test]
     fn every_spec_builds_its_motor_and_validates() {
-        for robot in Robot::ALL {
-            let spec = robot.spec();
-            assert_eq!(spec.robot, robot);
-            assert!(spec.motor().is_ok(), "{robot:?}");
-            assert!(spec.params.validate().is_ok(), "{robot:?}");
+        for spec in registry::specs() {
+            let name = spec.name;
+            assert!(spec.motor().is_ok(), "{name}");
+            assert!(spec.params.validate().is_ok(), "{name}");
+            assert!(name.len() <= MAX_NAME, "{name}");
             for (i, d) in spec.state.iter().enumerate() {
-                assert!(d.validate().is_ok(), "{robot:?} dimension {i}: {d:?}");
+                assert!(d.validate().is_ok(), "{name} dimension {i}: {d:?}");
             }
             if let Some(w) = spec.action_tiles {
                 assert_eq!(w.len(), spec.motor_dims as usize);
             }
-            assert_eq!(Robot::from_code(robot.code()), Some(robot));
-            assert_eq!(Robot::from_name(robot.name()), Some(robot));
+            assert!(spec.counted.end as usize <= spec.joints.len(), "{name}");
+            assert!(spec.joints.len() <= crate::limits::MAX_SERVOS, "{name}");
+            assert!(spec.gearboxes() <= crate::limits::MAX_GEARBOXES, "{name}");
+            if let TableNeed::Exact { weights } = spec.table {
+                assert_eq!(spec.exact_table_len::<TILINGS>(PolicyKind::Sarsa), Ok(weights), "{name}");
+            }
         }
-        assert_eq!(Robot::Leo.spec().motor().unwrap().joint_count(), 343);
-        assert_eq!(Robot::Leo.spec().state.len(), leo::OBS_DIM);
+        assert_eq!(leo::SPEC.motor().unwrap().joint_count(), 343);
+        assert_eq!(leo::SPEC.state.len(), leo::OBS_DIM);
+    }
+
+    #[test]
+    fn a_definition_is_its_name_and_hash() {
+        let hashes: heapless::Vec<u32, 8> = registry::specs().map(|s| s.definition_hash()).collect();
+        for (i, a) in hashes.iter().enumerate() {
+            for b in &hashes[i + 1..] {
+                assert_ne!(a, b);
+            }
+        }
+        // Any changed field is another robot, even under the same name.
+        let moved = RobotSpec { supply_nominal_v: 11.0, ..pendulum::SPEC_33HZ };
+        assert_ne!(moved.definition_hash(), pendulum::SPEC_33HZ.definition_hash());
+        assert_ne!(moved, pendulum::SPEC_33HZ);
+        let renamed = RobotSpec { name: "my-pendulum", ..pendulum::SPEC_33HZ };
+        assert_ne!(renamed, pendulum::SPEC_33HZ);
+        assert_eq!(RobotSpec { ..pendulum::SPEC_33HZ }, pendulum::SPEC_33HZ);
     }
 }

@@ -21,6 +21,7 @@
 use crate::crc::CRC32;
 use core::marker::PhantomData;
 use postcard::ser_flavors::Flavor;
+use super::messages::PROTOCOL_VERSION;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
@@ -168,6 +169,18 @@ impl FrameEncoder {
     }
 }
 
+/// The protocol version of a frame body that begins as a
+/// [`ToHost::Hello`](super::ToHost::Hello) of any version begins: the
+/// sequence number, the message's variant 0 and the `protocol` field, all
+/// varints. `None` for any other body. [`Hello::protocol`](super::Hello)
+/// is its first field so that this holds for every version.
+pub fn hello_protocol(body: &[u8]) -> Option<u16> {
+    match postcard::take_from_bytes::<(u32, u32, u16)>(body) {
+        Ok(((_seq, 0, protocol), _)) => Some(protocol),
+        _ => None,
+    }
+}
+
 /// Why a frame was lost. Each is also counted in [`LinkStats`], once.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -309,6 +322,7 @@ pub struct FrameDecoder<M, const N: usize = MAX_FRAME_LEN> {
     overflow: bool,
     expected: Option<u32>,
     stats: LinkStats,
+    foreign_protocol: Option<u16>,
     _msg: PhantomData<fn() -> M>,
 }
 
@@ -340,6 +354,7 @@ impl<M: DeserializeOwned + Serialize, const N: usize> FrameDecoder<M, N> {
                 frames_missed: 0,
                 seq_resyncs: 0,
             },
+            foreign_protocol: None,
             _msg: PhantomData,
         }
     }
@@ -358,6 +373,14 @@ impl<M: DeserializeOwned + Serialize, const N: usize> FrameDecoder<M, N> {
     /// Bytes of the frame in progress (received since the last 0x00).
     pub fn pending(&self) -> usize {
         self.len
+    }
+
+    /// The protocol version of a `Hello` this decoder refused because it is
+    /// of another version ([`hello_protocol`]), if it saw one: a recording
+    /// or a board of another pada, which a reader refuses in one line
+    /// rather than counting its frames as damaged.
+    pub fn foreign_protocol(&self) -> Option<u16> {
+        self.foreign_protocol
     }
 
     /// Takes one byte; a 0x00 ends a frame, which is then decoded. Returns
@@ -420,7 +443,12 @@ impl<M: DeserializeOwned + Serialize, const N: usize> FrameDecoder<M, N> {
         }
         let value = match postcard::take_from_bytes::<(u32, M)>(body) {
             Ok((v, [])) => v,
-            _ => return Err(self.lost(FrameError::Decode)),
+            _ => {
+                if let Some(found) = hello_protocol(body).filter(|p| *p != PROTOCOL_VERSION) {
+                    self.foreign_protocol = Some(found);
+                }
+                return Err(self.lost(FrameError::Decode));
+            }
         };
         if cobs_len(&frame[..n]) != len || !is_canonical(&value, body) {
             return Err(self.lost(FrameError::NonCanonical));

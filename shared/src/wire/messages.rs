@@ -24,8 +24,10 @@ pub use crate::safety::RunMode;
 /// [`ToHost::CheckpointChunk`], [`ToHost::RestoreWanted`],
 /// [`ToHost::Restored`], [`CheckpointReport::Streamed`],
 /// [`ToChip::RestoreChunk`] and [`ToChip::RestoreNone`], all appended
-/// last; `ToChip` is no longer `Copy`).
-pub const PROTOCOL_VERSION: u16 = 8;
+/// last; `ToChip` is no longer `Copy`); 9: [`Hello`] names the robot
+/// and its definition's hash instead of leaving it to be guessed from its
+/// dimensions (a robot is a definition, not a case of a closed list).
+pub const PROTOCOL_VERSION: u16 = 9;
 /// The capacities of a [`Step`] (state dimensions, motor outputs and
 /// counted gearboxes) and of a [`Health`] report (servos): pada-core's own
 /// ([`crate::limits`]).
@@ -79,10 +81,16 @@ pub enum ToHost {
 }
 
 /// Sent at boot and in answer to [`ToChip::Ping`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Hello {
-    /// [`PROTOCOL_VERSION`] of the sender.
+    /// [`PROTOCOL_VERSION`] of the sender. First, so that a reader can
+    /// tell another version's `Hello` even where the rest of it does not
+    /// decode ([`super::frame::hello_protocol`]).
     pub protocol: u16,
+    /// The robot's name (`crate::robot::RobotSpec::name`).
+    pub robot: heapless::String<{ crate::robot::MAX_NAME }>,
+    /// Its definition's hash (`crate::robot::RobotSpec::definition_hash`).
+    pub robot_hash: u32,
     /// Hash of the running configuration (as in checkpoints).
     pub config_hash: u32,
     /// Number of weights in the table.

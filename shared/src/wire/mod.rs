@@ -75,7 +75,7 @@ pub mod frame;
 pub mod messages;
 
 pub use frame::{
-    cobs_max_len, encode_frame, ChipDecoder, Decoded, FrameDecoder, FrameEncoder, FrameError, FrameFeed, HostDecoder,
+    cobs_max_len, encode_frame, hello_protocol, ChipDecoder, Decoded, FrameDecoder, FrameEncoder, FrameError, FrameFeed, HostDecoder,
     LinkStats, SeqGap, WireError, CRC_LEN, MAX_BODY, MAX_FRAME_LEN, MAX_SEQ_GAP,
 };
 pub use messages::*;

@@ -85,10 +85,11 @@ impl Board {
             }
         };
         let calibration = calibrate();
-        let robot = <crate::table::ThisRobot as pada_firmware::robot::RobotAdapter>::ROBOT.code();
+        let robot = PROFILE.robot;
         let boot = FromBoard::Boot {
             protocol: sil::CLOCK_PROTOCOL,
-            robot,
+            robot: heapless::String::try_from(robot.name).unwrap_or_default(),
+            robot_hash: robot.definition_hash(),
             board: heapless::String::try_from(PROFILE.board.name()).unwrap_or_default(),
             machine: heapless::String::try_from(machine::MACHINE).unwrap_or_default(),
             calibration,

@@ -31,7 +31,6 @@ use pada_core::wire::{
     self, CheckpointReport, Decoded, FrameEncoder, RestoreDenied, RestoreOutcome, RunMode, StepKind, ToChip, ToHost, Warning,
     MAX_FRAME_LEN,
 };
-use pada_firmware::config::Robot;
 use power::{LastSave, Power, Reboot, TransferCut};
 use pada_firmware::sil::{
     Channel, FromBoard, ToBoard, CALIBRATION_INSTRUCTIONS, CHUNK_LEN, CLOCK_FRAME_LEN, CLOCK_PROTOCOL,
@@ -133,7 +132,7 @@ impl<'a> Session<'a> {
         let plan = CutPlan::new(&cfg.power_cuts, cfg.seconds, cfg.save_every_s.unwrap_or(f64::INFINITY), ckpt, CHECKPOINT_SLOT_LEN);
         let mut hangs_us: Vec<u64> = cfg.hangs_s.iter().map(|t| (t * 1e6).round() as u64).collect();
         hangs_us.sort_unstable();
-        let protocol = RunProtocol::new(cfg.seconds, cfg.task.robot().spec().period_us);
+        let protocol = RunProtocol::new(cfg.seconds, cfg.task.robot().period_us);
         let power = Power::new(plan, hangs_us, cfg.save_every_s, protocol.clone());
         let kept = if ckpt > CHECKPOINT_SLOT_LEN {
             let path = out(KEPT_CHECKPOINT);
@@ -279,8 +278,8 @@ impl<'a> Session<'a> {
         self.loop_started = Instant::now();
         loop {
             match self.next_message()? {
-                FromBoard::Boot { protocol, robot, board, machine, calibration, resolution, watchdog_ms, reset } => {
-                    self.on_boot(protocol, robot, &board, &machine, calibration, resolution)?;
+                FromBoard::Boot { protocol, robot, robot_hash, board, machine, calibration, resolution, watchdog_ms, reset } => {
+                    self.on_boot(protocol, (&robot, robot_hash), &board, &machine, calibration, resolution)?;
                     self.power.watchdog_ms = watchdog_ms;
                     self.after_boot(reset)?;
                 }
@@ -305,7 +304,7 @@ impl<'a> Session<'a> {
     fn on_boot(
         &mut self,
         protocol: u16,
-        robot: u8,
+        (robot, robot_hash): (&str, u32),
         board: &str,
         machine: &str,
         calibration: u32,
@@ -316,11 +315,17 @@ impl<'a> Session<'a> {
         }
         let want = self.cfg.task.robot();
         let want_board = self.cfg.board.name();
-        if robot != want.code() || board != want_board {
-            let name = Robot::from_code(robot).map(|r| r.name()).unwrap_or("an unknown robot");
+        if robot != want.name || board != want_board {
             bail!(
-                "the image drives {name} on board {board} ({machine}), the run is for {} on {want_board}: build it with `cargo xtask qemu --board {want_board} --robot {}`",
-                want.name(),
+                "the image drives {robot} on board {board} ({machine}), the run is for {} on {want_board}: build it with `cargo xtask qemu --board {want_board} --robot {}`",
+                want.name,
+                self.cfg.task.name()
+            );
+        }
+        if robot_hash != want.definition_hash() {
+            bail!(
+                "the image drives another definition of {robot} (hash {robot_hash:08x}, the host's is {:08x}): rebuild it with `cargo xtask qemu --board {want_board} --robot {}`",
+                want.definition_hash(),
                 self.cfg.task.name()
             );
         }
@@ -522,7 +527,7 @@ impl<'a> Session<'a> {
                 // (After the final test episode the run ends at the board's
                 // next report; the firmware stays idle with torque off.)
                 if e.mode == RunMode::Learning {
-                    self.power.learning_done_s += e.length as f64 * self.cfg.task.robot().spec().period_us as f64 * 1e-6;
+                    self.power.learning_done_s += e.length as f64 * self.cfg.task.robot().period_us as f64 * 1e-6;
                     if let Some(h) = self.power.report.hangs.last_mut().filter(|h| h.reset_s.is_some()) {
                         h.episodes_after += 1;
                     }

@@ -336,7 +336,7 @@ impl Session<'_> {
     /// torque off for it: `Pause`, `SaveCheckpoint`, `Start`).
     pub(super) fn maybe_save(&mut self, at_us: u64) {
         let Some(every) = self.cfg.save_every_s else { return };
-        let spec = self.cfg.task.robot().spec();
+        let spec = self.cfg.task.robot();
         let max_episode_s = spec.episode_steps as f64 * spec.period_us as f64 * 1e-6;
         let since = self.protocol.learning_time_s() - self.power.last_attempt_learning_s;
         let test_next = spec.test_interval > 0 && self.protocol.learning_episodes() % spec.test_interval == 0;

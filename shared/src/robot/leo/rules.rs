@@ -1,11 +1,11 @@
-//! LEO on the robot: an adapter from its servos, the boom's encoder and the
-//! foot switches to the one definition in `pada_core::robot::leo`, whose
-//! rules (rate filter, stance, mirrored observation, reward, falls, held
-//! joints) it applies as the simulation does.
+//! LEO's rules ([`RobotRules`]): from its servos, the boom's encoder and
+//! the foot switches to the definition in [`super`] (rate filter, stance,
+//! mirrored observation, reward, falls, held joints), as the simulation
+//! applies them.
 //!
-//! - Joints in [`Joint`] order (the controller's servo table is in that
+//! - Joints in [`super::Joint`] order (the controller's servo table is in that
 //!   order; the servos' IDs are GRL's raw order, see
-//!   [`crate::config::hardware`]). Angles from the servos' positions; rates
+//!   [`super::JOINT_SPECS`]). Angles from the servos' positions; rates
 //!   are position differences over the period through GRL's Butterworth
 //!   filter (§3.2).
 //! - Torso angle φ = −(boom encoder angle) (§3.1), relative to the pose at
@@ -17,40 +17,23 @@
 //!   same: it puts the robot back in the start pose and holds it there until
 //!   the firmware starts the episode.)
 
-use crate::config::{RobotConfig, MAX_OBS, MAX_ROBOT_SERVOS};
-use crate::robot::{RobotAdapter, Sensed};
-use core::ops::Range;
-use pada_core::robot::filter::RateFilter;
-use pada_core::robot::leo::{
-    ankle_x, estimated_gear_torque, is_fall, joint_rate_filter, joint_voltages, observe, pose_voltages, reward,
-    step_energy, torso_rate_filter, Joint, Leg, StanceTracker, StanceUpdate, NUM_JOINTS, START_JOINT_ANGLES, START_PHI,
+use super::{
+    ankle_x, contact, estimated_gear_torque, is_fall, joint_rate_filter, joint_voltages, observe, pose_voltages, reward,
+    step_energy, torso_rate_filter, Leg, StanceTracker, StanceUpdate, NUM_JOINTS, OBS_DIM, SPEC,
+    START_JOINT_ANGLES, START_PHI,
 };
-use pada_core::robot::Robot;
-
-/// Foot switch bits of [`crate::io::Sensors::contacts`].
-pub mod contact {
-    /// Right toe.
-    pub const TOE_R: u8 = 1 << 0;
-    /// Right heel.
-    pub const HEEL_R: u8 = 1 << 1;
-    /// Left toe.
-    pub const TOE_L: u8 = 1 << 2;
-    /// Left heel.
-    pub const HEEL_L: u8 = 1 << 3;
-    /// Right foot.
-    pub const RIGHT: u8 = TOE_R | HEEL_R;
-    /// Left foot.
-    pub const LEFT: u8 = TOE_L | HEEL_L;
-}
+use crate::limits::{MAX_SERVOS, MAX_STATE_DIMS};
+use crate::robot::filter::RateFilter;
+use crate::robot::{PerServo, RobotRules, RobotSpec, Sensed};
 
 /// The next episode waits for |φ − φ_start| below this \[rad\] …
 const READY_PHI: f32 = 0.15;
 /// … with a foot on the ground, for this long \[µs\].
 const READY_TIME_US: u32 = 1_000_000;
 
-const _: () = assert!(NUM_JOINTS == MAX_ROBOT_SERVOS);
+const _: () = assert!(NUM_JOINTS <= MAX_SERVOS && OBS_DIM <= MAX_STATE_DIMS);
 
-/// LEO's adapter.
+/// LEO's rules.
 #[derive(Debug, Clone)]
 pub struct Leo {
     period_s: f32,
@@ -71,7 +54,36 @@ pub struct Leo {
     ready_steps: u32,
 }
 
+impl Default for Leo {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl Leo {
+    /// LEO before its first reading.
+    pub fn new() -> Self {
+        let period_us = SPEC.period_us;
+        Leo {
+            period_s: period_us as f32 * 1e-6,
+            rate_filters: [joint_rate_filter(); NUM_JOINTS],
+            torso_filter: torso_rate_filter(),
+            q: [0.0; NUM_JOINTS],
+            q_prev: [None; NUM_JOINTS],
+            qd: [0.0; NUM_JOINTS],
+            qd_prev: [0.0; NUM_JOINTS],
+            boom_prev: None,
+            phi: 0.0,
+            phid: 0.0,
+            contacts: 0,
+            stance: StanceTracker::new(),
+            update: StanceUpdate { length: 0.0, previous_length: 0.0, footstep: false },
+            energy: 0.0,
+            ready_needed: READY_TIME_US.div_ceil(period_us),
+            ready_steps: 0,
+        }
+    }
+
     /// The stance leg (left until the feet say otherwise).
     pub fn stance(&self) -> Leg {
         self.stance.stance_or_left()
@@ -93,29 +105,9 @@ impl Leo {
     }
 }
 
-impl RobotAdapter for Leo {
-    const ROBOT: Robot = Robot::Leo;
-
-    fn new(_config: &RobotConfig) -> Self {
-        let period_us = Self::spec().period_us;
-        Leo {
-            period_s: period_us as f32 * 1e-6,
-            rate_filters: [joint_rate_filter(); NUM_JOINTS],
-            torso_filter: torso_rate_filter(),
-            q: [0.0; NUM_JOINTS],
-            q_prev: [None; NUM_JOINTS],
-            qd: [0.0; NUM_JOINTS],
-            qd_prev: [0.0; NUM_JOINTS],
-            boom_prev: None,
-            phi: 0.0,
-            phid: 0.0,
-            contacts: 0,
-            stance: StanceTracker::new(),
-            update: StanceUpdate { length: 0.0, previous_length: 0.0, footstep: false },
-            energy: 0.0,
-            ready_needed: READY_TIME_US.div_ceil(period_us),
-            ready_steps: 0,
-        }
+impl RobotRules for Leo {
+    fn spec(&self) -> &'static RobotSpec {
+        &SPEC
     }
 
     /// Filters cleared, stance unknown, L = 0 (§3.2, §3.3).
@@ -155,7 +147,7 @@ impl RobotAdapter for Leo {
             self.phid = -self.torso_filter.update(raw);
         }
         self.contacts = s.contacts;
-        self.energy = step_energy(&s.applied, &self.qd_prev, &self.qd);
+        self.energy = step_energy(&joints_of(&s.applied), &self.qd_prev, &self.qd);
         let ankle = |leg: Leg| ankle_x(self.phi, self.q[leg.hip() as usize], self.q[leg.knee() as usize]);
         self.update = self.stance.update(
             s.contacts & contact::LEFT != 0,
@@ -166,12 +158,12 @@ impl RobotAdapter for Leo {
     }
 
     /// The mirrored observation (§3.4).
-    fn observe(&self, obs: &mut [f32; MAX_OBS]) -> usize {
-        obs.copy_from_slice(&observe(self.phi, self.phid, &self.q, &self.qd, self.stance()).0);
-        MAX_OBS
+    fn observe(&self, obs: &mut [f32; MAX_STATE_DIMS]) -> usize {
+        obs[..OBS_DIM].copy_from_slice(&observe(self.phi, self.phid, &self.q, &self.qd, self.stance()).0);
+        OBS_DIM
     }
 
-    fn reward(&self, _applied: &[f32; MAX_ROBOT_SERVOS]) -> f32 {
+    fn reward(&self, _applied: &PerServo) -> f32 {
         reward(self.energy, &self.update, self.absorbing())
     }
 
@@ -181,21 +173,22 @@ impl RobotAdapter for Leo {
 
     /// The learner's `[U_hip,st, U_hip,sw, U_knee,sw]` on the joints of the
     /// current stance, the held joints by §3.5.
-    fn commands(&self, output: &[f32], volts: &mut [f32; MAX_ROBOT_SERVOS]) {
+    fn commands(&self, output: &[f32], volts: &mut PerServo) {
         let mut action = [0.0; 3];
         for (a, o) in action.iter_mut().zip(output) {
             *a = *o;
         }
-        *volts = joint_voltages(action, &self.q, self.stance());
+        *volts = per_servo(joint_voltages(action, &self.q, self.stance()));
     }
 
     /// Every joint held in the start pose.
-    fn reset_commands(&self, volts: &mut [f32; MAX_ROBOT_SERVOS]) {
-        *volts = pose_voltages(&self.q, &START_JOINT_ANGLES);
+    fn reset_commands(&self, volts: &mut PerServo) {
+        *volts = per_servo(pose_voltages(&self.q, &START_JOINT_ANGLES));
     }
 
     /// The RX-28 model's torque at each servo's filtered rate.
-    fn gear_torques(&self, applied: &[f32; MAX_ROBOT_SERVOS], torques: &mut [f32; MAX_ROBOT_SERVOS]) {
+    fn gear_torques(&self, applied: &PerServo, torques: &mut PerServo) {
+        *torques = [0.0; MAX_SERVOS];
         for j in 0..NUM_JOINTS {
             torques[j] = estimated_gear_torque(applied[j], self.qd[j]);
         }
@@ -214,12 +207,6 @@ impl RobotAdapter for Leo {
         self.ready_steps >= self.ready_needed
     }
 
-    /// Both hips and both knees, which take turns as stance and swing
-    /// joints.
-    fn reported_joints() -> Range<usize> {
-        Joint::HipLeft as usize..Joint::KneeRight as usize + 1
-    }
-
     fn footstep(&self) -> bool {
         self.update.footstep
     }
@@ -229,25 +216,42 @@ impl RobotAdapter for Leo {
     }
 }
 
+/// LEO's seven joints of a per-servo array.
+fn joints_of(values: &PerServo) -> [f32; NUM_JOINTS] {
+    let mut out = [0.0; NUM_JOINTS];
+    out.copy_from_slice(&values[..NUM_JOINTS]);
+    out
+}
+
+/// A per-servo array of LEO's seven joints (the rest 0).
+fn per_servo(values: [f32; NUM_JOINTS]) -> PerServo {
+    let mut out = [0.0; MAX_SERVOS];
+    out[..NUM_JOINTS].copy_from_slice(&values);
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::hardware;
-    use pada_core::robot::leo::{ACTION_VOLTAGE_LIMIT, HELD_VOLTAGE_LIMIT};
+    use crate::robot::leo::{Joint, ACTION_VOLTAGE_LIMIT, HELD_VOLTAGE_LIMIT};
 
     fn leo() -> Leo {
-        let mut l = Leo::new(&hardware(Robot::Leo));
+        let mut l = Leo::new();
         l.start_episode();
         l
     }
 
-    fn sense(l: &mut Leo, angles: [f32; NUM_JOINTS], boom: f32, contacts: u8, applied: [f32; MAX_ROBOT_SERVOS]) {
-        l.sense(&Sensed { angles: angles.map(Some), encoder_angle: Some(boom), contacts, applied });
+    fn sense(l: &mut Leo, angles: [f32; NUM_JOINTS], boom: f32, contacts: u8, applied: [f32; MAX_SERVOS]) {
+        let mut sensed = [None; MAX_SERVOS];
+        for (s, a) in sensed.iter_mut().zip(angles) {
+            *s = Some(a);
+        }
+        l.sense(&Sensed { angles: sensed, encoder_angle: Some(boom), contacts, applied });
     }
 
     /// LEO in the start pose of §1.8 (left leg stance).
     fn start_pose(l: &mut Leo, contacts: u8) {
-        sense(l, START_JOINT_ANGLES, -START_PHI, contacts, [0.0; MAX_ROBOT_SERVOS]);
+        sense(l, START_JOINT_ANGLES, -START_PHI, contacts, [0.0; MAX_SERVOS]);
     }
 
     #[test]
@@ -255,8 +259,8 @@ mod tests {
         let mut l = leo();
         start_pose(&mut l, contact::LEFT);
         assert_eq!(l.stance(), Leg::Left);
-        let mut obs = [0.0; MAX_OBS];
-        assert_eq!(l.observe(&mut obs), 10);
+        let mut obs = [0.0; MAX_STATE_DIMS];
+        assert_eq!(l.observe(&mut obs), OBS_DIM);
         assert!((obs[0] + 0.10).abs() < 1e-6, "φ = −boom");
         assert!((obs[2] - 0.10).abs() < 1e-6, "stance hip = left hip");
         assert!((obs[4] - 0.82).abs() < 1e-6, "swing hip = right hip");
@@ -265,11 +269,11 @@ mod tests {
         // The second update: L flips from x_L − x_R to x_R − x_L, the
         // +11.9 artefact of the first transition (§3.7).
         start_pose(&mut l, contact::LEFT);
-        let r = l.reward(&[0.0; MAX_ROBOT_SERVOS]);
+        let r = l.reward(&[0.0; MAX_SERVOS]);
         assert!((r - 11.9).abs() < 0.5, "{r}");
         // Standing still afterwards: the time penalty only.
         start_pose(&mut l, contact::LEFT);
-        assert!((l.reward(&[0.0; MAX_ROBOT_SERVOS]) + 1.0).abs() < 1e-4);
+        assert!((l.reward(&[0.0; MAX_SERVOS]) + 1.0).abs() < 1e-4);
     }
 
     #[test]
@@ -282,13 +286,13 @@ mod tests {
         assert_eq!(l.stance(), Leg::Right);
         assert_eq!(l.footsteps(), 1);
         assert!(l.walked_m().unwrap() > 0.0);
-        let mut obs = [0.0; MAX_OBS];
+        let mut obs = [0.0; MAX_STATE_DIMS];
         l.observe(&mut obs);
         assert!((obs[2] - 0.82).abs() < 1e-6, "stance hip is now the right hip");
         // L is continuous across the switch: the next reward is the time
         // penalty only.
         start_pose(&mut l, contact::RIGHT);
-        assert!((l.reward(&[0.0; MAX_ROBOT_SERVOS]) + 1.0).abs() < 1e-4);
+        assert!((l.reward(&[0.0; MAX_SERVOS]) + 1.0).abs() < 1e-4);
         // Both feet down: the front foot stands (the right ankle is ahead).
         start_pose(&mut l, contact::LEFT | contact::RIGHT);
         assert_eq!(l.stance(), Leg::Right);
@@ -300,16 +304,16 @@ mod tests {
         start_pose(&mut l, contact::LEFT);
         start_pose(&mut l, contact::LEFT);
         assert!(!l.absorbing());
-        sense(&mut l, START_JOINT_ANGLES, 1.2, contact::LEFT, [0.0; MAX_ROBOT_SERVOS]);
+        sense(&mut l, START_JOINT_ANGLES, 1.2, contact::LEFT, [0.0; MAX_SERVOS]);
         assert!(l.absorbing());
-        assert!(l.reward(&[0.0; MAX_ROBOT_SERVOS]) < -100.0);
+        assert!(l.reward(&[0.0; MAX_SERVOS]) < -100.0);
     }
 
     #[test]
     fn learned_and_held_joints_by_stance() {
         let mut l = leo();
         start_pose(&mut l, contact::LEFT);
-        let mut v = [0.0; MAX_ROBOT_SERVOS];
+        let mut v = [0.0; MAX_SERVOS];
         l.commands(&[1.0, 2.0, 3.0], &mut v);
         let (hl, hr, kr, kl) =
             (Joint::HipLeft as usize, Joint::HipRight as usize, Joint::KneeRight as usize, Joint::KneeLeft as usize);
@@ -322,13 +326,14 @@ mod tests {
         // Learned voltages are clipped to ±10.7 V, held ones to 10.69 V.
         l.commands(&[50.0, 0.0, 0.0], &mut v);
         assert_eq!(v[hl], ACTION_VOLTAGE_LIMIT);
-        sense(&mut l, [3.0; NUM_JOINTS], 0.10, contact::LEFT, [0.0; MAX_ROBOT_SERVOS]);
+        sense(&mut l, [3.0; NUM_JOINTS], 0.10, contact::LEFT, [0.0; MAX_SERVOS]);
         l.commands(&[0.0; 3], &mut v);
         assert!((v[Joint::Shoulder as usize] + HELD_VOLTAGE_LIMIT).abs() < 1e-5);
         // Between episodes everything is held at the start pose.
         start_pose(&mut l, contact::LEFT);
         l.reset_commands(&mut v);
         assert!(v.iter().all(|u| u.abs() < 1e-5), "{v:?}");
+        assert_eq!(v[NUM_JOINTS..], [0.0; MAX_SERVOS - NUM_JOINTS], "no servo past LEO's seven");
     }
 
     #[test]
@@ -336,7 +341,7 @@ mod tests {
         let mut l = leo();
         start_pose(&mut l, contact::LEFT);
         start_pose(&mut l, contact::LEFT);
-        let mut applied = [0.0; MAX_ROBOT_SERVOS];
+        let mut applied = [0.0; MAX_SERVOS];
         applied[Joint::HipLeft as usize] = 10.0;
         sense(&mut l, START_JOINT_ANGLES, -START_PHI, contact::LEFT, applied);
         // At stall: U²/R · T; reward −1 − 3E.

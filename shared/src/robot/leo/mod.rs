@@ -1,9 +1,11 @@
 //! LEO, the Delft biped on its boom, walking (Section VIII), defined once:
-//! the facts of `docs/reference/grl.md` §1.3–1.8 the task needs and the walking task
-//! of §3. The rapier3d simulation (`host/src/leo/`) produces these
-//! quantities from physics; the firmware (`firmware/src/leo.rs`) from servo
-//! positions, the boom's encoder and the foot switches. Both then apply the
-//! same rules, so the chip's learner sees what the simulated learner sees.
+//! the facts of `docs/reference/grl.md` §1.3–1.8 the task needs, the
+//! walking task of §3, and its hardware (seven RX-28s, the boom's encoder,
+//! four foot switches). The rapier3d simulation (`host/src/leo/`) produces
+//! these quantities from physics; the firmware, through [`rules::Leo`],
+//! from servo positions, the boom's encoder and the foot switches. Both
+//! then apply the same rules, so the chip's learner sees what the
+//! simulated learner sees.
 //!
 //! - Joints in [`Joint`] order (shoulder, hip L/R, knee L/R, ankle L/R);
 //!   hinge angles follow ODE, `q = θ_parent − θ_child` (§1.2).
@@ -23,9 +25,17 @@
 // meant as π/4).
 #![allow(clippy::approx_constant)]
 
+mod rules;
+mod stance;
+
+pub use rules::Leo;
+pub use stance::{StanceTracker, StanceUpdate};
+
 use super::filter::RateFilter;
-use super::{MotorLevels, Robot, RobotSpec};
+use super::hardware::{EncoderSpec, JointRange, JointSpec};
+use super::{MotorLevels, RobotSpec, TableNeed, TorqueLaw};
 use crate::agent::{SarsaParams, WeightInit};
+use crate::safety::SoftLimit;
 use crate::rx28::{Rx28, LEO_MAX_VOLTAGE};
 use crate::tile_coding::StateDim;
 use crate::trace::TraceKind;
@@ -244,9 +254,10 @@ pub const PARAMS: SarsaParams = SarsaParams {
 
 /// LEO's learning task: 3 learned joints × 7 levels over ±10.7 V, the
 /// 10-D mirrored state, 25 s episodes at 30 Hz, a test run every 10
-/// learning episodes (Section VI).
-pub const SPEC: RobotSpec = RobotSpec {
-    robot: Robot::Leo,
+/// learning episodes (Section VI); its seven RX-28s, the boom's encoder,
+/// the wear of both hips and both knees counted.
+pub static SPEC: RobotSpec = RobotSpec {
+    name: "leo",
     period_us: CONTROL_PERIOD_US,
     episode_steps: EPISODE_STEPS,
     test_interval: 10,
@@ -255,10 +266,76 @@ pub const SPEC: RobotSpec = RobotSpec {
     levels: MotorLevels::Uniform { min: -ACTION_VOLTAGE_LIMIT, max: ACTION_VOLTAGE_LIMIT, count: ACTION_LEVELS },
     action_tiles: Some(&[ACTION_TILE_WIDTH; ACTION_DIM]),
     params: PARAMS,
-    gearboxes: GEARBOXES.len() as u8,
+    joints: &JOINT_SPECS,
+    counted: COUNTED,
+    // The boom's encoder; the torso angle is minus its angle (§3.1).
+    encoder: Some(EncoderSpec { counts_per_rev: 4096, sign: 1 }),
+    // LEO_SUPPLY_VOLTAGE (docs/reference/grl.md §2.2).
+    supply_nominal_v: crate::rx28::LEO_SUPPLY_VOLTAGE,
+    paper_torque: TorqueLaw::Rule(commanded_gear_torque),
     footstep_remap: Some(FOOTSTEP_REMAP),
     half_shift: HALF_SHIFT,
+    table: TableNeed::Claimed,
 };
+
+/// LEO's servos in [`Joint`] order (shoulder, hip L/R, knee L/R, ankle
+/// L/R), with the IDs of GRL's raw order (docs/reference/grl.md §3.1:
+/// shoulder 1, hip R 2, hip L 3, knee R 4, knee L 5, ankle R 6, ankle L
+/// 7). `zero` is the raw position at joint angle 0 and `sign` maps the
+/// servo's direction to GRL's joint sign (§1.2, §1.5): **calibrate both on
+/// your robot**; these are the mid-range defaults. Each soft limit is the
+/// joint's stop ([`joint_limits`]; the shoulder's ±90° where it has none)
+/// widened by [`STOP_MARGIN`].
+pub const JOINT_SPECS: [JointSpec; NUM_JOINTS] = [
+    servo("shoulder", Joint::Shoulder, 1),
+    servo("hip_left", Joint::HipLeft, 3),
+    servo("hip_right", Joint::HipRight, 2),
+    servo("knee_left", Joint::KneeLeft, 5),
+    servo("knee_right", Joint::KneeRight, 4),
+    servo("ankle_left", Joint::AnkleLeft, 7),
+    servo("ankle_right", Joint::AnkleRight, 6),
+];
+
+/// Margin outside LEO's joint stops (docs/reference/grl.md §1.5) before a
+/// soft-limit fault \[rad\]: the stops are soft springs, a joint that
+/// passes them by this much is being driven into them.
+pub const STOP_MARGIN: f32 = 0.15;
+
+/// The shoulder has no stop (§1.5, [`joint_limits`] is `None`): its soft
+/// limit, a fault and not a physical stop, is ±90°.
+pub const SHOULDER_SOFT_LIMITS: [f32; 2] = [-FRAC_PI_2, FRAC_PI_2];
+
+/// One of LEO's RX-28s: its ID, mid-range calibration and soft limit.
+const fn servo(name: &'static str, joint: Joint, id: u8) -> JointSpec {
+    let [min, max] = match joint_limits(joint) {
+        Some(stop) => stop,
+        None => SHOULDER_SOFT_LIMITS,
+    };
+    JointSpec {
+        name,
+        servo: "RX-28",
+        id,
+        zero: 512,
+        sign: 1,
+        soft_limit: Some(SoftLimit { min: min - STOP_MARGIN, max: max + STOP_MARGIN }),
+    }
+}
+
+/// LEO's foot switches, as [`crate::robot::Sensed::contacts`] carries them.
+pub mod contact {
+    /// Right toe.
+    pub const TOE_R: u8 = 1 << 0;
+    /// Right heel.
+    pub const HEEL_R: u8 = 1 << 1;
+    /// Left toe.
+    pub const TOE_L: u8 = 1 << 2;
+    /// Left heel.
+    pub const HEEL_L: u8 = 1 << 3;
+    /// Right foot.
+    pub const RIGHT: u8 = TOE_R | HEEL_R;
+    /// Left foot.
+    pub const LEFT: u8 = TOE_L | HEEL_L;
+}
 
 /// At a footstep the learned dimensions trade joints: the new stance hip
 /// was the swing hip, the new swing hip was the stance hip, and the new
@@ -295,104 +372,6 @@ pub fn torso_rate_filter() -> RateFilter {
 /// x_a = 0.116·sin(φ + q_hip) + 0.1045·sin(φ + q_hip + q_knee).
 pub fn ankle_x(phi: f32, q_hip: f32, q_knee: f32) -> f32 {
     THIGH_LENGTH * libm::sinf(phi + q_hip) + SHANK_LENGTH * libm::sinf(phi + q_hip + q_knee)
-}
-
-/// What one stance update found (§3.3).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StanceUpdate {
-    /// Footstep length L after the update.
-    pub length: f32,
-    /// L_prev for the reward (sign kept continuous across stance switches).
-    pub previous_length: f32,
-    /// Whether the stance leg changed (a footstep).
-    pub footstep: bool,
-}
-
-/// The stance/swing state machine of §3.3 (BW `updateDerivedStateVars`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StanceTracker {
-    stance: Option<Leg>,
-    length: f32,
-    last_was_footstep: bool,
-    footsteps: i32,
-    walked: f32,
-}
-
-impl Default for StanceTracker {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl StanceTracker {
-    /// Unknown stance, no footsteps (episode start).
-    pub const fn new() -> Self {
-        StanceTracker { stance: None, length: 0.0, last_was_footstep: false, footsteps: 0, walked: 0.0 }
-    }
-
-    /// The current stance leg, `None` before the first update.
-    pub fn stance(&self) -> Option<Leg> {
-        self.stance
-    }
-
-    /// The stance leg; the start pose stands on the left leg (§1.8), so
-    /// that is the answer before any foot ever touched.
-    pub fn stance_or_left(&self) -> Leg {
-        self.stance.unwrap_or(Leg::Left)
-    }
-
-    /// Footstep count: +1 per forward step, −1 per backward step.
-    pub fn footsteps(&self) -> i32 {
-        self.footsteps
-    }
-
-    /// Walked distance: the sum of footstep lengths \[m\].
-    pub fn walked(&self) -> f32 {
-        self.walked
-    }
-
-    /// One update after a control step. `contact_left/right`: toe or heel
-    /// of that foot touches; `ankle_left/right`: [`ankle_x`] of each leg.
-    ///
-    /// - stance: only left touches → left; only right → right; neither →
-    ///   unchanged; both → the front foot (larger ankle x);
-    /// - L = x_a(swing) − x_a(stance) with the stance from *before* this
-    ///   update (unknown before the first update: L = x_L − x_R);
-    /// - a footstep is a stance change with a known previous stance:
-    ///   count ±1 by the sign of L, walked distance += L;
-    /// - L_prev = old L, negated if the previous update was a footstep.
-    pub fn update(
-        &mut self,
-        contact_left: bool,
-        contact_right: bool,
-        ankle_left: f32,
-        ankle_right: f32,
-    ) -> StanceUpdate {
-        let previous_length = if self.last_was_footstep { -self.length } else { self.length };
-        let before = self.stance;
-        let after = match (contact_left, contact_right) {
-            (true, false) => Some(Leg::Left),
-            (false, true) => Some(Leg::Right),
-            (false, false) => before,
-            (true, true) => Some(if ankle_left >= ankle_right { Leg::Left } else { Leg::Right }),
-        };
-        let x = |leg: Leg| match leg {
-            Leg::Left => ankle_left,
-            Leg::Right => ankle_right,
-        };
-        self.length = match before {
-            Some(st) => x(st.other()) - x(st),
-            None => ankle_left - ankle_right,
-        };
-        let footstep = before.is_some() && after != before;
-        if footstep {
-            self.footsteps += if self.length > 0.0 { 1 } else { -1 };
-            self.walked += self.length;
-        }
-        self.last_was_footstep = footstep;
-        self.stance = after;
-        StanceUpdate { length: self.length, previous_length, footstep }
-    }
 }
 
 /// Voltages of the held joints (§3.5), from the current joint angles and
@@ -519,8 +498,20 @@ pub fn observe(
 }
 
 /// The gearboxes whose fatigue is counted, in this order: both hips and
-/// both knees (the shoulder and ankles are held and never learned).
+/// both knees (the shoulder and ankles are held and never learned), the
+/// joints the learned actions drive as stance and swing roles trade legs.
 pub const GEARBOXES: [Joint; 4] = [Joint::HipLeft, Joint::HipRight, Joint::KneeLeft, Joint::KneeRight];
+
+/// [`GEARBOXES`] as the definition's run of joints.
+pub const COUNTED: JointRange = JointRange { start: Joint::HipLeft as u8, end: Joint::KneeRight as u8 + 1 };
+const _: () = {
+    let mut i = 0;
+    while i < GEARBOXES.len() {
+        assert!(GEARBOXES[i] as u8 == COUNTED.start + i as u8);
+        i += 1;
+    }
+    assert!(COUNTED.len() == GEARBOXES.len());
+};
 
 /// The gearbox torque as the paper takes it (Section IV): linear in the
 /// commanded voltage, the RX-28's stall torque at that voltage,
@@ -565,36 +556,6 @@ mod tests {
             assert!((a - b).abs() < 1e-6, "{START_JOINT_ANGLES:?}");
         }
         assert!(!is_fall(START_PHI, START_JOINT_ANGLES[Joint::HipLeft as usize]));
-    }
-
-    #[test]
-    fn stance_logic_follows_section_3_3() {
-        let mut s = StanceTracker::new();
-        // First update, left on the floor, right foot ahead by 0.02 m:
-        // previous stance unknown → L = x_L − x_R.
-        let u = s.update(true, false, 0.01, 0.03);
-        assert_eq!(s.stance(), Some(Leg::Left));
-        assert!((u.length - (-0.02)).abs() < 1e-6 && !u.footstep);
-        // Still left stance: L = x_R − x_L.
-        let u = s.update(true, false, 0.0, 0.05);
-        assert!((u.length - 0.05).abs() < 1e-6 && (u.previous_length + 0.02).abs() < 1e-6);
-        // Right touches down ahead: both feet down, right is in front → footstep.
-        let u = s.update(true, true, -0.04, 0.06);
-        assert!(u.footstep && s.stance() == Some(Leg::Right));
-        assert!((u.length - 0.10).abs() < 1e-6);
-        assert_eq!(s.footsteps(), 1);
-        assert!((s.walked() - 0.10).abs() < 1e-6);
-        // Next update: L is measured for the right stance, L_prev is −L.
-        let u = s.update(false, true, -0.05, 0.05);
-        assert!((u.previous_length + 0.10).abs() < 1e-6);
-        assert!((u.length + 0.10).abs() < 1e-6);
-        // Neither foot: keep stance.
-        s.update(false, false, 0.0, 0.0);
-        assert_eq!(s.stance(), Some(Leg::Right));
-        // Backward step: left lands behind → footstep −1.
-        let u = s.update(true, false, -0.1, 0.0);
-        assert!(u.footstep && u.length < 0.0);
-        assert_eq!(s.footsteps(), 0);
     }
 
     #[test]

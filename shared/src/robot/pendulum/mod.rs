@@ -1,8 +1,9 @@
 //! The physical inverted pendulum of Section VII, defined once (constants,
-//! timing, observation, reward as GRL's, docs/reference/grl.md §4). The host's model
-//! (`host/src/pendulum/physical.rs`) integrates its dynamics; the firmware
-//! (`firmware/src/pendulum.rs`) reads it through an encoder on the axis and
-//! drives its motor. Both apply these rules.
+//! timing, observation, reward as GRL's, docs/reference/grl.md §4, and its
+//! hardware: one RX-28 in wheel mode, an encoder on the axis). The host's
+//! model (`host/src/pendulum/physical.rs`) integrates its dynamics; the
+//! firmware reads it through the encoder and drives its motor. Both apply
+//! the rules of [`rules::Pendulum`].
 //!
 //! - θ = 0 upright, the observation `[θ wrapped to (−π, π], θ̇]`;
 //! - actions {−3, 0, +3} V, at 33 Hz (the paper's experiment) or 20 Hz
@@ -13,7 +14,12 @@
 //!   motor's stall torque per volt `K/R` (the paper's "linear relationship
 //!   between voltage and torque"; see [`gearbox_torque`]).
 
-use super::{MotorLevels, Robot, RobotSpec};
+mod rules;
+
+pub use rules::Pendulum;
+
+use super::hardware::{EncoderSpec, JointRange, JointSpec};
+use super::{MotorLevels, RobotSpec, TableNeed, TorqueLaw};
 use crate::agent::{SarsaParams, WeightInit};
 use crate::tile_coding::StateDim;
 use core::f32::consts::PI;
@@ -51,10 +57,29 @@ pub const PARAMS: SarsaParams = SarsaParams { init: WeightInit::Uniform { min: 0
 /// saturate, and be counted).
 pub const HALF_SHIFT: u8 = 15;
 
+/// The pendulum's motor: one RX-28 in wheel mode, Dynamixel ID 1,
+/// position counts increasing with the positive (counter-clockwise)
+/// voltage. It turns freely: no soft limit.
+pub const JOINTS: [JointSpec; 1] =
+    [JointSpec { name: "axis", servo: "RX-28", id: 1, zero: 512, sign: 1, soft_limit: None }];
+
+/// The quadrature encoder on the axis (the servo's potentiometer covers
+/// only 300°): a 1024-line encoder, 4096 counts per turn.
+pub const ENCODER: EncoderSpec = EncoderSpec { counts_per_rev: 4096, sign: 1 };
+
+/// The supply assumed until the servo reports it \[V\].
+pub const SUPPLY_NOMINAL_V: f32 = 12.0;
+
+/// Weights of the pendulum's exact table with SARSA, the low-pass filter,
+/// the integrator or PADA: 20 angle tiles × 26 velocity tiles × 16
+/// tilings × 3 actions (the Markov variants add a state dimension and need
+/// 4× more).
+pub const EXACT_WEIGHTS: usize = 24_960;
+
 /// The pendulum's learning task at a control period of `period_us`.
-const fn spec(robot: Robot, period_us: u32) -> RobotSpec {
+const fn spec(name: &'static str, period_us: u32) -> RobotSpec {
     RobotSpec {
-        robot,
+        name,
         period_us,
         episode_steps: EPISODE_US / period_us,
         test_interval: 10,
@@ -63,16 +88,21 @@ const fn spec(robot: Robot, period_us: u32) -> RobotSpec {
         levels: MotorLevels::Listed(&LEVELS),
         action_tiles: None,
         params: PARAMS,
-        gearboxes: 1,
+        joints: &JOINTS,
+        counted: JointRange { start: 0, end: 1 },
+        encoder: Some(ENCODER),
+        supply_nominal_v: SUPPLY_NOMINAL_V,
+        paper_torque: TorqueLaw::Rule(paper_gear_torque),
         footstep_remap: None,
         half_shift: HALF_SHIFT,
+        table: TableNeed::Exact { weights: EXACT_WEIGHTS },
     }
 }
 
 /// At the paper's 33 Hz (30 ms, 100 steps per episode).
-pub const SPEC_33HZ: RobotSpec = spec(Robot::Pendulum33, 30_000);
+pub static SPEC_33HZ: RobotSpec = spec("physical-pendulum", 30_000);
 /// At 20 Hz (50 ms, 60 steps per episode).
-pub const SPEC_20HZ: RobotSpec = spec(Robot::Pendulum20, 50_000);
+pub static SPEC_20HZ: RobotSpec = spec("physical-pendulum-20hz", 50_000);
 
 /// An angle wrapped to (−π, π].
 pub fn wrap_angle(theta: f64) -> f64 {
@@ -107,6 +137,12 @@ pub fn clip_voltage(voltage: f64) -> f64 {
 /// near the paper's 10⁸ s; RX-28's 3.3/14 N·m/V would give ~10⁴ s.
 pub fn gearbox_torque(voltage: f64) -> f64 {
     clip_voltage(voltage) * TORQUE_CONSTANT / RESISTANCE
+}
+
+/// [`gearbox_torque`] in the form of the definition's [`TorqueLaw`]
+/// (`f32` in and out, as the fatigue counter takes torques).
+pub fn paper_gear_torque(voltage: f32) -> f32 {
+    gearbox_torque(voltage as f64) as f32
 }
 
 #[cfg(test)]

@@ -1,6 +1,6 @@
-//! The physical inverted pendulum of Section VII on the robot: an adapter
-//! from its encoder to the one definition in `pada_core::robot::pendulum`
-//! (observation, reward, torque), and the wait between episodes.
+//! The physical inverted pendulum's rules ([`RobotRules`]): from its
+//! encoder to the observation, reward and gearbox torque of the definition
+//! in [`super`], and the wait between episodes.
 //!
 //! One RX-28 in wheel mode turns the pendulum; a quadrature encoder on the
 //! axis measures the angle (the servo's potentiometer covers only 300°).
@@ -12,11 +12,9 @@
 //! (|θ − π| < 0.15 rad and |θ̇| < 0.3 rad/s for 1 s) or 15 s have passed,
 //! so every episode starts, as in the simulation, hanging at rest.
 
-use crate::config::{RobotConfig, MAX_OBS, MAX_ROBOT_SERVOS};
-use crate::robot::{RobotAdapter, Sensed};
-use core::ops::Range;
-use pada_core::robot::pendulum::{clip_voltage, gearbox_torque, swing_up_reward, wrap_angle};
-use pada_core::robot::Robot;
+use super::{clip_voltage, gearbox_torque, swing_up_reward, wrap_angle};
+use crate::limits::{MAX_SERVOS, MAX_STATE_DIMS};
+use crate::robot::{PerServo, RobotRules, RobotSpec, Sensed};
 
 /// Hanging within this angle counts as down \[rad\].
 const DOWN_ANGLE: f64 = 0.15;
@@ -27,9 +25,11 @@ const STILL_TIME_US: u32 = 1_000_000;
 /// Longest wait before an episode starts anyway \[µs\].
 const MAX_RESET_US: u32 = 15_000_000;
 
-/// The pendulum at 33 Hz or at 20 Hz (the same hardware).
+/// The pendulum's rules at 33 Hz ([`super::SPEC_33HZ`]) or at 20 Hz
+/// ([`super::SPEC_20HZ`]): the same hardware.
 #[derive(Debug, Clone)]
-pub struct Pendulum<const HZ20: bool> {
+pub struct Pendulum {
+    spec: &'static RobotSpec,
     period_s: f32,
     /// Periods of stillness that end the reset.
     still_needed: u32,
@@ -43,12 +43,34 @@ pub struct Pendulum<const HZ20: bool> {
     waited_steps: u32,
 }
 
-/// The paper's pendulum experiment at 33 Hz.
-pub type Pendulum33 = Pendulum<false>;
-/// The same pendulum at 20 Hz.
-pub type Pendulum20 = Pendulum<true>;
+impl Pendulum {
+    /// The rules of `spec` (one of the pendulum's, [`super::SPEC_33HZ`] or
+    /// [`super::SPEC_20HZ`]), hanging at rest.
+    pub fn new(spec: &'static RobotSpec) -> Self {
+        let period_us = spec.period_us;
+        Pendulum {
+            spec,
+            period_s: period_us as f32 * 1e-6,
+            still_needed: STILL_TIME_US.div_ceil(period_us),
+            max_wait: MAX_RESET_US.div_ceil(period_us),
+            raw: None,
+            theta: core::f32::consts::PI,
+            omega: 0.0,
+            still_steps: 0,
+            waited_steps: 0,
+        }
+    }
 
-impl<const HZ20: bool> Pendulum<HZ20> {
+    /// The paper's experiment at 33 Hz.
+    pub fn at_33hz() -> Self {
+        Self::new(&super::SPEC_33HZ)
+    }
+
+    /// The same pendulum at 20 Hz.
+    pub fn at_20hz() -> Self {
+        Self::new(&super::SPEC_20HZ)
+    }
+
     /// Angle, 0 upright \[rad\].
     pub fn theta(&self) -> f32 {
         self.theta
@@ -60,21 +82,9 @@ impl<const HZ20: bool> Pendulum<HZ20> {
     }
 }
 
-impl<const HZ20: bool> RobotAdapter for Pendulum<HZ20> {
-    const ROBOT: Robot = if HZ20 { Robot::Pendulum20 } else { Robot::Pendulum33 };
-
-    fn new(_config: &RobotConfig) -> Self {
-        let period_us = Self::spec().period_us;
-        Pendulum {
-            period_s: period_us as f32 * 1e-6,
-            still_needed: STILL_TIME_US.div_ceil(period_us),
-            max_wait: MAX_RESET_US.div_ceil(period_us),
-            raw: None,
-            theta: core::f32::consts::PI,
-            omega: 0.0,
-            still_steps: 0,
-            waited_steps: 0,
-        }
+impl RobotRules for Pendulum {
+    fn spec(&self) -> &'static RobotSpec {
+        self.spec
     }
 
     fn start_episode(&mut self) {}
@@ -94,13 +104,13 @@ impl<const HZ20: bool> RobotAdapter for Pendulum<HZ20> {
     }
 
     /// `[θ, θ̇]`.
-    fn observe(&self, obs: &mut [f32; MAX_OBS]) -> usize {
+    fn observe(&self, obs: &mut [f32; MAX_STATE_DIMS]) -> usize {
         obs[0] = self.theta;
         obs[1] = self.omega;
         2
     }
 
-    fn reward(&self, applied: &[f32; MAX_ROBOT_SERVOS]) -> f32 {
+    fn reward(&self, applied: &PerServo) -> f32 {
         let u = clip_voltage(applied[0] as f64);
         swing_up_reward(self.theta as f64, self.omega as f64, u) as f32
     }
@@ -109,17 +119,17 @@ impl<const HZ20: bool> RobotAdapter for Pendulum<HZ20> {
         false
     }
 
-    fn commands(&self, output: &[f32], volts: &mut [f32; MAX_ROBOT_SERVOS]) {
-        *volts = [0.0; MAX_ROBOT_SERVOS];
+    fn commands(&self, output: &[f32], volts: &mut PerServo) {
+        *volts = [0.0; MAX_SERVOS];
         volts[0] = clip_voltage(output.first().copied().unwrap_or(0.0) as f64) as f32;
     }
 
-    fn reset_commands(&self, volts: &mut [f32; MAX_ROBOT_SERVOS]) {
-        *volts = [0.0; MAX_ROBOT_SERVOS];
+    fn reset_commands(&self, volts: &mut PerServo) {
+        *volts = [0.0; MAX_SERVOS];
     }
 
-    fn gear_torques(&self, applied: &[f32; MAX_ROBOT_SERVOS], torques: &mut [f32; MAX_ROBOT_SERVOS]) {
-        *torques = [0.0; MAX_ROBOT_SERVOS];
+    fn gear_torques(&self, applied: &PerServo, torques: &mut PerServo) {
+        *torques = [0.0; MAX_SERVOS];
         torques[0] = gearbox_torque(applied[0] as f64) as f32;
     }
 
@@ -139,32 +149,28 @@ impl<const HZ20: bool> RobotAdapter for Pendulum<HZ20> {
         self.still_steps >= self.still_needed || self.waited_steps >= self.max_wait
     }
 
-    fn reported_joints() -> Range<usize> {
-        0..1
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::hardware;
     use core::f32::consts::PI;
 
-    fn sense(p: &mut Pendulum33, angle: Option<f32>) {
-        p.sense(&Sensed { angles: [None; MAX_ROBOT_SERVOS], encoder_angle: angle, contacts: 0, applied: [0.0; MAX_ROBOT_SERVOS] });
+    fn sense(p: &mut Pendulum, angle: Option<f32>) {
+        p.sense(&Sensed { angles: [None; MAX_SERVOS], encoder_angle: angle, contacts: 0, applied: [0.0; MAX_SERVOS] });
     }
 
-    fn applied(u: f32) -> [f32; MAX_ROBOT_SERVOS] {
-        let mut a = [0.0; MAX_ROBOT_SERVOS];
+    fn applied(u: f32) -> PerServo {
+        let mut a = [0.0; MAX_SERVOS];
         a[0] = u;
         a
     }
 
     #[test]
     fn hanging_at_boot_is_theta_pi() {
-        let mut p = Pendulum33::new(&hardware(Robot::Pendulum33));
+        let mut p = Pendulum::at_33hz();
         sense(&mut p, Some(0.0));
-        let mut obs = [0.0; MAX_OBS];
+        let mut obs = [0.0; MAX_STATE_DIMS];
         assert_eq!(p.observe(&mut obs), 2);
         assert!((obs[0].abs() - PI).abs() < 1e-6);
         assert_eq!(obs[1], 0.0);
@@ -179,7 +185,7 @@ mod tests {
 
     #[test]
     fn reward_and_torque_are_the_shared_definitions() {
-        let mut p = Pendulum33::new(&hardware(Robot::Pendulum33));
+        let mut p = Pendulum::at_33hz();
         sense(&mut p, Some(PI));
         sense(&mut p, Some(PI));
         // Upright at rest (up to the f32 encoder angle's rounding of π).
@@ -190,14 +196,14 @@ mod tests {
         let r = p.reward(&applied(0.0));
         let want = -5.0 * PI * PI - 0.1 * (PI / 0.03) * (PI / 0.03);
         assert!((r - want).abs() < 1e-2 * want.abs(), "{r} vs {want}");
-        let mut t = [0.0; MAX_ROBOT_SERVOS];
+        let mut t = [0.0; MAX_SERVOS];
         p.gear_torques(&applied(3.0), &mut t);
         assert!((t[0] - 3.0 * 0.0536 / 9.5).abs() < 1e-7);
     }
 
     #[test]
     fn reset_waits_until_hanging_still() {
-        let mut p = Pendulum33::new(&hardware(Robot::Pendulum33));
+        let mut p = Pendulum::at_33hz();
         sense(&mut p, Some(0.0));
         p.begin_reset();
         // Swinging: not done.
@@ -227,7 +233,7 @@ mod tests {
             }
         }
         assert_eq!(n, 500);
-        let q = Pendulum20::new(&hardware(Robot::Pendulum20));
+        let q = Pendulum::at_20hz();
         assert_eq!(q.max_wait, 300);
     }
 }
