@@ -27,6 +27,11 @@ impl ImageSource for [u8] {
     }
 
     fn read(&self, offset: usize, out: &mut [u8]) {
+        // Past the end the trait promises zeros: clear what the copy will
+        // not reach (bytes before the image start cannot occur, offsets
+        // being unsigned).
+        let inside = self.len().saturating_sub(offset).min(out.len());
+        out[inside..].fill(0);
         copy_overlap(self, 0, offset, out);
     }
 }
