@@ -314,13 +314,17 @@ impl<W: WeightStore, T: TagStore> ClaimTable<W, T> {
     }
 
     /// Counts the claimed slots again (after the tags were loaded from a
-    /// checkpoint), and sets the refusals to `refused`.
+    /// checkpoint), sets the refusals to `refused`, and the longest probe
+    /// to 0 (a checkpoint does not keep it, and a tag does not say how far
+    /// its feature sits from home).
     pub fn recount(&mut self, refused: u32) {
         self.claimed = (0..self.tags.len()).filter(|&i| self.tags.get(i) != EMPTY).count() as u32;
         self.refused = refused;
+        self.longest_probe = 0;
     }
 
-    /// Occupancy: slots claimed, slots, refusals, the longest probe.
+    /// Occupancy: slots claimed, slots, refusals, the longest probe a
+    /// claim needed ([`Occupancy::longest_probe`]: reads are not counted).
     pub fn occupancy(&self) -> Occupancy {
         Occupancy {
             claimed: self.claimed,
@@ -378,7 +382,8 @@ impl<W: WeightStore, T: TagStore> ClaimTable<W, T> {
     }
 
     /// The weight of the feature `key`: its slot's, or its initial weight
-    /// if it holds none. Claims nothing.
+    /// if it holds none. Claims nothing and changes nothing, the occupancy
+    /// included (the hot path: see [`Occupancy::longest_probe`]).
     #[inline]
     pub fn read(&self, key: u32) -> Q16 {
         match self.probe(key).0 {
@@ -389,7 +394,8 @@ impl<W: WeightStore, T: TagStore> ClaimTable<W, T> {
 
     /// The slot of the feature `key`, claimed now if it held none (its
     /// weight then starts at the initial weight it read before); refused
-    /// and counted if the probe finds neither its tag nor a free slot.
+    /// and counted if the probe finds neither its tag nor a free slot. Its
+    /// probe counts towards [`Occupancy::longest_probe`].
     pub fn claim(&mut self, key: u32) -> Claim {
         let (found, probed) = self.probe(key);
         if probed > self.longest_probe {

@@ -12,10 +12,12 @@
 //!   a 16-bit tag of a small table once let two features share a slot.
 //!
 //! Invariants, checked after every operation:
-//! - a read changes nothing;
+//! - a read changes nothing, the occupancy included;
 //! - a refused claim changes no slot, and is counted;
 //! - a claim is refused only when no slot is free within the probe bound;
 //! - the claimed count is the number of tagged slots, never above the size;
+//! - the longest probe is the longest a claim took (a refusal's is
+//!   `MAX_PROBE`); reads do not count, and a restored table starts from 0;
 //! - with 32-bit tags the table is a map: every claimed key reads what was
 //!   written to it, every other key its initial weight (the model);
 //! - with one home, with either tag width, the table is a map from a key's
@@ -88,15 +90,16 @@ fn run<T: TagStore>(t: &mut ClaimTable<Vec<Q16>, T>, ops: &[u8], exact: bool) ->
     // The model of a 32-bit-tag table: key identity is the tag.
     let mut model: HashMap<u32, i32> = HashMap::new();
     let mut refused = 0u32;
+    let mut longest = 0u32;
     let mut checksum = t.checksum();
     for op in ops.chunks_exact(5) {
         let k = key(op[1]);
         let inc = i16::from_le_bytes([op[2], op[3]]) as i32;
         match op[0] % 3 {
             0 => {
-                let before = snapshot(t);
+                let before = (snapshot(t), t.occupancy());
                 let w = t.read(k);
-                ensure!(snapshot(t) == before, "a read changed the table");
+                ensure!((snapshot(t), t.occupancy()) == before, "a read changed the table or its occupancy");
                 if exact {
                     let want = model.get(&tag_of(k, 32)).copied().unwrap_or(init.of(k).0);
                     ensure!(w.0 == want, "key {k:#x} reads {} but the model has {want}", w.0);
@@ -108,6 +111,7 @@ fn run<T: TagStore>(t: &mut ClaimTable<Vec<Q16>, T>, ops: &[u8], exact: bool) ->
                     Claim::Slot { slot, fresh } => {
                         let i = slot as usize;
                         ensure!(i < slots, "slot {i} outside the table of {slots}");
+                        longest = longest.max(slot.wrapping_sub(k) & (slots as u32 - 1));
                         if fresh {
                             checksum = checksum.wrapping_add(t.raw(i).wrapping_mul(entry_factor(i)));
                         }
@@ -123,6 +127,7 @@ fn run<T: TagStore>(t: &mut ClaimTable<Vec<Q16>, T>, ops: &[u8], exact: bool) ->
                     }
                     Claim::Refused => {
                         refused += 1;
+                        longest = MAX_PROBE;
                         ensure!(snapshot(t) == before, "a refused claim changed the table");
                         let free = before.iter().filter(|(tag, _)| *tag == 0).count();
                         // Every slot is within the bound of a table this small.
@@ -135,6 +140,7 @@ fn run<T: TagStore>(t: &mut ClaimTable<Vec<Q16>, T>, ops: &[u8], exact: bool) ->
         let tagged = snapshot(t).iter().filter(|(tag, _)| *tag != 0).count() as u32;
         ensure!(o.claimed == tagged && o.claimed as usize <= slots, "claimed {} but {tagged} slots tagged", o.claimed);
         ensure!(o.refused == refused, "refused {} counted, {refused} seen", o.refused);
+        ensure!(o.longest_probe == longest, "longest probe {} reported, {longest} taken by a claim", o.longest_probe);
         ensure!(checksum == t.checksum(), "running checksum {checksum:#x}, table {:#x}", t.checksum());
     }
     Outcome::Ok
@@ -177,7 +183,7 @@ fn run_one_home<T: TagStore>(t: &mut ClaimTable<Vec<Q16>, T>, home: u32, log2: u
     // Kept key -> weight, and kept key -> its slot.
     let mut model: HashMap<u32, (i32, u32)> = HashMap::new();
     let mut keys: Vec<u32> = Vec::new();
-    let mut refused = 0u32;
+    let (mut refused, mut longest) = (0u32, 0u32);
     // Every key of one home probes from it: at most this many can hold a
     // slot before claims are refused.
     let room = slots.min(MAX_PROBE) as usize;
@@ -194,8 +200,10 @@ fn run_one_home<T: TagStore>(t: &mut ClaimTable<Vec<Q16>, T>, home: u32, log2: u
         keys.push(k);
         let want = model.get(&(k & kept)).map_or(init.of(k & kept).0, |&(w, _)| w);
         if op[0] % 3 == 0 {
+            let before = t.occupancy();
             let w = t.read(k);
             ensure!(w.0 == want, "2^{log2} slots: key {k:#x} reads {} but the model has {want}", w.0);
+            ensure!(t.occupancy() == before, "a read changed the occupancy");
         } else {
             let inc = i16::from_le_bytes([op[3], op[4]]) as i32;
             match t.claim(k) {
@@ -209,6 +217,7 @@ fn run_one_home<T: TagStore>(t: &mut ClaimTable<Vec<Q16>, T>, home: u32, log2: u
                         !fresh || model.values().all(|&(_, s)| s != slot),
                         "2^{log2} slots: key {k:#x} took slot {slot}, another feature's"
                     );
+                    longest = longest.max(slot.wrapping_sub(home) & (slots - 1));
                     t.add(slot as usize, Q16(inc), 0);
                     let e = model.entry(k & kept).or_insert((want, slot));
                     e.0 = e.0.saturating_add(inc);
@@ -216,6 +225,7 @@ fn run_one_home<T: TagStore>(t: &mut ClaimTable<Vec<Q16>, T>, home: u32, log2: u
                 }
                 Claim::Refused => {
                     refused += 1;
+                    longest = MAX_PROBE;
                     ensure!(
                         !model.contains_key(&(k & kept)) && model.len() == room,
                         "2^{log2} slots: key {k:#x} refused with {} of {room} slots of its home held",
@@ -227,6 +237,16 @@ fn run_one_home<T: TagStore>(t: &mut ClaimTable<Vec<Q16>, T>, home: u32, log2: u
         let o = t.occupancy();
         ensure!(o.claimed as usize == model.len(), "claimed {} but the model holds {}", o.claimed, model.len());
         ensure!(o.refused == refused, "refused {} counted, {refused} seen", o.refused);
+        ensure!(o.longest_probe == longest, "longest probe {} reported, {longest} taken by a claim", o.longest_probe);
     }
+    // Restored as from a checkpoint: the same claims and refusals, and the
+    // longest probe from 0 (a checkpoint does not keep it).
+    t.restore_claims(init, refused);
+    let o = t.occupancy();
+    ensure!(
+        (o.claimed as usize, o.refused, o.longest_probe) == (model.len(), refused, 0),
+        "restored: {o:?}, the model holds {} with {refused} refused",
+        model.len()
+    );
     Outcome::Ok
 }

@@ -319,3 +319,29 @@ fn keys_that_agree_in_the_kept_bits_are_one_feature_to_a_small_table() {
     // One kept bit apart (bit 28): two features.
     assert!(matches!(t.claim(a ^ 1 << 28), Claim::Slot { fresh: true, .. }));
 }
+
+#[test]
+fn the_longest_probe_counts_claims_and_not_reads() {
+    let mut t = table(64);
+    // Three keys of home 9 in slots 9, 10, 11; a fourth key of home 9
+    // that holds no slot probes four slots to read.
+    for n in 1..=3 {
+        assert!(matches!(t.claim(key_at(9, n, 64)), Claim::Slot { fresh: true, .. }));
+    }
+    assert_eq!(t.occupancy().longest_probe, 2);
+    let before = t.occupancy();
+    assert_eq!(t.read(key_at(9, 4, 64)), t.initial_weights().of(key_at(9, 4, 64)));
+    assert_eq!(t.occupancy(), before, "a read leaves the occupancy as it was");
+    // Its claim probes three slots (9, 10, 11) before the free one.
+    assert!(matches!(t.claim(key_at(9, 4, 64)), Claim::Slot { slot: 12, fresh: true }));
+    assert_eq!(t.occupancy().longest_probe, 3);
+    // Finding a claimed slot again counts its probe too (never more than
+    // it took to claim it).
+    assert!(matches!(t.claim(key_at(9, 2, 64)), Claim::Slot { slot: 10, fresh: false }));
+    assert_eq!(t.occupancy().longest_probe, 3);
+    // A table restored from a checkpoint starts again from 0: the
+    // checkpoint does not keep it, and the probes before belong to the
+    // learner that was replaced.
+    t.restore_claims(t.initial_weights(), 0);
+    assert_eq!((t.occupancy().claimed, t.occupancy().longest_probe), (4, 0));
+}
