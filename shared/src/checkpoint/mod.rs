@@ -34,7 +34,7 @@
 //!
 //! # Learner-state record
 //!
-//! The 1024-byte record ([`STATE_LEN`], version [`STATE_VERSION`], 3) at
+//! The 1024-byte record ([`STATE_LEN`], version [`STATE_VERSION`], 4) at
 //! slot offset 32 holds what a learner carries between episodes: the agent's
 //! counters, ε, mode and policy, the generator, each joint's fatigue
 //! counters, the caller's counters, the flash wear and the wear governor's

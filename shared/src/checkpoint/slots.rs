@@ -390,7 +390,7 @@ fn wear_in<S: CheckpointStore>(store: &S, best: Newest) -> Result<FlashWear, S::
     let Some((slot, header)) = best else {
         return Ok(FlashWear::default());
     };
-    // Records of version 2 (512 bytes) and 3 keep the wear at the same
+    // Records of versions 2 (512 bytes) to 4 keep the wear at the same
     // offsets; a version-1 record (496 bytes) has none.
     if (header.state_len as usize) < WEAR_END {
         let g = header.generation;
