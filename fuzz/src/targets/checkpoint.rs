@@ -374,7 +374,6 @@ fn wear(rng: &mut impl RngCore) -> Outcome {
     let mut erased = [0u32; 2];
     let mut kept = FlashWear::default();
     let mut state = state(rng);
-    state.wear = FlashWear::default();
     for i in 0..2 + below(rng, 12) {
         state.wear = FlashWear { erases: kept.erases, operating_s: 100 * i as u64 };
         // A third of the saves lose power somewhere in the erase or writes.
