@@ -9,17 +9,20 @@
 //! table keeps, beside each slot's weight, a *tag* of the feature that owns
 //! it, and places features by open addressing with linear probing:
 //!
-//! - a feature's key is its full 32-bit hash ([`Layout::Claimed`]); its
-//!   home slot is `key mod slots` (the low bits), and its tag comes from
-//!   the key's other bits ([`tag_of`]);
+//! - a feature's key is its full 32-bit hash
+//!   ([`Layout::Claimed`](crate::tile_coding::Layout::Claimed)); its home
+//!   slot is `key mod slots` (the low bits), and its tag comes from the
+//!   key's bits as far as the table can tell them apart ([Tags](#tags),
+//!   [`stored_tag`]);
 //! - a **learning update claims** the feature's slot ([`ClaimTable::claim`]):
 //!   the first slot from home on that holds its tag, or else the first empty
 //!   one, which then gets the tag and the feature's initial weight;
 //! - **reads never claim** ([`ClaimTable::read`]): action selection reads
 //!   every candidate's features, and most of those are never written;
 //! - a feature that holds no slot reads its **initial weight**, a function
-//!   of the trial's seed and its key alone ([`InitialWeights`]), never
-//!   another feature's learned weight;
+//!   of the trial's seed and its key alone (the bits of it the table
+//!   keeps: [`ClaimTable::initial_weight`]), never another feature's
+//!   learned weight;
 //! - the probe is bounded ([`MAX_PROBE`] slots). A claim that finds neither
 //!   its tag nor an empty slot there is **refused**: the update for that
 //!   feature is dropped and counted, and lands in no other feature's slot.
@@ -40,21 +43,51 @@
 //!
 //! # Tags
 //!
-//! A [`Tags32`] table stores a tag that is a bijection of the whole key
-//! (except that keys whose tag would be 0, the empty mark, share tag 1):
-//! two features share a slot only if their 32-bit hashes are equal, as in
-//! the framework. A [`Tags16`] table halves the tag memory: features with
-//! the same home never share a slot (the tag then differs, below), and two
-//! features whose homes lie within one probe run share one with
-//! probability 2⁻¹⁶ per occupied slot they both pass.
+//! A feature's key is a 32-bit hash, but a slot holds only what its place
+//! and its tag can say: in a table of 2^k slots with b-bit tags, 2^k homes
+//! and 2^b − 1 tags (0 marks a free slot) tell apart fewer than 2^(k + b)
+//! keys, so no table of 2^16 slots or fewer with 16-bit tags can tell
+//! every 32-bit key apart. To a table a key is therefore its **low
+//! `key_bits` = min(32, k + b − 1) bits** ([`key_bits`], the most whole
+//! bits that 2^k homes and 2^b − 1 tags can hold): the home is the low k
+//! of them, and the tag and
+//! the initial weight are functions of all of them. For 32-bit tags that
+//! is the whole key at every size; for 16-bit tags, from 2^17 slots up
+//! (the F429's 2^21); a 2^14-slot table (the F405's) keeps 29 bits, and
+//! two keys that agree in those are one feature to it.
 //!
-//! Why the tag is a remix and not the key's top bits: in a table of 2²¹
+//! **The promise: two features with the same home never share a slot**
+//! unless their keys agree in their low `key_bits` bits (then they are one
+//! feature, with one initial weight). Features with different homes whose
+//! probe runs meet share one when their tags are equal: with 16-bit tags
+//! with probability about 2⁻¹⁶ per occupied slot they both pass; with
+//! 32-bit tags only the two keys that both get tag 1 (below), so that two
+//! features share a slot only if their 32-bit hashes are equal, as in the
+//! framework, but for that one pair.
+//!
+//! Why it holds. The stored tag of `key` is [`tag_of`]`(key << s, b)` with
+//! s = 32 − `key_bits` ([`stored_tag`]): the key's kept bits moved to the
+//! top, multiplied by an odd constant, and the product's top b bits taken,
+//! 0 becoming 1. Let `x` and `y` be two keys of one home, shifted by s.
+//! Their low s + k ≥ 33 − b bits are equal (s zeros, then the home), so
+//! their products with the odd constant are equal modulo 2^(33 − b), and
+//! they are equal modulo 2³² only if `x = y` (an odd multiplier is a
+//! bijection). Two products that differ but agree in bits 0 … 32 − b
+//! differ in bits 33 − b … 31, all of them in the tag, so the tags differ;
+//! and the lowest tag bit (bit 32 − b) is equal, so the two tags have the
+//! same parity, and a tag 0 made 1 can meet no other tag of that home (its
+//! parity is even). `x = y` means the keys agree in their low `key_bits`
+//! bits. For 32-bit tags s = 0 and the stored tag is a bijection of the
+//! whole key but for the empty mark: the key whose product is 0 shares
+//! tag 1 with the key whose product is 1, and the two have different
+//! homes (the second is odd), so they share a slot only if their probe
+//! runs meet.
+//!
+//! Why a remix and not the key's bits as they are: in a table of 2²¹
 //! slots the home takes bits 0–20, so a 16-bit tag from bits 16–31 would
 //! repeat five of the home's bits, and features whose homes lie close
 //! together (exactly those that meet on a probe run) would be told apart by
-//! 11 bits only. Multiplying by an odd constant first spreads every key bit
-//! over the tag's bits; for two keys with the same home the product's top
-//! bits differ whenever the keys do.
+//! 11 bits only. The multiplication spreads every kept bit over the tag.
 //!
 //! Capacities are in the types: the slots are the stores' lengths (a power
 //! of two, fixed at compile time on the chip), the probe bound a constant.
@@ -77,7 +110,9 @@ pub const EMPTY: u32 = 0;
 /// golden-ratio fraction).
 const TAG_MIX: u32 = 0x9E37_79B1;
 
-/// The `bits`-bit tag of `key` (1 ..= 32 bits): never [`EMPTY`].
+/// The `bits`-bit remix of `key` (1 ..= 32 bits): its product with an odd
+/// constant, the top `bits` bits, 0 made 1 so that it is never [`EMPTY`].
+/// A table stores [`stored_tag`], this of the key's kept bits.
 #[inline]
 pub const fn tag_of(key: u32, bits: u32) -> u32 {
     let t = key.wrapping_mul(TAG_MIX) >> (32 - bits);
@@ -86,6 +121,33 @@ pub const fn tag_of(key: u32, bits: u32) -> u32 {
     } else {
         t
     }
+}
+
+/// The bits of a key that a table of 2^`log2_slots` slots with
+/// `tag_bits`-bit tags tells apart: its low min(32, `log2_slots` +
+/// `tag_bits` − 1). Keys that agree in these are one feature to it
+/// ([module documentation](self#tags)). 32 for 32-bit tags at any size
+/// and for 16-bit tags from 2^17 slots up; 29 for 16-bit tags in 2^14.
+#[inline]
+pub const fn key_bits(tag_bits: u32, log2_slots: u32) -> u32 {
+    let bits = log2_slots + tag_bits;
+    if bits > 32 {
+        32
+    } else {
+        // A tag of b bits has 2^b − 1 values besides the empty mark: it
+        // tells apart b − 1 bits beyond the home's.
+        bits - 1
+    }
+}
+
+/// The tag a table of 2^`log2_slots` slots with `tag_bits`-bit tags stores
+/// for `key`: [`tag_of`] its [`key_bits`] kept bits moved to the top. Two
+/// keys of one home get the same stored tag only if they agree in those
+/// bits (proved in the [module documentation](self#tags)); never
+/// [`EMPTY`].
+#[inline]
+pub const fn stored_tag(key: u32, tag_bits: u32, log2_slots: u32) -> u32 {
+    tag_of(key << (32 - key_bits(tag_bits, log2_slots)), tag_bits)
 }
 
 /// Where a table keeps its tags: one per slot, [`EMPTY`] for a free one.
@@ -171,6 +233,10 @@ pub struct ClaimTable<W, T> {
     weights: W,
     tags: T,
     mask: u32,
+    /// 32 − [`key_bits`]: how far a key is shifted up to drop the bits the
+    /// table cannot tell apart (0 from 2^17 slots up with 16-bit tags, and
+    /// always with 32-bit tags).
+    shift: u32,
     init: InitialWeights,
     claimed: u32,
     refused: u32,
@@ -220,6 +286,7 @@ impl<W: WeightStore, T: TagStore> ClaimTable<W, T> {
             weights,
             tags,
             mask: (n - 1) as u32,
+            shift: 32 - key_bits(T::BITS, n.trailing_zeros()),
             init: InitialWeights { seed: 0, lo: 0, span: 1 },
             claimed: 0,
             refused: 0,
@@ -247,13 +314,17 @@ impl<W: WeightStore, T: TagStore> ClaimTable<W, T> {
     }
 
     /// Counts the claimed slots again (after the tags were loaded from a
-    /// checkpoint), and sets the refusals to `refused`.
+    /// checkpoint), sets the refusals to `refused`, and the longest probe
+    /// to 0 (a checkpoint does not keep it, and a tag does not say how far
+    /// its feature sits from home).
     pub fn recount(&mut self, refused: u32) {
         self.claimed = (0..self.tags.len()).filter(|&i| self.tags.get(i) != EMPTY).count() as u32;
         self.refused = refused;
+        self.longest_probe = 0;
     }
 
-    /// Occupancy: slots claimed, slots, refusals, the longest probe.
+    /// Occupancy: slots claimed, slots, refusals, the longest probe a
+    /// claim needed ([`Occupancy::longest_probe`]: reads are not counted).
     pub fn occupancy(&self) -> Occupancy {
         Occupancy {
             claimed: self.claimed,
@@ -273,9 +344,29 @@ impl<W: WeightStore, T: TagStore> ClaimTable<W, T> {
         &self.weights
     }
 
+    /// The bits of a key this table tells apart ([`key_bits`]): keys that
+    /// agree in their low `key_bits()` bits are one feature to it.
+    pub fn key_bits(&self) -> u32 {
+        32 - self.shift
+    }
+
+    /// The tag this table stores for `key` ([`stored_tag`]).
+    #[inline]
+    pub fn tag_for(&self, key: u32) -> u32 {
+        tag_of(key << self.shift, T::BITS)
+    }
+
+    /// The weight `key` reads while it holds no slot: the initial weight
+    /// ([`InitialWeights::of`]) of its kept bits, so that keys which are
+    /// one feature to the table start from one weight.
+    #[inline]
+    pub fn initial_weight(&self, key: u32) -> Q16 {
+        self.init.of((key << self.shift) >> self.shift)
+    }
+
     #[inline]
     fn probe(&self, key: u32) -> (Probe, u32) {
-        let tag = tag_of(key, T::BITS);
+        let tag = self.tag_for(key);
         let mut i = key & self.mask;
         for n in 0..MAX_PROBE {
             let t = self.tags.get(i as usize);
@@ -291,18 +382,20 @@ impl<W: WeightStore, T: TagStore> ClaimTable<W, T> {
     }
 
     /// The weight of the feature `key`: its slot's, or its initial weight
-    /// if it holds none. Claims nothing.
+    /// if it holds none. Claims nothing and changes nothing, the occupancy
+    /// included (the hot path: see [`Occupancy::longest_probe`]).
     #[inline]
     pub fn read(&self, key: u32) -> Q16 {
         match self.probe(key).0 {
             Probe::Found(i) => self.weights.get(i as usize),
-            Probe::Free(_) | Probe::Exhausted => self.init.of(key),
+            Probe::Free(_) | Probe::Exhausted => self.initial_weight(key),
         }
     }
 
     /// The slot of the feature `key`, claimed now if it held none (its
     /// weight then starts at the initial weight it read before); refused
-    /// and counted if the probe finds neither its tag nor a free slot.
+    /// and counted if the probe finds neither its tag nor a free slot. Its
+    /// probe counts towards [`Occupancy::longest_probe`].
     pub fn claim(&mut self, key: u32) -> Claim {
         let (found, probed) = self.probe(key);
         if probed > self.longest_probe {
@@ -311,8 +404,8 @@ impl<W: WeightStore, T: TagStore> ClaimTable<W, T> {
         match found {
             Probe::Found(i) => Claim::Slot { slot: i, fresh: false },
             Probe::Free(i) => {
-                self.tags.set(i as usize, tag_of(key, T::BITS));
-                self.weights.set(i as usize, self.init.of(key));
+                self.tags.set(i as usize, self.tag_for(key));
+                self.weights.set(i as usize, self.initial_weight(key));
                 self.claimed += 1;
                 Claim::Slot { slot: i, fresh: true }
             }

@@ -59,8 +59,20 @@ pub struct Occupancy {
     pub slots: u32,
     /// Claims refused since the table was reset (a full probe run).
     pub refused: u32,
-    /// The longest probe a claim or read has needed (the framework's
-    /// "memory pressure").
+    /// The longest probe a **claim** has needed since the table was reset
+    /// or restored: slots looked at past the feature's home before its slot
+    /// was found or taken, [`crate::claim_table::MAX_PROBE`] once a claim
+    /// was refused. Claimed slots are never freed, so this is also the
+    /// farthest any claimed feature sits from its home, and a read of a
+    /// claimed feature never probes farther (the framework's "memory
+    /// pressure", which it warns of past 7).
+    ///
+    /// Reads are not counted. A read of a feature that holds no slot stops
+    /// at the first free slot or at the bound, as a claim of it would; it
+    /// says how full the table is, not where the features are, and
+    /// counting it would add a store to every read (`read` takes `&self`;
+    /// the agent reads about 5 500 features per decision on LEO). A
+    /// checkpoint does not keep it: a restored table starts from 0.
     pub longest_probe: u32,
 }
 

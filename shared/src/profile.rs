@@ -299,7 +299,9 @@ pub const CONFIG_HASH_VERSION: u32 = 4;
 
 /// The hash of everything that gives a learner's weights their meaning
 /// (FNV-1a, stored in checkpoints and sent in `Hello`): the robot, the
-/// board's profile (its name, layout, table size, weight format), and what
+/// board's profile (its name, layout, table size, weight format, a claim
+/// table's tag bytes and, if it keeps fewer than 32 bits of a key, how many:
+/// [`crate::claim_table::key_bits`]), and what
 /// the built agent knows of itself ([`Agent::write_config`]: the tile
 /// coder's dimensions as prepared, tilings, trace capacity, the learner's
 /// actions and their tiles, α, γ, λ and the trace settings).
@@ -322,6 +324,16 @@ pub fn config_hash<W: WeightStore, const TILINGS_: usize, const TRACE_: usize>(
         .write_u32(agent.weights().len() as u32)
         .write_u32(agent.weights().format().code())
         .write_u32(agent.weights().tag_bytes() as u32);
+    let w = agent.weights();
+    let kept = crate::claim_table::key_bits(w.tag_bytes() as u32 * 8, w.len().trailing_zeros());
+    if w.claims() && kept < 32 {
+        // A claim table that keeps fewer than 32 bits of a key (16-bit tags
+        // below 2^17 slots: the F405's LEO table) tags those bits only; its
+        // tags once covered the whole key, so a checkpoint saved before
+        // holds tags of other features and must be refused. Written only
+        // for such a table, so every other hash stays as it was.
+        h.write_str("claim key bits").write_u32(kept);
+    }
     agent.write_config(&mut h);
     h.finish()
 }
@@ -331,6 +343,46 @@ pub fn config_hash<W: WeightStore, const TILINGS_: usize, const TRACE_: usize>(
 mod tests {
     use super::*;
     use crate::robot::{leo, pendulum, registry};
+
+    #[test]
+    fn the_hash_names_the_key_bits_of_a_table_that_keeps_fewer_than_32() {
+        extern crate std;
+        use crate::action_space::{ActionDim, ActionSpace};
+        use crate::agent::SarsaParams;
+        use crate::claim_table::{ClaimTable, TagStore, Tags16, Tags32};
+        use crate::policy::PolicyKind;
+        use crate::tile_coding::StateDim;
+        use std::vec;
+
+        fn agent<T: TagStore>(tags: T) -> Agent<ClaimTable<std::vec::Vec<crate::fixed::Q16>, T>, 4, 8> {
+            let n = tags.len();
+            let table = ClaimTable::new(vec![crate::fixed::Q16::ZERO; n], tags).unwrap();
+            let obs = [StateDim::new(0.0, 1.0, 0.5).unwrap()];
+            let space = ActionSpace::repeated(ActionDim::from_levels(&[-1.0, 1.0]).unwrap(), 1).unwrap();
+            Agent::new(&obs, space, PolicyKind::Sarsa, SarsaParams::default(), Layout::Claimed, table).unwrap()
+        }
+        // The hash as it was computed before a table's key bits were part
+        // of it: tables that keep whole keys must still hash to it.
+        fn whole_key_hash<W: WeightStore>(p: &LearnerProfile, a: &Agent<W, 4, 8>) -> u32 {
+            let mut h = ConfigHasher::new();
+            h.write_u32(CONFIG_HASH_VERSION)
+                .write_str(p.robot.name())
+                .write_str(p.board.name())
+                .write_u32(p.layout.code())
+                .write_u32(a.weights().len() as u32)
+                .write_u32(a.weights().format().code())
+                .write_u32(a.weights().tag_bytes() as u32);
+            a.write_config(&mut h);
+            h.finish()
+        }
+        let p = Board::F405.profile(Robot::Leo);
+        let small16 = agent(Tags16(vec![0u16; 1 << 14]));
+        let large16 = agent(Tags16(vec![0u16; 1 << 17]));
+        let small32 = agent(Tags32(vec![0u32; 1 << 14]));
+        assert_ne!(config_hash(&p, &small16), whole_key_hash(&p, &small16), "2^14 slots keep 29 bits of a key");
+        assert_eq!(config_hash(&p, &large16), whole_key_hash(&p, &large16));
+        assert_eq!(config_hash(&p, &small32), whole_key_hash(&p, &small32));
+    }
 
     #[test]
     fn chip_tables_fit_their_memory() {

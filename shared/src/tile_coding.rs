@@ -121,7 +121,9 @@ pub enum Layout {
     Exact,
     /// Hashed as [`Hashed`](Self::Hashed), but the feature is the whole
     /// 32-bit hash, a key that a [`crate::claim_table::ClaimTable`] of a
-    /// power-of-two size places without collisions.
+    /// power-of-two size places so that features of one home never share
+    /// a slot (as far as the table keeps a key's bits:
+    /// [`crate::claim_table::key_bits`]).
     Claimed,
 }
 

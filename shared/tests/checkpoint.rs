@@ -329,3 +329,93 @@ fn a_save_beyond_the_wear_budget_is_refused_before_anything_is_erased() {
     assert_eq!(stored_wear(&store).unwrap().erases, [6, 6]);
     assert_eq!(save_within(&mut store, 42, &s, &weights(1), &budget), Err(SaveError::Wear(WearRefusal::WornOut { erases: 6 })));
 }
+
+/// A RAM store that counts the erases of each slot's sector, as the flash
+/// wears whatever a save makes of them.
+#[derive(Clone)]
+struct Counting {
+    inner: Store,
+    erases: [u32; 2],
+}
+
+impl Counting {
+    fn new() -> Self {
+        Counting { inner: Store::new(), erases: [0; 2] }
+    }
+}
+
+impl CheckpointStore for Counting {
+    type Error = OutOfRange;
+    fn capacity(&self) -> usize {
+        self.inner.capacity()
+    }
+    fn read(&self, slot: u8, offset: usize, buf: &mut [u8]) -> Result<(), OutOfRange> {
+        self.inner.read(slot, offset, buf)
+    }
+    fn erase(&mut self, slot: u8) -> Result<(), OutOfRange> {
+        if let Some(n) = self.erases.get_mut(slot as usize) {
+            *n += 1;
+        }
+        self.inner.erase(slot)
+    }
+    fn write(&mut self, slot: u8, offset: usize, data: &[u8]) -> Result<(), OutOfRange> {
+        self.inner.write(slot, offset, data)
+    }
+}
+
+#[test]
+fn a_table_of_six_byte_entries_is_refused_before_anything_is_erased() {
+    use pada_core::claim_table::{ClaimTable, Tags16, Tags32};
+    use pada_core::weights::{Half, WeightStore};
+    // Q16 weights with 16-bit tags, and 16-bit weights with 32-bit tags:
+    // 6 bytes an entry, which no header can describe.
+    let mut q16_tag16 = ClaimTable::new(vec![Q16::ZERO; 16], Tags16(vec![0u16; 16])).unwrap();
+    q16_tag16.claim(77);
+    let half_tag32 = ClaimTable::new(Half::<_, 12>::new(vec![0i16; 16]), Tags32(vec![0u32; 16])).unwrap();
+    assert_eq!((q16_tag16.entry_bytes(), half_tag32.entry_bytes()), (6, 6));
+    let budget = WearBudget::new(5, 2, 1_000_000).unwrap();
+    let mut store = Counting::new();
+    let s = state(1);
+    for _ in 0..10 {
+        for r in [
+            save_within(&mut store, 42, &s, &q16_tag16, &budget),
+            save_within(&mut store, 42, &s, &half_tag32, &budget),
+            save(&mut store, 42, &s, &q16_tag16),
+        ] {
+            assert_eq!(r, Err(SaveError::EntryBytes { found: 6 }));
+        }
+    }
+    assert_eq!(store.erases, [0, 0], "a save that cannot be written erased a sector");
+    let why = SaveError::<OutOfRange>::EntryBytes { found: 6 }.to_string();
+    assert!(why.contains("6 bytes") && why.contains("valid are 2, 4 or 8"), "{why}");
+    // Every erase the store saw is in the record of the next good save.
+    save(&mut store, 42, &s, &weights(1)).unwrap();
+    assert_eq!(stored_wear(&store).unwrap().erases, store.erases);
+}
+
+#[test]
+fn an_erase_made_by_a_save_that_fails_afterwards_is_counted() {
+    // A save cut after its erase (the store fails on the 10th byte
+    // written) leaves no valid record of that erase in the slot: the error
+    // carries the count, and a caller that keeps it (as the firmware's
+    // controller does) has it recorded by its next save.
+    let mut store = Counting::new();
+    let mut s = state(1);
+    let first = save(&mut store, 42, &s, &weights(1)).unwrap();
+    assert_eq!((first.slot, first.erases), (0, 1));
+    let mut torn = TornStore::new(store.clone(), 10);
+    let r = save(&mut torn, 42, &s, &weights(2));
+    assert!(matches!(r, Err(SaveError::StoreAfterErase { slot: 1, erases: 1, .. })), "{r:?}");
+    let (slot, erases) = r.unwrap_err().erased().unwrap();
+    store = torn.inner;
+    assert_eq!(store.erases, [1, 1]);
+    assert_eq!(stored_wear(&store).unwrap().erases, [1, 0], "the slot holds no record of the erase");
+    s.wear.erases[slot as usize] = s.wear.erases[slot as usize].max(erases);
+    let next = save(&mut store, 42, &s, &weights(2)).unwrap();
+    assert_eq!((next.slot, next.erases), (1, 2));
+    assert_eq!(stored_wear(&store).unwrap().erases, [1, 2], "every erase the flash saw is in the record");
+    // Saves that erase nothing say so.
+    assert_eq!(SaveError::<()>::EntryBytes { found: 6 }.erased(), None);
+    assert_eq!(SaveError::<()>::Store(()).erased(), None);
+    assert_eq!(SaveError::<()>::VerifyFailed { slot: 0, erases: 3 }.erased(), Some((0, 3)));
+}

@@ -170,7 +170,9 @@ where
     /// ([`checkpoint_bytes`](Self::checkpoint_bytes) > `store.capacity()`:
     /// the F429's 8 MiB LEO table against a 128 KiB flash sector) is refused
     /// as `SaveError::TooLarge` before the store is touched; every other
-    /// failed save counts in [`saves_failed`](Self::saves_failed).
+    /// failed save counts in [`saves_failed`](Self::saves_failed), and the
+    /// erase of one that failed after erasing ([`SaveError::erased`]) counts
+    /// in the [`flash_wear`](Self::flash_wear) the next save records.
     pub fn save_checkpoint<S: CheckpointStore>(&mut self, store: &mut S) -> Result<Saved, CheckpointError<S::Error>> {
         if self.torque_enabled() {
             return Err(CheckpointError::Busy);
@@ -183,7 +185,16 @@ where
                 self.flash_wear.erases[slot] = self.flash_wear.erases[slot].max(saved.erases);
             }
             Err(SaveError::Wear(_)) => self.saves_refused = self.saves_refused.saturating_add(1),
-            Err(_) => self.saves_failed = self.saves_failed.saturating_add(1),
+            Err(ref e) => {
+                // A save that failed after its erase leaves no valid record
+                // of that erase in the slot: keep the count here, so that
+                // the next save records it and the budget sees it.
+                if let Some((slot, erases)) = e.erased() {
+                    let slot = slot as usize & 1;
+                    self.flash_wear.erases[slot] = self.flash_wear.erases[slot].max(erases);
+                }
+                self.saves_failed = self.saves_failed.saturating_add(1);
+            }
         }
         result.map_err(CheckpointError::Save)
     }
@@ -415,6 +426,36 @@ mod tests {
         let mut health = wire::Health::default();
         d.health(&mut health);
         assert_eq!((health.checkpoint_erases, health.saves_refused), (5001, 1));
+    }
+
+    #[test]
+    fn the_erase_of_a_save_that_fails_afterwards_is_counted_and_recorded_by_the_next() {
+        /// A flash whose writes fail (its erases work).
+        struct WritesFail(Store);
+        impl CheckpointStore for WritesFail {
+            type Error = pada_core::checkpoint::OutOfRange;
+            fn capacity(&self) -> usize {
+                self.0.capacity()
+            }
+            fn read(&self, slot: u8, offset: usize, buf: &mut [u8]) -> Result<(), Self::Error> {
+                self.0.read(slot, offset, buf)
+            }
+            fn erase(&mut self, slot: u8) -> Result<(), Self::Error> {
+                self.0.erase(slot)
+            }
+            fn write(&mut self, _: u8, _: usize, _: &[u8]) -> Result<(), Self::Error> {
+                Err(pada_core::checkpoint::OutOfRange)
+            }
+        }
+        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 3).unwrap();
+        let mut flash = WritesFail(Store::new());
+        let r = c.save_checkpoint(&mut flash);
+        assert!(matches!(r, Err(CheckpointError::Save(SaveError::StoreAfterErase { slot: 0, erases: 1, .. }))), "{r:?}");
+        assert_eq!((c.saves_failed(), c.flash_wear().erases), (1, [1, 0]));
+        // The next save, on the same flash, records both erases of slot 0.
+        let mut store = flash.0;
+        assert_eq!(c.save_checkpoint(&mut store), Ok(Saved { generation: 1, slot: 0, erases: 2 }));
+        assert_eq!(checkpoint::stored_wear(&store).unwrap().erases, [2, 0]);
     }
 
     #[test]

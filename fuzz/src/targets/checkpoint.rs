@@ -1,9 +1,19 @@
-//! Checkpoint loading from damaged or random slots, and saves torn by a
-//! power cut at any byte (of the erase or of the writes).
+//! Checkpoint loading from damaged or random slots, saves torn by a power
+//! cut at any byte (of the erase or of the writes), and the flash wear of
+//! a run of saves of any table.
 //!
 //! An input is a scenario: byte 0 picks the mode, bytes 1–8 seed the
 //! states, weights and damage, bytes 9–12 are the power cut's byte budget.
 //! So a failing input in `target/fuzz-failures/` replays exactly.
+//!
+//! The wear mode (4) saves one of six tables (2, 4, 6 or 8 bytes an entry:
+//! weights alone, or claim tables of every weight and tag width) again and
+//! again under a small erase budget, some saves cut by a power loss, as a
+//! caller that keeps what each save reports. Invariants: a table of 6-byte
+//! entries is refused with `SaveError::EntryBytes` and any other table is
+//! not; a save that says it erased nothing left the store as it was; every
+//! erase the flash saw is in the newest record or in what the caller kept
+//! from a failed save's report; no sector is erased beyond the budget.
 
 use super::{ensure, Outcome, Target};
 use crate::gen::below;
@@ -11,6 +21,7 @@ use pada_core::checkpoint::*;
 use pada_core::fatigue::JointFatigueState;
 use pada_core::fixed::Q16;
 use pada_core::policy::PolicyName;
+use pada_core::weights::WeightStore;
 use rand_core::{RngCore, SeedableRng};
 
 const WEIGHTS: usize = 64;
@@ -80,6 +91,14 @@ struct Torn {
     inner: Store,
     budget: usize,
     dead: bool,
+    /// Erases begun per slot (a cut one included: it wore the sector).
+    erases: [u32; 2],
+}
+
+impl Torn {
+    fn new(inner: Store, budget: usize) -> Self {
+        Torn { inner, budget, dead: false, erases: [0; 2] }
+    }
 }
 
 #[derive(Debug)]
@@ -96,6 +115,9 @@ impl CheckpointStore for Torn {
     fn erase(&mut self, slot: u8) -> Result<(), PowerLost> {
         if self.dead {
             return Err(PowerLost);
+        }
+        if let Some(n) = self.erases.get_mut(slot as usize) {
+            *n += 1;
         }
         if self.budget < SLOT {
             let s = self.inner.slot_mut(slot).ok_or(PowerLost)?;
@@ -163,7 +185,7 @@ impl Target for Checkpoints {
     }
 
     fn generate(&mut self, rng: &mut rand_pcg::Pcg64) -> Vec<u8> {
-        let mut input = vec![below(rng, 4) as u8];
+        let mut input = vec![below(rng, 5) as u8];
         input.extend(rng.next_u64().to_le_bytes());
         // A cut anywhere in the erase and the writes of one save.
         input.extend((below(rng, 2 * SLOT + 16) as u32).to_le_bytes());
@@ -216,11 +238,7 @@ impl Target for Checkpoints {
                         "the second save failed"
                     );
                 }
-                let mut torn = Torn {
-                    inner: store,
-                    budget,
-                    dead: false,
-                };
+                let mut torn = Torn::new(store, budget);
                 let saved = save(&mut torn, HASH, &b, &wb).is_ok();
                 let Some((outcome, st, w)) = load_all(&torn.inner) else {
                     return Outcome::Failed("load failed on a RAM store".into());
@@ -279,6 +297,7 @@ impl Target for Checkpoints {
                 }
                 return reencodes(&store, &outcome, &st);
             }
+            4 => return wear(&mut rng),
             // Random slots, some with a valid header over random bytes.
             _ => {
                 for slot in 0..2u8 {
@@ -312,4 +331,88 @@ impl Target for Checkpoints {
         }
         Outcome::Ok
     }
+}
+
+/// The tables the wear mode saves: (entry bytes, table).
+fn table(kind: usize, rng: &mut impl RngCore) -> (usize, Box<dyn WeightStore>) {
+    use pada_core::claim_table::{ClaimTable, InitialWeights, TagStore, Tags16, Tags32};
+    use pada_core::weights::Half;
+    fn claimed<W: WeightStore + 'static, T: TagStore + 'static>(
+        weights: W,
+        tags: T,
+        rng: &mut impl RngCore,
+    ) -> Box<dyn WeightStore> {
+        let mut t = ClaimTable::new(weights, tags).unwrap();
+        t.reset(InitialWeights { seed: rng.next_u64(), lo: 0, span: 1 << 16 });
+        for _ in 0..below(rng, WEIGHTS) {
+            t.claim(rng.next_u32());
+        }
+        Box::new(t)
+    }
+    let n = WEIGHTS / 2;
+    match kind {
+        0 => (4, Box::new(weights(rng))),
+        1 => (2, Box::new(Half::<_, 12>::new((0..WEIGHTS).map(|_| rng.next_u32() as i16).collect::<Vec<_>>()))),
+        2 => (8, claimed(vec![Q16::ZERO; n], Tags32(vec![0u32; n]), rng)),
+        3 => (4, claimed(Half::<_, 12>::new(vec![0i16; n]), Tags16(vec![0u16; n]), rng)),
+        4 => (6, claimed(vec![Q16::ZERO; n], Tags16(vec![0u16; n]), rng)),
+        _ => (6, claimed(Half::<_, 12>::new(vec![0i16; n]), Tags32(vec![0u32; n]), rng)),
+    }
+}
+
+/// The wear mode (see the module documentation).
+fn wear(rng: &mut impl RngCore) -> Outcome {
+    let (entry, table) = table(below(rng, 6), rng);
+    ensure!(table.entry_bytes() == entry, "a table of {} bytes an entry, {entry} expected", table.entry_bytes());
+    let endurance = 2 + below(rng, 10) as u32;
+    let reserve = below(rng, endurance as usize + 1) as u32;
+    let Ok(budget) = WearBudget::new(endurance, reserve, 1000) else {
+        return Outcome::Failed("a valid budget refused".into());
+    };
+    let mut store = Store::new();
+    // What the flash saw, and what the caller kept of each save's report.
+    let mut erased = [0u32; 2];
+    let mut kept = FlashWear::default();
+    let mut state = state(rng);
+    for i in 0..2 + below(rng, 12) {
+        state.wear = FlashWear { erases: kept.erases, operating_s: 100 * i as u64 };
+        // A third of the saves lose power somewhere in the erase or writes.
+        let cut = if below(rng, 3) == 0 { below(rng, 2 * SLOT) } else { usize::MAX };
+        let before = store.clone();
+        let mut torn = Torn::new(store, cut);
+        let r = save_within(&mut torn, HASH, &state, &*table, &budget);
+        store = torn.inner;
+        for (e, n) in erased.iter_mut().zip(torn.erases) {
+            *e += n;
+        }
+        ensure!(
+            (entry == 6) == matches!(r, Err(SaveError::EntryBytes { found: 6 })),
+            "a table of {entry}-byte entries: {r:?}"
+        );
+        let reported = match &r {
+            Ok(saved) => Some((saved.slot, saved.erases)),
+            Err(e) => e.erased(),
+        };
+        match reported {
+            Some((slot, n)) => {
+                let s = slot as usize & 1;
+                ensure!(n == erased[s], "save {i} reports {n} erases of slot {slot}, the flash saw {}", erased[s]);
+                kept.erases[s] = kept.erases[s].max(n);
+            }
+            None => {
+                ensure!(torn.erases == [0, 0], "save {i} ({r:?}) reports no erase but erased {:?}", torn.erases);
+                ensure!(
+                    store.slot(0) == before.slot(0) && store.slot(1) == before.slot(1),
+                    "save {i} ({r:?}) reports no erase but changed the store"
+                );
+            }
+        }
+        let Ok(stored) = stored_wear(&store) else {
+            return Outcome::Failed("stored_wear failed on a RAM store".into());
+        };
+        let known = stored.max(&kept);
+        ensure!(known.erases == erased, "save {i}: the flash saw {erased:?} erases, records and reports know {:?}", known.erases);
+        ensure!(erased.iter().all(|&n| n <= endurance), "save {i}: {erased:?} erases, beyond the budget of {endurance}");
+    }
+    Outcome::Ok
 }

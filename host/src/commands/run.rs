@@ -112,7 +112,9 @@ pub struct RunArgs {
     pub weight_bits: Option<String>,
     /// With --board: a claim table's tags in 16 or 32 bits (16: features
     /// whose homes lie within one probe run share a slot with probability
-    /// 2^-16; 32: only features with equal 32-bit hashes share one).
+    /// 2^-16, and below 2^17 slots a table keeps only log2 + 15 bits of a
+    /// key; 32: only features with equal 32-bit hashes share one; see
+    /// pada_core::claim_table).
     #[arg(long, value_name = "BITS", requires = "board", value_parser = ["16", "32"])]
     pub tag_bits: Option<String>,
     /// Seed and threads.

@@ -34,7 +34,7 @@
 //!
 //! # Learner-state record
 //!
-//! The 1024-byte record ([`STATE_LEN`], version [`STATE_VERSION`], 3) at
+//! The 1024-byte record ([`STATE_LEN`], version [`STATE_VERSION`], 4) at
 //! slot offset 32 holds what a learner carries between episodes: the agent's
 //! counters, ε, mode and policy, the generator, each joint's fatigue
 //! counters, the caller's counters, the flash wear and the wear governor's
@@ -72,11 +72,14 @@
 //! Every record counts the erases of both sectors ([`FlashWear`]): [`save`]
 //! takes the newest valid record's counts (whatever its configuration),
 //! adds its own erase, and writes them into the record it saves, so the
-//! count survives resets, configuration changes and re-flashing. An erase
-//! whose save is cut by a power loss is not counted (at most one per power
-//! cut). [`save_within`] refuses a save that would take a sector beyond its
-//! [`WearBudget`] (module [`wear`]: at most 10 000 erases within ten years
-//! of operation).
+//! count survives resets, configuration changes and re-flashing. A save
+//! that fails after its erase returns the count ([`SaveError::erased`]) for
+//! the caller to carry into its next save; an erase whose save is cut by a
+//! power loss is not counted (at most one per power cut). A table whose
+//! entries a slot cannot store ([`valid_entry_bytes`]) is refused before
+//! anything is erased. [`save_within`] refuses a save that would take a
+//! sector beyond its [`WearBudget`] (module [`wear`]: at most 10 000
+//! erases within ten years of operation).
 //!
 //! # Modules
 //!
@@ -97,8 +100,8 @@ pub mod wear;
 pub use crate::crc::{config_hash, crc32, ConfigHasher, CRC32};
 pub use record::{LearnerState, RECORD_JOINTS, STATE_LEN, STATE_VERSION, USER_COUNTERS};
 pub use slots::{
-    find, inspect, is_newer, load, read_weights, save, save_within, slot_len, stored_wear, Found, Header,
-    HeaderError, LoadOutcome, SaveError, Saved, SlotStatus, FORMAT_VERSION, HEADER_LEN, MAGIC, SLOTS,
+    find, inspect, is_newer, load, read_weights, save, save_within, slot_len, stored_wear, valid_entry_bytes, Found,
+    Header, HeaderError, LoadOutcome, SaveError, Saved, SlotStatus, FORMAT_VERSION, HEADER_LEN, MAGIC, SLOTS,
 };
 pub use store::{CheckpointStore, OutOfRange, RamStore};
 pub use wear::{FlashWear, WearBudget, WearRefusal, SECTOR_ENDURANCE};

@@ -17,6 +17,15 @@ pub const FORMAT_VERSION: u16 = 4;
 pub const HEADER_LEN: usize = 32;
 /// Number of slots.
 pub const SLOTS: u8 = 2;
+/// Whether a slot can store entries of `entry_bytes` bytes: 2, 4 or 8 (a
+/// 16-bit or Q16 weight alone, a 16-bit weight with a 16-bit tag, a Q16
+/// weight with a 32-bit tag). The header's width field is read as one of
+/// these ([`Header::slot_bytes`]), so [`save`] and a streamed image refuse
+/// any other before they write.
+pub const fn valid_entry_bytes(entry_bytes: usize) -> bool {
+    matches!(entry_bytes, 2 | 4 | 8)
+}
+
 /// Bytes a slot needs for `weights` weights of `weight_bytes` bytes each
 /// (header, state record, weights padded to a multiple of 4).
 pub const fn slot_len(weights: usize, weight_bytes: usize) -> usize {
@@ -131,7 +140,7 @@ impl Header {
     /// Bytes of the slot this header describes, if that fits a `usize`:
     /// also the length of a streamed image ([`super::stream`]).
     pub fn slot_bytes(&self) -> Option<usize> {
-        if !matches!(self.weight_bytes, 2 | 4 | 8) {
+        if !valid_entry_bytes(self.weight_bytes as usize) {
             return None;
         }
         (self.weight_count as usize)
@@ -191,26 +200,100 @@ pub enum LoadOutcome {
 }
 
 /// Why [`save`] failed. The previous checkpoint is intact in every case.
+///
+/// A failure after the slot's sector was erased ([`StoreAfterErase`],
+/// [`VerifyFailed`]) carries that sector's erase count, this erase
+/// included ([`erased`](Self::erased)): the slot holds no valid record to
+/// keep it, so the caller keeps it (in the [`FlashWear`] it saves next),
+/// and every erase that happened is counted. The other variants erased
+/// nothing.
+///
+/// [`StoreAfterErase`]: Self::StoreAfterErase
+/// [`VerifyFailed`]: Self::VerifyFailed
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum SaveError<E> {
-    /// The weights do not fit a slot.
+    /// The weights do not fit a slot; nothing erased.
     TooLarge {
         /// Bytes needed.
         needed: usize,
         /// Bytes per slot.
         capacity: usize,
     },
-    /// The store failed.
+    /// The store failed before the erase (reading the slots); nothing
+    /// erased.
     Store(E),
     /// Reading back the written checkpoint did not give a valid one.
     VerifyFailed {
         /// The slot written.
         slot: u8,
+        /// Erases of its sector, this save's included.
+        erases: u32,
     },
     /// Refused before anything was erased: the slot's sector would exceed
     /// its erase budget ([`save_within`]).
     Wear(WearRefusal),
+    /// Refused before anything was erased: the table's entries are of a
+    /// width no header describes. A slot stores 2, 4 or 8 bytes an entry
+    /// (a 16-bit or [`crate::fixed::Q16`] weight alone, a 16-bit weight
+    /// with a 16-bit tag, a Q16 weight with a 32-bit tag); a Q16 weight
+    /// with a 16-bit tag, or a 16-bit weight with a 32-bit tag, is 6.
+    EntryBytes {
+        /// The table's bytes per entry ([`WeightStore::entry_bytes`]).
+        found: usize,
+    },
+    /// The store failed while erasing the slot's sector or writing it (the
+    /// erase counted, as it may have begun).
+    StoreAfterErase {
+        /// The slot.
+        slot: u8,
+        /// Erases of its sector, this save's included.
+        erases: u32,
+        /// The store's error.
+        error: E,
+    },
+}
+
+impl<E> SaveError<E> {
+    /// The slot whose sector this failed save erased and that sector's
+    /// erase count, this erase included; `None` if nothing was erased.
+    pub fn erased(&self) -> Option<(u8, u32)> {
+        match *self {
+            SaveError::VerifyFailed { slot, erases } | SaveError::StoreAfterErase { slot, erases, .. } => {
+                Some((slot, erases))
+            }
+            SaveError::TooLarge { .. } | SaveError::Store(_) | SaveError::Wear(_) | SaveError::EntryBytes { .. } => {
+                None
+            }
+        }
+    }
+}
+
+/// One line naming the cause and what is valid (for logs and refusals).
+impl<E: core::fmt::Debug> core::fmt::Display for SaveError<E> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            SaveError::TooLarge { needed, capacity } => {
+                write!(f, "checkpoint of {needed} bytes not saved: a slot holds at most {capacity}")
+            }
+            SaveError::Store(e) => write!(f, "checkpoint not saved: the store failed before erasing: {e:?}"),
+            SaveError::VerifyFailed { slot, erases } => write!(
+                f,
+                "checkpoint written to slot {slot} did not read back as valid (its sector erased {erases} times)"
+            ),
+            SaveError::Wear(r) => write!(f, "checkpoint not saved to spare the flash: {r:?}"),
+            SaveError::EntryBytes { found } => write!(
+                f,
+                "table entry of {found} bytes cannot be checkpointed: valid are 2, 4 or 8 (a weight alone, a \
+                 16-bit weight with a 16-bit tag, a Q16 weight with a 32-bit tag)"
+            ),
+            SaveError::StoreAfterErase { slot, erases, error } => write!(
+                f,
+                "checkpoint not saved: the store failed erasing or writing slot {slot} (its sector erased \
+                 {erases} times): {error:?}"
+            ),
+        }
+    }
 }
 
 /// A successful save.
@@ -307,7 +390,7 @@ fn wear_in<S: CheckpointStore>(store: &S, best: Newest) -> Result<FlashWear, S::
     let Some((slot, header)) = best else {
         return Ok(FlashWear::default());
     };
-    // Records of version 2 (512 bytes) and 3 keep the wear at the same
+    // Records of versions 2 (512 bytes) to 4 keep the wear at the same
     // offsets; a version-1 record (496 bytes) has none.
     if (header.state_len as usize) < WEAR_END {
         let g = header.generation;
@@ -323,6 +406,11 @@ fn wear_in<S: CheckpointStore>(store: &S, best: Newest) -> Result<FlashWear, S::
 /// first, header last — then reads it back to verify. The record's wear is
 /// the higher of the store's ([`stored_wear`]) and `state.wear`, with this
 /// save's erase counted; no budget is applied (see [`save_within`]).
+///
+/// A table whose entries no header describes is refused with
+/// [`SaveError::EntryBytes`] before anything is erased; a save that fails
+/// after its erase says so with the count ([`SaveError::erased`]), for the
+/// caller to carry into its next save's `state.wear`.
 pub fn save<S: CheckpointStore, W: WeightStore + ?Sized>(
     store: &mut S,
     config_hash: u32,
@@ -353,6 +441,11 @@ fn save_checked<S: CheckpointStore, W: WeightStore + ?Sized>(
     budget: Option<&WearBudget>,
 ) -> Result<Saved, SaveError<S::Error>> {
     let bytes = weights.entry_bytes();
+    // Only widths a header describes (Header::slot_bytes): any other would
+    // be erased and written, then never read back as a checkpoint.
+    if !valid_entry_bytes(bytes) {
+        return Err(SaveError::EntryBytes { found: bytes });
+    }
     let needed = slot_len(weights.len(), bytes);
     if needed > store.capacity() || weights.len() > u32::MAX as usize {
         return Err(SaveError::TooLarge { needed, capacity: store.capacity() });
@@ -367,12 +460,16 @@ fn save_checked<S: CheckpointStore, W: WeightStore + ?Sized>(
         budget.check(wear.erases[slot as usize], wear.operating_s).map_err(SaveError::Wear)?;
     }
     wear.erases[slot as usize] = wear.erases[slot as usize].saturating_add(1);
-    store.erase(slot).map_err(SaveError::Store)?;
+    let erases = wear.erases[slot as usize];
+    // From here on the slot's sector is (being) erased: a failure reports
+    // the count, since the slot will hold no valid record of it.
+    let after_erase = |error| SaveError::StoreAfterErase { slot, erases, error };
+    store.erase(slot).map_err(after_erase)?;
     let mut digest = CRC32.digest();
     let mut record = state.to_bytes();
     put_wear(&mut record, &wear);
     digest.update(&record);
-    store.write(slot, HEADER_LEN, &record).map_err(SaveError::Store)?;
+    store.write(slot, HEADER_LEN, &record).map_err(after_erase)?;
     let mut buf = [0u8; CHUNK];
     let mut offset = HEADER_LEN + STATE_LEN;
     let per_chunk = CHUNK / bytes;
@@ -387,7 +484,7 @@ fn save_checked<S: CheckpointStore, W: WeightStore + ?Sized>(
         let n = used.div_ceil(4) * 4;
         buf[used..n].fill(0);
         digest.update(&buf[..n]);
-        store.write(slot, offset, &buf[..n]).map_err(SaveError::Store)?;
+        store.write(slot, offset, &buf[..n]).map_err(after_erase)?;
         offset += n;
         i += count;
     }
@@ -400,10 +497,10 @@ fn save_checked<S: CheckpointStore, W: WeightStore + ?Sized>(
         state_len: STATE_LEN as u32,
         weight_bytes: bytes as u16,
     };
-    store.write(slot, 0, &header.to_bytes()).map_err(SaveError::Store)?;
-    match inspect(store, slot).map_err(SaveError::Store)? {
-        SlotStatus::Valid(h) if h == header => Ok(Saved { generation, slot, erases: wear.erases[slot as usize] }),
-        _ => Err(SaveError::VerifyFailed { slot }),
+    store.write(slot, 0, &header.to_bytes()).map_err(after_erase)?;
+    match inspect(store, slot).map_err(after_erase)? {
+        SlotStatus::Valid(h) if h == header => Ok(Saved { generation, slot, erases }),
+        _ => Err(SaveError::VerifyFailed { slot, erases }),
     }
 }
 

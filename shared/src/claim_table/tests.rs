@@ -189,3 +189,159 @@ proptest! {
         }
     }
 }
+
+/// A 16-bit-tag table of `slots` slots with 16-bit weights (as the chips').
+fn chip_table(slots: usize) -> ClaimTable<Half<Vec<i16>, 12>, Tags16<Vec<u16>>> {
+    let mut t = ClaimTable::new(Half::<_, 12>::new(vec![0i16; slots]), Tags16(vec![0u16; slots])).unwrap();
+    t.reset(InitialWeights { seed: 11, lo: 0, span: 1 << 12 });
+    t
+}
+
+#[test]
+fn two_features_of_one_home_keep_their_own_weights_in_the_f405s_table() {
+    // Found by an independent fuzz harness: both keys have home 11990 in
+    // 2^14 slots, and the old 16-bit tag (the remix's top bits) was 0x6cf5
+    // for both, so the second read the first's learned weight.
+    let mut t = chip_table(1 << 14);
+    let (a, b) = (0xd438_2ed6u32, 0x3c8f_aed6u32);
+    assert_eq!((a & 0x3FFF, b & 0x3FFF), (11990, 11990));
+    let Claim::Slot { slot, fresh: true } = t.claim(a) else { panic!("claim refused") };
+    t.set(slot as usize, Q16(1000 << 16));
+    assert_eq!(t.read(a), Q16(1000 << 16));
+    assert_eq!(t.read(b), t.initial_weight(b), "b holds no slot: it reads its initial weight, not a's");
+    let Claim::Slot { slot: sb, fresh: true } = t.claim(b) else { panic!("b found a's slot") };
+    assert_ne!(sb, slot);
+}
+
+/// A SplitMix64 step, for reproducible keys.
+fn splitmix(state: &mut u64) -> u32 {
+    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    let mut z = *state;
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    (z ^ (z >> 31)) as u32
+}
+
+#[test]
+fn at_every_size_features_of_one_home_never_share_a_slot() {
+    // Tables of 2^1 … 2^18 slots with 16-bit tags; in each, homes spaced
+    // so that their probe runs do not meet, and up to 64 keys per home
+    // with random high bits that differ in the bits the table keeps of a
+    // key (the low min(32, log2 + 15)). Every claim must take a slot of
+    // its own, and every key read its own weight back.
+    let mut rng = 7u64;
+    for log2 in 1..=18u32 {
+        let slots = 1usize << log2;
+        let mut t = chip_table(slots);
+        let per_home = slots.min(MAX_PROBE as usize);
+        let key_mask = if log2 + 15 >= 32 { u32::MAX } else { (1u32 << (log2 + 15)) - 1 };
+        let mut written: Vec<(u32, Q16)> = Vec::new();
+        for home in (0..slots).step_by(per_home).take(64) {
+            let mut seen = std::collections::BTreeSet::new();
+            while seen.len() < per_home {
+                let key = (splitmix(&mut rng) & !(slots as u32 - 1)) | home as u32;
+                if !seen.insert(key & key_mask) {
+                    continue;
+                }
+                let w = Q16((written.len() as i32 + 1) << 12);
+                match t.claim(key) {
+                    Claim::Slot { slot, fresh: true } => t.set(slot as usize, w),
+                    other => panic!("2^{log2} slots: key {key:#x} (home {home}): {other:?}, another key's slot"),
+                }
+                written.push((key, w));
+            }
+        }
+        for &(key, w) in &written {
+            assert_eq!(t.read(key), w, "2^{log2} slots: key {key:#x} reads another weight");
+        }
+    }
+}
+
+#[test]
+fn a_stored_tag_tells_apart_every_kept_key_of_one_home_at_every_size() {
+    // Exhaustively, for several homes of every size 2^1 … 2^31: the keys
+    // of one home that differ in their kept bits (all 2^(key_bits − k) of
+    // them, at most 2^15) get distinct stored tags, none of them EMPTY.
+    for bits in [16u32, 32] {
+        for log2 in 1..=31u32 {
+            let kept = key_bits(bits, log2);
+            assert_eq!(kept, (log2 + bits - 1).min(32));
+            let varying = (kept - log2).min(15);
+            for home in [0x2ed6u32, u32::MAX] {
+                let home = home & ((1u32 << log2) - 1);
+                let mut tags: Vec<u32> = (0..1u32 << varying).map(|n| stored_tag(home | (n << log2), bits, log2)).collect();
+                assert!(!tags.contains(&EMPTY));
+                tags.sort_unstable();
+                let repeated = tags.windows(2).find(|w| w[0] == w[1]);
+                assert_eq!(repeated, None, "{bits}-bit tags, 2^{log2} slots, home {home:#x}: a tag repeats");
+            }
+        }
+    }
+}
+
+#[test]
+fn large_tables_store_the_tags_they_always_stored() {
+    // The F429's 2^21 slots with 16-bit tags and the host's 2^22 with
+    // 32-bit tags keep every bit of a key: their stored tags are the
+    // remix of the whole key, as before key_bits, so they learn bit for
+    // bit as they did.
+    let mut state = 3u64;
+    for _ in 0..10_000 {
+        let key = splitmix(&mut state);
+        for log2 in 17..=31 {
+            assert_eq!(stored_tag(key, 16, log2), tag_of(key, 16));
+        }
+        for log2 in 1..=31 {
+            assert_eq!(stored_tag(key, 32, log2), tag_of(key, 32));
+        }
+    }
+    let t = chip_table(1 << 17);
+    assert_eq!((t.key_bits(), t.tag_for(0xd438_2ed6)), (32, tag_of(0xd438_2ed6, 16)));
+    let t = table(1 << 4);
+    assert_eq!(t.key_bits(), 32);
+    assert_eq!(t.initial_weight(0xFFFF_FFF0), t.initial_weights().of(0xFFFF_FFF0));
+}
+
+#[test]
+fn keys_that_agree_in_the_kept_bits_are_one_feature_to_a_small_table() {
+    // 2^14 slots keep 29 bits: keys that differ only in bits 29–31 are
+    // one feature, with one initial weight and one slot.
+    let mut t = chip_table(1 << 14);
+    assert_eq!(t.key_bits(), 29);
+    let a = 0x0438_2ed6u32;
+    let b = a | 0xE000_0000;
+    assert_eq!(t.initial_weight(a), t.initial_weight(b));
+    assert_eq!(t.read(a), t.read(b));
+    let Claim::Slot { slot, fresh: true } = t.claim(a) else { panic!("refused") };
+    t.set(slot as usize, Q16(3 << 16));
+    assert_eq!(t.claim(b), Claim::Slot { slot, fresh: false });
+    assert_eq!(t.read(b), Q16(3 << 16));
+    // One kept bit apart (bit 28): two features.
+    assert!(matches!(t.claim(a ^ 1 << 28), Claim::Slot { fresh: true, .. }));
+}
+
+#[test]
+fn the_longest_probe_counts_claims_and_not_reads() {
+    let mut t = table(64);
+    // Three keys of home 9 in slots 9, 10, 11; a fourth key of home 9
+    // that holds no slot probes four slots to read.
+    for n in 1..=3 {
+        assert!(matches!(t.claim(key_at(9, n, 64)), Claim::Slot { fresh: true, .. }));
+    }
+    assert_eq!(t.occupancy().longest_probe, 2);
+    let before = t.occupancy();
+    assert_eq!(t.read(key_at(9, 4, 64)), t.initial_weights().of(key_at(9, 4, 64)));
+    assert_eq!(t.occupancy(), before, "a read leaves the occupancy as it was");
+    // Its claim probes three slots (9, 10, 11) before the free one.
+    assert!(matches!(t.claim(key_at(9, 4, 64)), Claim::Slot { slot: 12, fresh: true }));
+    assert_eq!(t.occupancy().longest_probe, 3);
+    // Finding a claimed slot again counts its probe too (never more than
+    // it took to claim it).
+    assert!(matches!(t.claim(key_at(9, 2, 64)), Claim::Slot { slot: 10, fresh: false }));
+    assert_eq!(t.occupancy().longest_probe, 3);
+    // A table restored from a checkpoint starts again from 0: the
+    // checkpoint does not keep it, and the probes before belong to the
+    // learner that was replaced.
+    t.restore_claims(t.initial_weights(), 0);
+    assert_eq!((t.occupancy().claimed, t.occupancy().longest_probe), (4, 0));
+}

@@ -3,7 +3,7 @@
 //! SDRAM, and there is no second 8 MiB to assemble it in.
 
 use crate::checkpoint::record::STATE_LEN;
-use crate::checkpoint::slots::{Header, FORMAT_VERSION, HEADER_LEN};
+use crate::checkpoint::slots::{valid_entry_bytes, Header, FORMAT_VERSION, HEADER_LEN};
 use crate::crc::CRC32;
 use crate::weights::WeightStore;
 
@@ -27,6 +27,11 @@ impl ImageSource for [u8] {
     }
 
     fn read(&self, offset: usize, out: &mut [u8]) {
+        // Past the end the trait promises zeros: clear what the copy will
+        // not reach (bytes before the image start cannot occur, offsets
+        // being unsigned).
+        let inside = self.len().saturating_sub(offset).min(out.len());
+        out[inside..].fill(0);
         copy_overlap(self, 0, offset, out);
     }
 }
@@ -100,7 +105,7 @@ impl<'a, W: WeightStore + ?Sized> TableImage<'a, W> {
         weights: &'a W,
     ) -> Result<Self, ImageError> {
         let entry = weights.entry_bytes();
-        if !matches!(entry, 2 | 4 | 8) {
+        if !valid_entry_bytes(entry) {
             return Err(ImageError::EntryBytes { found: entry });
         }
         let n = weights.len();

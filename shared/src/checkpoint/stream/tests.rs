@@ -165,6 +165,32 @@ fn a_restore_sends_the_header_first_and_a_kept_slot_streams_back_unchanged() {
 }
 
 #[test]
+fn bytes_past_the_end_of_an_image_read_as_zero_from_a_slice_as_from_a_table() {
+    // The trait's promise, for an image in memory: a read that runs past
+    // the end fills the rest with zeros, whatever `out` held before.
+    let image = [0u8; 64];
+    let mut out = [0xEE; 8];
+    ImageSource::read(&image[..], 60, &mut out);
+    assert_eq!(out, [0; 8]);
+    let mut out = [0xEE; 4];
+    ImageSource::read(&image[..], 1000, &mut out);
+    assert_eq!(out, [0; 4], "a read wholly past the end");
+    // A slice and a table image of the same bytes read alike at every
+    // offset around the end, into a buffer that held other bytes.
+    let weights = plain(7);
+    let record = saved_record(3);
+    let table = TableImage::new(HASH, 1, &record, &weights[..]).unwrap();
+    let bytes = bytes_of(&table);
+    let len = bytes.len();
+    for offset in len - 12..len + 4 {
+        let (mut a, mut b) = ([0xA5u8; 16], [0x5Au8; 16]);
+        ImageSource::read(&bytes[..], offset, &mut a);
+        table.read(offset, &mut b);
+        assert_eq!(a, b, "offset {offset} of {len}");
+    }
+}
+
+#[test]
 fn zero_words_and_zero_windows_are_not_sent() {
     let weights = vec![Q16::ZERO; 4096];
     let record = [0u8; STATE_LEN];
