@@ -210,13 +210,13 @@ impl Item {
     }
 
     /// Bytes the item (or row) covers.
-    pub const fn len(&self) -> u16 {
+    pub const fn span(&self) -> u16 {
         self.size as u16 * self.count as u16
     }
 
     /// One past the last address.
     pub const fn end(&self) -> u16 {
-        self.address + self.len()
+        self.address + self.span()
     }
 
     /// The value of one item's bytes (little endian, sign-extended if the

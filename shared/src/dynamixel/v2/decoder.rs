@@ -294,7 +294,7 @@ impl<P: FromFrame<N>, const N: usize> Decoder<P, N> {
                     Some(_) => {}
                 }
             }
-            let Some(&id) = self.buf[..self.len].get(4) else { return None };
+            let &id = self.buf[..self.len].get(4)?;
             if id > MAX_ID && id != BROADCAST_ID {
                 return self.refuse(|s| &mut s.unexpected_ids, 1, DecodeError::InvalidId { id });
             }
@@ -317,7 +317,7 @@ impl<P: FromFrame<N>, const N: usize> Decoder<P, N> {
             if length < P::MIN_LENGTH || total > N || !in_window {
                 return self.refuse(|s| &mut s.bad_lengths, 1, DecodeError::BadLength { id, length });
             }
-            let Some(&instruction) = self.buf[..self.len].get(PREFIX_LEN) else { return None };
+            let &instruction = self.buf[..self.len].get(PREFIX_LEN)?;
             if P::STATUS_ONLY && instruction != STATUS {
                 return self.refuse(|s| &mut s.not_status, 1, DecodeError::NotStatus { id, instruction });
             }
@@ -325,7 +325,7 @@ impl<P: FromFrame<N>, const N: usize> Decoder<P, N> {
                 // A status packet without its ERROR byte.
                 return self.refuse(|s| &mut s.bad_lengths, 1, DecodeError::BadLength { id, length });
             }
-            let Some(packet) = self.buf.get(..total).filter(|_| self.len >= total) else { return None };
+            let packet = self.buf.get(..total).filter(|_| self.len >= total)?;
             let (body, crc) = packet.split_at(total - 2);
             let expected = crc16(body);
             let got = u16::from_le_bytes([crc.first().copied().unwrap_or(0), crc.get(1).copied().unwrap_or(0)]);

@@ -58,13 +58,13 @@ pub fn fast_sync_read<'b>(addr: u16, len: u16, ids: &[u8], out: &'b mut [u8]) ->
     Instruction::FastSyncRead { addr, len, ids }.encode(BROADCAST_ID, out)
 }
 
-fn sync_write_frame<'b, I: Iterator<Item = u8> + Clone>(
+fn sync_write_frame<I: Iterator<Item = u8> + Clone>(
     addr: u16,
     len: u16,
     ids: impl Iterator<Item = u8>,
     entries: I,
-    out: &'b mut [u8],
-) -> Result<&'b [u8], EncodeError> {
+    out: &mut [u8],
+) -> Result<&[u8], EncodeError> {
     let code = InstructionCode::SyncWrite as u8;
     if len == 0 || !distinct_servo_ids(ids) {
         return Err(EncodeError::BadParams { code });

@@ -96,7 +96,7 @@ pub enum EncodeError {
 /// (stuffed unless [`is_stuffed`] says not), the CRC. Returns the written
 /// prefix of `out`. `body` is iterated twice (to size, then to write), so
 /// nothing is buffered.
-pub fn write_frame<'b, I>(id: u8, instruction: u8, body: I, out: &'b mut [u8]) -> Result<&'b [u8], EncodeError>
+pub fn write_frame<I>(id: u8, instruction: u8, body: I, out: &mut [u8]) -> Result<&[u8], EncodeError>
 where
     I: Iterator<Item = u8> + Clone,
 {
