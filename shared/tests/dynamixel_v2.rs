@@ -89,6 +89,16 @@ fn the_manuals_fast_bulk_read_packet_has_a_misprinted_crc() {
     assert_eq!(&ours[ours.len() - 2..], &[0xDA, 0x2D]);
     // As printed, the packet fails its CRC: the decoder refuses it.
     assert!(matches!(InstructionDecoder::<64>::new().feed(&printed).next(), Some(Err(DecodeError::BadCrc { .. }))));
+    // § "Control Table Backup" (not implemented): the backup example's CRC
+    // is right, the restore example's is printed 92 F5 for 9E F5.
+    let crc = |s: &str| {
+        let b = hex(s);
+        (pada_core::dynamixel::v2::crc::crc16(&b[..b.len() - 2]).to_le_bytes(), [b[b.len() - 2], b[b.len() - 1]])
+    };
+    let (ours, printed) = crc("FF FF FD 00 01 08 00 20 01 43 54 52 4C 16 F5");
+    assert_eq!(ours, printed);
+    let (ours, printed) = crc("FF FF FD 00 01 08 00 20 02 43 54 52 4C 92 F5");
+    assert_eq!((ours, printed), ([0x9E, 0xF5], [0x92, 0xF5]));
 }
 
 #[test]
@@ -454,4 +464,26 @@ proptest! {
         want.remove(target);
         prop_assert_eq!(got, want);
     }
+}
+
+#[test]
+fn a_sync_reads_replies_are_expected_one_after_the_other() {
+    // The e-Manual's Sync Read replies (IDs 1 and 2), arriving together.
+    let mut bytes = hex("FF FF FD 00 01 08 00 55 00 A6 00 00 00 8C C0");
+    bytes.extend(hex("FF FF FD 00 02 08 00 55 00 1F 08 00 00 BA BE"));
+    let ins = Instruction::SyncRead { addr: 132, len: 4, ids: &[1, 2] };
+    let mut ids = ins.ids();
+    let mut dec = StatusDecoder::<64>::new();
+    dec.expect(Some(Reply::status(ids.next().unwrap(), ins.reply_params().unwrap())));
+    let mut got = Vec::new();
+    for &b in &bytes {
+        let mut next = dec.push(b);
+        while let Some(r) = next {
+            got.push(r.unwrap().id);
+            dec.expect(ids.next().map(|id| Reply::status(id, 4)));
+            next = dec.poll();
+        }
+    }
+    assert_eq!(got, vec![1, 2]);
+    assert_eq!(dec.stats().skipped_bytes, 0);
 }

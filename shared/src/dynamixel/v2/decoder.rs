@@ -218,8 +218,11 @@ impl<P: FromFrame<N>, const N: usize> Decoder<P, N> {
     }
 
     /// Accept only `reply` (`None`: any packet). A status decoder is told
-    /// before every request that has one reply; for a sync or bulk read,
-    /// before each servo's.
+    /// before every request that has one reply. For a sync or bulk read,
+    /// whose replies follow one another, drive it with
+    /// [`push`](Self::push) and set the next servo's reply after each
+    /// accepted packet, before [`poll`](Self::poll) looks at the bytes
+    /// already buffered (or expect `None` and check the IDs afterwards).
     pub fn expect(&mut self, reply: Option<Reply>) {
         self.expected = reply;
     }
