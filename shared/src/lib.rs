@@ -28,7 +28,10 @@
 //! - [`fatigue`]: backlash re-engagements → damage J → predicted MTBF
 //!   (Section IV, Eqs. 1–7);
 //! - [`dynamixel`]: the Dynamixel Protocol 1.0 codec and the RX-28 control
-//!   table (both directions, so the host can emulate servos);
+//!   table, the Protocol 2.0 codec ([`dynamixel::v2`]) and the control
+//!   tables of the X-series servos and the MX-28(2.0)
+//!   ([`dynamixel::control_table`]) (both directions, so the host can
+//!   emulate servos);
 //! - [`wire`]: the telemetry and command protocol between chip and host
 //!   (postcard + CRC-32 + COBS), so both ends decode exactly what the other
 //!   encodes;

@@ -4,6 +4,7 @@
 mod checkpoint;
 mod claim_table;
 mod dynamixel;
+mod dynamixel_v2;
 mod stream;
 mod wire;
 
@@ -46,9 +47,9 @@ const TO_HOST_VARIANTS: u8 = 16;
 const TO_CHIP_VARIANTS: u8 = 14;
 
 /// Every target: the host's and the chip's frame decoders, the status and
-/// instruction packet decoders, checkpoint loading and torn saves, a
-/// checkpoint streamed back to a board and damaged on the way, and the
-/// claim table's reads, claims and writes.
+/// instruction packet decoders of Protocol 1.0 and 2.0, checkpoint loading
+/// and torn saves, a checkpoint streamed back to a board and damaged on the
+/// way, and the claim table's reads, claims and writes.
 pub fn all(corpus: &Corpus) -> Vec<Box<dyn Target>> {
     vec![
         Box::new(
@@ -66,6 +67,10 @@ pub fn all(corpus: &Corpus) -> Vec<Box<dyn Target>> {
         )),
         Box::new(dynamixel::Status::<32>::new("dynamixel-status")),
         Box::new(dynamixel::Instructions::<64>::new("dynamixel-instr")),
+        // Protocol 2.0: the firmware's default buffer, and a small one so
+        // that too-long packets are common.
+        Box::new(dynamixel_v2::Status::<{ pada_core::dynamixel::v2::DEFAULT_PACKET_LEN }>::new("dxl2-status")),
+        Box::new(dynamixel_v2::Instructions::<64>::new("dxl2-instr")),
         Box::new(checkpoint::Checkpoints::new("checkpoint")),
         Box::new(stream::Stream::new("checkpoint-stream")),
         Box::new(claim_table::Claims::new("claim-table")),

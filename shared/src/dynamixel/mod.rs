@@ -1,4 +1,8 @@
-//! Dynamixel Protocol 1.0 codec and the RX-28 control table.
+//! Dynamixel servos: the Protocol 1.0 codec and the RX-28 control table
+//! (this module's items, as before), the Protocol 2.0 codec ([`v2`]) and
+//! the control tables of the Protocol 2.0 servos pada supports
+//! ([`control_table`]: XM430-W350, XL430-W250, XL330-M288, MX-28(2.0)).
+//! [`Protocol`] says which protocol a bus or a servo speaks.
 //!
 //! Pure codec: packets are encoded into caller buffers and decoded from bytes
 //! fed one at a time or in chunks; the firmware does the IO (RS-485 half
@@ -10,7 +14,7 @@
 //! instruction packets ([`InstructionDecoder`]) and encodes status packets
 //! ([`StatusPacket::encode`]).
 //!
-//! # Packet format (Robotis e-Manual, "DYNAMIXEL Protocol 1.0")
+//! # Protocol 1.0 packet format (Robotis e-Manual, "DYNAMIXEL Protocol 1.0")
 //!
 //! ```text
 //! instruction: 0xFF 0xFF ID LENGTH INSTRUCTION PARAM_1 … PARAM_N CHECKSUM
@@ -29,11 +33,29 @@
 //! instruction parser; [`decoder`]: the one incremental decoder of both
 //! directions, which never panics and counts every byte it discards
 //! (property-tested, and fuzzed by `cargo xtask fuzz`); [`table`]: the
-//! RX-28 control table.
+//! RX-28 control table; [`v2`]: Protocol 2.0 (its own module docs);
+//! [`control_table`]: the Protocol 2.0 control tables as data, with the
+//! value checks a virtual servo makes.
 
+pub mod control_table;
 pub mod decoder;
 pub mod packet;
 pub mod table;
+pub mod v2;
+
+/// The Dynamixel protocol a servo or a bus speaks. Both use the same
+/// half-duplex serial line; their packets differ in header, length field
+/// and check (Protocol 1.0: `FF FF`, 8-bit LENGTH, checksum; Protocol 2.0:
+/// `FF FF FD 00`, 16-bit LENGTH, CRC-16 and byte stuffing).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Protocol {
+    /// Protocol 1.0 (RX, AX, MX on 1.0 firmware): [`packet`], [`decoder`].
+    V1,
+    /// Protocol 2.0 (X series, MX(2.0), P series): [`v2`].
+    V2,
+}
 
 pub use decoder::{DecodeError, Decoder, DecoderStats, Feed, FromRaw, InstructionDecoder, Reply, StatusDecoder};
 pub use packet::*;

@@ -1,0 +1,391 @@
+//! The incremental decoder of Protocol 2.0 packets, for both directions:
+//! status packets on the firmware ([`StatusDecoder`]), instruction packets
+//! in a servo or the bus emulator ([`InstructionDecoder`]).
+//!
+//! It follows the 1.0 decoder ([`crate::dynamixel::decoder`]): the bytes
+//! of the packet being received sit in a fixed buffer of `N` bytes that
+//! always starts at a candidate header, and every byte fed ends up in
+//! exactly one of three places: an accepted packet,
+//! [`DecoderStats::skipped_bytes`], or the buffer ([`Decoder::buffered`]).
+//! A packet longer than `N` is a counted [`DecodeError::BadLength`], never
+//! a panic.
+//!
+//! Reception follows the e-Manual's "Processing Order of Reception"
+//! (§ "Packet Process"): find `FF FF FD 00` (a stuffed `FF FF FD FD` is
+//! not a header), read LENGTH bytes, check the CRC over the bytes as
+//! received, then remove the stuffing. A refusal found before the CRC
+//! (a bad ID or LENGTH, a packet of the wrong kind, a CRC mismatch) drops
+//! only the first header byte and scans the rest again, so a packet that a
+//! damaged one swallowed is still found; a refusal after the CRC matched
+//! (stuffing that is not the e-Manual's, or the wrong parameter count for
+//! the expected reply) drops the whole packet, which is certainly one.
+//!
+//! A status decoder told which reply to expect ([`Decoder::expect`])
+//! refuses a header from any other ID, or whose LENGTH cannot be the
+//! reply's, as soon as those bytes arrive.
+
+use super::crc::crc16;
+use super::packet::{is_stuffed, InstructionPacket, StatusPacket, BROADCAST_ID, DEFAULT_PACKET_LEN, HEADER, MAX_ID, PREFIX_LEN, STATUS, STATUS_OVERHEAD};
+use super::status::StatusError;
+use super::stuffing::{destuff, max_stuffed_len};
+use core::marker::PhantomData;
+use heapless::Vec;
+
+/// Why bytes received did not form an acceptable packet. The decoder has
+/// already resynchronised when it reports one of these.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum DecodeError {
+    /// The CRC does not match the packet's bytes.
+    BadCrc {
+        /// ID byte of the corrupted packet (itself possibly corrupted).
+        id: u8,
+        /// CRC computed over the received bytes.
+        expected: u16,
+        /// CRC received.
+        got: u16,
+    },
+    /// LENGTH below the smallest packet, a packet longer than the
+    /// decoder's buffer, or not the expected reply's length.
+    BadLength {
+        /// ID byte of the packet.
+        id: u8,
+        /// The LENGTH field.
+        length: u16,
+    },
+    /// ID 253 or 255, which are never IDs.
+    InvalidId {
+        /// The ID byte.
+        id: u8,
+    },
+    /// A header from another ID than the one asked.
+    UnexpectedId {
+        /// The ID that was asked.
+        expected: u8,
+        /// The ID in the header.
+        got: u8,
+    },
+    /// A packet that is not a status packet (INSTRUCTION ≠ 0x55) where one
+    /// was expected: an instruction echoed, or noise.
+    NotStatus {
+        /// ID byte of the packet.
+        id: u8,
+        /// Its INSTRUCTION byte.
+        instruction: u8,
+    },
+    /// The CRC matched but the payload holds a bare `FF FF FD` (see
+    /// [`super::stuffing`]).
+    BadStuffing {
+        /// ID of the packet.
+        id: u8,
+    },
+}
+
+/// Decoder counters, for health telemetry. Every byte fed is in an accepted
+/// packet, in `skipped_bytes`, or still buffered; every refusal is counted
+/// in exactly one of the other fields.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct DecoderStats {
+    /// Packets decoded.
+    pub packets: u32,
+    /// Bytes discarded: outside any header, the first header byte of every
+    /// packet refused before its CRC, every byte of one refused after.
+    pub skipped_bytes: u32,
+    /// Packets with a wrong CRC ([`DecodeError::BadCrc`]).
+    pub bad_crcs: u32,
+    /// [`DecodeError::BadLength`].
+    pub bad_lengths: u32,
+    /// [`DecodeError::InvalidId`] and [`DecodeError::UnexpectedId`].
+    pub unexpected_ids: u32,
+    /// [`DecodeError::NotStatus`].
+    pub not_status: u32,
+    /// [`DecodeError::BadStuffing`].
+    pub bad_stuffing: u32,
+}
+
+/// The reply a status decoder waits for: from `id`, with `params`
+/// parameter bytes after ERROR (unstuffed).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Reply {
+    /// The servo asked, or [`BROADCAST_ID`] for a fast read's combined
+    /// reply.
+    pub id: u8,
+    /// Parameter bytes of its status packet
+    /// ([`super::instruction::Instruction::reply_params`]; for a fast
+    /// reply [`super::fast::fast_sync_reply_params`]).
+    pub params: u16,
+}
+
+impl Reply {
+    /// A status packet from servo `id` with `params` parameter bytes.
+    pub const fn status(id: u8, params: u16) -> Self {
+        Reply { id, params }
+    }
+
+    /// The LENGTH values this reply can have when the smallest LENGTH of
+    /// its kind is `base` (4 for status packets): `params + base`
+    /// unstuffed, and up to a third more of the stuffed bytes (INSTRUCTION
+    /// excluded, as it is never `FF`); a fast reply is never stuffed.
+    fn length_range(&self, base: u16, status: bool) -> (usize, usize) {
+        let min = self.params as usize + base as usize;
+        if status && self.id == BROADCAST_ID {
+            (min, min)
+        } else {
+            let stuffed = min - 3; // ERROR (for status) and parameters
+            (min, min - stuffed + max_stuffed_len(stuffed))
+        }
+    }
+}
+
+/// A packet type the decoder can build.
+pub trait FromFrame<const N: usize>: Sized {
+    /// Only status packets (INSTRUCTION 0x55) are accepted.
+    const STATUS_ONLY: bool;
+    /// The smallest LENGTH: INSTRUCTION (and ERROR) and the CRC.
+    const MIN_LENGTH: u16;
+    /// The packet from its ID, INSTRUCTION byte and unstuffed bytes after
+    /// INSTRUCTION (`None` if they do not fit).
+    fn from_frame(id: u8, instruction: u8, body: &[u8]) -> Option<Self>;
+}
+
+impl<const N: usize> FromFrame<N> for StatusPacket<N> {
+    const STATUS_ONLY: bool = true;
+    const MIN_LENGTH: u16 = 4;
+    fn from_frame(id: u8, _instruction: u8, body: &[u8]) -> Option<Self> {
+        let (&error, params) = body.split_first()?;
+        Some(StatusPacket { id, error: StatusError(error), params: Vec::from_slice(params).ok()? })
+    }
+}
+
+impl<const N: usize> FromFrame<N> for InstructionPacket<N> {
+    const STATUS_ONLY: bool = false;
+    const MIN_LENGTH: u16 = 3;
+    fn from_frame(id: u8, instruction: u8, body: &[u8]) -> Option<Self> {
+        Some(InstructionPacket { id, instruction, params: Vec::from_slice(body).ok()? })
+    }
+}
+
+/// Incremental decoder of packets `P` of up to `N` bytes (header to CRC,
+/// as received). Feed it bytes with [`push`](Self::push) or
+/// [`feed`](Self::feed).
+///
+/// `N` must hold the smallest status packet, 11 bytes; a smaller decoder
+/// could never complete one. Such a decoder does not compile:
+///
+/// ```compile_fail
+/// let d = pada_core::dynamixel::v2::StatusDecoder::<10>::new();
+/// ```
+///
+/// ```
+/// let d = pada_core::dynamixel::v2::StatusDecoder::<11>::new();
+/// assert_eq!(d.buffered(), 0);
+/// ```
+#[derive(Debug, Clone)]
+pub struct Decoder<P, const N: usize> {
+    buf: [u8; N],
+    len: usize,
+    stats: DecoderStats,
+    expected: Option<Reply>,
+    _packet: PhantomData<fn() -> P>,
+}
+
+/// The firmware's decoder of status packets.
+pub type StatusDecoder<const N: usize = DEFAULT_PACKET_LEN> = Decoder<StatusPacket<N>, N>;
+/// A servo's (or the bus emulator's) decoder of instruction packets.
+pub type InstructionDecoder<const N: usize = DEFAULT_PACKET_LEN> = Decoder<InstructionPacket<N>, N>;
+
+impl<P: FromFrame<N>, const N: usize> Default for Decoder<P, N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<P: FromFrame<N>, const N: usize> Decoder<P, N> {
+    /// A decoder that accepts any ID and length; `N` below 11 is a
+    /// compile-time error naming the valid range.
+    pub const fn new() -> Self {
+        const {
+            assert!(
+                N >= STATUS_OVERHEAD,
+                "Decoder capacity N is too small: valid is N >= 11 (STATUS_OVERHEAD: header, ID, LENGTH, 0x55, ERROR, CRC)"
+            )
+        };
+        Decoder { buf: [0; N], len: 0, stats: DecoderStats {
+            packets: 0, skipped_bytes: 0, bad_crcs: 0, bad_lengths: 0, unexpected_ids: 0, not_status: 0, bad_stuffing: 0,
+        }, expected: None, _packet: PhantomData }
+    }
+
+    /// Accept only `reply` (`None`: any packet). A status decoder is told
+    /// before every request that has one reply. For a sync or bulk read,
+    /// whose replies follow one another, drive it with
+    /// [`push`](Self::push) and set the next servo's reply after each
+    /// accepted packet, before [`poll`](Self::poll) looks at the bytes
+    /// already buffered (or expect `None` and check the IDs afterwards).
+    pub fn expect(&mut self, reply: Option<Reply>) {
+        self.expected = reply;
+    }
+
+    /// Drops any partial packet (e.g. after a timeout, before the next
+    /// request); the dropped bytes count as skipped.
+    pub fn reset(&mut self) {
+        self.skip(self.len);
+    }
+
+    /// Counters since creation.
+    pub fn stats(&self) -> DecoderStats {
+        self.stats
+    }
+
+    /// Bytes held for a packet not yet complete.
+    pub fn buffered(&self) -> usize {
+        self.len
+    }
+
+    fn skip(&mut self, n: usize) {
+        let n = n.min(self.len);
+        self.stats.skipped_bytes = self.stats.skipped_bytes.saturating_add(n as u32);
+        self.buf.copy_within(n..self.len, 0);
+        self.len -= n;
+    }
+
+    /// Counts a refusal (through `counter`), drops `drop` bytes and
+    /// returns the error.
+    fn refuse(
+        &mut self,
+        counter: fn(&mut DecoderStats) -> &mut u32,
+        drop: usize,
+        e: DecodeError,
+    ) -> Option<Result<P, DecodeError>> {
+        let c = counter(&mut self.stats);
+        *c = c.saturating_add(1);
+        self.skip(drop);
+        Some(Err(e))
+    }
+
+    /// Takes one byte; returns a packet or an error if this byte completed
+    /// one. After `Some`, call [`poll`](Self::poll) until `None`: the bytes
+    /// kept after an error may already hold the next packet.
+    pub fn push(&mut self, byte: u8) -> Option<Result<P, DecodeError>> {
+        if self.len >= N {
+            // Cannot happen (a candidate longer than N is refused as soon
+            // as its LENGTH is seen), but never overrun.
+            self.skip(1);
+        }
+        if let Some(slot) = self.buf.get_mut(self.len) {
+            *slot = byte;
+            self.len += 1;
+        }
+        self.poll()
+    }
+
+    /// Looks for one complete packet or error in the buffered bytes.
+    pub fn poll(&mut self) -> Option<Result<P, DecodeError>> {
+        'scan: loop {
+            // The first header byte at the front.
+            let start = self.buf[..self.len].iter().position(|&b| b == HEADER[0]).unwrap_or(self.len);
+            self.skip(start);
+            // The rest of the header, byte by byte as it arrives.
+            for (i, &h) in HEADER.iter().enumerate().skip(1) {
+                match self.buf[..self.len].get(i) {
+                    None => return None,
+                    Some(&b) if b != h => {
+                        self.skip(1);
+                        continue 'scan;
+                    }
+                    Some(_) => {}
+                }
+            }
+            let &id = self.buf[..self.len].get(4)?;
+            if id > MAX_ID && id != BROADCAST_ID {
+                return self.refuse(|s| &mut s.unexpected_ids, 1, DecodeError::InvalidId { id });
+            }
+            if let Some(r) = self.expected {
+                if id != r.id {
+                    let e = DecodeError::UnexpectedId { expected: r.id, got: id };
+                    return self.refuse(|s| &mut s.unexpected_ids, 1, e);
+                }
+            }
+            let (l0, l1) = match self.buf[..self.len].get(5..7) {
+                Some(&[l0, l1]) => (l0, l1),
+                _ => return None,
+            };
+            let length = u16::from_le_bytes([l0, l1]);
+            let total = PREFIX_LEN + length as usize;
+            let in_window = self.expected.is_none_or(|r| {
+                let (min, max) = r.length_range(P::MIN_LENGTH, P::STATUS_ONLY);
+                (min..=max).contains(&(length as usize))
+            });
+            if length < P::MIN_LENGTH || total > N || !in_window {
+                return self.refuse(|s| &mut s.bad_lengths, 1, DecodeError::BadLength { id, length });
+            }
+            let &instruction = self.buf[..self.len].get(PREFIX_LEN)?;
+            if P::STATUS_ONLY && instruction != STATUS {
+                return self.refuse(|s| &mut s.not_status, 1, DecodeError::NotStatus { id, instruction });
+            }
+            if instruction == STATUS && length < 4 {
+                // A status packet without its ERROR byte.
+                return self.refuse(|s| &mut s.bad_lengths, 1, DecodeError::BadLength { id, length });
+            }
+            let packet = self.buf.get(..total).filter(|_| self.len >= total)?;
+            let (body, crc) = packet.split_at(total - 2);
+            let expected = crc16(body);
+            let got = u16::from_le_bytes([crc.first().copied().unwrap_or(0), crc.get(1).copied().unwrap_or(0)]);
+            if expected != got {
+                return self.refuse(|s| &mut s.bad_crcs, 1, DecodeError::BadCrc { id, expected, got });
+            }
+            // From here on it is a packet: refusals drop all of it.
+            let payload = body.get(PREFIX_LEN..).unwrap_or_default();
+            let mut plain: Vec<u8, N> = Vec::new();
+            let ok = if is_stuffed(id, instruction) {
+                destuff(payload, &mut plain).is_ok()
+            } else {
+                plain.extend_from_slice(payload).is_ok()
+            };
+            // INSTRUCTION (and ERROR) precede the parameters.
+            let params_ok = self.expected.is_none_or(|r| plain.len() == r.params as usize + P::MIN_LENGTH as usize - 2);
+            let packet = if ok { plain.get(1..).and_then(|b| P::from_frame(id, instruction, b)) } else { None };
+            match packet {
+                None => return self.refuse(|s| &mut s.bad_stuffing, total, DecodeError::BadStuffing { id }),
+                Some(_) if !params_ok => {
+                    return self.refuse(|s| &mut s.bad_lengths, total, DecodeError::BadLength { id, length })
+                }
+                Some(p) => {
+                    self.buf.copy_within(total..self.len, 0);
+                    self.len -= total;
+                    self.stats.packets = self.stats.packets.saturating_add(1);
+                    return Some(Ok(p));
+                }
+            }
+        }
+    }
+
+    /// Feeds a chunk and iterates over every packet and error in it.
+    pub fn feed<'s, 'b>(&'s mut self, bytes: &'b [u8]) -> Feed<'s, 'b, P, N> {
+        Feed { decoder: self, rest: bytes }
+    }
+}
+
+/// Iterator over the packets and errors of a chunk fed to a decoder. Bytes
+/// of an incomplete packet at the end stay in the decoder for the next chunk.
+pub struct Feed<'s, 'b, P, const N: usize> {
+    decoder: &'s mut Decoder<P, N>,
+    rest: &'b [u8],
+}
+
+impl<P: FromFrame<N>, const N: usize> Iterator for Feed<'_, '_, P, N> {
+    type Item = Result<P, DecodeError>;
+    fn next(&mut self) -> Option<Self::Item> {
+        if let Some(r) = self.decoder.poll() {
+            return Some(r);
+        }
+        while let Some((&b, rest)) = self.rest.split_first() {
+            self.rest = rest;
+            if let Some(r) = self.decoder.push(b) {
+                return Some(r);
+            }
+        }
+        None
+    }
+}
