@@ -14,6 +14,7 @@ pub mod display;
 pub mod error;
 pub mod experiment;
 pub mod foxglove;
+pub mod gearbox_spec;
 pub mod integrator;
 pub mod leo;
 pub mod mcap;

@@ -232,6 +232,112 @@ fn mtbf_of_a_known_log() {
     );
 }
 
+/// A bang-bang joint `a` (±1.5 N·m, 9 re-engagements in 10 steps) and a
+/// constant joint `b`, as in `mtbf_of_a_known_log`.
+fn bang_bang_log(dir: &Path) -> String {
+    let mut csv = String::from("a,b\n");
+    for k in 0..10 {
+        csv += &format!("{},0.7\n", if k % 2 == 0 { 1.5 } else { -1.5 });
+    }
+    write(dir, "log.csv", &csv)
+}
+
+fn mtbf_json(args: &[&str]) -> serde_json::Value {
+    let out = pada(args);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// The MTBF of joint `a` of [`bang_bang_log`] at 20 Hz with `p`.
+fn expected_mtbf(p: &pada_core::fatigue::GearboxParams) -> f64 {
+    0.5 / (9.0 * p.damage_per_reengagement(1.5))
+}
+
+const TABLE_I_FIELDS: &str = "theta_bl_rad = 0.01\nk_nm_per_rad = 106.0\nd = -0.262\nsigma_f_mpa = 4402.0\nb_mm = 4.0\nm_n_mm = 0.4\nd_w_mm = 18.5\ny_fa = 2.15\ny_sa = 2.0\ny_epsilon = 1.22\ny_beta = 1.0\nteeth = 45\n";
+
+#[test]
+fn mtbf_default_gearbox_is_table_i_and_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = bang_bang_log(dir.path());
+    let v = mtbf_json(&["mtbf", "--torques", &log, "--rate", "20", "--json"]);
+    let g = &v["joints"][0]["gearbox"];
+    assert_eq!(g["name"], "RX-28");
+    assert_eq!(g["estimate"], false);
+    assert_eq!(v["gearbox_estimate"], false);
+    let mtbf = v["joints"][0]["report"]["mtbf_s"].as_f64().unwrap();
+    let want = expected_mtbf(&pada_core::fatigue::GearboxParams::TABLE_I);
+    assert!((mtbf / want - 1.0).abs() < 1e-9, "{mtbf} vs {want}");
+    let text = String::from_utf8_lossy(&pada(&["mtbf", "--torques", &log]).stdout).into_owned();
+    assert!(text.contains("gearbox: RX-28 (Table I of the paper, measured)"), "{text}");
+    assert!(!text.contains("estimate"), "{text}");
+}
+
+#[test]
+fn mtbf_named_gearbox_is_used_and_marked_an_estimate() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = bang_bang_log(dir.path());
+    let v = mtbf_json(&["mtbf", "--torques", &log, "--rate", "20", "--gearbox", "xm430-w350", "--json"]);
+    for j in 0..2 {
+        assert_eq!(v["joints"][j]["gearbox"]["name"], "XM430-W350");
+        assert_eq!(v["joints"][j]["gearbox"]["estimate"], true);
+    }
+    assert_eq!(v["gearbox_estimate"], true);
+    let xm = pada_core::servo::gearbox("XM430-W350").unwrap().params;
+    let mtbf = v["joints"][0]["report"]["mtbf_s"].as_f64().unwrap();
+    assert!((mtbf / expected_mtbf(&xm) - 1.0).abs() < 1e-9, "{mtbf}");
+    assert!(mtbf < expected_mtbf(&pada_core::fatigue::GearboxParams::TABLE_I), "a smaller gear wears faster");
+    let text = String::from_utf8_lossy(&pada(&["mtbf", "--torques", &log, "--gearbox", "XM430-W350"]).stdout).into_owned();
+    assert!(text.contains("XM430-W350 (its last gear's geometry is an estimate"), "{text}");
+    assert!(text.contains("XM430-W350 (estimate)"), "{text}");
+    // One per joint, in the log's order.
+    let v = mtbf_json(&["mtbf", "--torques", &log, "--gearbox", "RX-28,XL330-M288", "--json"]);
+    assert_eq!(v["joints"][0]["gearbox"]["name"], "RX-28");
+    assert_eq!(v["joints"][1]["gearbox"]["name"], "XL330-M288");
+    assert_eq!(v["gearbox_estimate"], true);
+}
+
+#[test]
+fn mtbf_gearbox_file_is_read_and_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = bang_bang_log(dir.path());
+    let fields = TABLE_I_FIELDS.replace("b_mm = 4.0", "b_mm = 3.0");
+    let file = write(dir.path(), "mine.toml", &format!("name = \"my servo\"\n{fields}"));
+    let v = mtbf_json(&["mtbf", "--torques", &log, "--rate", "20", "--gearbox", &file, "--json"]);
+    assert_eq!(v["joints"][0]["gearbox"]["name"], "my servo");
+    assert_eq!(v["joints"][0]["gearbox"]["estimate"], false);
+    assert_eq!(v["joints"][0]["gearbox"]["source"], file.as_str());
+    let p = pada_core::fatigue::GearboxParams { b_mm: 3.0, ..pada_core::fatigue::GearboxParams::TABLE_I };
+    let mtbf = v["joints"][0]["report"]["mtbf_s"].as_f64().unwrap();
+    assert!((mtbf / expected_mtbf(&p) - 1.0).abs() < 1e-9, "{mtbf}");
+}
+
+#[test]
+fn mtbf_gearbox_errors_name_the_problem_and_the_valid_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = bang_bang_log(dir.path());
+    assert_bad_input(
+        &["mtbf", "--torques", &log, "--gearbox", "XM430-W999"],
+        &["unknown gearbox \"XM430-W999\"", "RX-28", "MX-28", "XM430-W350", "XL430-W250", "XL330-M288", "TOML"],
+    );
+    let bad = write(dir.path(), "bad.toml", &TABLE_I_FIELDS.replace("b_mm = 4.0", "b_mm = -4.0"));
+    assert_bad_input(&["mtbf", "--torques", &log, "--gearbox", &bad], &[&bad, "b_mm = -4", "0 < b_mm < inf (mm)"]);
+    let zero = write(dir.path(), "zero.toml", &TABLE_I_FIELDS.replace("teeth = 45", "teeth = 0"));
+    assert_bad_input(&["mtbf", "--torques", &log, "--gearbox", &zero], &[&zero, "teeth", "teeth >= 1"]);
+    let typo = write(dir.path(), "typo.toml", &format!("{TABLE_I_FIELDS}teeht = 4\n"));
+    assert_bad_input(&["mtbf", "--torques", &log, "--gearbox", &typo], &[&typo, "line 13", "teeht"]);
+    let missing = write(dir.path(), "missing.toml", &TABLE_I_FIELDS.replace("d_w_mm = 18.5\n", ""));
+    assert_bad_input(&["mtbf", "--torques", &log, "--gearbox", &missing], &[&missing, "d_w_mm"]);
+    let nowhere = dir.path().join("nowhere.toml");
+    assert_bad_input(
+        &["mtbf", "--torques", &log, "--gearbox", nowhere.to_str().unwrap()],
+        &["cannot read gearbox file", "nowhere.toml"],
+    );
+    assert_bad_input(
+        &["mtbf", "--torques", &log, "--gearbox", "RX-28,RX-28,RX-28"],
+        &["--gearbox has 3 entries for 2 joints", "one per joint"],
+    );
+}
+
 #[test]
 fn run_json_prints_the_summary_and_writes_the_files() {
     let dir = tempfile::tempdir().unwrap();

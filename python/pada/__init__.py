@@ -32,7 +32,7 @@ __all__ = [
 class Fatigue(_pada.Fatigue):
     """The fatigue counter of every gearbox of a robot (Eqs. 3–7, Table I).
 
-    ``Fatigue(joints, rate_hz, *, torque_per_volt=None, window=1200)``
+    ``Fatigue(joints, rate_hz, *, torque_per_volt=None, window=1200, gearbox=None)``
 
     - ``joints``: gearboxes counted (1–64); ``rate_hz``: control steps per
       second (0 < rate_hz <= 1e6).
@@ -40,6 +40,15 @@ class Fatigue(_pada.Fatigue):
       gear torque is ``torque_per_volt * U`` (the paper's linear law, Section
       IV; ``pada.RX28_TORQUE_PER_VOLT`` for LEO's RX-28 servos).
     - ``window``: the paper's MTBF is over the first ``window`` steps (1200).
+    - ``gearbox``: each gearbox's last gear (Eqs. 3–7). ``None`` is Table I
+      (the RX-28's); a name of pada's table (``"RX-28"``, ``"MX-28"``,
+      ``"XM430-W350"``, ``"XL430-W250"``, ``"XL330-M288"``), a TOML file's
+      path, or a dict of the Table I fields (``theta_bl_rad``,
+      ``k_nm_per_rad``, ``d``, ``sigma_f_mpa``, ``b_mm``, ``m_n_mm``,
+      ``d_w_mm``, ``y_fa``, ``y_sa``, ``y_epsilon``, ``y_beta``, ``teeth``)
+      applies to every gearbox; a list gives one per gearbox. Every gearbox
+      but the RX-28's is an estimate (``gearbox_estimate``; see
+      docs/reference/servos.md), and so is its MTBF.
 
     ``add(torques)`` counts one step (one value per gearbox, a number for
     one gearbox); ``add_many(array)`` a whole ``(steps, joints)`` array.
@@ -51,7 +60,8 @@ class Fatigue(_pada.Fatigue):
     ``report()`` returns a dict with the per-gearbox lists
     ``reengagements``, ``damage``, ``mtbf_s`` and their ``window_*``
     counterparts, and ``robot_mtbf_s`` / ``robot_window_mtbf_s`` (the
-    weakest gearbox), as ``pada mtbf`` reports them. Torques are counted in
+    weakest gearbox), as ``pada mtbf`` reports them, and ``gearbox`` /
+    ``gearbox_estimate`` (each gearbox's name and whether it is an estimate). Torques are counted in
     float32, as ``pada mtbf`` reads its log, so the figures are bit for bit
     ``pada mtbf``'s on the same torques. NaN or a wrong shape raises
     ``ValueError`` and counts nothing.

@@ -1,12 +1,15 @@
-//! `pada.Fatigue`: the learning core's fatigue counter (Eqs. 3–7, Table I)
-//! per gearbox, fed one step's torques at a time or a whole array, with the
-//! figures `pada mtbf` reports.
+//! `pada.Fatigue`: the learning core's fatigue counter (Eqs. 3–7) per
+//! gearbox, fed one step's torques at a time or a whole array, with the
+//! figures `pada mtbf` reports. Each gearbox is Table I's (the RX-28's)
+//! unless `gearbox=` names another of pada's table, a TOML file, or gives
+//! the fields as a dict.
 
 use crate::check;
-use pada_core::fatigue::{FatigueReport, GearboxParams, JointFatigue, PAPER_WINDOW_STEPS};
+use pada::gearbox_spec::{self, ChosenGearbox, GearboxFile};
+use pada_core::fatigue::{FatigueReport, JointFatigue, PAPER_WINDOW_STEPS};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyList, PyString, PyTuple};
 
 /// Most gearboxes one counter follows.
 pub const MAX_COUNTED_JOINTS: i64 = 64;
@@ -25,6 +28,7 @@ pub const MAX_COUNTED_JOINTS: i64 = 64;
 #[pyclass(name = "Fatigue", module = "pada", subclass)]
 pub struct Fatigue {
     joints: Vec<JointFatigue>,
+    gearboxes: Vec<ChosenGearbox>,
     rate_hz: f64,
     torque_per_volt: Option<f64>,
     window: u32,
@@ -35,12 +39,14 @@ pub struct Fatigue {
 }
 
 impl Fatigue {
-    /// A counter of `joints` gearboxes; the arguments checked.
+    /// A counter of `joints` gearboxes; the arguments checked. `gearboxes`
+    /// holds one per gearbox, or is empty for Table I's everywhere.
     pub fn build(
         joints: i64,
         rate_hz: f64,
         torque_per_volt: Option<f64>,
         window: i64,
+        gearboxes: Vec<ChosenGearbox>,
     ) -> PyResult<Fatigue> {
         let n = check::count("joints", joints, 1, MAX_COUNTED_JOINTS)?;
         let rate_hz = check::rate_hz("rate_hz", rate_hz)?;
@@ -54,15 +60,27 @@ impl Fatigue {
             }
         }
         let window = check::count("window", window, 1, u32::MAX as i64)? as u32;
+        let gearboxes = if gearboxes.is_empty() {
+            vec![ChosenGearbox::table_i(); n]
+        } else {
+            gearboxes
+        };
+        if gearboxes.len() != n {
+            return Err(PyValueError::new_err(format!(
+                "gearbox: {} gearboxes for {n} joints: valid is one for every joint or one per joint",
+                gearboxes.len()
+            )));
+        }
         let mut v = Vec::with_capacity(n);
-        for _ in 0..n {
+        for g in &gearboxes {
             v.push(
-                JointFatigue::new(&GearboxParams::TABLE_I, Some(window))
+                JointFatigue::new(&g.params, Some(window))
                     .map_err(|e| PyValueError::new_err(format!("window: {e}")))?,
             );
         }
         Ok(Fatigue {
             joints: v,
+            gearboxes,
             rate_hz,
             torque_per_volt,
             window,
@@ -135,6 +153,50 @@ impl Fatigue {
     }
 }
 
+/// One gearbox from Python: a name of pada's table or a TOML file's path
+/// (a str), or the Table I fields (a dict).
+fn one_gearbox(obj: &Bound<'_, PyAny>) -> PyResult<ChosenGearbox> {
+    if let Ok(s) = obj.cast::<PyString>() {
+        let spec = s.to_cow()?;
+        return gearbox_spec::resolve(&spec).map_err(|e| PyValueError::new_err(format!("gearbox: {e}")));
+    }
+    if obj.cast::<PyDict>().is_ok() {
+        let json: String = obj
+            .py()
+            .import("json")?
+            .call_method1("dumps", (obj,))?
+            .extract()?;
+        let file: GearboxFile = serde_json::from_str(&json)
+            .map_err(|e| PyValueError::new_err(format!("gearbox: {e}")))?;
+        return file
+            .check("gearbox")
+            .map_err(PyValueError::new_err);
+    }
+    Err(PyValueError::new_err(format!(
+        "gearbox: {} is not a gearbox: valid is a name of pada's table, a TOML file, or a dict of the Table I fields",
+        obj.get_type().name()?
+    )))
+}
+
+/// `gearbox=`: `None` (Table I everywhere), one gearbox for every joint, or
+/// a list/tuple of one per joint.
+pub fn gearboxes_from_py(obj: Option<&Bound<'_, PyAny>>, joints: i64) -> PyResult<Vec<ChosenGearbox>> {
+    let Some(obj) = obj else { return Ok(Vec::new()) };
+    if obj.is_none() {
+        return Ok(Vec::new());
+    }
+    let items: Vec<Bound<'_, PyAny>> = if let Ok(l) = obj.cast::<PyList>() {
+        l.iter().collect()
+    } else if let Ok(t) = obj.cast::<PyTuple>() {
+        t.iter().collect()
+    } else {
+        let g = one_gearbox(obj)?;
+        let n = joints.max(0) as usize;
+        return Ok(vec![g; n]);
+    };
+    items.iter().map(one_gearbox).collect()
+}
+
 fn reports(f: &Fatigue) -> Vec<FatigueReport> {
     let p = f.period_s();
     f.joints.iter().map(|j| j.report(p)).collect()
@@ -143,9 +205,29 @@ fn reports(f: &Fatigue) -> Vec<FatigueReport> {
 #[pymethods]
 impl Fatigue {
     #[new]
-    #[pyo3(signature = (joints, rate_hz, *, torque_per_volt=None, window=PAPER_WINDOW_STEPS as i64))]
-    fn new(joints: i64, rate_hz: f64, torque_per_volt: Option<f64>, window: i64) -> PyResult<Self> {
-        Fatigue::build(joints, rate_hz, torque_per_volt, window)
+    #[pyo3(signature = (joints, rate_hz, *, torque_per_volt=None, window=PAPER_WINDOW_STEPS as i64, gearbox=None))]
+    fn new(
+        joints: i64,
+        rate_hz: f64,
+        torque_per_volt: Option<f64>,
+        window: i64,
+        gearbox: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let gearboxes = gearboxes_from_py(gearbox, joints)?;
+        Fatigue::build(joints, rate_hz, torque_per_volt, window, gearboxes)
+    }
+
+    /// Each gearbox's name (Table I's is "RX-28").
+    #[getter]
+    fn gearbox(&self) -> Vec<String> {
+        self.gearboxes.iter().map(|g| g.name.clone()).collect()
+    }
+
+    /// Per gearbox, whether its last gear's geometry is an estimate (then so
+    /// is its MTBF; docs/reference/servos.md).
+    #[getter]
+    fn gearbox_estimate(&self) -> Vec<bool> {
+        self.gearboxes.iter().map(|g| g.estimate).collect()
     }
 
     /// Counts one control step: `torques` holds one value per gearbox (a
@@ -313,6 +395,8 @@ impl Fatigue {
         )?;
         d.set_item("window_mtbf_s", wm)?;
         d.set_item("robot_mtbf_s", self.robot_mtbf_s())?;
+        d.set_item("gearbox", self.gearbox())?;
+        d.set_item("gearbox_estimate", self.gearbox_estimate())?;
         Ok(d)
     }
 

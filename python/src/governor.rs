@@ -80,7 +80,7 @@ impl WearGovernor {
         };
         let governor = Governor::new(&kind, &motor, &config)
             .map_err(|e| PyValueError::new_err(format!("mtbf_budget: {e}")))?;
-        let fatigue = Fatigue::build(n as i64, rate_hz, None, PAPER_WINDOW_STEPS as i64)?;
+        let fatigue = Fatigue::build(n as i64, rate_hz, None, PAPER_WINDOW_STEPS as i64, Vec::new())?;
         Ok(WearGovernor {
             governor,
             fatigue,

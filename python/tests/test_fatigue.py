@@ -114,3 +114,77 @@ def test_bad_input_names_the_argument_and_range():
     with pytest.raises(ValueError, match=r"(?i)torques\[2, 0\] = nan"):
         f.add_many(np.array([[0, 0], [1, 1], [np.nan, 0]]))
     assert f.steps == 0, "a refused input counts nothing"
+
+
+TABLE_I = {
+    "theta_bl_rad": 0.01, "k_nm_per_rad": 106.0, "d": -0.262, "sigma_f_mpa": 4402.0,
+    "b_mm": 4.0, "m_n_mm": 0.4, "d_w_mm": 18.5, "y_fa": 2.15, "y_sa": 2.0,
+    "y_epsilon": 1.22, "y_beta": 1.0, "teeth": 45,
+}
+
+
+def test_default_gearbox_is_table_i():
+    f = pada.Fatigue(2, 20.0)
+    assert f.gearbox == ["RX-28", "RX-28"]
+    assert f.gearbox_estimate == [False, False]
+    g = pada.Fatigue(2, 20.0, gearbox="rx-28")
+    h = pada.Fatigue(2, 20.0, gearbox=dict(TABLE_I))
+    for row in [[1.5, -0.3], [-1.5, 0.3]] * 40:
+        f.add(row)
+        g.add(row)
+        h.add(row)
+    assert f.damage == g.damage == h.damage
+    assert f.report()["gearbox"] == ["RX-28", "RX-28"]
+
+
+def test_named_gearbox_equals_pada_mtbf_gearbox(tmp_path, pada_bin):
+    rng = np.random.default_rng(5)
+    torques = rng.choice([-1.2, 0.0, 1.2], size=(800, 2)).astype(np.float32)
+    log = tmp_path / "log.csv"
+    write_log(log, torques, ["a", "b"])
+    out = json.loads(run_pada(pada_bin, "mtbf", "--torques", str(log), "--rate", "20",
+                              "--gearbox", "XM430-W350,XL330-M288", "--json"))
+    f = pada.Fatigue(2, 20.0, gearbox=["xm430-w350", "XL330-M288"])
+    f.add_many(torques)
+    r = f.report()
+    assert r["gearbox"] == ["XM430-W350", "XL330-M288"]
+    assert r["gearbox_estimate"] == [True, True]
+    for j, joint in enumerate(out["joints"]):
+        assert joint["gearbox"]["name"] == r["gearbox"][j]
+        assert joint["gearbox"]["estimate"] is True
+        assert joint["report"]["damage"] == r["damage"][j]
+        assert joint["report"]["reengagements"] == r["reengagements"][j]
+    # A different gearbox gives a different damage for the same torques.
+    t = pada.Fatigue(2, 20.0)
+    t.add_many(torques)
+    assert t.damage[0] != r["damage"][0]
+
+
+def test_gearbox_file_and_dict_agree(tmp_path, pada_bin):
+    fields = dict(TABLE_I, b_mm=3.0)
+    toml = "\n".join(f"{k} = {v!r}" for k, v in fields.items()) + "\n"
+    path = tmp_path / "mine.toml"
+    path.write_text(toml)
+    torques = np.array([[1.5], [-1.5]] * 30, dtype=np.float32)
+    log = tmp_path / "log.csv"
+    write_log(log, torques, ["a"])
+    out = json.loads(run_pada(pada_bin, "mtbf", "--torques", str(log), "--gearbox", str(path), "--json"))
+    f = pada.Fatigue(1, 20.0, gearbox=str(path))
+    g = pada.Fatigue(1, 20.0, gearbox=fields)
+    f.add_many(torques)
+    g.add_many(torques)
+    assert f.damage == g.damage
+    assert out["joints"][0]["report"]["damage"] == f.damage[0]
+
+
+def test_bad_gearbox_names_the_problem():
+    with pytest.raises(ValueError, match=r"gearbox: unknown gearbox \"XM999\": valid are RX-28, MX-28, XM430-W350, XL430-W250, XL330-M288"):
+        pada.Fatigue(1, 20.0, gearbox="XM999")
+    with pytest.raises(ValueError, match=r"gearbox: invalid b_mm = -1: valid is 0 < b_mm < inf \(mm\)"):
+        pada.Fatigue(1, 20.0, gearbox=dict(TABLE_I, b_mm=-1.0))
+    with pytest.raises(ValueError, match=r"gearbox: missing field `teeth`"):
+        pada.Fatigue(1, 20.0, gearbox={k: v for k, v in TABLE_I.items() if k != "teeth"})
+    with pytest.raises(ValueError, match=r"gearbox: 2 gearboxes for 3 joints"):
+        pada.Fatigue(3, 20.0, gearbox=["RX-28", "MX-28"])
+    with pytest.raises(ValueError, match=r"gearbox: int is not a gearbox"):
+        pada.Fatigue(1, 20.0, gearbox=3)

@@ -45,7 +45,10 @@
 //!   torque enable;
 //! - [`limits`]: the capacities, each defined once;
 //! - [`rx28`]: the RX-28 servo's voltage-driven motor model (shared by the
-//!   LEO simulator and the firmware's torque estimate).
+//!   LEO simulator and the firmware's torque estimate);
+//! - [`servo`]: servos and gearboxes as data: the servo models (datasheet
+//!   figures with their sources, the DC motor derived from them) and each
+//!   one's last gear for Eqs. 3–7, estimates marked.
 //!
 //! Section and equation numbers refer to Meijdam, Plooij and Caarls,
 //! "Learning while preventing mechanical failure due to random motions".
@@ -77,6 +80,7 @@ pub mod rng;
 pub mod robot;
 pub mod rx28;
 pub mod safety;
+pub mod servo;
 pub mod tile_coding;
 mod tiling;
 pub mod trace;
