@@ -366,7 +366,8 @@ mod tests {
         fn whole_key_hash<W: WeightStore>(p: &LearnerProfile, a: &Agent<W, 4, 8>) -> u32 {
             let mut h = ConfigHasher::new();
             h.write_u32(CONFIG_HASH_VERSION)
-                .write_str(p.robot.name())
+                .write_str(p.robot.name)
+                .write_u32(p.robot.definition_hash())
                 .write_str(p.board.name())
                 .write_u32(p.layout.code())
                 .write_u32(a.weights().len() as u32)
@@ -375,7 +376,7 @@ mod tests {
             a.write_config(&mut h);
             h.finish()
         }
-        let p = Board::F405.profile(Robot::Leo);
+        let p = Board::F405.profile(&leo::SPEC).unwrap();
         let small16 = agent(Tags16(vec![0u16; 1 << 14]));
         let large16 = agent(Tags16(vec![0u16; 1 << 17]));
         let small32 = agent(Tags32(vec![0u32; 1 << 14]));
