@@ -1,4 +1,4 @@
-//! The A/B table of `host/src/leo/README.md`: the largest angle error
+//! The A/B table of `sim/src/leo/README.md`: the largest angle error
 //! (rad, torso and the seven joints) over the first 0.2 s, or until the
 //! framework's first touchdown if that comes sooner, of pada's LEO driven
 //! open loop by each reference of `tests/data/leo-ab/` (every servo's

@@ -1,7 +1,7 @@
 //! Step-size study for the LEO model (README.md table): for each
 //! (physics steps per control period, rapier solver iterations) it measures
 //! the passive fall against the same settings at half the step (the
-//! convergence criterion of host/src/leo/README.md), accuracy under random actions against a fine
+//! convergence criterion of sim/src/leo/README.md), accuracy under random actions against a fine
 //! reference, the sanity checks, then speed.
 //!
 //! cargo run --release -p pada --example leo_stepsize [-- quick]

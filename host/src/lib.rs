@@ -1,7 +1,9 @@
-//! pada on the host: the plants, the experiment runner of Section VI, the
-//! paper's pendulum experiments (Section VII), the LEO biped in rapier3d
-//! (Section VIII, [`leo`]), plots and the fatigue check of a recorded
-//! torque log.
+//! pada on the host: the experiment runner of Section VI, the paper's
+//! experiments (Sections VII and VIII), plots, the fatigue check of a
+//! recorded torque log, telemetry capture, the software-in-the-loop run
+//! and the `pada` command. The simulator (the pendulums, LEO in rapier3d,
+//! the rigs) is the crate `pada_sim`, re-exported here under its module
+//! names.
 
 #![warn(missing_docs)]
 
@@ -14,18 +16,14 @@ pub mod display;
 pub mod error;
 pub mod experiment;
 pub mod foxglove;
+pub mod gait;
 pub mod gearbox_spec;
-pub mod integrator;
-pub mod leo;
 pub mod mcap;
-pub mod model_presets;
 pub mod output;
 pub mod paper;
-pub mod pendulum;
 pub mod plan;
 pub mod plot;
 pub mod progress;
-pub mod rig;
 pub mod robots;
 pub mod seed;
 pub mod serial_link;
@@ -38,3 +36,5 @@ pub mod timing;
 pub mod torque_log;
 pub mod watch;
 pub mod weights;
+
+pub use pada_sim::{integrator, leo, model_presets, pendulum, rig};

@@ -6,8 +6,8 @@
 //! `tests/data/sil-pendulum-3s.bin` (repository root) is the raw USART2 stream of
 //! `pada sil --task pendulum --seconds 3` (telemetry.bin; wire protocol 9).
 //! Regenerate it with that command when the wire format changes.
-//! `tests/data/sil-pendulum-3s-protocol7.bin` is the same run recorded by
-//! an older pada (protocol 7), which a capture refuses in one line.
+//! `tests/data/sil-pendulum-3s-protocol8.bin` is the same run recorded by
+//! an older pada (protocol 8), which a capture refuses in one line.
 
 mod common;
 use common::{capture_json, damaged, frames, plug_at, raw_pty};
@@ -170,10 +170,10 @@ fn capture_from_a_file_counts_the_same() {
 
 #[test]
 fn a_recording_of_an_older_protocol_is_refused_in_one_line() {
-    let old = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/sil-pendulum-3s-protocol7.bin");
+    let old = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/sil-pendulum-3s-protocol8.bin");
     common::assert_bad_input(
         &["capture", "--file", old],
-        &["telemetry protocol 7", "this pada reads protocol 9", "an older pada wrote it"],
+        &["telemetry protocol 8", "this pada reads protocol 9", "an older pada wrote it"],
     );
 }
 

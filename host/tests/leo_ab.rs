@@ -5,7 +5,7 @@
 //!
 //! Under actuation the model's default step (4 physics steps per control
 //! period) still lags the reference: the largest error over the first
-//! 0.2 s is 0.015–0.041 rad (`host/src/leo/README.md`, "Against the
+//! 0.2 s is 0.015–0.041 rad (`sim/src/leo/README.md`, "Against the
 //! framework under actuation"). Most of the first-order error was the
 //! dry friction's break-away, seen one physics step late after each
 //! voltage change; a joint now breaks away at the change
@@ -15,7 +15,7 @@
 //! steps per period; the touchdown test checks the default step.
 //!
 //! The tolerances come from the model's step-size study
-//! (`host/src/leo/README.md`), not from these references:
+//! (`sim/src/leo/README.md`), not from these references:
 //! - [`STEP_TOLERANCE`]: 0.02 rad, the study's convergence criterion (the
 //!   torso may move by less than 0.02 rad when the step is halved);
 //! - [`HORIZON_STEPS`]: 6 control steps (0.2 s), the horizon of the

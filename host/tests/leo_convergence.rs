@@ -2,7 +2,7 @@
 //! the step, dry friction holds a joint whose load stays below it at any
 //! step, and the stance foot does not slide on the floor.
 //!
-//! The measured values behind each bound are in `host/src/leo/README.md`
+//! The measured values behind each bound are in `sim/src/leo/README.md`
 //! ("Step size").
 
 use pada::leo::constants::*;

@@ -1,7 +1,7 @@
 //! Sanity checks of the LEO model, against `docs/reference/grl.md` §1–3.
 //!
 //! Each test states its bound; the measured values at the default settings
-//! are recorded in `host/src/leo/README.md`.
+//! are recorded in `sim/src/leo/README.md`.
 
 use pada::leo::constants::*;
 use pada::leo::model::*;

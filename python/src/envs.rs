@@ -1,12 +1,12 @@
 //! `pada._pada.PlantEnv`: one of pada's simulated robots stepped as
-//! `pada run` steps it — the plant of the task (`pada::experiment::task`),
+//! `pada run` steps it — the plant of the task (`pada_sim::task`),
 //! the motor's levels (or continuous commands), the task's time limit —
 //! for the Gymnasium environments of `pada.envs`.
 
 use crate::check;
-use pada::experiment::task::{Plant, Task, TaskSpec};
-use pada::leo::rl::{LeoPlant, LeoTask};
-use pada::pendulum::{
+use pada_sim::task::{Plant, Task, TaskSpec};
+use pada_sim::leo::rl::{LeoPlant, LeoTask};
+use pada_sim::pendulum::{
     PhysicalPendulum, PhysicalPendulumTask, SimulatedPendulum, SimulatedPendulumTask,
 };
 use pada_core::action_space::{Levels, MAX_ACTION_DIMS};

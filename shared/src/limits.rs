@@ -10,6 +10,7 @@
 //! | [`MAX_ACTION_DIMS`] | 4 | a robot's motor outputs (LEO learns 3); a `Step`'s outputs |
 //! | [`MAX_LEVELS`] | 16 | levels of one action dimension (the paper's 7 on LEO) |
 //! | [`MAX_SERVOS`] | 8 | servos on one robot's bus (LEO's 7 and one spare): the soft limits, the servo temperatures a `Health` report carries, and the learner-state record's fatigue counters, one per servo |
+//! | [`MAX_ROBOT_NAME`] | 32 | bytes of a robot's name in `Hello` and the software-in-the-loop link |
 //! | [`MAX_GEARBOXES`] | 4 | gearboxes a robot counts for the paper's MTBF (LEO's hips and knees); a `Step`'s fatigue entries |
 //!
 //! The learner-state record's room for fatigue counters
@@ -24,6 +25,9 @@ pub const MAX_ACTION_DIMS: usize = 4;
 pub const MAX_LEVELS: usize = 16;
 /// Servos on one robot's bus (LEO has seven).
 pub const MAX_SERVOS: usize = 8;
+/// Bytes of a robot's name (`crate::robot::RobotSpec::name`), as the
+/// wire's `Hello` and the software-in-the-loop link carry it.
+pub const MAX_ROBOT_NAME: usize = 32;
 /// Gearboxes whose wear a robot counts (LEO's four: hips and knees).
 pub const MAX_GEARBOXES: usize = 4;
 

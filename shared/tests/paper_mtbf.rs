@@ -28,7 +28,7 @@ fn random_leo_actions_give_the_hand_calculated_mtbf() {
     let expected_mtbf = 1200.0 * period / (expected_reengagements * mean_damage);
     assert!((250.0..800.0).contains(&expected_mtbf), "hand calculation {expected_mtbf} s");
     assert!((commanded_gear_torque(10.7) - 1.786).abs() < 0.01);
-    assert_eq!(SPEC.paper_torque.torque(0, -5.0), commanded_gear_torque(-5.0));
+    assert_eq!(SPEC.paper_gear_torque(0, -5.0), commanded_gear_torque(-5.0));
 
     let mut mtbfs = Vec::new();
     for seed in 0..20 {

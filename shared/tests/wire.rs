@@ -310,15 +310,16 @@ fn the_protocol_version_changes_with_the_layout() {
     // A change of any message's layout changes this fingerprint: then bump
     // PROTOCOL_VERSION and put the new pair here (with the docs that name
     // the version: docs/sil.md, docs/core.md, firmware/README.md).
-    assert_eq!((PROTOCOL_VERSION, layout_fingerprint()), (8, EXPECTED_FINGERPRINT), "{:#010x}", layout_fingerprint());
+    assert_eq!((PROTOCOL_VERSION, layout_fingerprint()), (9, EXPECTED_FINGERPRINT), "{:#010x}", layout_fingerprint());
 }
 
-/// [`layout_fingerprint`] of protocol 8 (the checkpoint the host keeps:
+/// [`layout_fingerprint`] of protocol 9 (`Hello` names the robot and its
+/// definition's hash; 8 the checkpoint the host keeps:
 /// `CheckpointChunk`, `RestoreWanted`, `Restored`, `Streamed`,
 /// `RestoreChunk`, `RestoreNone`; 7 the claim table's occupancy in
 /// `Health`; 6 added the gentle explorations in `PolicyKind`, the governor
 /// in `PolicyReport`, `SetMtbfBudget`; 5 `Step::footstep`).
-const EXPECTED_FINGERPRINT: u32 = 0xaca4_4e73;
+const EXPECTED_FINGERPRINT: u32 = 0xa210_acaf;
 
 #[test]
 fn every_chip_message_round_trips() {

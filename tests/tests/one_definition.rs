@@ -16,7 +16,7 @@ use pada::experiment::build_agent;
 use pada::experiment::table::HostTable;
 use pada::experiment::task::{Task, TaskSpec};
 use pada::leo::rl::{leo_params, LeoTask};
-use pada::robots::{board_task_spec, host_robot, DynRules};
+use pada::robots::{board_task_spec, sim_robot, DynRules};
 use pada_core::policy::PolicyKind;
 use pada_core::profile::{config_hash, Board, LearnerProfile};
 use pada_core::robot::{leo, pendulum, registry, RobotRules};
@@ -58,7 +58,7 @@ fn table_of(profile: LearnerProfile, weights: usize) -> HostTable {
 
 /// The rules of `profile`'s robot, as the host builds them.
 fn rules(profile: LearnerProfile) -> DynRules {
-    (host_robot(profile.robot).unwrap().rules)()
+    (sim_robot(profile.robot).unwrap().rules)()
 }
 
 /// The firmware controller's hash for `profile` and `policy` on a table of

@@ -42,7 +42,7 @@ use pada_core::fatigue::{FatigueCounter, GearboxParams, PAPER_WINDOW_STEPS};
 use pada_core::fixed::Q16;
 use pada_core::policy::PolicyKind;
 use pada_core::episodes::is_learning_action;
-use crate::robots::{host_robot, DynRules};
+use crate::robots::{sim_robot, DynRules};
 use pada_core::claim_table::{ClaimTable, Tags16, Tags32};
 use pada_core::profile::{LearnerProfile, TILINGS};
 use pada_core::robot::{RobotRules, RobotSpec};
@@ -155,7 +155,7 @@ pub fn run_board_trial_on(
 ) -> anyhow::Result<BoardTrial> {
     let n = table_len(&profile, cfg.policy)?;
     let seed = trial_seed(cfg.seed, trial);
-    let rules = (host_robot(profile.robot)?.rules)();
+    let rules = (sim_robot(profile.robot)?.rules)();
     // On the host a table split over CCM and SRAM is one slice: `Split`
     // addresses the same weights in the same order.
     match (profile.layout, profile.format) {
@@ -308,7 +308,7 @@ fn run<R: RobotRules, W: WeightStore>(
             let mut sim = [0.0f32; COUNTED];
             let mut est = [0.0f32; COUNTED];
             for (c, (j, id)) in counted.clone().zip(&ids).enumerate() {
-                com[c] = spec.paper_torque.torque(c, volts_of[*id as usize]);
+                com[c] = spec.paper_gear_torque(c, volts_of[*id as usize]);
                 sim[c] = rig.gear_torque(*id);
                 est[c] = out.torques[j];
             }

@@ -57,7 +57,7 @@ pub struct CompareArgs {
     /// the reference applied (the physics alone is compared); `learned`
     /// gives only the three learned voltages and lets pada's task compute
     /// the held joints and the stance.
-    #[arg(long, value_enum, default_value_t = Drive::Applied)]
+    #[arg(long, value_parser = drive_parser(), default_value = "applied")]
     pub drive: Drive,
     /// Print the comparison as JSON (keys: drive, provenance, substeps,
     /// solver_iterations, start_error, steps, first_touchdown,
@@ -180,10 +180,7 @@ fn comparison_table(c: &Comparison) -> String {
     let mut s = format!(
         "LEO against a reference, driven by its {} voltages; {} physics steps x {} solver \
          iteration(s) per 1/30 s\n",
-        match c.drive {
-            Drive::Applied => "applied",
-            Drive::Learned => "learned",
-        },
+        c.drive.name(),
         c.substeps,
         c.solver_iterations
     );
@@ -332,4 +329,11 @@ fn table(r: &PassiveRollout) -> String {
         s.push_str(&format!("the simulation blew up {} time(s)\n", r.blow_ups));
     }
     s
+}
+
+/// The parser of `--drive`: [`Drive`]'s names.
+fn drive_parser() -> impl clap::builder::TypedValueParser<Value = Drive> {
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(Drive::ALL.map(|d| d.name()))
+        .try_map(|name| Drive::ALL.into_iter().find(|d| d.name() == name).ok_or("unknown drive"))
 }

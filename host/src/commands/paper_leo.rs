@@ -79,14 +79,14 @@ pub fn run(args: PaperArgs) -> Result<(), CliError> {
             b.switched,
             &b.agent,
         )?;
-        let (frames, fell) = crate::leo::gait::record_agent(&mut b.agent, 10.0)?;
+        let (frames, fell) = crate::gait::record_agent(&mut b.agent, 10.0)?;
         let source = format!(
             "{}, trial {} (best end performance)",
             name(&r, b.config),
             b.trial
         );
-        let title = crate::leo::gait::gait_title(&source, &frames, fell);
-        out.write_all(&crate::leo::gait::gait_files(&frames, 12, &title)?)?;
+        let title = crate::gait::gait_title(&source, &frames, fell);
+        out.write_all(&crate::gait::gait_files(&frames, 12, &title)?)?;
         outln!("{title}")?;
     }
     outln!("{report}")?;

@@ -6,7 +6,7 @@ use crate::console::outln;
 use crate::error::{usage, CliError};
 use crate::experiment::task::Task;
 use crate::experiment::tasks::TaskName;
-use crate::leo::gait::{gait_files, gait_title, record_agent, Frame};
+use crate::gait::{gait_files, gait_title, record_agent, Frame};
 use crate::leo::rl::LeoTask;
 use crate::output::OutDir;
 use std::path::PathBuf;

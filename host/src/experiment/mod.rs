@@ -24,7 +24,7 @@ pub mod governed;
 pub mod metrics;
 pub mod runner;
 pub mod table;
-pub mod task;
+pub use pada_sim::task;
 pub mod tasks;
 pub mod trial;
 

@@ -23,7 +23,7 @@ use crate::leo::constants::{
 };
 use crate::leo::model::{assemble, Body, InitialPose};
 use pada_core::robot::leo::Leg;
-use crate::robots::{host_robot, Body as RobotBody};
+use crate::robots::{sim_robot, Body as RobotBody};
 use pada_core::robot::RobotSpec;
 use pada_core::wire::{Step, StepKind};
 
@@ -86,7 +86,7 @@ pub struct SceneBuilder {
 impl SceneBuilder {
     /// The robot is now this one (a `Hello`), or unknown.
     pub fn robot(&mut self, robot: Option<&'static RobotSpec>) {
-        let robot = robot.and_then(|r| Some((host_robot(r).ok()?.body, r.name)));
+        let robot = robot.and_then(|r| Some((sim_robot(r).ok()?.body, r.name)));
         *self = SceneBuilder { robot, ..SceneBuilder::default() };
     }
 

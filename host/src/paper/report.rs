@@ -327,7 +327,7 @@ pub fn render(r: &PendulumResults, command: &str) -> String {
          weights U[0, 1], a test run every 10 learning episodes and {} s (physical: {} s) of learning; the end \
          performance scales with the episode length and the rise time with the learning time, so both depend on \
          these choices. A hand-written energy-pumping swing-up controller scores −864 on a 3 s episode \
-         (a unit test of `host/src/pendulum/simulated.rs`), close to the paper's −851, which supports the 3 s \
+         (a unit test of `sim/src/pendulum/simulated.rs`), close to the paper's −851, which supports the 3 s \
          choice.",
         o.sim_seconds,
         o.phys_seconds

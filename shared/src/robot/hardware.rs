@@ -7,6 +7,7 @@
 
 use crate::dynamixel::table;
 use crate::safety::SoftLimit;
+use crate::servo::ServoModel;
 
 /// Position unit of the RX-28: 300° over 1023 counts \[rad\].
 pub const POSITION_UNIT_RAD: f32 = table::POSITION_RANGE_RAD / table::POSITION_MAX as f32;
@@ -16,9 +17,8 @@ pub const POSITION_UNIT_RAD: f32 = table::POSITION_RANGE_RAD / table::POSITION_M
 pub struct JointSpec {
     /// The joint's name (in a URDF robot, the URDF's joint name).
     pub name: &'static str,
-    /// The servo model that drives it, as `pada_core::servo`'s table names
-    /// it (e.g. `RX-28`).
-    pub servo: &'static str,
+    /// The servo model that drives it, from [`crate::servo`]'s table.
+    pub servo: &'static ServoModel,
     /// Dynamixel ID.
     pub id: u8,
     /// Raw Present Position at joint angle 0.
@@ -124,7 +124,7 @@ impl JointRange {
 mod tests {
     use super::*;
 
-    const J: JointSpec = JointSpec { name: "j", servo: "RX-28", id: 1, zero: 512, sign: 1, soft_limit: None };
+    const J: JointSpec = JointSpec { name: "j", servo: &crate::servo::RX28, id: 1, zero: 512, sign: 1, soft_limit: None };
 
     #[test]
     fn angle_follows_calibration() {

@@ -31,9 +31,11 @@ pub mod leo;
 pub mod pendulum;
 pub mod registry;
 pub mod rules;
+pub mod vocabulary;
 
 pub use hardware::{EncoderSpec, JointRange, JointSpec};
 pub use rules::{PerServo, RobotRules, Sensed};
+pub use vocabulary::{Vocab, Vocabulary};
 
 use crate::action_space::{ActionDim, ActionSpace, MAX_ACTION_DIMS};
 use crate::agent::{coder_for, exact_table_len, Agent, SarsaParams, WeightInit};
@@ -45,7 +47,7 @@ use crate::weights::WeightStore;
 
 /// Longest robot name, in bytes: what the wire's `Hello` and the
 /// software-in-the-loop link carry.
-pub const MAX_NAME: usize = 32;
+pub use crate::limits::MAX_ROBOT_NAME as MAX_NAME;
 
 /// How the paper turns a commanded voltage into the gearbox torque of its
 /// MTBF (Section IV: "a linear relationship between voltage and torque").
@@ -54,15 +56,10 @@ pub enum TorqueLaw {
     /// The robot's own law, the same for each of its counted joints (the
     /// pendulum's K/R, LEO's RX-28 stall torque per volt).
     Rule(fn(f32) -> f32),
-}
-
-impl TorqueLaw {
-    /// The gearbox torque \[N·m\] of `voltage` on counted joint `joint`.
-    pub fn torque(&self, _joint: usize, voltage: f32) -> f32 {
-        match self {
-            TorqueLaw::Rule(law) => law(voltage),
-        }
-    }
+    /// Each counted joint's servo at stall: `η·G·k·U/R` of its motor model
+    /// ([`crate::servo::DcMotor::stall_torque`]), the datasheet's stall
+    /// torque per volt.
+    ServoStall,
 }
 
 /// What kind of weight table a robot's learner needs; a board's profile
@@ -154,6 +151,10 @@ pub struct RobotSpec {
     pub half_shift: u8,
     /// The kind of weight table its learner needs.
     pub table: TableNeed,
+    /// Its rules said in the vocabulary of a `robot.toml` ([`Vocab`]
+    /// applies them); `None` for a robot whose rules are code (the
+    /// pendulum, LEO).
+    pub vocabulary: Option<&'static Vocabulary>,
 }
 
 impl PartialEq for RobotSpec {
@@ -228,7 +229,7 @@ impl RobotSpec {
         };
         h.write_u32(self.joints.len() as u32);
         for j in self.joints {
-            h.write_str(j.name).write_str(j.servo).write_u32(j.id as u32).write_u32(j.zero as u32);
+            h.write_str(j.name).write_str(j.servo.name).write_u32(j.id as u32).write_u32(j.zero as u32);
             h.write_u32(j.sign as u32);
             match j.soft_limit {
                 None => h.write_u32(0),
@@ -256,6 +257,14 @@ impl RobotSpec {
             TableNeed::Exact { weights } => h.write_u32(1).write_u32(weights as u32),
             TableNeed::Claimed => h.write_u32(2),
         };
+        match self.paper_torque {
+            // The rule is code, named by the robot's name.
+            TorqueLaw::Rule(_) => h.write_u32(1),
+            TorqueLaw::ServoStall => h.write_u32(2),
+        };
+        if let Some(words) = self.vocabulary {
+            words.hash_into(&mut h);
+        }
         h.finish()
     }
 
@@ -286,6 +295,19 @@ impl RobotSpec {
         ActionSpace::repeated(dim, self.motor_dims as usize)
     }
 
+    /// The paper's gearbox torque \[N·m\] of `voltage` on counted joint
+    /// `counted` (the `counted`-th joint of [`counted`](Self::counted))
+    /// ([`paper_torque`](Self::paper_torque)).
+    pub fn paper_gear_torque(&self, counted: usize, voltage: f32) -> f32 {
+        match self.paper_torque {
+            TorqueLaw::Rule(law) => law(voltage),
+            TorqueLaw::ServoStall => {
+                let joint = self.joints.get(self.counted.start as usize + counted);
+                joint.map_or(0.0, |j| j.servo.motor().stall_torque(voltage))
+            }
+        }
+    }
+
     /// The largest gearbox torque one learning action can command \[N·m\]:
     /// the paper's torque law ([`RobotSpec::paper_torque`]) at the level of
     /// largest magnitude, on the counted joint where it is largest. Its
@@ -297,7 +319,7 @@ impl RobotSpec {
         for joint in 0..self.gearboxes() {
             for i in 0..motor.dims() {
                 for &v in motor.dim(i).values() {
-                    worst = worst.max(self.paper_torque.torque(joint, v).abs());
+                    worst = worst.max(self.paper_gear_torque(joint, v).abs());
                 }
             }
         }

@@ -87,9 +87,9 @@ pub struct Hello {
     /// tell another version's `Hello` even where the rest of it does not
     /// decode ([`super::frame::hello_protocol`]).
     pub protocol: u16,
-    /// The robot's name (`crate::robot::RobotSpec::name`).
-    pub robot: heapless::String<{ crate::robot::MAX_NAME }>,
-    /// Its definition's hash (`crate::robot::RobotSpec::definition_hash`).
+    /// The robot's name (`RobotSpec::name` of `crate::robot`).
+    pub robot: heapless::String<{ crate::limits::MAX_ROBOT_NAME }>,
+    /// Its definition's hash (`RobotSpec::definition_hash`).
     pub robot_hash: u32,
     /// Hash of the running configuration (as in checkpoints).
     pub config_hash: u32,

@@ -37,6 +37,15 @@ use heapless::Vec;
 /// Bytes a block adds besides its data: ERROR, ID and the two CRC bytes.
 pub const BLOCK_OVERHEAD: usize = 4;
 
+// The default buffer holds the fast reply of the present block from every
+// servo a robot may have (a robot that asks for more is refused at build
+// time, not at run time). (Here, not beside the buffer's size in
+// `packet`, so that `packet` need not know this module.)
+const _: () = {
+    let block = crate::dynamixel::control_table::x_series::PRESENT_BLOCK_LEN as usize + BLOCK_OVERHEAD;
+    assert!(super::packet::PREFIX_LEN + 1 + crate::limits::MAX_SERVOS * block <= super::packet::DEFAULT_PACKET_LEN);
+};
+
 /// One servo's block of a fast reply.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]

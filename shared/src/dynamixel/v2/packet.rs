@@ -41,14 +41,6 @@ pub const STATUS_OVERHEAD: usize = 11;
 /// 7 + 1 + 8 × (23 + 4) = 224 bytes.
 pub const DEFAULT_PACKET_LEN: usize = 256;
 
-// The default buffer holds the fast reply of the present block from every
-// servo a robot may have (a robot that asks for more is refused at build
-// time, not at run time).
-const _: () = {
-    let block = crate::dynamixel::control_table::x_series::PRESENT_BLOCK_LEN as usize + super::fast::BLOCK_OVERHEAD;
-    assert!(PREFIX_LEN + 1 + crate::limits::MAX_SERVOS * block <= DEFAULT_PACKET_LEN);
-};
-
 /// Whether a packet with this ID and INSTRUCTION byte is byte-stuffed:
 /// every one but the Fast Sync/Bulk Read reply (a status packet from the
 /// broadcast ID), which the e-Manual sends unstuffed.

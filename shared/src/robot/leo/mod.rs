@@ -1,7 +1,7 @@
 //! LEO, the Delft biped on its boom, walking (Section VIII), defined once:
 //! the facts of `docs/reference/grl.md` §1.3–1.8 the task needs, the
 //! walking task of §3, and its hardware (seven RX-28s, the boom's encoder,
-//! four foot switches). The rapier3d simulation (`host/src/leo/`) produces
+//! four foot switches). The rapier3d simulation (`sim/src/leo/`) produces
 //! these quantities from physics; the firmware, through [`rules::Leo`],
 //! from servo positions, the boom's encoder and the foot switches. Both
 //! then apply the same rules, so the chip's learner sees what the
@@ -276,6 +276,7 @@ pub static SPEC: RobotSpec = RobotSpec {
     footstep_remap: Some(FOOTSTEP_REMAP),
     half_shift: HALF_SHIFT,
     table: TableNeed::Claimed,
+    vocabulary: None,
 };
 
 /// LEO's servos in [`Joint`] order (shoulder, hip L/R, knee L/R, ankle
@@ -313,7 +314,7 @@ const fn servo(name: &'static str, joint: Joint, id: u8) -> JointSpec {
     };
     JointSpec {
         name,
-        servo: "RX-28",
+        servo: &crate::servo::RX28,
         id,
         zero: 512,
         sign: 1,

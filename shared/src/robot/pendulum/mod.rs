@@ -1,7 +1,7 @@
 //! The physical inverted pendulum of Section VII, defined once (constants,
 //! timing, observation, reward as GRL's, docs/reference/grl.md §4, and its
 //! hardware: one RX-28 in wheel mode, an encoder on the axis). The host's
-//! model (`host/src/pendulum/physical.rs`) integrates its dynamics; the
+//! model (`sim/src/pendulum/physical.rs`) integrates its dynamics; the
 //! firmware reads it through the encoder and drives its motor. Both apply
 //! the rules of [`rules::Pendulum`].
 //!
@@ -61,7 +61,7 @@ pub const HALF_SHIFT: u8 = 15;
 /// position counts increasing with the positive (counter-clockwise)
 /// voltage. It turns freely: no soft limit.
 pub const JOINTS: [JointSpec; 1] =
-    [JointSpec { name: "axis", servo: "RX-28", id: 1, zero: 512, sign: 1, soft_limit: None }];
+    [JointSpec { name: "axis", servo: &crate::servo::RX28, id: 1, zero: 512, sign: 1, soft_limit: None }];
 
 /// The quadrature encoder on the axis (the servo's potentiometer covers
 /// only 300°): a 1024-line encoder, 4096 counts per turn.
@@ -96,6 +96,7 @@ const fn spec(name: &'static str, period_us: u32) -> RobotSpec {
         footstep_remap: None,
         half_shift: HALF_SHIFT,
         table: TableNeed::Exact { weights: EXACT_WEIGHTS },
+        vocabulary: None,
     }
 }
 

@@ -7,7 +7,7 @@
 //! `leolearnwalking-sarsa-tc.xml` and `LeoBhWalkSym.cpp`). The few numbers
 //! that are choices of this simulator, not facts of the reference (rapier's
 //! step, solver iterations and contact softness), are grouped at the end and
-//! justified in `host/src/leo/README.md`.
+//! justified in `sim/src/leo/README.md`.
 //!
 //! Frames (§1.1–1.2): z is up, the robot walks in +x, every hinge axis is y.
 //! A point "(x, z)" on a body is relative to that body's reference origin;

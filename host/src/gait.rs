@@ -3,9 +3,9 @@
 //! (SVG, PNG), an animation (SVG) and a trajectory (CSV). Used by
 //! `pada render` and `pada paper leo`.
 
-use super::constants::*;
-use super::model::Body;
-use super::rl::{LeoPlant, LeoTask};
+use crate::leo::constants::*;
+use crate::leo::model::Body;
+use crate::leo::rl::{LeoPlant, LeoTask};
 use crate::experiment::task::{Plant, Task};
 use crate::experiment::HostAgent;
 use crate::plot::{plot_err, svg_to_png, FONT};

@@ -1,4 +1,4 @@
-//! LEO as a task of the experiment runner ([`crate::experiment::task::Task`]):
+//! LEO as a task of the experiment runner ([`crate::task::Task`]):
 //! the walking task of Section VIII learned with SARSA(λ), PADA or the
 //! low-pass filter through the same code as the pendulums.
 //!
@@ -18,7 +18,7 @@
 
 use super::task::{commanded_gear_torque, Observation, GEARBOXES, OBS_DIM};
 use super::{LeoConfig, LeoEnv, Terminal};
-use crate::experiment::task::{Plant, Step, Task, TaskSpec};
+use crate::task::{Plant, Step, Task, TaskSpec};
 use pada_core::action_space::{Output, MAX_ACTION_DIMS};
 use pada_core::agent::SarsaParams;
 use pada_core::profile::{Board, LearnerProfile};

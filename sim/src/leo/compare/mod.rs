@@ -22,13 +22,26 @@ use crate::leo::{LeoConfig, LeoEnv, LeoError, Terminal};
 pub use reference::{references_in, LeoState, Reference, ReferenceError, ReferenceStep};
 
 /// How the reference drives pada's LEO (see the module's documentation).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Drive {
     /// Every servo's applied voltage from the reference.
     Applied,
     /// The three learned voltages from the reference, the rest pada's.
     Learned,
+}
+
+impl Drive {
+    /// Both, for a command line's choices.
+    pub const ALL: [Drive; 2] = [Drive::Applied, Drive::Learned];
+
+    /// The name a command line gives it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Drive::Applied => "applied",
+            Drive::Learned => "learned",
+        }
+    }
 }
 
 /// How far (control steps) a touchdown of pada's may lie from the

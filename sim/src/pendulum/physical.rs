@@ -18,7 +18,7 @@
 //! own stall torque per volt `K/R` = 5.642·10⁻³ N·m/V
 //! ([`pada_core::robot::pendulum::gearbox_torque`]).
 
-use crate::experiment::task::{Task, TaskSpec};
+use crate::task::{Task, TaskSpec};
 use pada_core::profile::{Board, LearnerProfile};
 use pada_core::robot::pendulum::{self as robot, gearbox_torque};
 
@@ -167,7 +167,7 @@ impl Task for PhysicalPendulumTask {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::experiment::task::Plant;
+    use crate::task::Plant;
     use std::f64::consts::PI;
 
     #[test]

@@ -146,7 +146,7 @@ impl Stiction {
     /// sliding the way the load pushes it. Without this the break-away is
     /// seen only after a step held by the tie, and a driven joint loses one
     /// physics step of motion at every voltage change: a first-order error
-    /// in the step (`host/src/leo/README.md`, the A/B table). A sliding
+    /// in the step (`sim/src/leo/README.md`, the A/B table). A sliding
     /// joint, or a held one whose tie keeps up, is left as it is.
     pub fn at_load_change(
         &self,

@@ -115,8 +115,8 @@ mod tests {
     #[test]
     fn a_reading_is_in_the_servos_frame_and_the_calibration_undoes_it() {
         for joint in [
-            Joint { name: "a", servo: "RX-28", id: 1, zero: 512, sign: 1, soft_limit: None },
-            Joint { name: "b", servo: "RX-28", id: 4, zero: 300, sign: -1, soft_limit: None },
+            Joint { name: "a", servo: &pada_core::servo::RX28, id: 1, zero: 512, sign: 1, soft_limit: None },
+            Joint { name: "b", servo: &pada_core::servo::RX28, id: 4, zero: 300, sign: -1, soft_limit: None },
         ] {
             let r = servo_reading(&joint, 0.4, 2.0, 0.25, 12.0);
             assert!((joint.angle(r.position) - 0.4).abs() <= 0.5 * pada_core::robot::hardware::POSITION_UNIT_RAD);

@@ -13,7 +13,7 @@ pub use simulated::{SimulatedPendulum, SimulatedPendulumParams, SimulatedPendulu
 /// same, on its torque instead of a voltage).
 pub use pada_core::robot::pendulum::{swing_up_reward, wrap_angle};
 
-use crate::experiment::task::{Plant, Step};
+use crate::task::{Plant, Step};
 use crate::integrator::{rk4_step, SinNear};
 use pada_core::action_space::{Output, MAX_ACTION_DIMS};
 use rand_core::RngCore;

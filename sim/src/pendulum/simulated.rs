@@ -14,7 +14,7 @@
 //! Reward on the next state: `−5θ² − 0.1θ̇² − a²` with `a` the applied
 //! torque. Episodes start hanging down at rest (θ = π).
 
-use crate::experiment::task::{Task, TaskSpec, WeightTable};
+use crate::task::{Task, TaskSpec, WeightTable};
 use pada_core::action_space::{ActionDim, ActionSpace};
 use pada_core::agent::{SarsaParams, WeightInit};
 use pada_core::tile_coding::StateDim;
@@ -180,7 +180,7 @@ impl Task for SimulatedPendulumTask {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::experiment::task::Plant;
+    use crate::task::Plant;
     use std::f64::consts::PI;
     use crate::pendulum::{swing_up_reward, wrap_angle};
     use rand_core::SeedableRng;

@@ -49,7 +49,7 @@ impl LeoModel {
         // on LEO: with it off, 300 s of SARSA(λ) and of PADA learning end
         // on the same weights bit for bit, and the passive fall and the A/B
         // comparisons are unchanged. It cost 3 % of the instructions
-        // (host/src/leo/README.md, "Speed").
+        // (sim/src/leo/README.md, "Speed").
         p.max_ccd_substeps = 0;
 
         let robot_groups =

@@ -19,7 +19,6 @@
 
 pub mod compare;
 pub mod constants;
-pub mod gait;
 pub mod model;
 pub mod passive;
 pub mod rl;
