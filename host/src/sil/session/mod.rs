@@ -706,7 +706,11 @@ impl<'a> Session<'a> {
             messages: self.recorder.counts(),
             latest: self.recorder.latest().clone(),
             sink: self.sink.take(),
-            power: std::mem::take(&mut self.power.report),
+            power: {
+                let mut power = std::mem::take(&mut self.power.report);
+                power.note_transfers(self.recorder.transfers(), self.now_s());
+                power
+            },
         };
         report::summarize(self.cfg, facts)
     }
