@@ -365,7 +365,8 @@ impl PowerReport {
     /// recorder's, one per save and restore) over `emulated_s` of run.
     pub fn note_transfers(&mut self, transfers: &[crate::capture::transfer::Transfer], emulated_s: f64) {
         use crate::capture::transfer::Direction;
-        let sum = |d: Direction| transfers.iter().filter(|t| t.direction == d).map(|t| t.link_s).sum::<f64>();
+        // (A fold from +0: an empty f64 sum is -0, which summary.json would show.)
+        let sum = |d: Direction| transfers.iter().filter(|t| t.direction == d).fold(0.0, |a, t| a + t.link_s);
         self.save_link_s = sum(Direction::Save);
         self.restore_link_s = sum(Direction::Restore);
         let paused = self.save_link_s + self.restore_link_s;
@@ -411,6 +412,32 @@ mod tests {
         assert_eq!(parse_hang("hang"), Some(Ok(10.0)));
         assert!(parse_hang("hang:when=2").unwrap().is_err());
         assert_eq!(parse_hang("drop:at=2"), None);
+    }
+
+    #[test]
+    fn the_paused_fraction_is_the_transfers_link_time_over_the_run_with_it() {
+        use crate::capture::transfer::{Direction, Transfer};
+        let t = |direction, link_s| Transfer {
+            direction,
+            generation: Some(1),
+            bytes: 8,
+            chunks: 1,
+            requests: 0,
+            board_bytes: 0,
+            host_bytes: 0,
+            link_s,
+            outcome: "streamed".into(),
+            reported: true,
+            reported_chunks: Some(1),
+            started_s: 0.0,
+            ended_s: 0.0,
+        };
+        let mut p = PowerReport::default();
+        p.note_transfers(&[], 100.0);
+        // No transfer: +0 s (an empty float sum is -0, printed as such).
+        assert_eq!((p.save_link_s.to_bits(), p.paused_fraction), (0f64.to_bits(), 0.0));
+        p.note_transfers(&[t(Direction::Save, 30.0), t(Direction::Restore, 50.0), t(Direction::Save, 20.0)], 300.0);
+        assert_eq!((p.save_link_s, p.restore_link_s, p.paused_fraction), (50.0, 50.0, 0.25));
     }
 
     #[test]
