@@ -9,7 +9,7 @@
 //! oversize, too short, undecodable) and by sequence gap (frames missing).
 //!
 //! A checkpoint streamed to or from the host (LEO on the F429: up to
-//! 65 543 chunks a save, a request per 3 chunks of a restore) is one CSV
+//! 65 543 chunks a save, a request per batch of a restore) is one CSV
 //! row per save and per restore ([`transfer`]), not one per frame; the raw
 //! stream keeps every frame.
 
@@ -57,7 +57,8 @@ pub const CSV_HEADER: &[&str] = &[
     "detail",
 ];
 
-/// Column of [`CSV_HEADER`] named `name` (checked at compile time).
+/// Column of [`CSV_HEADER`] named `name` (a const: a wrong name fails the
+/// build).
 const fn col(name: &str) -> usize {
     let mut i = 0;
     while i < CSV_HEADER.len() {
@@ -85,6 +86,11 @@ const fn const_eq(a: &str, b: &str) -> bool {
 }
 
 const DETAIL: usize = col("detail");
+const GENERATION: usize = col("generation");
+const BYTES: usize = col("bytes");
+const CHUNKS: usize = col("chunks");
+const LINK_S: usize = col("link_s");
+const OUTCOME: usize = col("outcome");
 
 /// Frames decoded, by message.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
@@ -542,11 +548,11 @@ fn transfer_row(t: &transfer::Transfer) -> Vec<String> {
     let mut r: Vec<String> = vec![String::new(); CSV_HEADER.len()];
     r[0] = format!("{:.6}", t.ended_s);
     r[2] = t.direction.row_kind().into();
-    r[col("generation")] = t.generation.map(|g| g.to_string()).unwrap_or_default();
-    r[col("bytes")] = t.bytes.to_string();
-    r[col("chunks")] = t.chunks.to_string();
-    r[col("link_s")] = format!("{:.3}", t.link_s);
-    r[col("outcome")] = t.outcome.clone();
+    r[GENERATION] = t.generation.map(|g| g.to_string()).unwrap_or_default();
+    r[BYTES] = t.bytes.to_string();
+    r[CHUNKS] = t.chunks.to_string();
+    r[LINK_S] = format!("{:.3}", t.link_s);
+    r[OUTCOME] = t.outcome.clone();
     r[DETAIL] = t.detail();
     r
 }
