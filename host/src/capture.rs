@@ -806,7 +806,16 @@ mod transfer_tests {
     const LEN: u32 = 32 + 128 * WINDOWS;
 
     fn hello() -> ToHost {
-        ToHost::Hello(Hello { protocol: PROTOCOL_VERSION, config_hash: 9, weight_count: 2, period_us: 3, state_dims: 2, joints: 1 })
+        ToHost::Hello(Hello {
+            protocol: PROTOCOL_VERSION,
+            robot: "leo".try_into().unwrap(),
+            robot_hash: 0,
+            config_hash: 9,
+            weight_count: 2,
+            period_us: 3,
+            state_dims: 2,
+            joints: 1,
+        })
     }
 
     /// A save of generation `g` as the board streams it: every body window
@@ -933,7 +942,7 @@ mod transfer_tests {
     fn a_full_leo_table_takes_about_two_minutes_to_save() {
         // LEO's F429 image: the 32-byte header, the learner record and
         // 2^21 four-byte entries.
-        let profile = pada_core::profile::Board::F429Sdram.profile(pada_core::robot::Robot::Leo);
+        let profile = pada_core::profile::Board::F429Sdram.profile(&pada_core::robot::leo::SPEC).unwrap();
         let image = pada_core::checkpoint::slot_len(profile.weights().unwrap(), profile.entry_bytes());
         let s = full_save_link_s(image as u32);
         assert!((100.0..140.0).contains(&s), "{s} s");

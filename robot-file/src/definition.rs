@@ -35,6 +35,8 @@ pub struct RobotFile {
     pub spec: &'static RobotSpec,
     /// Physics steps per control period of the host's simulation.
     pub substeps: u32,
+    /// rapier's solver iterations per physics step.
+    pub solver_iterations: u32,
 }
 
 impl RobotFile {
@@ -394,6 +396,10 @@ fn build(path: &Path, at: &Locator, t: RobotToml) -> Result<RobotFile, RobotFile
     if !(1..=1000).contains(&substeps) {
         return Err(at.at(&t.simulation.substeps.span(), "simulation.substeps", format!("{substeps} is not valid: 1 to 1000 physics steps per control period")));
     }
+    let solver_iterations = *t.simulation.solver_iterations.get_ref();
+    if !(1..=64).contains(&solver_iterations) {
+        return Err(at.at(&t.simulation.solver_iterations.span(), "simulation.solver_iterations", format!("{solver_iterations} is not valid: 1 to 64")));
+    }
 
     let vocabulary: &'static Vocabulary = Box::leak(Box::new(Vocabulary {
         observation: leak(observation),
@@ -447,7 +453,7 @@ fn build(path: &Path, at: &Locator, t: RobotToml) -> Result<RobotFile, RobotFile
     Vocab::check(spec, vocabulary).map_err(|e| at.field(e.param, e.to_string()))?;
     spec.params.validate().map_err(|e| at.field(format!("learning.{}", e.param), e.to_string()))?;
     spec.motor().map_err(|e| at.field("action", e.to_string()))?;
-    Ok(RobotFile { path: path.to_path_buf(), urdf, spec, substeps })
+    Ok(RobotFile { path: path.to_path_buf(), urdf, spec, substeps, solver_iterations })
 }
 
 trait Leaked {

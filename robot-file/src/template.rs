@@ -94,7 +94,8 @@ timeout_s = 8.0
 
 # How the host simulates the body (rapier3d).
 [simulation]
-substeps = 8              # physics steps per control period
+substeps = 1              # physics steps per control period
+solver_iterations = 2     # rapier's solver iterations per physics step
 "#
     )
 }

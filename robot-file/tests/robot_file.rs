@@ -61,7 +61,7 @@ fn a_new_robots_template_reads_as_it_is() {
     std::fs::write(dir.path().join("robot.toml"), template::robot_toml("my-arm")).unwrap();
     std::fs::write(dir.path().join("my-arm.urdf"), template::urdf("my-arm")).unwrap();
     let r = load(&dir.path().join("robot.toml")).unwrap();
-    assert_eq!((r.spec.name, r.spec.joints.len(), r.spec.state.len(), r.substeps), ("my-arm", 1, 2, 8));
+    assert_eq!((r.spec.name, r.spec.joints.len(), r.spec.state.len(), r.substeps, r.solver_iterations), ("my-arm", 1, 2, 1, 2));
     assert!(r.profile(Board::F405).is_ok() && r.profile(Board::F429Sdram).is_ok());
 }
 

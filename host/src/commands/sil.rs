@@ -155,12 +155,12 @@ pub fn run(args: SilArgs) -> Result<(), CliError> {
             return Err(usage(format!("--checkpoint-every {s}: at least 1 s of learning")));
         }
     }
+    let spec = args.task.robot();
+    let profile = board.profile(spec).map_err(|e| usage(e.to_string()))?;
     let save_every_s = args.checkpoint_every.or((!power_cuts.is_empty() || !hangs_s.is_empty()).then(|| {
         // The interval follows the time a save of this image takes on the
         // link: 20 s between LEO's 2-minute streams stopped learning most of
         // the time.
-        let profile = board.profile(args.task.robot());
-        let spec = args.task.robot().spec();
         sil::power_cut::default_save_every_s(
             sil::power_cut::checkpoint_bytes(profile.weights().unwrap_or(0), profile.entry_bytes()),
             pada_firmware::sil::CHECKPOINT_SLOT_LEN,

@@ -448,9 +448,9 @@ mod tests {
         // LEO on f429-sdram (its image, 25 s episodes): three full saves'
         // link time between two saves even when one comes two episodes
         // early, so saves stop learning at most a quarter of the time.
-        let profile = pada_core::profile::Board::F429Sdram.profile(pada_core::robot::Robot::Leo);
+        let profile = pada_core::profile::Board::F429Sdram.profile(&pada_core::robot::leo::SPEC).unwrap();
         let image = checkpoint_bytes(profile.weights().unwrap(), profile.entry_bytes());
-        let spec = pada_core::robot::Robot::Leo.spec();
+        let spec = &pada_core::robot::leo::SPEC;
         let episode_s = spec.episode_steps as f64 * spec.period_us as f64 * 1e-6;
         let every = default_save_every_s(image, 131_072, episode_s);
         let link = full_save_link_s(image as u32);

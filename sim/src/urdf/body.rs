@@ -108,12 +108,19 @@ pub struct UrdfModel {
     spec: &'static pada_core::robot::RobotSpec,
     start: Vec<f32>,
     substeps: u32,
+    solver_iterations: u32,
 }
 
 impl UrdfModel {
     /// The robot's definition.
     pub fn spec(&self) -> &'static pada_core::robot::RobotSpec {
         self.spec
+    }
+
+    /// The same body stepped `substeps` times a period with
+    /// `solver_iterations` (for studies of the step's accuracy).
+    pub fn with_steps(&self, substeps: u32, solver_iterations: u32) -> UrdfModel {
+        UrdfModel { substeps, solver_iterations, ..self.clone() }
     }
 
     /// The body of `robot`, read from its URDF and checked by building it
@@ -144,6 +151,7 @@ impl UrdfModel {
             spec: robot.spec,
             start: robot.vocabulary().start.to_vec(),
             substeps: robot.substeps,
+            solver_iterations: robot.solver_iterations,
         };
         UrdfBody::new(&model).map_err(|e| anyhow::anyhow!("{}: {e}", robot.urdf.path.display()))?;
         Ok(model)
@@ -153,10 +161,11 @@ impl UrdfModel {
 impl UrdfBody {
     /// A body of `model`, at rest in its start pose.
     pub fn new(model: &UrdfModel) -> anyhow::Result<UrdfBody> {
-        let UrdfModel { urdf, joint_names, axes, spec, start, substeps } = model.clone();
+        let UrdfModel { urdf, joint_names, axes, spec, start, substeps, solver_iterations } = model.clone();
         let mut world = PhysicsWorld::new();
         world.gravity = Vector::new(0.0, 0.0, -GRAVITY);
         world.integration_parameters.dt = spec.period_s() as f32 / substeps as f32;
+        world.integration_parameters.num_solver_iterations = solver_iterations as usize;
         let handles = urdf.insert_using_multibody_joints(
             &mut world.bodies,
             &mut world.colliders,
