@@ -277,9 +277,14 @@ fn python(root: &Path, slurm_conf: &Path) -> Result<(), String> {
     status(&mut cmd)
 }
 
-/// Runs `cmd`; Err names the program and its exit status.
+/// Runs `cmd`; Err names the command (program's file name and arguments)
+/// and its exit status.
 fn status(cmd: &mut Command) -> Result<(), String> {
-    let program = cmd.get_program().to_string_lossy().into_owned();
+    let name = Path::new(cmd.get_program()).file_name().unwrap_or(cmd.get_program()).to_string_lossy().into_owned();
+    let program = std::iter::once(name)
+        .chain(cmd.get_args().map(|a| a.to_string_lossy().into_owned()))
+        .collect::<Vec<_>>()
+        .join(" ");
     match cmd.status() {
         Ok(s) if s.success() => Ok(()),
         Ok(s) => Err(format!("{program}: {s}")),
