@@ -26,7 +26,7 @@ def need(module):
         return importlib.import_module(module)
     except ImportError:
         if os.environ.get("CI") == "true":
-            pytest.fail(f"{module} is not installed (.ci/run installs it)")
+            pytest.fail(f"{module} is not installed (`cargo xtask test` installs it in its venv)")
         pytest.skip(f"{module} is not installed")
 
 
