@@ -160,11 +160,69 @@ pub trait WeightStore {
         self.get(feature as usize)
     }
 
+    /// [`touch`](Self::touch) of every feature in `features`, the bits
+    /// combined (for `core::hint::black_box`). One call per batch, so that
+    /// a table behind a dispatch dispatches once.
+    #[inline]
+    fn touch_each(&self, features: &[u32]) -> u32 {
+        features.iter().fold(0, |bits, &f| bits ^ self.touch(f))
+    }
+
+    /// [`read`](Self::read) of every feature in `buf`, each replaced by
+    /// its weight's bits (`Q16.0 as u32`). One call per batch, so that a
+    /// table behind a dispatch dispatches once, and the loop keeps the
+    /// table's fields in registers.
+    #[inline]
+    fn read_each(&self, buf: &mut [u32]) {
+        for x in buf {
+            *x = self.read(*x).0 as u32;
+        }
+    }
+
     /// The slot a learning update of `feature` writes: the index itself in
     /// a plain table (never fresh), the claimed slot in a claim table.
     #[inline]
     fn claim(&mut self, feature: u32) -> Claim {
         Claim::Slot { slot: feature, fresh: false }
+    }
+
+    /// [`read`](Self::read) of every feature in `features`, then
+    /// [`claim`](Self::claim) of each in order (a learning update needs
+    /// the pair's `Q` and the slots it writes): the claims go to `claims`,
+    /// the sum of the weights read is returned. A claim table does both
+    /// with one probe per feature where it can
+    /// ([`ClaimTable::read_then_claim`](crate::claim_table::ClaimTable::read_then_claim)).
+    fn read_then_claim(&mut self, features: &[u32], claims: &mut [Claim]) -> i64 {
+        let sum = features.iter().map(|&f| self.read(f).0 as i64).sum();
+        for (claim, &f) in claims.iter_mut().zip(features) {
+            *claim = self.claim(f);
+        }
+        sum
+    }
+
+    /// [`add`](Self::add) of `inc` to the weight of each slot in `slots`,
+    /// in order; a slot outside the table is skipped (a refused claim's
+    /// `u32::MAX`). A [`dithered`](Self::dithered) table takes one draw
+    /// from `dither` per weight it writes, others none. Returns the
+    /// saturations and the change of the [`checksum`](Self::checksum).
+    /// One call per trace entry, so that a table behind a dispatch (the
+    /// host's one type for every table) dispatches once per entry rather
+    /// than three times per weight.
+    fn add_each<D: FnMut() -> u32>(&mut self, slots: &[u32], inc: Q16, mut dither: D) -> Added {
+        let dithered = self.dithered();
+        let mut out = Added::default();
+        for &slot in slots {
+            let i = slot as usize;
+            if i >= self.len() {
+                continue;
+            }
+            let d = if dithered { dither() } else { 0 };
+            let old = self.raw(i);
+            out.saturations += self.add(i, inc, d) as u32;
+            let change = self.raw(i).wrapping_sub(old);
+            out.checksum_change = out.checksum_change.wrapping_add(change.wrapping_mul(entry_factor(i)));
+        }
+        out
     }
 
     /// Frees every slot of a claim table and sets its unclaimed features'
@@ -193,6 +251,15 @@ pub trait WeightStore {
     fn checksum(&self) -> u32 {
         (0..self.len()).fold(0u32, |sum, i| sum.wrapping_add(self.raw(i).wrapping_mul(entry_factor(i))))
     }
+}
+
+/// What [`WeightStore::add_each`] did.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Added {
+    /// Writes that hit the format's range and saturated.
+    pub saturations: u32,
+    /// What the writes added to the table's checksum (wrapping).
+    pub checksum_change: u32,
 }
 
 /// The multiplier of weight `i` in the table checksum: `(2i + 1)·φ`, with

@@ -35,6 +35,7 @@ use rand_core::RngCore;
 mod choice;
 mod coder;
 mod params;
+mod tiled;
 mod update;
 pub use coder::{coder_for, exact_table_len};
 pub use params::{SarsaParams, WeightInit};

@@ -12,19 +12,20 @@ impl<W, const TILINGS: usize, const TRACE: usize> Agent<W, TILINGS, TRACE>
 where
     W: WeightStore,
 {
-    /// The slots a learning update of `features` writes. A plain table's
-    /// features are its slots. A claim table claims each feature's slot now
-    /// (a fresh claim enters the running checksum); a refused claim gets
-    /// `u32::MAX`, outside the table, so its update is dropped (and the
-    /// table counts it).
+    /// `TILINGS · Q` of `features` and the slots a learning update of them
+    /// writes. A plain table's features are its slots. A claim table reads
+    /// every feature's weight, then claims each feature's slot (a fresh
+    /// claim enters the running checksum), one probe for both where it can
+    /// ([`WeightStore::read_then_claim`]); a refused claim gets `u32::MAX`,
+    /// outside the table, so its update is dropped (and the table counts
+    /// it).
     #[inline]
-    fn claim_slots(&mut self, features: &[u32; TILINGS]) -> [u32; TILINGS] {
-        if !self.weights.claims() {
-            return *features;
-        }
+    fn read_and_claim(&mut self, features: &[u32; TILINGS]) -> (i64, [u32; TILINGS]) {
+        let mut claims = [Claim::Refused; TILINGS];
+        let sum = self.weights.read_then_claim(features, &mut claims);
         let mut slots = [u32::MAX; TILINGS];
-        for (slot, &f) in slots.iter_mut().zip(features) {
-            if let Claim::Slot { slot: s, fresh } = self.weights.claim(f) {
+        for (slot, claim) in slots.iter_mut().zip(claims) {
+            if let Claim::Slot { slot: s, fresh } = claim {
                 *slot = s;
                 if fresh {
                     if let Some(c) = self.checksum.as_mut() {
@@ -34,7 +35,7 @@ where
                 }
             }
         }
-        slots
+        (sum, slots)
     }
 
     /// The SARSA(λ) update for the pair `current` that earned `reward`;
@@ -47,7 +48,8 @@ where
     /// plant's.
     pub(super) fn update<R: RngCore + ?Sized>(&mut self, current: &Current<TILINGS>, reward: f32, q_next: Option<Q16>, rng: &mut R) {
         let reward = reward - self.policy.penalty();
-        let q = self.q_of(&current.features);
+        let (sum, slots) = self.read_and_claim(&current.features);
+        let q = Q16::from_wide(sum / TILINGS as i64);
         let mut delta = Q16::from_f32(reward).0 as i64 - q.0 as i64;
         if let Some(qn) = q_next {
             delta += qn.mul_frac(self.gamma).0 as i64;
@@ -55,32 +57,24 @@ where
         let delta = Q16::from_wide(delta);
         self.stats.last_td_error = delta;
         let step = delta.mul_frac(self.alpha);
-        let slots = self.claim_slots(&current.features);
         self.trace.push(&slots);
-        let dithered = self.weights.dithered();
         let weights = &mut self.weights;
-        let checksum = &mut self.checksum;
         let mut saturations = 0u32;
+        let mut change = 0u32;
         self.trace.for_each_entry(|entry, eligibility| {
             let inc = step.mul_frac(eligibility);
             if inc == Q16::ZERO {
                 return;
             }
-            for &f in entry {
-                // Replaced slots hold u32::MAX: outside the table, so the
-                // store writes nothing (and no dither is drawn for them).
-                let i = f as usize;
-                if i < weights.len() {
-                    let dither = if dithered { rng.next_u32() } else { 0 };
-                    let old = weights.raw(i);
-                    saturations += weights.add(i, inc, dither) as u32;
-                    if let Some(c) = checksum.as_mut() {
-                        let change = weights.raw(i).wrapping_sub(old);
-                        *c = c.wrapping_add(change.wrapping_mul(entry_factor(i)));
-                    }
-                }
-            }
+            // Replaced slots hold u32::MAX: outside the table, so the store
+            // writes nothing (and draws no dither for them).
+            let added = weights.add_each(entry, inc, || rng.next_u32());
+            saturations += added.saturations;
+            change = change.wrapping_add(added.checksum_change);
         });
+        if let Some(c) = self.checksum.as_mut() {
+            *c = c.wrapping_add(change);
+        }
         self.stats.saturations = self.stats.saturations.saturating_add(saturations);
         self.stats.updates += 1;
     }
