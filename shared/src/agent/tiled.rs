@@ -91,9 +91,13 @@ where
         rng: &mut R,
     ) -> (Levels, i64) {
         const MASK: usize = MAX_ACTION_COMBOS - 1;
+        const ROW: usize = MAX_ACTION_COMBOS + MAX_LEVELS;
         // Each combination's share of its feature's hash, once per choice
         // rather than once per tiling.
-        let mut word = [0u32; MAX_ACTION_COMBOS];
+        // (MAX_LEVELS more entries than combinations, here and in the rows,
+        // so that a run of the first dimension is copied as a whole block
+        // of MAX_LEVELS, the tail overwritten by the next run.)
+        let mut word = [0u32; ROW];
         for (c, w) in word.iter_mut().enumerate().take(at.combos() as usize) {
             *w = TileCoder::<TILINGS>::word_part(c as u32);
         }
@@ -103,22 +107,22 @@ where
         // passes: the touch folded into the hashing loop measured 25·10³
         // more instructions per choice.) Each row holds its tiling's
         // features, then their weights' bits.
-        let mut table = [[0u32; MAX_ACTION_COMBOS]; TILINGS];
+        let mut table = [[0u32; ROW]; TILINGS];
         for (j, row) in table.iter_mut().enumerate() {
             // The word parts of the box's combinations in the row's order
-            // (runs of the first dimension, whose stride is 1), then the
-            // features, in a loop the compiler vectorises.
+            // (runs of the first dimension, whose stride is 1, of at most
+            // MAX_LEVELS tiles), then the features, in a loop the compiler
+            // vectorises.
             let (first, count) = (boxes.first[j], boxes.count[j]);
             let mut k = 0usize;
             for t3 in first[3]..first[3] + count[3] {
                 for t2 in first[2]..first[2] + count[2] {
                     for t1 in first[1]..first[1] + count[1] {
                         let base = (t1 * at.stride(1) + t2 * at.stride(2) + t3 * at.stride(3) + first[0]) as usize;
-                        for t0 in 0..count[0] as usize {
-                            // k < the box's size ≤ MAX_ACTION_COMBOS and every
-                            // combination is below it: the masks only drop
-                            // the checks.
-                            row[(k + t0) & MASK] = word[(base + t0) & MASK];
+                        // k and base are below MAX_ACTION_COMBOS: both
+                        // blocks are in their arrays.
+                        if let (Some(to), Some(from)) = (row.get_mut(k..k + MAX_LEVELS), word.get(base..base + MAX_LEVELS)) {
+                            to.copy_from_slice(from);
                         }
                         k += count[0] as usize;
                     }
@@ -145,23 +149,28 @@ where
         let mut best = lo;
         let mut best_sum = i64::MIN;
         let mut ties = 0u32;
-        let mut base = [0u8; TILINGS];
         for l3 in lo[3]..=hi[3] {
             for l2 in lo[2]..=hi[2] {
                 for l1 in lo[1]..=hi[1] {
+                    // Every candidate of this run's index in every tiling
+                    // at once, in fixed-size loops the compiler does in
+                    // vector registers (the offsets of levels beyond `hi`
+                    // are 0, their indices unused), then the sums.
                     let (o1, o2, o3) = (offset(1, l1), offset(2, l2), offset(3, l3));
-                    for j in 0..TILINGS {
-                        base[j] = o1[j] + o2[j] + o3[j];
+                    let mut index = [[0u8; TILINGS]; MAX_LEVELS];
+                    for (l, row) in index.iter_mut().enumerate() {
+                        let o0 = &boxes.offset[0][l];
+                        for j in 0..TILINGS {
+                            // Below the box's size ≤ MAX_ACTION_COMBOS =
+                            // 128: no u8 overflow.
+                            row[j] = o0[j] + o1[j] + o2[j] + o3[j];
+                        }
                     }
                     for l0 in lo[0]..=hi[0] {
-                        let o0 = offset(0, l0);
                         let mut sum = 0i64;
-                        for (j, row) in table.iter().enumerate() {
-                            // The index is below the box's size ≤
-                            // MAX_ACTION_COMBOS = 128: no u8 overflow, and
-                            // the mask only drops the check.
-                            let i = (base[j] + o0[j]) as usize & MASK;
-                            sum += row[i] as i32 as i64;
+                        for (row, &i) in table.iter().zip(&index[l0 as usize & (MAX_LEVELS - 1)]) {
+                            // The mask only drops the check.
+                            sum += row[i as usize & MASK] as i32 as i64;
                         }
                         if sum > best_sum {
                             best_sum = sum;
