@@ -553,15 +553,6 @@ impl<W: WeightStore, T: TagStore> WeightStore for ClaimTable<W, T> {
         ClaimTable::read(self, feature)
     }
 
-    /// The key's home slot's tag, what a read looks at first. Not the
-    /// weight: in a table far from full, most of the features a choice
-    /// reads hold no slot and their home is free, so their reads never
-    /// load a weight (98 % of LEO's in its first minutes).
-    #[inline]
-    fn touch(&self, feature: u32) -> u32 {
-        self.tags.get((feature & self.mask) as usize)
-    }
-
     #[inline]
     fn claim(&mut self, feature: u32) -> Claim {
         ClaimTable::claim(self, feature)

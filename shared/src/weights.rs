@@ -132,27 +132,6 @@ pub trait WeightStore {
         self.format().bytes() + self.tag_bytes()
     }
 
-    /// Whether a reader of many features should [`touch`](Self::touch)
-    /// them all before it reads them: a table in cached memory far larger
-    /// than the cache (the host's LEO table), where a read's branches wait
-    /// on its cache miss, so misses taken one read at a time do not
-    /// overlap. `false` by default: the chips' tables sit in memory with
-    /// no data cache to fill, where touching is only extra reads.
-    #[inline]
-    fn touches_before_reading(&self) -> bool {
-        false
-    }
-
-    /// Loads the memory that [`read`](Self::read) of `feature` looks at
-    /// first and returns its bits (for `core::hint::black_box`). A batch of
-    /// touches are independent loads that the processor issues together;
-    /// the reads after them then find their lines in the cache. Changes
-    /// nothing and reads nothing outside the table.
-    #[inline]
-    fn touch(&self, feature: u32) -> u32 {
-        self.raw(feature as usize)
-    }
-
     /// The weight of `feature`: the weight at that index in a plain table,
     /// the feature's slot's (or its initial weight) in a claim table.
     #[inline]
@@ -160,18 +139,11 @@ pub trait WeightStore {
         self.get(feature as usize)
     }
 
-    /// [`touch`](Self::touch) of every feature in `features`, the bits
-    /// combined (for `core::hint::black_box`). One call per batch, so that
-    /// a table behind a dispatch dispatches once.
-    #[inline]
-    fn touch_each(&self, features: &[u32]) -> u32 {
-        features.iter().fold(0, |bits, &f| bits ^ self.touch(f))
-    }
-
     /// [`read`](Self::read) of every feature in `buf`, each replaced by
     /// its weight's bits (`Q16.0 as u32`). One call per batch, so that a
     /// table behind a dispatch dispatches once, and the loop keeps the
-    /// table's fields in registers.
+    /// table's fields in registers. The reads are independent, so a
+    /// processor that executes ahead overlaps their cache misses.
     #[inline]
     fn read_each(&self, buf: &mut [u32]) {
         for x in buf {

@@ -130,23 +130,6 @@ impl WeightStore for HostTable {
         each!(self, t => WeightStore::read(t, feature))
     }
 
-    /// Every host table is in cached memory, and LEO's are far larger
-    /// than the cache.
-    #[inline]
-    fn touches_before_reading(&self) -> bool {
-        true
-    }
-
-    #[inline]
-    fn touch(&self, feature: u32) -> u32 {
-        each!(self, t => t.touch(feature))
-    }
-
-    #[inline]
-    fn touch_each(&self, features: &[u32]) -> u32 {
-        each!(self, t => t.touch_each(features))
-    }
-
     #[inline]
     fn read_each(&self, buf: &mut [u32]) {
         each!(self, t => t.read_each(buf))

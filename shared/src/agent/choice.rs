@@ -75,12 +75,16 @@ where
                 if explore {
                     (self.policy.explore_candidates().random(rng), true, None)
                 } else {
-                    let (levels, sum) = self.greedy(&code, &self.policy.candidates(), self.policy.learner_space(), rng);
+                    let candidates = self.policy.candidates();
+                    self.prepare_boxes(&candidates);
+                    let (levels, sum) = self.greedy(&code, &candidates, self.policy.learner_space(), rng);
                     (levels, false, Some(sum))
                 }
             }
             Exploration::Noise => {
-                let (greedy, sum) = self.greedy(&code, &self.policy.candidates(), self.policy.learner_space(), rng);
+                let candidates = self.policy.candidates();
+                self.prepare_boxes(&candidates);
+                let (greedy, sum) = self.greedy(&code, &candidates, self.policy.learner_space(), rng);
                 if learning {
                     let moved = self.policy.perturb(&greedy, rng);
                     (moved, moved != greedy, (moved == greedy).then_some(sum))
@@ -113,12 +117,29 @@ where
             // Fewer weights to read as each tiling's tile combinations than
             // as each candidate's features: read each once. Same sums, same
             // order, same ties.
-            let boxes = TileBoxes::new(at, candidates);
+            let local;
+            let boxes = match &self.boxes {
+                Some((made_for, boxes)) if made_for == candidates => boxes,
+                _ => {
+                    local = TileBoxes::new(at, candidates);
+                    &local
+                }
+            };
             if boxes.total() < candidates.count().saturating_mul(TILINGS as u32) {
-                return self.greedy_tiled(code, candidates, at, &boxes, rng);
+                return self.greedy_tiled(code, candidates, at, boxes, rng);
             }
         }
         self.greedy_walk(code, candidates, space, rng)
+    }
+
+    /// Makes the tiled greedy choice's boxes for `candidates` unless they
+    /// are made already (with action tiles only).
+    fn prepare_boxes(&mut self, candidates: &Candidates) {
+        if let Some(at) = self.coder.action_tiles() {
+            if !matches!(&self.boxes, Some((made_for, _)) if made_for == candidates) {
+                self.boxes = Some((*candidates, TileBoxes::new(at, candidates)));
+            }
+        }
     }
 
     /// [`greedy`](Self::greedy) by every candidate's own features: the

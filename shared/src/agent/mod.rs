@@ -26,11 +26,12 @@ use crate::action_space::{ActionSpace, Levels, Output, MAX_ACTION_DIMS};
 use crate::claim_table::InitialWeights;
 use crate::error::{check_range, ConfigError, StepError};
 use crate::fixed::{Frac, Q16};
-use crate::policy::{Policy, PolicyKind, PolicyState};
+use crate::policy::{Candidates, Policy, PolicyKind, PolicyState};
 use crate::tile_coding::{Layout, StateDim, TileCoder};
 use crate::trace::Trace;
 use crate::weights::WeightStore;
 use rand_core::RngCore;
+use tiled::TileBoxes;
 
 mod choice;
 mod coder;
@@ -159,6 +160,10 @@ pub struct Agent<W, const TILINGS: usize, const TRACE: usize> {
     /// ([`WeightStore::checksum`]); `None` after the weights were handed
     /// out mutably, until [`rehash`](Agent::rehash).
     checksum: Option<u32>,
+    /// With action tiles, the tiled greedy choice's boxes and the
+    /// candidates they were made for: SARSA's candidates are the same at
+    /// every step, PADA's move with its previous action.
+    boxes: Option<(Candidates, TileBoxes<TILINGS>)>,
 }
 
 impl<W, const TILINGS: usize, const TRACE: usize> Agent<W, TILINGS, TRACE>
@@ -205,6 +210,7 @@ where
             current: None,
             stats: AgentStats::default(),
             checksum: None,
+            boxes: None,
         })
     }
 
@@ -217,6 +223,7 @@ where
     /// unchanged then.
     pub fn generalise_actions(&mut self, widths: &[f32]) -> Result<(), ConfigError> {
         self.coder = self.coder.clone().with_action_tiles(self.policy.learner_space(), widths)?;
+        self.boxes = None;
         Ok(())
     }
 
