@@ -384,14 +384,21 @@ impl<W: WeightStore, T: TagStore> ClaimTable<W, T> {
     /// The weight of the feature `key`: its slot's, or its initial weight
     /// if it holds none. Claims nothing and changes nothing, the occupancy
     /// included (the hot path: see [`Occupancy::longest_probe`]).
-    #[inline]
+    #[inline(always)]
     pub fn read(&self, key: u32) -> Q16 {
         // Most features a choice reads hold no slot, and in a table far
         // from full most of their homes are free: the first look of the
-        // probe settles those, without the tag.
+        // probe settles those, without the tag, inlined into the caller's
+        // loop; the probe is a call.
         if self.tags.get((key & self.mask) as usize) == EMPTY {
             return self.initial_weight(key);
         }
+        self.read_probing(key)
+    }
+
+    /// [`read`](Self::read) past a home that is not free.
+    #[inline(never)]
+    fn read_probing(&self, key: u32) -> Q16 {
         match self.probe(key).0 {
             Probe::Found(i) => self.weights.get(i as usize),
             Probe::Free(_) | Probe::Exhausted => self.initial_weight(key),

@@ -101,16 +101,18 @@ where
         for (c, w) in word.iter_mut().enumerate().take(at.combos() as usize) {
             *w = TileCoder::<TILINGS>::word_part(c as u32);
         }
-        // The features first, then their reads, each tiling's in one tight
-        // loop, so that the processor overlaps their cache misses itself.
-        // (A pass that loaded each feature's home slot before the reads
-        // paid for itself when a read was a call through the host table's
-        // dispatch; with these loops it measured no faster in CPU time on
-        // LEO with the home's tag alone, and 15 % slower with its tag and
-        // weight.) Each row holds its tiling's features, then their
-        // weights' bits.
-        let mut table = [[0u32; ROW]; TILINGS];
-        for (j, row) in table.iter_mut().enumerate() {
+        // Each tiling's row: its features, then their weights' bits, read
+        // in one tight loop so that the processor overlaps their cache
+        // misses itself. (A pass that loaded each feature's home slot
+        // before the reads paid for itself when a read was a call through
+        // the host table's dispatch; with this loop it measured no faster
+        // in CPU time on LEO with the home's tag alone, and 15 % slower
+        // with its tag and weight.) Row by row (`from_fn`), so that each
+        // row is cleared on its own rather than the whole table at once,
+        // which glibc does with `rep stosb` and valgrind counts as a
+        // thousands of instructions.
+        let table: [[u32; ROW]; TILINGS] = core::array::from_fn(|j| {
+            let mut row = [0u32; ROW];
             // The word parts of the box's combinations in the row's order
             // (runs of the first dimension, whose stride is 1, of at most
             // MAX_LEVELS tiles), then the features, in a loop the compiler
@@ -130,14 +132,14 @@ where
                     }
                 }
             }
+            let features = &mut row[..boxes.size[j] as usize];
             let state = self.coder.state_part(code, j);
-            for x in &mut row[..boxes.size[j] as usize] {
+            for x in features.iter_mut() {
                 *x = self.coder.feature_of_parts(state, *x);
             }
-        }
-        for (row, &n) in table.iter_mut().zip(&boxes.size) {
-            self.weights.read_each(&mut row[..n as usize]);
-        }
+            self.weights.read_each(features);
+            row
+        });
         // Unused dimensions have lo = hi = 0 and offset 0.
         let (lo, hi) = (candidates.lo, candidates.hi);
         let offset = |d: usize, l: u8| &boxes.offset[d][l as usize & (MAX_LEVELS - 1)];
