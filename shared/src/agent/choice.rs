@@ -27,7 +27,7 @@ where
 
     /// Sum of the active weights of (state, action): `TILINGS · Q`.
     #[inline]
-    fn q_sum(&self, code: &StateCode<TILINGS>, action: u32) -> i64 {
+    pub(super) fn q_sum(&self, code: &StateCode<TILINGS>, action: u32) -> i64 {
         let w = &self.weights;
         let mut sum = 0i64;
         // The action-tile test once, not per tiling (the greedy loop's

@@ -186,3 +186,99 @@ where
         (best, best_sum)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    //! The tiled choice against the plain walk over every candidate's own
+    //! features ([`Agent::greedy_walk`]): the same action, the same sum and
+    //! the same draws for its ties, on every kind of table.
+    extern crate std;
+    use super::*;
+    use crate::action_space::{ActionDim, ActionSpace};
+    use crate::agent::{EpisodeEnd, SarsaParams, WeightInit};
+    use crate::claim_table::{ClaimTable, Tags16, Tags32};
+    use crate::fixed::Q16;
+    use crate::policy::PolicyKind;
+    use crate::tile_coding::{Layout, StateDim};
+    use crate::weights::Half;
+    use proptest::prelude::*;
+    use rand_core::{RngCore, SeedableRng};
+    use rand_pcg::Pcg32;
+    use std::vec;
+    use std::vec::Vec;
+
+    /// LEO's learner in small: 4 state dimensions, 3 × 7 voltages in
+    /// 6.67 V action tiles, 16 tilings.
+    fn agent<W: WeightStore>(layout: Layout, weights: W, init: WeightInit) -> Agent<W, 16, 64> {
+        let obs: Vec<StateDim> = (0..4).map(|_| StateDim::new(-3.0, 3.0, 0.5).unwrap()).collect();
+        let space = ActionSpace::repeated(ActionDim::uniform(-10.7, 10.7, 7).unwrap(), 3).unwrap();
+        let params = SarsaParams { init, epsilon: 0.3, ..SarsaParams::default() };
+        let mut a = Agent::new(&obs, space, PolicyKind::Sarsa, params, layout, weights).unwrap();
+        a.generalise_actions(&[6.67; 3]).unwrap();
+        a
+    }
+
+    fn observation(rng: &mut Pcg32) -> [f32; 4] {
+        core::array::from_fn(|_| (rng.next_u32() as f32 / u32::MAX as f32) * 6.0 - 3.0)
+    }
+
+    /// Learns a little with rewards from `{-1, 0, 1}` (claims, moves
+    /// weights, leaves many ties), then compares the two choices on random
+    /// states and random boxes of candidates.
+    fn tiled_is_the_walk<W: WeightStore>(mut a: Agent<W, 16, 64>, seed: u64) -> Result<(), TestCaseError> {
+        let mut rng = Pcg32::seed_from_u64(seed);
+        a.reset_weights(&mut rng);
+        for _ in 0..(seed % 4) {
+            a.start_episode(&observation(&mut rng), &mut rng).unwrap();
+            for _ in 0..20 {
+                let r = (rng.next_u32() % 3) as f32 - 1.0;
+                a.step(r, &observation(&mut rng), &mut rng).unwrap();
+            }
+            a.end_episode(-1.0, EpisodeEnd::Absorbing, &mut rng).unwrap();
+        }
+        let at = a.coder().action_tiles().unwrap().clone();
+        let space = a.policy().learner_space().clone();
+        for _ in 0..20 {
+            let code = a.code(&observation(&mut rng));
+            let (mut lo, mut hi) = ([0u8; 4], [0u8; 4]);
+            for d in 0..3 {
+                let (x, y) = ((rng.next_u32() % 7) as u8, (rng.next_u32() % 7) as u8);
+                (lo[d], hi[d]) = (x.min(y), x.max(y));
+            }
+            if rng.next_u32() % 2 == 0 {
+                (lo, hi) = ([0; 4], [6, 6, 6, 0]);
+            }
+            let candidates = Candidates { lo, hi, dims: 3 };
+            let (mut r1, mut r2) = (rng.clone(), rng.clone());
+            let tiled = a.greedy_tiled(&code, &candidates, &at, &TileBoxes::new(&at, &candidates), &mut r1);
+            let walk = a.greedy_walk(&code, &candidates, &space, &mut r2);
+            prop_assert_eq!(tiled, walk);
+            prop_assert_eq!(r1.next_u64(), r2.next_u64(), "the same draws for the ties");
+            prop_assert_eq!(tiled.1, a.q_sum(&code, space.encode(&tiled.0)), "the sum is the chosen action's");
+            rng.next_u32();
+        }
+        Ok(())
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(24))]
+        #[test]
+        fn the_tiled_choice_is_the_plain_walk(seed in any::<u64>()) {
+            // A plain hashed table of weights from {0, 16, 32} (ties).
+            let mut a = agent(Layout::Hashed, vec![Q16::ZERO; 1 << 12], WeightInit::Constant(0.0));
+            let mut rng = Pcg32::seed_from_u64(seed);
+            a.reset_weights(&mut rng);
+            for w in a.weights_mut().iter_mut() {
+                *w = Q16((rng.next_u32() % 3) as i32 * 16);
+            }
+            a.rehash();
+            tiled_is_the_walk(a, seed)?;
+            // Claim tables: the host's, and the chips' 16-bit one; constant
+            // initial weights (every candidate ties until learning).
+            let host = ClaimTable::new(vec![Q16::ZERO; 1 << 12], Tags32(vec![0u32; 1 << 12])).unwrap();
+            tiled_is_the_walk(agent(Layout::Claimed, host, WeightInit::Constant(0.0)), seed)?;
+            let chip = ClaimTable::new(Half::<_, 12>::new(vec![0i16; 1 << 12]), Tags16(vec![0u16; 1 << 12])).unwrap();
+            tiled_is_the_walk(agent(Layout::Claimed, chip, WeightInit::Uniform { min: 0.0, max: 0.01 }), seed)?;
+        }
+    }
+}
