@@ -449,7 +449,9 @@ fn main() -> ExitCode {
     let task = match parse_args(&args) {
         Ok(task) => task,
         Err(e) => {
-            eprintln!("xtask: error: {e}\n\n{USAGE}");
+            // One line: the mistake and where the usage is (the usage
+            // itself is longer than a screen and buried the mistake).
+            eprintln!("xtask: error: {e} (`cargo xtask help` prints the usage)");
             return ExitCode::from(2);
         }
     };
