@@ -173,6 +173,9 @@ pub fn run(args: SilArgs) -> Result<(), CliError> {
         Some(path) => usage(format!("--robot {}: {e} on board {}", path.display(), board.name())),
         None => usage(e.to_string()),
     })?;
+    if let Some(path) = &args.robot {
+        crate::board::readable::check_readable(spec).map_err(|e| usage(format!("--robot {}: {e}", path.display())))?;
+    }
     let save_every_s = args.checkpoint_every.or((!power_cuts.is_empty() || !hangs_s.is_empty()).then(|| {
         // The interval follows the time a save of this image takes on the
         // link: 20 s between LEO's 2-minute streams stopped learning most of
