@@ -181,6 +181,9 @@ fn run_on_board(args: RunArgs, board: Board, sim: crate::robots::SimRobot) -> Re
         Some(p) => usage(format!("{}: {e}", p.display())),
         None => usage(e.to_string()),
     })?;
+    if let Some(p) = &args.robot {
+        crate::board::readable::check_readable(robot).map_err(|e| usage(format!("{}: {e}", p.display())))?;
+    }
     let format = match args.weight_bits.as_deref() {
         Some("16") => WeightFormat::Half { shift: robot.half_shift },
         Some(_) => WeightFormat::Q16,
