@@ -66,10 +66,12 @@ pub mod opt_f64 {
 pub mod vec_f64 {
     use super::*;
 
+    /// Writes each value as [`f64`](mod@super::f64) does.
     pub fn serialize<S: Serializer>(x: &[::core::primitive::f64], s: S) -> Result<S::Ok, S::Error> {
         s.collect_seq(x.iter().map(|v| Exact(*v)))
     }
 
+    /// Reads each value as [`f64`](mod@super::f64) does.
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<::core::primitive::f64>, D::Error> {
         Ok(Vec::<Exact>::deserialize(d)?.into_iter().map(|e| e.0).collect())
     }
