@@ -49,8 +49,12 @@ pub enum Command {
     /// run's telemetry (decoded and recorded as capture does).
     #[command(allow_negative_numbers = true)]
     Watch(commands::watch::WatchArgs),
-    /// Draw a learned LEO gait (saved weights) as a strip of stick figures.
+    /// Draw a learned LEO gait (saved weights) as a strip of stick figures,
+    /// or a robot of files' learned motion (--robot).
     Render(commands::render::RenderArgs),
+    /// Write a new robot's robot.toml and URDF, commented field by field,
+    /// which run as they are (docs/your-robot.md).
+    NewRobot(commands::new_robot::NewRobotArgs),
     /// The LEO model on its own: `pada leo passive` (the passive rollout).
     Leo(commands::leo::LeoArgs),
     /// Run one trial of a plan (written with --plan DIR), as a Slurm array
@@ -140,6 +144,7 @@ where
         Command::Capture(a) => commands::capture::run(a),
         Command::Watch(a) => commands::watch::run(a),
         Command::Render(a) => commands::render::run(a),
+        Command::NewRobot(a) => commands::new_robot::run(a),
         Command::Leo(a) => commands::leo::run(a),
         Command::Trial(a) => commands::trial::run(a),
     }

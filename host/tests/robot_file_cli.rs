@@ -55,3 +55,23 @@ fn bad_robot_input_is_one_line() {
     assert_bad_input(&["render", "--robot", &robot, "--policy", "/nonexistent.wts"], &["/nonexistent.wts"]);
     assert_bad_input(&["run", "--robot", "/nonexistent/robot.toml", "--algo", "pada"], &["/nonexistent/robot.toml"]);
 }
+
+#[test]
+fn a_new_robot_runs_as_written_on_the_host_and_as_the_board_would() {
+    let dir = tempfile::tempdir().unwrap();
+    let parent = dir.path().display().to_string();
+    let out = ok(&pada(&["new-robot", "flipper", "--dir", &parent]));
+    assert!(out.contains("robot.toml") && out.contains("flipper.urdf"), "{out}");
+    let toml = dir.path().join("flipper/robot.toml").display().to_string();
+    let runs = dir.path().join("runs").display().to_string();
+    let host = ok(&pada(&["run", "--robot", &toml, "--algo", "pada", "--trials", "1", "--seconds", "30", "--out", &format!("{runs}/host")]));
+    assert!(host.contains("flipper, pada"), "{host}");
+    let board = ok(&pada(&[
+        "run", "--robot", &toml, "--board", "f405", "--algo", "pada", "--trials", "1", "--seconds", "30", "--out", &format!("{runs}/board"),
+    ]));
+    assert!(board.contains("flipper"), "{board}");
+    // Never over what is there.
+    assert_bad_input(&["new-robot", "flipper", "--dir", &parent], &["exists already"]);
+    assert_bad_input(&["new-robot", "Flipper", "--dir", &parent], &["lowercase letters"]);
+    assert_bad_input(&["new-robot", "leo", "--dir", &parent], &["pada's own robots"]);
+}

@@ -10,6 +10,7 @@ pub mod paper;
 pub mod paper_args;
 pub mod paper_leo;
 pub mod paper_wear;
+pub mod new_robot;
 pub mod render;
 pub mod run;
 pub mod sil;
