@@ -71,7 +71,7 @@ pub struct RunArgs {
     /// (lowpass, pada and the gentle explorations; Section VIII).
     #[arg(long, value_name = "SECONDS")]
     pub switch_at: Option<f64>,
-    /// Trials (default: the paper's count for the task, 29 or 28).
+    /// Trials (default: the task's: 29 for the pendulum and 28 for the physical one, as the paper; 2 for LEO; 10 for a robot of files).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=10000))]
     pub trials: Option<u32>,
     /// Learning time per trial [s of simulated time] (default: the task's).

@@ -70,7 +70,9 @@ pub struct SilArgs {
     pub mtbf_budget: Option<f32>,
     /// Inject a fault on the servo bus (repeatable):
     /// KIND[:at=S][:for=S][:servo=ID][:ms=MS][:bits=NAME] with KIND drop,
-    /// corrupt, delay, error-bits or past-limit (docs/sil.md).
+    /// corrupt, delay, error-bits or past-limit; or `hang[:at=S]` (the
+    /// control loop stops; the watchdog must reset the chip; mps2 boards
+    /// only, board f429-sdram) (docs/sil.md).
     #[arg(long, value_name = "SPEC")]
     pub fault: Vec<String>,
     /// A power cut, repeatable: `at=SECONDS` (emulated time),

@@ -168,7 +168,7 @@ fn spawn(setup: &QemuSetup, dir: &Path, append: bool) -> anyhow::Result<Child> {
         .spawn()
         .map_err(|e| {
             anyhow!(
-                "cannot start {} ({e}); install QEMU 10 (DESIGN.md: qemu-system-arm from bookworm-backports) or pass --qemu",
+                "cannot start {} ({e}); install QEMU 10 (`bash .ci/install qemu`: qemu-system-arm from bookworm-backports) or pass --qemu",
                 setup.qemu.display()
             )
         })

@@ -21,7 +21,8 @@
 //! | 32 + s | b·n | the entries as the table stores them, each its weight then its tag ([`crate::weights::WeightStore::stored_le`]), little endian |
 //! | 32 + s + b·n | 0–3 | zeros up to a multiple of 4 bytes |
 //!
-//! Format 3 (tables without claim tags, a record of version 3), format 2
+//! Format 3 (tables without claim tags, with a learner-state record of
+//! version 3, which this crate refuses too), format 2
 //! (4-byte weights only, a 4-byte state length at 24) and format 1
 //! (weights without the learner's state) are refused as
 //! [`LoadOutcome::UnsupportedVersion`]. The weight format is part of the
