@@ -26,8 +26,10 @@ pub use crate::safety::RunMode;
 /// [`ToChip::RestoreChunk`] and [`ToChip::RestoreNone`], all appended
 /// last; `ToChip` is no longer `Copy`); 9: [`Hello`] names the robot
 /// and its definition's hash instead of leaving it to be guessed from its
-/// dimensions (a robot is a definition, not a case of a closed list).
-pub const PROTOCOL_VERSION: u16 = 9;
+/// dimensions (a robot is a definition, not a case of a closed list);
+/// 10: [`FaultCause::HardwareAlert`], a Protocol 2.0 servo's Alert bit
+/// with its Hardware Error Status, appended last.
+pub const PROTOCOL_VERSION: u16 = 10;
 /// The capacities of a [`Step`] (state dimensions, motor outputs and
 /// counted gearboxes) and of a [`Health`] report (servos): pada-core's own
 /// ([`crate::limits`]).
