@@ -447,7 +447,7 @@ mod tests {
                 Err(pada_core::checkpoint::OutOfRange)
             }
         }
-        let mut c = Controller::<_, Pendulum33>::new(profile(Robot::Pendulum33), PolicyKind::Sarsa, table(), 3).unwrap();
+        let mut c = Controller::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Sarsa, table(), 3).unwrap();
         let mut flash = WritesFail(Store::new());
         let r = c.save_checkpoint(&mut flash);
         assert!(matches!(r, Err(CheckpointError::Save(SaveError::StoreAfterErase { slot: 0, erases: 1, .. }))), "{r:?}");
