@@ -7,6 +7,13 @@
 //! next frame delimiter after garbage, so a bad frame costs that frame only;
 //! nothing here stops on one. Losses are counted by kind (CRC, COBS,
 //! oversize, too short, undecodable) and by sequence gap (frames missing).
+//!
+//! A checkpoint streamed to or from the host (LEO on the F429: up to
+//! 65 543 chunks a save, a request per batch of a restore) is one CSV
+//! row per save and per restore ([`transfer`]), not one per frame; the raw
+//! stream keeps every frame.
+
+pub mod transfer;
 
 use pada_core::wire::{Decoded, FrameError, HostDecoder, LinkStats, RunMode, StepKind, ToHost};
 use serde::Serialize;
@@ -14,7 +21,11 @@ use std::fmt::Write as _;
 use std::io::Write;
 
 /// The CSV header of [`Recorder`]'s rows: one row per frame, per lost frame
-/// and per sequence gap. Vectors (`state`, `output`, `damage`,
+/// and per sequence gap, except the frames of a checkpoint transfer, which
+/// make one row per save (`checkpoint-save`) and per restore
+/// (`checkpoint-restore`) with its `generation`, image `bytes`, `chunks`,
+/// `link_s` (seconds on the telemetry link) and `outcome`
+/// ([`transfer::Transfer`]). Vectors (`state`, `output`, `damage`,
 /// `reengagements`) are space-separated within their cell.
 pub const CSV_HEADER: &[&str] = &[
     "time_s",
@@ -38,8 +49,48 @@ pub const CSV_HEADER: &[&str] = &[
     "return",
     "length",
     "weights_checksum",
+    "generation",
+    "bytes",
+    "chunks",
+    "link_s",
+    "outcome",
     "detail",
 ];
+
+/// Column of [`CSV_HEADER`] named `name` (a const: a wrong name fails the
+/// build).
+const fn col(name: &str) -> usize {
+    let mut i = 0;
+    while i < CSV_HEADER.len() {
+        if const_eq(CSV_HEADER[i], name) {
+            return i;
+        }
+        i += 1;
+    }
+    panic!("no such CSV column");
+}
+
+const fn const_eq(a: &str, b: &str) -> bool {
+    let (a, b) = (a.as_bytes(), b.as_bytes());
+    if a.len() != b.len() {
+        return false;
+    }
+    let mut i = 0;
+    while i < a.len() {
+        if a[i] != b[i] {
+            return false;
+        }
+        i += 1;
+    }
+    true
+}
+
+const DETAIL: usize = col("detail");
+const GENERATION: usize = col("generation");
+const BYTES: usize = col("bytes");
+const CHUNKS: usize = col("chunks");
+const LINK_S: usize = col("link_s");
+const OUTCOME: usize = col("outcome");
 
 /// Frames decoded, by message.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
@@ -56,7 +107,14 @@ pub struct MessageCounts {
     pub state: u64,
     /// `Fault`.
     pub fault: u64,
-    /// Everything else (checkpoint, log, warning, weights, ack, nack).
+    /// `CheckpointChunk`: the chunks of saves streamed to the host (one
+    /// CSV row per save, not per chunk).
+    pub checkpoint_chunk: u64,
+    /// `RestoreWanted`: a restoring board's requests, one per batch of
+    /// chunks (one CSV row per restore, not per request).
+    pub restore_wanted: u64,
+    /// Everything else (checkpoint report, restored, log, warning,
+    /// weights, ack, nack, policy).
     pub other: u64,
 }
 
@@ -95,6 +153,9 @@ pub trait FrameTap {
     fn frame(&mut self, frame: &Decoded<ToHost>, stats: LinkStats) -> std::io::Result<()>;
     /// A lost frame, with the link's counters after it.
     fn lost(&mut self, e: &FrameError, stats: LinkStats) -> std::io::Result<()>;
+    /// A checkpoint save or restore ended (its frames went to
+    /// [`FrameTap::frame`] too), with the link's counters.
+    fn transfer(&mut self, t: &transfer::Transfer, stats: LinkStats) -> std::io::Result<()>;
     /// The end of the stream, with the final counters.
     fn finish(&mut self, stats: LinkStats) -> std::io::Result<()>;
 }
@@ -147,6 +208,12 @@ pub struct Recorder {
     latest: Latest,
     /// The channels of an MCAP file or a live Foxglove view, when asked for.
     tap: Option<Box<dyn FrameTap + Send>>,
+    /// Saves and restores of a checkpoint the host keeps, gathered from
+    /// their frames.
+    transfers: transfer::Transfers,
+    /// Link bytes counted when the last frame ended (decoded or lost): a
+    /// frame's bytes are the difference.
+    bytes_at_frame_end: u64,
 }
 
 impl Recorder {
@@ -166,6 +233,8 @@ impl Recorder {
             counts: MessageCounts::default(),
             latest: Latest::default(),
             tap: None,
+            transfers: transfer::Transfers::default(),
+            bytes_at_frame_end: 0,
         })
     }
 
@@ -204,6 +273,8 @@ impl Recorder {
                             return Err(foreign_protocol(h.protocol));
                         }
                     }
+                    let frame_bytes = self.decoder.stats().bytes - self.bytes_at_frame_end;
+                    self.bytes_at_frame_end = self.decoder.stats().bytes;
                     if let Some(gap) = frame.gap {
                         let detail = if gap.is_resync() {
                             format!(
@@ -221,7 +292,13 @@ impl Recorder {
                         self.row_other(time_s, Some(frame.seq), "gap", &detail)?;
                     }
                     self.note(&frame.msg);
-                    self.row(time_s, &frame)?;
+                    // A transfer's frames make its one row when it ends (a
+                    // Hello ends the one in progress first).
+                    let in_transfer = self.transfers.frame(&frame.msg, frame_bytes, time_s);
+                    self.write_transfers()?;
+                    if !in_transfer {
+                        self.row(time_s, &frame)?;
+                    }
                     if let Some(tap) = self.tap.as_mut() {
                         tap.frame(&frame, self.decoder.stats())?;
                     }
@@ -231,6 +308,7 @@ impl Recorder {
                     if let Some(found) = self.decoder.foreign_protocol() {
                         return Err(foreign_protocol(found));
                     }
+                    self.bytes_at_frame_end = self.decoder.stats().bytes;
                     self.row_other(time_s, None, "lost", &loss_name(&e))?;
                     if let Some(tap) = self.tap.as_mut() {
                         tap.lost(&e, self.decoder.stats())?;
@@ -260,11 +338,13 @@ impl Recorder {
 
     /// The sender restarted on purpose (a board booted again after a
     /// power cut or a reset): its sequence numbers start over, so the next
-    /// frame is not a gap; a frame cut short by the restart counts as lost.
-    /// Returns whether there was one.
-    pub fn restarted(&mut self) -> bool {
+    /// frame is not a gap; a frame cut short by the restart counts as lost;
+    /// a checkpoint transfer in progress is recorded as `cut-off`.
+    /// Returns whether a frame was cut short.
+    pub fn restarted(&mut self) -> std::io::Result<bool> {
         let cut = match self.decoder.finish() {
             Some(e) => {
+                self.bytes_at_frame_end = self.decoder.stats().bytes;
                 if let Some(tap) = self.tap.as_mut() {
                     // A sink's write error shows again at close_tap.
                     let _ = tap.lost(&e, self.decoder.stats());
@@ -274,7 +354,44 @@ impl Recorder {
             None => false,
         };
         self.decoder.resync_seq();
-        cut
+        self.transfers.interrupt("cut-off");
+        self.write_transfers()?;
+        Ok(cut)
+    }
+
+    /// The capture is over (after [`Recorder::finish`] when the input
+    /// ended): a checkpoint save or restore still in progress is recorded
+    /// as `unfinished`, so that every transfer begun has its row.
+    pub fn end(&mut self) -> std::io::Result<()> {
+        self.transfers.interrupt("unfinished");
+        self.write_transfers()
+    }
+
+    /// The host answered the board's restore request in progress with
+    /// `chunks` chunks in `bytes` frame bytes: the host-to-board half of the
+    /// restore's link time, which the board's stream does not carry.
+    pub fn answered(&mut self, chunks: u32, bytes: u64) {
+        self.transfers.answered(chunks, bytes);
+    }
+
+    /// Every checkpoint save and restore recorded so far, in order.
+    pub fn transfers(&self) -> &[transfer::Transfer] {
+        self.transfers.all()
+    }
+
+    /// Writes the rows of the transfers that ended since the last call and
+    /// hands them to the tap.
+    fn write_transfers(&mut self) -> std::io::Result<()> {
+        let stats = self.decoder.stats();
+        for t in self.transfers.take_new() {
+            if let Some(w) = self.csv.as_mut() {
+                w.write_record(transfer_row(t)).map_err(std::io::Error::other)?;
+            }
+            if let Some(tap) = self.tap.as_mut() {
+                tap.transfer(t, stats)?;
+            }
+        }
+        Ok(())
     }
 
     /// Link counters: frames, bytes, every kind of loss.
@@ -379,6 +496,8 @@ impl Recorder {
                 c.fault += 1;
                 l.fault = Some(f.cause.name().to_string());
             }
+            ToHost::CheckpointChunk(_) => c.checkpoint_chunk += 1,
+            ToHost::RestoreWanted(_) => c.restore_wanted += 1,
             _ => c.other += 1,
         }
     }
@@ -421,7 +540,7 @@ impl Recorder {
             other => {
                 let (kind, detail) = describe(other);
                 r[2] = kind.into();
-                r[21] = detail;
+                r[DETAIL] = detail;
             }
         }
         w.write_record(&r).map_err(std::io::Error::other)
@@ -441,9 +560,24 @@ impl Recorder {
         r[0] = format!("{time_s:.6}");
         r[1] = seq.map(|s| s.to_string()).unwrap_or_default();
         r[2] = kind.into();
-        r[21] = detail.into();
+        r[DETAIL] = detail.into();
         w.write_record(&r).map_err(std::io::Error::other)
     }
+}
+
+/// The CSV row of one checkpoint save or restore: its end's time, no
+/// sequence number (it stands for many frames), its kind and columns.
+fn transfer_row(t: &transfer::Transfer) -> Vec<String> {
+    let mut r: Vec<String> = vec![String::new(); CSV_HEADER.len()];
+    r[0] = format!("{:.6}", t.ended_s);
+    r[2] = t.direction.row_kind().into();
+    r[GENERATION] = t.generation.map(|g| g.to_string()).unwrap_or_default();
+    r[BYTES] = t.bytes.to_string();
+    r[CHUNKS] = t.chunks.to_string();
+    r[LINK_S] = format!("{:.3}", t.link_s);
+    r[OUTCOME] = t.outcome.clone();
+    r[DETAIL] = t.detail();
+    r
 }
 
 /// The CSV name of a run mode.
@@ -657,5 +791,160 @@ mod tests {
         assert_eq!(kinds[0], "hello");
         assert!(kinds[1] == "lost");
         assert_eq!(&kinds[2..], ["gap", "episode"]);
+    }
+}
+
+#[cfg(test)]
+mod transfer_tests {
+    use super::transfer::{full_save_link_s, link_s, Direction};
+    use super::*;
+    use pada_core::checkpoint::stream::Chunk;
+    use pada_core::wire::{CheckpointReport, FrameEncoder, Hello, RestoreOutcome, RestoreRequest, MAX_FRAME_LEN, PROTOCOL_VERSION};
+
+    /// An image of a header and `windows` body windows.
+    const WINDOWS: u32 = 40;
+    const LEN: u32 = 32 + 128 * WINDOWS;
+
+    fn hello() -> ToHost {
+        ToHost::Hello(Hello {
+            protocol: PROTOCOL_VERSION,
+            robot: "leo".try_into().unwrap(),
+            robot_hash: 0,
+            config_hash: 9,
+            weight_count: 2,
+            period_us: 3,
+            state_dims: 2,
+            joints: 1,
+        })
+    }
+
+    /// A save of generation `g` as the board streams it: every body window
+    /// (one of them a run of zeros), the header last.
+    fn save(g: u32) -> Vec<ToHost> {
+        let mut v: Vec<ToHost> = (0..WINDOWS - 2)
+            .map(|k| ToHost::CheckpointChunk(Chunk::words(g, LEN, 32 + 128 * k, &[k as u8 + 1; 128])))
+            .collect();
+        v.push(ToHost::CheckpointChunk(Chunk::zeros(g, LEN, 32 + 128 * (WINDOWS - 2), 2)));
+        v.push(ToHost::CheckpointChunk(Chunk::words(g, LEN, 0, &[7; 32])));
+        v
+    }
+
+    fn request(offset: u32) -> ToHost {
+        ToHost::RestoreWanted(RestoreRequest { config_hash: 9, image_len: LEN, offset })
+    }
+
+    /// Records `msgs` into a CSV; returns the recorder and the rows.
+    fn record(msgs: &[ToHost], then: impl FnOnce(&mut Recorder)) -> (Recorder, Vec<csv::StringRecord>) {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.csv");
+        let file = std::fs::File::create(&path).unwrap();
+        let mut rec = Recorder::new(Some(Box::new(file) as Box<dyn Write + Send>)).unwrap();
+        let mut enc = FrameEncoder::new();
+        let mut out = Vec::new();
+        for (i, m) in msgs.iter().enumerate() {
+            let mut buf = [0u8; MAX_FRAME_LEN];
+            rec.feed(enc.encode(m, &mut buf).unwrap(), i as f64, &mut out).unwrap();
+        }
+        then(&mut rec);
+        rec.end().unwrap();
+        rec.flush().unwrap();
+        let rows = csv::Reader::from_path(&path).unwrap().records().map(|r| r.unwrap()).collect();
+        (rec, rows)
+    }
+
+    fn kinds(rows: &[csv::StringRecord]) -> Vec<&str> {
+        rows.iter().map(|r| &r[2]).collect()
+    }
+
+    #[test]
+    fn a_save_is_one_row_and_a_restore_one_row_not_one_per_frame() {
+        // Regression: every chunk and every request was a row of its own
+        // (475 865 + 105 723 rows in a 1800 s LEO run).
+        let mut msgs = vec![hello()];
+        msgs.extend(save(3));
+        msgs.push(ToHost::Checkpoint(CheckpointReport::Streamed { generation: 3, chunks: WINDOWS, image_len: LEN }));
+        msgs.push(hello());
+        msgs.extend((0..WINDOWS / 3 + 1).map(|k| request(if k == 0 { 0 } else { 32 + 128 * (3 * k - 1) })));
+        msgs.push(ToHost::Restored(RestoreOutcome::Loaded { generation: 3, chunks: WINDOWS }));
+        let (rec, rows) = record(&msgs, |_| {});
+        assert_eq!(kinds(&rows), ["hello", "checkpoint-save", "hello", "checkpoint-restore"]);
+        let col = |r: &csv::StringRecord, name: &str| r[col(name)].to_string();
+        let (s, r) = (&rows[1], &rows[3]);
+        assert_eq!([col(s, "generation"), col(s, "bytes"), col(s, "chunks"), col(s, "outcome")], ["3", &LEN.to_string(), &WINDOWS.to_string(), "streamed"]);
+        assert_eq!([col(r, "generation"), col(r, "bytes"), col(r, "chunks"), col(r, "outcome")], ["3", &LEN.to_string(), &WINDOWS.to_string(), "loaded"]);
+        assert_eq!(col(r, "seq"), "", "a row of many frames has no one sequence number");
+        // Every frame is still counted, and its bytes are the link time.
+        let c = rec.counts();
+        assert_eq!((c.checkpoint_chunk, c.restore_wanted, c.hello, c.other), (WINDOWS as u64, (WINDOWS / 3 + 1) as u64, 2, 2));
+        let t = rec.transfers();
+        assert_eq!(t.len(), 2);
+        assert_eq!((t[0].direction, t[1].direction), (Direction::Save, Direction::Restore));
+        assert_eq!(t[1].requests, WINDOWS / 3 + 1);
+        let hello_bytes = 2 * {
+            let mut buf = [0u8; MAX_FRAME_LEN];
+            FrameEncoder::new().encode(&hello(), &mut buf).unwrap().len() as u64
+        };
+        assert_eq!(t[0].board_bytes + t[1].board_bytes + hello_bytes, rec.stats().bytes);
+        assert_eq!(col(s, "link_s"), format!("{:.3}", link_s(t[0].board_bytes)));
+        assert!(t[0].link_s > 0.0 && t[0].link_s < full_save_link_s(LEN));
+    }
+
+    #[test]
+    fn a_transfer_cut_short_is_a_row_too_and_a_new_stream_starts_another() {
+        let mut msgs = save(4);
+        msgs.truncate(10);
+        // The board was restored and saves generation 4 again from the start.
+        msgs.extend(save(4));
+        msgs.push(ToHost::Checkpoint(CheckpointReport::Streamed { generation: 4, chunks: WINDOWS + 1, image_len: LEN }));
+        msgs.push(save(5)[0].clone());
+        msgs.push(request(0));
+        let (rec, rows) = record(&msgs, |rec| {
+            // A power cut: the save of generation 5 and the restore end.
+            assert!(!rec.restarted().unwrap());
+        });
+        let outcomes: Vec<(&str, &str, &str)> = rows.iter().map(|r| (&r[2], &r[col("outcome")], &r[col("chunks")])).collect();
+        assert_eq!(
+            outcomes,
+            [
+                ("checkpoint-save", "cut-off", "10"),
+                ("checkpoint-save", "incomplete", "40"),
+                ("checkpoint-save", "cut-off", "1"),
+                ("checkpoint-restore", "cut-off", "0"),
+            ],
+            "{rows:?}"
+        );
+        assert!(rows[1][DETAIL].contains("the board sent 41 chunks, 40 arrived"), "{:?}", &rows[1][DETAIL]);
+        assert_eq!(rec.counts().checkpoint_chunk, 51);
+        // The end of the input inside a save: unfinished.
+        let (_, rows) = record(&save(6)[..5], |_| {});
+        assert_eq!((&rows[0][2], &rows[0][col("outcome")]), ("checkpoint-save", "unfinished"));
+    }
+
+    #[test]
+    fn a_restores_answers_count_on_its_link_time() {
+        let msgs = [request(0)];
+        let (rec, rows) = record(&msgs, |rec| {
+            rec.answered(3, 500);
+            let mut buf = [0u8; MAX_FRAME_LEN];
+            let restored = ToHost::Restored(RestoreOutcome::Denied(pada_core::wire::RestoreDenied::Older));
+            let mut out = Vec::new();
+            let mut enc = FrameEncoder::new();
+            enc.encode(&hello(), &mut buf).unwrap();
+            rec.feed(enc.encode(&restored, &mut buf).unwrap(), 2.0, &mut out).unwrap();
+        });
+        let t = &rec.transfers()[0];
+        assert_eq!((t.chunks, t.host_bytes, t.outcome.as_str(), t.generation), (3, 500, "denied-older", None));
+        assert_eq!(t.link_s, link_s(t.board_bytes + 500));
+        assert_eq!(&rows[0][col("generation")], "", "no generation loaded");
+    }
+
+    #[test]
+    fn a_full_leo_table_takes_about_two_minutes_to_save() {
+        // LEO's F429 image: the 32-byte header, the learner record and
+        // 2^21 four-byte entries.
+        let profile = pada_core::profile::Board::F429Sdram.profile(&pada_core::robot::leo::SPEC).unwrap();
+        let image = pada_core::checkpoint::slot_len(profile.weights().unwrap(), profile.entry_bytes());
+        let s = full_save_link_s(image as u32);
+        assert!((100.0..140.0).contains(&s), "{s} s");
     }
 }

@@ -124,9 +124,9 @@ impl SilTask {
         sim_robot(self.robot()).map_or(Board::F405, |e| e.default_board)
     }
 
-    /// The robot behind the bus ([`sil_rig`]).
+    /// The robot behind the bus ([`SimRobot::sil_rig`]).
     pub fn rig(self) -> anyhow::Result<Box<dyn Rig>> {
-        sil_rig(self.robot())
+        sim_robot(self.robot())?.sil_rig()
     }
 
     fn help(self) -> &'static str {

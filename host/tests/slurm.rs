@@ -6,7 +6,8 @@
 //!
 //! The cluster is found through SLURM_CONF, else `.ci/slurm`'s
 //! `$PADA_SLURM_DIR/slurm.conf` (default /tmp/pada-slurm). Without one the
-//! tests fail under CI=true and are skipped, with the reason, elsewhere.
+//! tests fail under CI=true (`cargo xtask test` sets it, and starts the
+//! cluster) and are skipped, with the reason, elsewhere.
 
 mod common;
 use common::{ok, without_timing};
@@ -99,14 +100,14 @@ fn cluster() -> Option<Cluster> {
     match find_cluster() {
         Ok(c) => Some(c),
         Err(why) if std::env::var("CI").as_deref() == Ok("true") => {
-            panic!("CI=true but no Slurm cluster answers ({why}); .ci/run starts one with .ci/slurm up")
+            panic!("CI=true but no Slurm cluster answers ({why}); `cargo xtask test` starts one (.ci/slurm up)")
         }
         Err(why) => {
             // Straight to stderr, past the test harness's capture, so the
             // reason shows in a passing run.
             let _ = writeln!(
                 std::io::stderr(),
-                "skipping: no Slurm cluster answers ({why}); start one with `.ci/slurm up`"
+                "skipping: no Slurm cluster answers ({why}); `cargo xtask test` starts one (or `.ci/slurm up`)"
             );
             None
         }

@@ -8,7 +8,7 @@
 //! The DevTools client is three calls (`Runtime.evaluate`,
 //! `Page.captureScreenshot`, over one WebSocket with tungstenite) written
 //! here: a full client crate generates the whole protocol at build time
-//! for them. `.ci/run` installs Chromium (`apt-get install chromium`).
+//! for them. `cargo xtask test` installs Chromium (`.ci/install chromium`).
 
 mod watch_common;
 
@@ -43,7 +43,7 @@ impl Browser {
     fn open(url: &str) -> Browser {
         assert!(
             std::path::Path::new(CHROMIUM).exists(),
-            "{CHROMIUM} is missing: `apt-get install chromium` (.ci/run installs it)"
+            "{CHROMIUM} is missing: `cargo xtask test` installs it (as root; or run `sudo .ci/install chromium`)"
         );
         let profile = tempfile::tempdir().unwrap();
         let mut child = Command::new(CHROMIUM)

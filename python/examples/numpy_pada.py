@@ -9,7 +9,7 @@ The learner is tabular SARSA(0) with ε-greedy on a 21 × 21 grid of
 (angle, angular velocity) and three actions (−max, 0, +max torque). PADA
 (Eq. 9, ``PadaWrapper``) lets each action move at most Δ of the range from
 the previous one; ``MtbfWrapper`` underneath sees the torque applied. Run
-in CI by .ci/run.
+by `cargo xtask test` (and so in CI).
 """
 
 import argparse

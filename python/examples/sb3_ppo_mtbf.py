@@ -2,7 +2,7 @@
 long would the gearbox last under the actions PPO explores with?
 
 NOT RUN IN CI: stable-baselines3 pulls in PyTorch (hundreds of MB), which
-.ci/run does not install. Run it by hand:
+`cargo xtask test` does not install. Run it by hand:
 
     pip install ./python stable-baselines3
     python python/examples/sb3_ppo_mtbf.py [--steps 50000] [--delta 0.1]

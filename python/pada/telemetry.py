@@ -27,6 +27,14 @@ def read_telemetry(path):
       ``damage`` (J per learned joint, Eq. 7) and ``reengagements``;
     - ``episodes``: ``index``, ``mode``, ``return``, ``length``,
       ``weights_checksum``;
+    - ``checkpoints``: one entry per save and per restore of a checkpoint
+      the host keeps (LEO on the F429 streams its 8 MiB table in up to
+      65 543 chunks), as ``pada capture``'s ``checkpoint-save`` and
+      ``checkpoint-restore`` CSV rows: ``direction`` ("save"/"restore"),
+      ``generation`` (-1: none loaded), ``bytes`` (the image), ``chunks``,
+      ``requests`` (a restore's), ``link_s`` (seconds on the 921 600-baud
+      telemetry link; in a recording a restore's answers, which go to the
+      board, are not counted) and ``outcome``;
     - ``link``: frames, bytes and every kind of loss, ``bad_frames`` and
       ``messages`` (frames by message) — the counts ``pada capture --json``
       reports for the same file.
@@ -61,9 +69,20 @@ def read_telemetry(path):
         "weights_checksum": np.asarray(e["weights_checksum"], dtype=np.uint32),
     }
     summary = json.loads(raw["summary_json"])
+    c = summary["checkpoints"]
+    checkpoints = {
+        "direction": np.asarray([t["direction"] for t in c], dtype="<U7"),
+        "generation": np.asarray([-1 if t["generation"] is None else t["generation"] for t in c], dtype=np.int64),
+        "bytes": np.asarray([t["bytes"] for t in c], dtype=np.uint32),
+        "chunks": np.asarray([t["chunks"] for t in c], dtype=np.uint32),
+        "requests": np.asarray([t["requests"] for t in c], dtype=np.uint32),
+        "link_s": np.asarray([t["link_s"] for t in c], dtype=np.float64),
+        "outcome": np.asarray([t["outcome"] for t in c], dtype=str),
+    }
     return {
         "steps": steps,
         "episodes": episodes,
+        "checkpoints": checkpoints,
         "link": summary["link"],
         "bad_frames": summary["bad_frames"],
         "messages": summary["messages"],

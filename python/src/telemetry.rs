@@ -30,6 +30,8 @@ pub fn read_telemetry<'py>(
         let mut frames = Vec::new();
         let _ = rec.feed(&bytes, 0.0, &mut frames);
         let _ = rec.finish(0.0);
+        // A save or restore the file ends inside is listed as unfinished.
+        let _ = rec.end();
         (rec, frames)
     });
     let d = PyDict::new(py);
@@ -114,6 +116,8 @@ pub fn read_telemetry<'py>(
         "link": stats,
         "bad_frames": stats.bad_frames(),
         "messages": rec.counts(),
+        // One per checkpoint save and restore, as pada capture's CSV rows.
+        "checkpoints": rec.transfers(),
     });
     d.set_item("summary_json", summary.to_string())?;
     Ok(d)

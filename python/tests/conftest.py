@@ -22,7 +22,7 @@ def pada_binary():
     on_path = shutil.which("pada")
     if on_path:
         return on_path
-    msg = "the pada command is not built (cargo build -p pada, or set PADA_BIN)"
+    msg = "the pada command is not built (cargo build -p pada, or set PADA_BIN; `cargo xtask test` sets it)"
     if os.environ.get("CI") == "true":
         pytest.fail(msg)
     pytest.skip(msg)

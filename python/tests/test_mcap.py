@@ -26,7 +26,7 @@ def need(module):
         return importlib.import_module(module)
     except ImportError:
         if os.environ.get("CI") == "true":
-            pytest.fail(f"{module} is not installed (.ci/run installs it)")
+            pytest.fail(f"{module} is not installed (`cargo xtask test` installs it in its venv)")
         pytest.skip(f"{module} is not installed")
 
 
@@ -109,9 +109,15 @@ def test_counts_per_channel_equal_the_capture_summary(recordings, name, gearboxe
     want = expected_counts(summary, gearboxes, scene)
     for topic, n in want.items():
         assert counts[topic] == n, (topic, counts)
-    # Policy reports and the other events make the summary's "other".
-    assert counts["/policy"] + counts["/event"] == summary["messages"]["other"]
-    assert set(counts) <= set(want) | {"/policy", "/event", "/governor", "/claims"}, counts
+    # Policy reports and the other events make the summary's "other"; a
+    # checkpoint transfer's frames (chunks, requests and the board's report
+    # that ends it) are one /checkpoint message each transfer.
+    transfers = [json.loads(m.data) for _, c, m in messages if c.topic == "/checkpoint"]
+    reported = sum(t["reported"] for t in transfers)
+    assert counts["/policy"] + counts["/event"] + reported == summary["messages"]["other"]
+    assert sum(t["requests"] for t in transfers) == summary["messages"]["restore_wanted"]
+    assert sum(t["chunks"] for t in transfers if t["direction"] == "save") == summary["messages"]["checkpoint_chunk"]
+    assert set(counts) <= set(want) | {"/policy", "/event", "/governor", "/claims", "/checkpoint"}, counts
     # The claim table's occupancy beside each health report of a claim table.
     assert counts["/claims"] in (0, summary["messages"]["health"])
     if summary["latest"].get("table"):
@@ -120,6 +126,9 @@ def test_counts_per_channel_equal_the_capture_summary(recordings, name, gearboxe
         # The board's claim table reports its occupancy with every health.
         assert summary["latest"]["table"]["slots"] == 1 << 21
         assert counts["/claims"] == summary["messages"]["health"] > 0
+        # At boot it asked the host for its checkpoint (none in a capture
+        # of a file): one restore, one message.
+        assert [(t["direction"], t["requests"], t["outcome"]) for t in transfers] == [("restore", 1, "no-checkpoint")]
     # The file's own statistics agree with what was read.
     stats = file_summary.statistics
     by_id = {c.id: c.topic for c in file_summary.channels.values()}

@@ -1,7 +1,9 @@
 """read_telemetry's frame and loss counts equal `pada capture --json`'s, on
 a clean stream of `pada run --telemetry` and on a damaged copy."""
 
+import csv
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -36,6 +38,21 @@ def test_clean_stream(stream, pada_bin):
     assert s["state"].shape == (len(s["step"]), 2) and s["damage"].shape[1] == 1
     assert np.all(np.diff(s["damage"][:, 0]) >= 0)
     assert set(np.unique(s["mode"])) <= {"learning", "testing"}
+
+
+def test_checkpoints_are_one_entry_per_save_and_restore(pada_bin, tmp_path):
+    # The SIL recording of LEO on f429-sdram: its board asked the host for
+    # the checkpoint it keeps at boot (one request, none kept), as pada
+    # capture's one checkpoint-restore row.
+    path = Path(__file__).resolve().parents[2] / "tests" / "data" / "sil-leo-3s.bin"
+    t = check_counts(pada_bin, path)
+    c = t["checkpoints"]
+    assert list(c["direction"]) == ["restore"] and list(c["outcome"]) == ["no-checkpoint"]
+    assert list(c["requests"]) == [1] and list(c["generation"]) == [-1] and c["link_s"][0] > 0
+    csv_path = tmp_path / "leo.csv"
+    run_pada(pada_bin, "capture", "--file", str(path), "--out", str(csv_path))
+    rows = [r for r in csv.DictReader(csv_path.open()) if r["kind"].startswith("checkpoint-")]
+    assert [(r["kind"], r["outcome"], r["bytes"]) for r in rows] == [("checkpoint-restore", "no-checkpoint", str(c["bytes"][0]))]
 
 
 def test_damaged_stream(stream, pada_bin, tmp_path):

@@ -41,9 +41,14 @@ pub struct ActionTiles<const TILINGS: usize> {
     dims: usize,
     /// Levels per action dimension (to decode joint indices).
     levels: [u8; MAX_ACTION_DIMS],
-    /// `part[j][d][l] = k_jdl · stride_d`: what level `l` of dimension `d`
-    /// adds to the combination index in tiling `j`.
-    part: [[[u8; MAX_LEVELS]; MAX_ACTION_DIMS]; TILINGS],
+    /// `tile[j][d][l] = k_jdl`: the tile of level `l` of dimension `d` in
+    /// tiling `j`, counted from the tile of the dimension's lowest level
+    /// (non-decreasing in `l`: levels ascend).
+    tile: [[[u8; MAX_LEVELS]; MAX_ACTION_DIMS]; TILINGS],
+    /// `stride_d`: what one tile of dimension `d` adds to the combination
+    /// index (1 for the first dimension; 0 for a dimension the space does
+    /// not have).
+    stride: [u32; MAX_ACTION_DIMS],
     combos: u32,
 }
 
@@ -94,24 +99,30 @@ impl<const TILINGS: usize> ActionTiles<TILINGS> {
                 "at most 128 per tiling (use wider action tiles or fewer levels)",
             ));
         }
-        let mut part = [[[0u8; MAX_LEVELS]; MAX_ACTION_DIMS]; TILINGS];
-        for (j, part_j) in part.iter_mut().enumerate() {
+        let mut tile = [[[0u8; MAX_LEVELS]; MAX_ACTION_DIMS]; TILINGS];
+        for (j, tile_j) in tile.iter_mut().enumerate() {
             for d in 0..space.dims() {
                 for (l, &v) in space.dim(d).values().iter().enumerate() {
-                    // tile · stride < combos ≤ MAX_ACTION_COMBOS: fits a u8.
-                    part_j[d][l] = (tile_of(d, j, v) * stride[d]) as u8;
+                    // tile < combos ≤ MAX_ACTION_COMBOS: fits a u8.
+                    tile_j[d][l] = tile_of(d, j, v) as u8;
                 }
             }
         }
-        Ok(ActionTiles { dims: space.dims(), levels, part, combos })
+        Ok(ActionTiles { dims: space.dims(), levels, tile, stride, combos })
     }
 
     /// Writes the tiling into a configuration hash: dimensions, levels,
     /// combinations and every tiling's offsets.
     pub fn write_config(&self, h: &mut crate::checkpoint::ConfigHasher) {
         h.write_u32(self.dims as u32).write_u32(self.combos).write(&self.levels[..self.dims]);
-        for tiling in &self.part {
-            for (d, row) in tiling.iter().enumerate().take(self.dims) {
+        // Each level's part of the combination index, as bytes: what this
+        // hash has always been given (it was the stored table).
+        for j in 0..TILINGS {
+            for d in 0..self.dims {
+                let mut row = [0u8; MAX_LEVELS];
+                for (l, b) in row.iter_mut().enumerate().take(self.levels[d] as usize) {
+                    *b = self.part(j, d, l as u8) as u8;
+                }
                 h.write(&row[..self.levels[d] as usize]);
             }
         }
@@ -123,12 +134,32 @@ impl<const TILINGS: usize> ActionTiles<TILINGS> {
     }
 
     /// What level `level` of action dimension `d` adds to the combination
-    /// index in tiling `j` (0 for a dimension the space does not have).
+    /// index in tiling `j` (0 for a dimension the space does not have):
+    /// its [`tile`](Self::tile) times the dimension's
+    /// [`stride`](Self::stride).
     #[inline(always)]
     pub fn part(&self, j: usize, d: usize, level: u8) -> u32 {
+        self.tile(j, d, level) * self.stride(d)
+    }
+
+    /// The tile that level `level` of action dimension `d` falls into in
+    /// tiling `j`, counted from the tile of the dimension's lowest level
+    /// (0 for a dimension the space does not have). Non-decreasing in
+    /// `level`.
+    #[inline(always)]
+    pub fn tile(&self, j: usize, d: usize, level: u8) -> u32 {
         // MAX_LEVELS is a power of two and every level is below it: the
         // mask changes nothing but lets the compiler drop the bounds check.
-        self.part[j][d & (MAX_ACTION_DIMS - 1)][level as usize & (MAX_LEVELS - 1)] as u32
+        self.tile[j][d & (MAX_ACTION_DIMS - 1)][level as usize & (MAX_LEVELS - 1)] as u32
+    }
+
+    /// What one tile of action dimension `d` adds to the combination index
+    /// (1 for the first dimension, the product of the earlier dimensions'
+    /// tile counts for the others; 0 for a dimension the space does not
+    /// have).
+    #[inline(always)]
+    pub fn stride(&self, d: usize) -> u32 {
+        self.stride[d & (MAX_ACTION_DIMS - 1)]
     }
 
     /// The combination that `levels` falls into in tiling `j`.

@@ -93,7 +93,7 @@
 //! of two, fixed at compile time on the chip), the probe bound a constant.
 
 use crate::fixed::Q16;
-use crate::weights::WeightStore;
+use crate::weights::{entry_factor, Added, WeightStore};
 
 pub use crate::claims::{Claim, InitialWeights, Occupancy};
 
@@ -384,12 +384,74 @@ impl<W: WeightStore, T: TagStore> ClaimTable<W, T> {
     /// The weight of the feature `key`: its slot's, or its initial weight
     /// if it holds none. Claims nothing and changes nothing, the occupancy
     /// included (the hot path: see [`Occupancy::longest_probe`]).
-    #[inline]
+    #[inline(always)]
     pub fn read(&self, key: u32) -> Q16 {
+        // Most features a choice reads hold no slot, and in a table far
+        // from full most of their homes are free: the first look of the
+        // probe settles those, without the tag, inlined into the caller's
+        // loop; the probe is a call.
+        if self.tags.get((key & self.mask) as usize) == EMPTY {
+            return self.initial_weight(key);
+        }
+        self.read_probing(key)
+    }
+
+    /// [`read`](Self::read) past a home that is not free.
+    #[inline(never)]
+    fn read_probing(&self, key: u32) -> Q16 {
         match self.probe(key).0 {
             Probe::Found(i) => self.weights.get(i as usize),
             Probe::Free(_) | Probe::Exhausted => self.initial_weight(key),
         }
+    }
+
+    /// [`read`](Self::read) of every key in `keys`, then
+    /// [`claim`](Self::claim) of each in order, with one probe per key
+    /// where the claims leave its probe's outcome as it was: a claim only
+    /// fills a free slot, so a key found stays found, a key refused stays
+    /// refused, and a key whose probe stopped at a free slot takes that
+    /// slot if it is still free (the earlier keys' claims did not fill
+    /// it) and probes again if not. So the weights, the claims and the
+    /// counts are those of the reads and claims one by one. Writes each
+    /// claim to `claims` and returns the sum of the weights read.
+    pub fn read_then_claim(&mut self, keys: &[u32], claims: &mut [Claim]) -> i64 {
+        let mut sum = 0i64;
+        // The probes, their outcomes kept in `claims` for now: a free slot
+        // as a fresh claim of it.
+        for (claim, &key) in claims.iter_mut().zip(keys) {
+            let (found, _) = self.probe(key);
+            let (c, w) = match found {
+                Probe::Found(i) => (Claim::Slot { slot: i, fresh: false }, self.weights.get(i as usize)),
+                Probe::Free(i) => (Claim::Slot { slot: i, fresh: true }, self.initial_weight(key)),
+                Probe::Exhausted => (Claim::Refused, self.initial_weight(key)),
+            };
+            *claim = c;
+            sum += w.0 as i64;
+        }
+        for (claim, &key) in claims.iter_mut().zip(keys) {
+            let probed = match *claim {
+                Claim::Slot { slot, fresh: true } if self.tags.get(slot as usize) == EMPTY => {
+                    self.tags.set(slot as usize, self.tag_for(key));
+                    self.weights.set(slot as usize, self.initial_weight(key));
+                    self.claimed += 1;
+                    slot.wrapping_sub(key) & self.mask
+                }
+                Claim::Slot { fresh: true, .. } => {
+                    // An earlier key of this batch took the free slot.
+                    *claim = self.claim(key);
+                    continue;
+                }
+                Claim::Slot { slot, fresh: false } => slot.wrapping_sub(key) & self.mask,
+                Claim::Refused => {
+                    self.refused = self.refused.saturating_add(1);
+                    MAX_PROBE
+                }
+            };
+            if probed > self.longest_probe {
+                self.longest_probe = probed;
+            }
+        }
+        sum
     }
 
     /// The slot of the feature `key`, claimed now if it held none (its
@@ -498,16 +560,38 @@ impl<W: WeightStore, T: TagStore> WeightStore for ClaimTable<W, T> {
         ClaimTable::read(self, feature)
     }
 
-    /// The key's home slot: its tag, and the weight beside it.
-    #[inline]
-    fn touch(&self, feature: u32) -> u32 {
-        let home = (feature & self.mask) as usize;
-        self.tags.get(home) ^ self.weights.raw(home)
-    }
-
     #[inline]
     fn claim(&mut self, feature: u32) -> Claim {
         ClaimTable::claim(self, feature)
+    }
+
+    #[inline]
+    fn read_then_claim(&mut self, features: &[u32], claims: &mut [Claim]) -> i64 {
+        ClaimTable::read_then_claim(self, features, claims)
+    }
+
+    /// The weight store's writes, with the checksum's change taken from
+    /// the weight alone: a write leaves the slot's tag as it is, so a
+    /// claimed slot's [`raw`](WeightStore::raw) changes with its weight's,
+    /// and a free slot's stays 0.
+    fn add_each<D: FnMut() -> u32>(&mut self, slots: &[u32], inc: Q16, mut dither: D) -> Added {
+        let dithered = self.weights.dithered();
+        let n = self.weights.len();
+        let mut out = Added::default();
+        for &slot in slots {
+            let i = slot as usize;
+            if i >= n {
+                continue;
+            }
+            let d = if dithered { dither() } else { 0 };
+            let old = self.weights.raw(i);
+            out.saturations += self.weights.add(i, inc, d) as u32;
+            if self.tags.get(i) != EMPTY {
+                let change = self.weights.raw(i).wrapping_sub(old);
+                out.checksum_change = out.checksum_change.wrapping_add(change.wrapping_mul(entry_factor(i)));
+            }
+        }
+        out
     }
 
     fn reset_claims(&mut self, init: InitialWeights) {

@@ -320,6 +320,34 @@ impl<const TILINGS: usize> TileCoder<TILINGS> {
         murmur_finish(murmur_mix(code.per_tiling[tiling], combo)) & self.mask
     }
 
+    /// The state's share of `tiling`'s hashed features, for
+    /// [`feature_of_parts`](Self::feature_of_parts): the same for every
+    /// action or combination in that tiling.
+    #[inline]
+    pub fn state_part(&self, code: &StateCode<TILINGS>, tiling: usize) -> u32 {
+        code.per_tiling[tiling].wrapping_mul(MURMUR_M)
+    }
+
+    /// The last hashed word's share of a feature (a joint action or an
+    /// action-tile combination), for [`feature_of_parts`](Self::feature_of_parts):
+    /// the same in every state and tiling, so a caller that hashes many
+    /// features of few words computes it once per word.
+    #[inline]
+    pub const fn word_part(word: u32) -> u32 {
+        murmur_word(word)
+    }
+
+    /// The hashed feature of a state's and a word's shares:
+    /// `feature_of_parts(state_part(code, j), word_part(c))` is
+    /// [`combo_feature`](Self::combo_feature)`(code, j, c)`, and with the
+    /// joint action as the word, [`action_feature`](Self::action_feature)
+    /// of a hashed layout. (MurmurHash2 mixes the word independently of
+    /// the state before the two meet, so the split changes no bit.)
+    #[inline]
+    pub fn feature_of_parts(&self, state_part: u32, word_part: u32) -> u32 {
+        murmur_finish(state_part ^ word_part) & self.mask
+    }
+
     /// Writes what gives this coder's features their meaning into a
     /// configuration hash: tilings, layout, table size, joint actions, each
     /// dimension as prepared (range, sub-tiles per unit, wrap period,
@@ -457,10 +485,15 @@ impl<const TILINGS: usize> TileCoder<TILINGS> {
 /// One MurmurHash2 round: absorbs the 32-bit word `k` into `h`.
 #[inline]
 fn murmur_mix(h: u32, k: u32) -> u32 {
+    h.wrapping_mul(MURMUR_M) ^ murmur_word(k)
+}
+
+/// MurmurHash2's mixing of one word before it meets the running hash.
+#[inline]
+const fn murmur_word(k: u32) -> u32 {
     let mut k = k.wrapping_mul(MURMUR_M);
     k ^= k >> MURMUR_R;
-    k = k.wrapping_mul(MURMUR_M);
-    h.wrapping_mul(MURMUR_M) ^ k
+    k.wrapping_mul(MURMUR_M)
 }
 
 /// MurmurHash2's finaliser.

@@ -132,27 +132,6 @@ pub trait WeightStore {
         self.format().bytes() + self.tag_bytes()
     }
 
-    /// Whether a reader of many features should [`touch`](Self::touch)
-    /// them all before it reads them: a table in cached memory far larger
-    /// than the cache (the host's LEO table), where a read's branches wait
-    /// on its cache miss, so misses taken one read at a time do not
-    /// overlap. `false` by default: the chips' tables sit in memory with
-    /// no data cache to fill, where touching is only extra reads.
-    #[inline]
-    fn touches_before_reading(&self) -> bool {
-        false
-    }
-
-    /// Loads the memory that [`read`](Self::read) of `feature` looks at
-    /// first and returns its bits (for `core::hint::black_box`). A batch of
-    /// touches are independent loads that the processor issues together;
-    /// the reads after them then find their lines in the cache. Changes
-    /// nothing and reads nothing outside the table.
-    #[inline]
-    fn touch(&self, feature: u32) -> u32 {
-        self.raw(feature as usize)
-    }
-
     /// The weight of `feature`: the weight at that index in a plain table,
     /// the feature's slot's (or its initial weight) in a claim table.
     #[inline]
@@ -160,11 +139,62 @@ pub trait WeightStore {
         self.get(feature as usize)
     }
 
+    /// [`read`](Self::read) of every feature in `buf`, each replaced by
+    /// its weight's bits (`Q16.0 as u32`). One call per batch, so that a
+    /// table behind a dispatch dispatches once, and the loop keeps the
+    /// table's fields in registers. The reads are independent, so a
+    /// processor that executes ahead overlaps their cache misses.
+    #[inline]
+    fn read_each(&self, buf: &mut [u32]) {
+        for x in buf {
+            *x = self.read(*x).0 as u32;
+        }
+    }
+
     /// The slot a learning update of `feature` writes: the index itself in
     /// a plain table (never fresh), the claimed slot in a claim table.
     #[inline]
     fn claim(&mut self, feature: u32) -> Claim {
         Claim::Slot { slot: feature, fresh: false }
+    }
+
+    /// [`read`](Self::read) of every feature in `features`, then
+    /// [`claim`](Self::claim) of each in order (a learning update needs
+    /// the pair's `Q` and the slots it writes): the claims go to `claims`,
+    /// the sum of the weights read is returned. A claim table does both
+    /// with one probe per feature where it can
+    /// ([`ClaimTable::read_then_claim`](crate::claim_table::ClaimTable::read_then_claim)).
+    fn read_then_claim(&mut self, features: &[u32], claims: &mut [Claim]) -> i64 {
+        let sum = features.iter().map(|&f| self.read(f).0 as i64).sum();
+        for (claim, &f) in claims.iter_mut().zip(features) {
+            *claim = self.claim(f);
+        }
+        sum
+    }
+
+    /// [`add`](Self::add) of `inc` to the weight of each slot in `slots`,
+    /// in order; a slot outside the table is skipped (a refused claim's
+    /// `u32::MAX`). A [`dithered`](Self::dithered) table takes one draw
+    /// from `dither` per weight it writes, others none. Returns the
+    /// saturations and the change of the [`checksum`](Self::checksum).
+    /// One call per trace entry, so that a table behind a dispatch (the
+    /// host's one type for every table) dispatches once per entry rather
+    /// than three times per weight.
+    fn add_each<D: FnMut() -> u32>(&mut self, slots: &[u32], inc: Q16, mut dither: D) -> Added {
+        let dithered = self.dithered();
+        let mut out = Added::default();
+        for &slot in slots {
+            let i = slot as usize;
+            if i >= self.len() {
+                continue;
+            }
+            let d = if dithered { dither() } else { 0 };
+            let old = self.raw(i);
+            out.saturations += self.add(i, inc, d) as u32;
+            let change = self.raw(i).wrapping_sub(old);
+            out.checksum_change = out.checksum_change.wrapping_add(change.wrapping_mul(entry_factor(i)));
+        }
+        out
     }
 
     /// Frees every slot of a claim table and sets its unclaimed features'
@@ -193,6 +223,15 @@ pub trait WeightStore {
     fn checksum(&self) -> u32 {
         (0..self.len()).fold(0u32, |sum, i| sum.wrapping_add(self.raw(i).wrapping_mul(entry_factor(i))))
     }
+}
+
+/// What [`WeightStore::add_each`] did.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Added {
+    /// Writes that hit the format's range and saturated.
+    pub saturations: u32,
+    /// What the writes added to the table's checksum (wrapping).
+    pub checksum_change: u32,
 }
 
 /// The multiplier of weight `i` in the table checksum: `(2i + 1)·φ`, with

@@ -315,8 +315,10 @@ fn the_protocol_version_changes_with_the_layout() {
 }
 
 /// [`layout_fingerprint`] of protocol 10 (`FaultCause::HardwareAlert`, a
-/// Protocol 2.0 servo's Alert with its Hardware Error Status; 9 `Hello`
-/// names the robot and its definition's hash; 8 the checkpoint the host keeps:
+/// Protocol 2.0 servo's Alert with its Hardware Error Status); 9 (`Hello`
+/// names the robot and its definition's hash, and a restore's batch grew
+/// from 3 to 24 chunks, which only the board's receive buffer sees; 8 was
+/// 0xaca4_4e73) and 8 (the checkpoint the host keeps:
 /// `CheckpointChunk`, `RestoreWanted`, `Restored`, `Streamed`,
 /// `RestoreChunk`, `RestoreNone`; 7 the claim table's occupancy in
 /// `Health`; 6 added the gentle explorations in `PolicyKind`, the governor
@@ -344,11 +346,15 @@ fn the_largest_messages_fit_the_documented_limits() {
         let b = body(&(u32::MAX, &m));
         assert!(b.len() <= MAX_BODY, "{} body bytes: {m:?}", b.len());
     }
-    // A batch of the largest restore chunks fits the board's 512-byte
-    // command buffer (firmware/src/board/lockstep/link.rs).
+    // A batch of the largest restore chunks fits the board's command
+    // buffer (firmware/src/board/hw.rs and lockstep/link.rs), and a batch
+    // is large enough that a restore of LEO's table (65 543 chunks) takes
+    // at most 2 731 requests, each a round trip (21 848 with protocol 8's
+    // batches of 3 in a 512-byte buffer).
     let mut frame = [0u8; MAX_FRAME_LEN];
     let largest = encode_frame(&ToChip::RestoreChunk(full_chunk()), u32::MAX, &mut frame).unwrap().len();
-    assert!(largest * RESTORE_BATCH <= 512, "{RESTORE_BATCH} x {largest} B");
+    assert!(largest * RESTORE_BATCH <= CHIP_RX_BUFFER, "{RESTORE_BATCH} x {largest} B in {CHIP_RX_BUFFER} B");
+    assert!(65_543usize.div_ceil(RESTORE_BATCH) <= 2_731, "{RESTORE_BATCH} chunks a request");
     let step = body(&(u32::MAX, ToHost::Step(full_step())));
     let weights = body(&(
         u32::MAX,

@@ -10,6 +10,7 @@
 //! | [`leo`] | LEO in rapier3d (Section VIII), its RX-28 servos, the walking task |
 //! | [`rig`] | the robot behind a board's servos and sensors, for `pada run --board` and `pada sil` |
 //! | [`robots`] | which body and rules each of pada's robots has |
+//! | [`urdf`] | a robot of the user's own: its URDF in rapier, driven through its rules and servos |
 //! | [`integrator`] | RK4 for the pendulums |
 //! | [`model_presets`] | settings of LEO's model that its checks share |
 //!
@@ -24,3 +25,4 @@ pub mod pendulum;
 pub mod rig;
 pub mod robots;
 pub mod task;
+pub mod urdf;

@@ -8,24 +8,40 @@ use crate::leo::rl::{leo_params, LeoTask};
 use crate::pendulum::{PhysicalPendulumParams, PhysicalPendulumTask};
 use crate::rig::{LeoRig, PendulumRig, Rig};
 use crate::task::{Task, TaskSpec};
+use crate::urdf::{UrdfModel, UrdfRig, UrdfTask};
 use pada_core::limits::MAX_STATE_DIMS;
 use pada_core::profile::{Board, LearnerProfile};
 use pada_core::robot::leo::{self, Leo};
 use pada_core::robot::pendulum::{self, Pendulum};
-use pada_core::robot::{PerServo, RobotRules, RobotSpec, Sensed};
+use pada_core::robot::{PerServo, RobotRules, RobotSpec, Sensed, Vocab};
+use pada_robot_file::RobotFile;
+use std::sync::Arc;
 
 /// The simulated body behind a robot's servos: pada's two hand-built
-/// models.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// models, or a robot of files' URDF.
+#[derive(Clone)]
 pub enum Body {
     /// The physical pendulum's model (`crate::pendulum::physical`).
     Pendulum,
     /// The rapier3d LEO (`crate::leo`).
     Leo,
+    /// A robot of files: its URDF in rapier (`crate::urdf`).
+    Urdf(Arc<UrdfModel>),
 }
 
-/// How the simulator runs one robot.
-#[derive(Debug, Clone, Copy)]
+impl std::fmt::Debug for Body {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Body::Pendulum => "Pendulum",
+            Body::Leo => "Leo",
+            Body::Urdf(_) => "Urdf",
+        })
+    }
+}
+
+/// How the simulator runs one robot: one of pada's ([`built_in`]) or a
+/// robot of files ([`from_file`]).
+#[derive(Debug, Clone)]
 pub struct SimRobot {
     /// The robot.
     pub robot: &'static RobotSpec,
@@ -33,38 +49,80 @@ pub struct SimRobot {
     pub default_board: Board,
     /// The body that simulates it.
     pub body: Body,
-    /// Its rules, before the first reading.
-    pub rules: fn() -> DynRules,
 }
 
-/// The simulator's entries, in the order of the core's registry (a test
-/// checks it).
-pub static ROBOTS: [SimRobot; 3] = [
-    SimRobot {
-        robot: &pendulum::SPEC_33HZ,
-        default_board: Board::F405,
-        body: Body::Pendulum,
-        rules: || DynRules(Box::new(Pendulum::at_33hz())),
-    },
-    SimRobot {
-        robot: &pendulum::SPEC_20HZ,
-        default_board: Board::F405,
-        body: Body::Pendulum,
-        rules: || DynRules(Box::new(Pendulum::at_20hz())),
-    },
-    SimRobot {
-        robot: &leo::SPEC,
-        default_board: Board::F429Sdram,
-        body: Body::Leo,
-        rules: || DynRules(Box::new(Leo::new())),
-    },
+/// The body and default board of each of pada's robots, in the order of
+/// the core's registry (a test checks it).
+const BUILT_IN: [(&RobotSpec, Board, fn() -> Body); 3] = [
+    (&pendulum::SPEC_33HZ, Board::F405, || Body::Pendulum),
+    (&pendulum::SPEC_20HZ, Board::F405, || Body::Pendulum),
+    (&leo::SPEC, Board::F429Sdram, || Body::Leo),
 ];
 
-/// The entry of `robot`, if the simulator knows it.
-pub fn sim_robot(robot: &RobotSpec) -> anyhow::Result<&'static SimRobot> {
-    ROBOTS.iter().find(|e| e.robot == robot).ok_or_else(|| {
-        anyhow::anyhow!("robot {} (definition {:08x}) is none the host simulates", robot.name, robot.definition_hash())
+/// The simulator's entry of one of pada's own robots.
+pub fn built_in(robot: &RobotSpec) -> Option<SimRobot> {
+    BUILT_IN.iter().find(|(r, ..)| *r == robot).map(|(r, board, body)| SimRobot { robot: r, default_board: *board, body: body() })
+}
+
+/// Every one of pada's robots, in the core registry's order.
+pub fn built_ins() -> impl Iterator<Item = SimRobot> {
+    BUILT_IN.iter().map(|(r, board, body)| SimRobot { robot: r, default_board: *board, body: body() })
+}
+
+/// The simulator's entry of `robot` if it is one of pada's, or why not.
+pub fn sim_robot(robot: &RobotSpec) -> anyhow::Result<SimRobot> {
+    built_in(robot).ok_or_else(|| {
+        anyhow::anyhow!("robot {} (definition {:08x}) is none of pada's own: give its robot.toml", robot.name, robot.definition_hash())
     })
+}
+
+/// The simulator's entry of a robot of files: its URDF, read and checked.
+pub fn from_file(file: &RobotFile) -> anyhow::Result<SimRobot> {
+    Ok(SimRobot { robot: file.spec, default_board: Board::F405, body: Body::Urdf(Arc::new(UrdfModel::load(file)?)) })
+}
+
+impl SimRobot {
+    /// Its rules, before the first reading.
+    pub fn rules(&self) -> DynRules {
+        DynRules(match &self.body {
+            Body::Pendulum => Box::new(Pendulum::new(self.robot)),
+            Body::Leo => Box::new(Leo::new()),
+            // A robot of files was checked when it was read.
+            Body::Urdf(_) => Box::new(Vocab::new(self.robot).unwrap_or_else(|e| unreachable!("checked at load: {e}"))),
+        })
+    }
+
+    /// The rig a board trial runs against (`pada run --board`): the
+    /// physical pendulum's model with an operator who stops it between
+    /// episodes, the rapier3d LEO with its operator, or a robot of files
+    /// with one.
+    pub fn board_rig(&self) -> anyhow::Result<Box<dyn Rig>> {
+        Ok(match &self.body {
+            Body::Leo => Box::new(LeoRig::new(ModelOptions::default())?),
+            Body::Pendulum => Box::new(PendulumRig::with_operator(PhysicalPendulumParams::default())),
+            Body::Urdf(model) => Box::new(UrdfRig::of_model(model)?),
+        })
+    }
+
+    /// The rig behind the emulated bus of `pada sil`: the physical
+    /// pendulum's model swinging freely between episodes, as on the real
+    /// rig; the others as [`board_rig`](Self::board_rig).
+    pub fn sil_rig(&self) -> anyhow::Result<Box<dyn Rig>> {
+        Ok(match &self.body {
+            Body::Pendulum => Box::new(PendulumRig::new(PhysicalPendulumParams::default())),
+            _ => self.board_rig()?,
+        })
+    }
+
+    /// Its task as the runner describes it with `profile`'s table (`pada
+    /// run --board`: the summary's keys and parameters are `pada run`'s).
+    pub fn task_spec(&self, profile: LearnerProfile) -> anyhow::Result<TaskSpec> {
+        Ok(match &self.body {
+            Body::Leo => LeoTask::with_profile(profile, leo_params()).spec().clone(),
+            Body::Pendulum => PhysicalPendulumTask::with_profile(PhysicalPendulumParams::default(), profile).spec().clone(),
+            Body::Urdf(model) => UrdfTask::of_model(model, profile).spec().clone(),
+        })
+    }
 }
 
 /// A robot's rules behind a pointer, so that one controller type drives
@@ -114,48 +172,18 @@ impl RobotRules for DynRules {
     }
 }
 
-/// The rig a board trial of `robot` runs against (`pada run --board`): the
-/// physical pendulum's model with an operator who stops it between
-/// episodes, or the rapier3d LEO with its operator.
-pub fn board_rig(robot: &RobotSpec) -> anyhow::Result<Box<dyn Rig>> {
-    Ok(match sim_robot(robot)?.body {
-        Body::Leo => Box::new(LeoRig::new(ModelOptions::default())?),
-        Body::Pendulum => Box::new(PendulumRig::with_operator(PhysicalPendulumParams::default())),
-    })
-}
-
-/// The rig behind the emulated bus of `pada sil`: the physical pendulum's
-/// model, swinging freely between episodes as on the real rig; or the
-/// rapier3d LEO with its operator.
-pub fn sil_rig(robot: &RobotSpec) -> anyhow::Result<Box<dyn Rig>> {
-    Ok(match sim_robot(robot)?.body {
-        Body::Leo => Box::new(LeoRig::new(ModelOptions::default())?),
-        Body::Pendulum => Box::new(PendulumRig::new(PhysicalPendulumParams::default())),
-    })
-}
-
-/// The task of `profile`'s robot as the runner describes it, with
-/// `profile`'s table (`pada run --board`: the summary's keys and
-/// parameters are `pada run`'s).
-pub fn board_task_spec(profile: LearnerProfile) -> anyhow::Result<TaskSpec> {
-    Ok(match sim_robot(profile.robot)?.body {
-        Body::Leo => LeoTask::with_profile(profile, leo_params()).spec().clone(),
-        Body::Pendulum => PhysicalPendulumTask::with_profile(PhysicalPendulumParams::default(), profile).spec().clone(),
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn every_robot_has_one_entry_in_the_order_of_the_core() {
-        let ours: Vec<&RobotSpec> = ROBOTS.iter().map(|e| e.robot).collect();
+        let ours: Vec<&RobotSpec> = built_ins().map(|e| e.robot).collect();
         let core: Vec<&RobotSpec> = pada_core::robot::registry::specs().collect();
         assert_eq!(ours, core);
         for robot in core {
             assert_eq!(sim_robot(robot).unwrap().robot, robot);
-            let rules = (sim_robot(robot).unwrap().rules)();
+            let rules = sim_robot(robot).unwrap().rules();
             assert_eq!(rules.spec(), robot, "{}'s rules are its own", robot.name);
         }
         assert!(sim_robot(&pada_core::robot::RobotSpec { name: "mine", ..leo::SPEC }).is_err());

@@ -174,6 +174,18 @@ impl WeightTable {
 }
 
 impl TaskSpec {
+    /// The gearbox of counted joint `counted` (Eqs. 3–7): the robot's
+    /// servo's, Table I for a task without a robot.
+    pub fn gearbox(&self, counted: usize) -> pada_core::fatigue::GearboxParams {
+        self.profile.map_or(pada_core::fatigue::GearboxParams::TABLE_I, |p| p.robot.gearbox(counted))
+    }
+
+    /// The counted gearbox the worst action damages most (the wear
+    /// governor's): Table I for a task without a robot.
+    pub fn weakest_gearbox(&self) -> pada_core::fatigue::GearboxParams {
+        self.profile.map_or(pada_core::fatigue::GearboxParams::TABLE_I, |p| p.robot.weakest_gearbox())
+    }
+
     /// The rules of the task's episodes, for the shared episode cycle
     /// ([`pada_core::episodes::Episodes`]).
     pub fn episode_rules(&self) -> pada_core::episodes::EpisodeRules {

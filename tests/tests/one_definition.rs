@@ -16,7 +16,7 @@ use pada::experiment::build_agent;
 use pada::experiment::table::HostTable;
 use pada::experiment::task::{Task, TaskSpec};
 use pada::leo::rl::{leo_params, LeoTask};
-use pada::robots::{board_task_spec, sim_robot, DynRules};
+use pada::robots::{sim_robot, DynRules};
 use pada_core::policy::PolicyKind;
 use pada_core::profile::{config_hash, Board, LearnerProfile};
 use pada_core::robot::{leo, pendulum, registry, RobotRules};
@@ -58,7 +58,7 @@ fn table_of(profile: LearnerProfile, weights: usize) -> HostTable {
 
 /// The rules of `profile`'s robot, as the host builds them.
 fn rules(profile: LearnerProfile) -> DynRules {
-    (sim_robot(profile.robot).unwrap().rules)()
+    sim_robot(profile.robot).unwrap().rules()
 }
 
 /// The firmware controller's hash for `profile` and `policy` on a table of
@@ -120,7 +120,7 @@ fn host_and_firmware_build_the_same_learner_for_every_robot_on_every_board() {
     for robot in registry::specs() {
         for board in Board::ALL {
             let profile = board.profile(robot).unwrap();
-            let task = board_task_spec(profile).unwrap();
+            let task = sim_robot(robot).unwrap().task_spec(profile).unwrap();
             let refused = check(&task, profile);
             if robot == &leo::SPEC {
                 assert_eq!(profile.layout, Layout::Claimed, "LEO learns on a claim table on every board");
@@ -136,7 +136,7 @@ fn host_and_firmware_build_the_same_learner_for_every_robot_on_every_board() {
 fn the_hash_tells_boards_robots_and_learners_apart() {
     let pendulum = |board: Board| {
         let p = board.profile(&pendulum::SPEC_33HZ).unwrap();
-        let n = board_task_spec(p).unwrap().profile.and_then(|p| p.weights()).unwrap_or(24_960);
+        let n = sim_robot(&pendulum::SPEC_33HZ).unwrap().task_spec(p).unwrap().profile.and_then(|p| p.weights()).unwrap_or(24_960);
         firmware_hash(p, PolicyKind::Sarsa, n)
     };
     // The same exact table on two boards: a checkpoint of one is refused by

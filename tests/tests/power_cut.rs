@@ -160,6 +160,25 @@ fn leo_on_f429_resumes_every_cut_from_the_checkpoint_the_host_keeps() {
     // The file survived the cuts whole: the last save kept.
     let kept = pada::checkpoint_keeper::read_kept(&dir.path().join("checkpoint.bin")).unwrap();
     assert_eq!(kept.image().len() as u64, p.kept_bytes);
+    // Each restore that loaded asked once per batch of 24 chunks (protocol
+    // 9; once per 3 before, 21 848 round trips for a full LEO table),
+    // counted from the raw stream: the CSV has one row per restore.
+    let stream = std::fs::read(dir.path().join("telemetry.bin")).unwrap();
+    let mut rec = pada::capture::Recorder::new(None).unwrap();
+    rec.feed(&stream, 0.0, &mut Vec::new()).unwrap();
+    rec.end().unwrap();
+    let loaded: Vec<_> = rec
+        .transfers()
+        .iter()
+        .filter(|t| t.direction == pada::capture::transfer::Direction::Restore && t.outcome == "loaded")
+        .collect();
+    assert!(!loaded.is_empty(), "{:#?}", rec.transfers());
+    for t in loaded {
+        assert!(t.chunks > 24 && t.requests == t.chunks.div_ceil(24), "{t:?}");
+    }
+    let csv = std::fs::read_to_string(dir.path().join("telemetry.csv")).unwrap();
+    let rows = csv.lines().filter(|l| l.contains(",checkpoint-restore,")).count();
+    assert_eq!(rows as u32, p.restores_asked, "one row per restore");
 }
 
 #[test]

@@ -11,6 +11,8 @@
 //!   `f429-sdram`), and a software-in-the-loop run of it (`pada sil`).
 //! - `fuzz [--seconds S]`: the decoders that face untrusted bytes, fuzzed
 //!   on stable Rust (`fuzz/`, package `pada-fuzz`).
+//! - `test`: every test, after installing what the tests need (see
+//!   [`test`]); the README's test command.
 //!
 //! The xtask has no dependencies. Its command line is a few flags and a
 //! subcommand, so a hand-written parser is shorter than the argument-parser
@@ -18,6 +20,7 @@
 //! CI machine.
 
 mod elf;
+mod test;
 mod toolchain;
 
 use pada_core::robot::registry::{self, BuiltIn};
@@ -35,6 +38,14 @@ const USAGE: &str = "\
 usage: cargo xtask <task>
 
 tasks:
+  test  every test of pada: installs with apt what the tests need and is
+        missing (.ci/install: the firmware toolchain, QEMU 10 from
+        bookworm-backports, Chromium, Slurm and munge, python3-venv; needs
+        root, else it prints the one `sudo` line to run first and exits 2),
+        starts a one-node Slurm cluster (.ci/slurm) for the run, then runs
+        `cargo test --workspace`, the firmware library's tests
+        (`firmware-test`) and the Python package's (pytest in a venv), all
+        with CI=true (a test whose tool is missing fails, never skips)
   firmware [--release] [--board f405|f429-sdram] [--chip f405|f407|f429]
            [--robot pendulum|pendulum-20hz|leo]
         build the firmware ELF of a board's learner profile for
@@ -200,6 +211,8 @@ enum Task {
     Sil(Build, Vec<String>),
     /// Run `pada-fuzz` with these options (`--seconds S`, `--seed K`).
     Fuzz(Vec<String>),
+    /// Install what the tests need, then run every test.
+    Test,
 }
 
 /// `qemu` and `sil`: release unless `--debug`, a board profile, a robot,
@@ -338,6 +351,11 @@ fn parse_args(args: &[String]) -> Result<Task, String> {
             None => Ok(Task::FirmwareTest),
             Some(other) => Err(format!("unknown argument `{other}` for `firmware-test`")),
         },
+        "test" => match rest.first().map(String::as_str) {
+            None => Ok(Task::Test),
+            Some("-h" | "--help") => Ok(Task::Help),
+            Some(other) => Err(format!("unknown argument `{other}` for `test`")),
+        },
         other => Err(format!("unknown task `{other}`")),
     }
 }
@@ -365,6 +383,8 @@ fn main() -> ExitCode {
         }
     };
     let result = match task {
+        // Its own exit codes: 2 when it needs root to install (no test ran).
+        Task::Test => return test::run(&workspace_root()),
         Task::Help => {
             println!("{USAGE}");
             Ok(())
@@ -698,6 +718,8 @@ mod tests {
             Ok(Task::Firmware(Build { release: false, chip: Chip::F407, robot: registry::find("pendulum-20hz").unwrap() }))
         );
         assert_eq!(parse_args(&args("firmware-test")), Ok(Task::FirmwareTest));
+        assert_eq!(parse_args(&args("test")), Ok(Task::Test));
+        assert!(parse_args(&args("test --workspace")).is_err());
         assert!(parse_args(&args("firmware-test --release")).is_err());
         assert!(parse_args(&args("firmware --robot walker")).is_err());
     }

@@ -39,8 +39,10 @@ pub const WATCHDOG_FLASH_US: u32 = 8_000_000;
 
 /// Bytes of the servo bus's circular DMA receive buffer.
 const SERVO_RX_BUF: usize = 256;
-/// Bytes of the telemetry link's circular DMA receive buffer.
-const TELEMETRY_RX_BUF: usize = 512;
+/// Bytes of the telemetry link's circular DMA receive buffer: a whole batch
+/// of a restore's chunks, even if the board reads none until it has all
+/// arrived (the wire's).
+const TELEMETRY_RX_BUF: usize = pada_core::wire::CHIP_RX_BUFFER;
 
 /// Everything the tasks get from the board ([`Parts`]).
 pub type Board = Parts<ServoPort, TelemetryTx, TelemetryRx, BoardSensors, FlashStore, Watchdog, Cycles, Led>;

@@ -16,7 +16,6 @@ use crate::config::MAX_ROBOT_SERVOS;
 use pada_core::robot::RobotRules;
 use pada_core::episodes::wear;
 use pada_core::error::ConfigError;
-use pada_core::fatigue::GearboxParams;
 use pada_core::governor::{Governor, GovernorConfig, GOVERNED_JOINTS};
 use pada_core::policy::PolicyKind;
 use pada_core::weights::WeightStore;
@@ -33,7 +32,7 @@ where
         let config = GovernorConfig {
             budget_s,
             period_s: self.spec.period_s(),
-            gearbox: GearboxParams::TABLE_I,
+            gearbox: self.spec.weakest_gearbox(),
             worst_torque_nm: self.spec.worst_commanded_torque(),
             joints: self.reported_joints().len().min(GOVERNED_JOINTS) as u8,
         };

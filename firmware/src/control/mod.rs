@@ -80,7 +80,7 @@ use pada_core::robot::RobotRules;
 use pada_core::checkpoint::FlashWear;
 use pada_core::episodes::Episodes;
 use pada_core::error::ConfigError;
-use pada_core::fatigue::{FatigueCounter, GearboxParams, PAPER_WINDOW_STEPS};
+use pada_core::fatigue::{FatigueCounter, PAPER_WINDOW_STEPS};
 use pada_core::governor::Governor;
 use pada_core::policy::PolicyKind;
 use pada_core::profile::config_hash;
@@ -171,8 +171,8 @@ where
             return Err(ConfigError::new("weights", weights.len() as f32, "the profile's table size"));
         }
         let safety = Safety::new(safety_config(soft_limits(spec)))?;
-        let fatigue = FatigueCounter::new(GearboxParams::TABLE_I, spec.period_s(), Some(PAPER_WINDOW_STEPS))
-            .map_err(|_| ConfigError::new("fatigue", 0.0, "Table I parameters"))?;
+        let fatigue = FatigueCounter::with_gearboxes(|j| spec.joint_gearbox(j), spec.period_s(), Some(PAPER_WINDOW_STEPS))
+            .map_err(|_| ConfigError::new("fatigue", 0.0, "valid gearbox parameters (Eqs. 3-7)"))?;
         let mut controller = Controller {
             profile,
             spec,

@@ -27,7 +27,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 pub use protocol::{EpisodeOutcome, Phase, RunProtocol};
-pub use trial::{run_board_trial, run_board_trial_on, standard_rig, BoardTrial};
+pub use trial::{run_board_trial, run_board_trial_on, BoardTrial};
 
 /// A board's learner, as `summary.json` reports it.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -90,10 +90,11 @@ pub fn robot_of_task(task: crate::experiment::tasks::TaskName) -> Result<&'stati
 /// `progress` is told the environment steps of every finished episode.
 pub fn run_board(
     profile: LearnerProfile,
+    robot: &crate::robots::SimRobot,
     cfg: &RunConfig,
     progress: &(dyn Fn(u64) + Sync),
 ) -> anyhow::Result<Vec<BoardTrial>> {
-    (0..cfg.trials).into_par_iter().map(|i| run_board_trial(profile, cfg, i, progress)).collect()
+    (0..cfg.trials).into_par_iter().map(|i| run_board_trial(profile, robot, cfg, i, progress)).collect()
 }
 
 /// The per-trial results of board trials.

@@ -38,14 +38,14 @@ use crate::experiment::TrialResult;
 use crate::rig::Rig;
 use crate::seed::trial_seed;
 use anyhow::{anyhow, bail};
-use pada_core::fatigue::{FatigueCounter, GearboxParams, PAPER_WINDOW_STEPS};
+use pada_core::fatigue::{FatigueCounter, PAPER_WINDOW_STEPS};
 use pada_core::fixed::Q16;
 use pada_core::policy::PolicyKind;
 use pada_core::episodes::is_learning_action;
-use crate::robots::{sim_robot, DynRules};
+use crate::robots::{DynRules, SimRobot};
 use pada_core::claim_table::{ClaimTable, Tags16, Tags32};
 use pada_core::profile::{LearnerProfile, TILINGS};
-use pada_core::robot::{RobotRules, RobotSpec};
+use pada_core::robot::RobotRules;
 use pada_core::tile_coding::Layout;
 use pada_core::weights::{Half, WeightFormat, WeightStore};
 use pada_core::wire::{Episode, RunMode, StepKind, ToChip};
@@ -99,23 +99,17 @@ pub fn table_len(profile: &LearnerProfile, policy: PolicyKind) -> anyhow::Result
     profile.robot.exact_table_len::<TILINGS>(policy).map_err(|e| anyhow!("{e}"))
 }
 
-/// The rig a board trial of `robot` runs against: the physical pendulum's
-/// model with an operator who stops it between episodes, or the rapier3d
-/// LEO.
-pub fn standard_rig(robot: &RobotSpec) -> anyhow::Result<Box<dyn Rig>> {
-    crate::robots::board_rig(robot)
-}
-
 /// Trial `trial` of `cfg` with `profile`'s learner against its robot's
-/// [`standard_rig`].
+/// rig ([`SimRobot::board_rig`]).
 pub fn run_board_trial(
     profile: LearnerProfile,
+    robot: &SimRobot,
     cfg: &RunConfig,
     trial: u32,
     progress: &(dyn Fn(u64) + Sync),
 ) -> anyhow::Result<BoardTrial> {
-    let mut rig = standard_rig(profile.robot)?;
-    run_board_trial_on(profile, cfg, trial, rig.as_mut(), progress)
+    let mut rig = robot.board_rig()?;
+    run_board_trial_on(profile, robot, cfg, trial, rig.as_mut(), progress)
 }
 
 /// `$body` applied to `n` 16-bit weights shifted by `$shift`: the shift
@@ -180,6 +174,7 @@ fn claim_on<W: WeightStore, V: TableVisitor>(profile: &LearnerProfile, weights: 
 /// Trial `trial` of `cfg` with `profile`'s learner against `rig`.
 pub fn run_board_trial_on(
     profile: LearnerProfile,
+    robot: &SimRobot,
     cfg: &RunConfig,
     trial: u32,
     rig: &mut dyn Rig,
@@ -187,7 +182,8 @@ pub fn run_board_trial_on(
 ) -> anyhow::Result<BoardTrial> {
     let n = table_len(&profile, cfg.policy)?;
     let seed = trial_seed(cfg.seed, trial);
-    let rules = (sim_robot(profile.robot)?.rules)();
+    anyhow::ensure!(robot.robot == profile.robot, "the profile is {}'s, the robot {}", profile.robot.name, robot.robot.name);
+    let rules = robot.rules();
     struct Visit<'a> {
         profile: LearnerProfile,
         rules: DynRules,
@@ -247,7 +243,7 @@ fn run<R: RobotRules, W: WeightStore>(
     let ids: Vec<u8> = counted.clone().map(|j| joints[j].id).collect();
     anyhow::ensure!(ids.len() <= COUNTED, "at most {COUNTED} counted joints");
     let window = Some(PAPER_WINDOW_STEPS);
-    let fatigue = |_: ()| FatigueCounter::<COUNTED>::new(GearboxParams::TABLE_I, period_s, window);
+    let fatigue = |_: ()| FatigueCounter::<COUNTED>::with_gearboxes(|c| spec.gearbox(c), period_s, window);
     let mut paper = fatigue(()).map_err(|e| anyhow!("{e}"))?;
     let mut simulated = fatigue(()).map_err(|e| anyhow!("{e}"))?;
     let mut estimated = fatigue(()).map_err(|e| anyhow!("{e}"))?;

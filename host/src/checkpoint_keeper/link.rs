@@ -28,6 +28,8 @@ pub struct KeeperLink {
     refusing: bool,
     /// Refusals after that first one, not printed yet.
     refused_quietly: u64,
+    /// Restore chunks and frame bytes sent since [`KeeperLink::take_answered`].
+    answered: (u32, u64),
 }
 
 impl KeeperLink {
@@ -42,6 +44,7 @@ impl KeeperLink {
             encoder: FrameEncoder::new(),
             refusing: false,
             refused_quietly: 0,
+            answered: (0, 0),
         })
     }
 
@@ -136,9 +139,21 @@ impl KeeperLink {
                 }
             }
         }
-        if let Err(e) = port.write_all(&bytes) {
-            lines.push(format!("cannot answer the board's restore request (offset {}): {e}", request.offset));
+        match port.write_all(&bytes) {
+            Ok(()) => {
+                let chunks = answer.messages.iter().filter(|m| matches!(m, pada_core::wire::ToChip::RestoreChunk(_))).count();
+                self.answered.0 += chunks as u32;
+                self.answered.1 += bytes.len() as u64;
+            }
+            Err(e) => lines.push(format!("cannot answer the board's restore request (offset {}): {e}", request.offset)),
         }
+    }
+
+    /// The restore chunks and frame bytes sent to the board since the last
+    /// call: the host's half of a restore's link time, for
+    /// [`crate::capture::Recorder::answered`].
+    pub fn take_answered(&mut self) -> (u32, u64) {
+        std::mem::take(&mut self.answered)
     }
 
     /// The refusals not printed yet, as a last line (at the end of the

@@ -245,6 +245,8 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
             for line in k.frames(&frames, port) {
                 errln!("capture: {line}");
             }
+            let (chunks, bytes) = k.take_answered();
+            rec.answered(chunks, bytes);
         }
         let every = if tty {
             Duration::from_millis(100)
@@ -261,6 +263,7 @@ pub fn run(args: CaptureArgs) -> Result<(), CliError> {
             .context("cannot write the CSV")
             .map_err(CliError::Runtime)?;
     }
+    rec.end().context("cannot write the CSV").map_err(CliError::Runtime)?;
     rec.flush()
         .context("cannot write the CSV")
         .map_err(CliError::Runtime)?;

@@ -160,6 +160,7 @@ pub fn run(args: DriveArgs) -> Result<(), CliError> {
         let stop = stop.clone();
         let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
     }
+    let spec = robot.spec;
     let setup = DriveSetup {
         robot,
         profile,
@@ -173,7 +174,7 @@ pub fn run(args: DriveArgs) -> Result<(), CliError> {
     };
     errln!(
         "drive: {} on {} at {} bps, {} on the {} learner, {} s of learning{}",
-        robot.spec.name,
+        spec.name,
         args.port.display(),
         args.baud,
         label(&policy),
@@ -217,15 +218,15 @@ pub fn run(args: DriveArgs) -> Result<(), CliError> {
     } else {
         outln!(
             "{}: {} episodes ({} learning), {:.0} s of learning; end performance {:.1}",
-            robot.spec.name,
+            spec.name,
             outcome.trial.episodes.len(),
             outcome.trial.result.learning_episodes,
-            outcome.trial.result.learning_steps as f64 * robot.spec.period_s(),
+            outcome.trial.result.learning_steps as f64 * spec.period_s(),
             outcome.trial.result.end_performance
         )?;
         outln!(
             "  period {} ms: {} periods, jitter p50 {} µs, p99 {} µs, max {} µs; work p99 {} µs; {} overruns, {} ticks skipped",
-            robot.spec.period_us as f64 / 1000.0,
+            spec.period_us as f64 / 1000.0,
             c.periods,
             c.jitter_us.p50,
             c.jitter_us.p99,

@@ -34,6 +34,11 @@ pub struct RunArgs {
     /// The task.
     #[arg(long, value_enum, default_value_t = TaskName::Pendulum)]
     pub task: TaskName,
+    /// A robot of your own instead of a task: its robot.toml (and the URDF
+    /// it names), simulated in rapier3d, driven through its servos' models
+    /// and its rules (docs/your-robot.md; `pada new-robot` writes one).
+    #[arg(long, value_name = "robot.toml", conflicts_with = "task")]
+    pub robot: Option<PathBuf>,
     /// The algorithm (Section V, and the gentle explorations epsilon-pada,
     /// ou, pink, action-penalty).
     #[arg(long, value_parser = crate::experiment::algo::algo_parser())]
@@ -127,15 +132,32 @@ pub struct RunArgs {
 
 /// Runs `pada run`.
 pub fn run(args: RunArgs) -> Result<(), CliError> {
+    let file = match &args.robot {
+        Some(path) => Some(pada_robot_file::load(path).map_err(|e| usage(e.to_string()))?),
+        None => None,
+    };
     if let Some(board) = args.board {
-        return run_on_board(args, board);
+        let robot = match &file {
+            Some(f) => crate::robots::from_file(f).map_err(|e| usage(e.to_string()))?,
+            None => crate::robots::sim_robot(robot_of_task(args.task).map_err(usage)?).map_err(|e| usage(e.to_string()))?,
+        };
+        return run_on_board(args, board, robot);
     }
-    visit_task(args.task, RunVisitor(args))
+    match file {
+        Some(f) => {
+            if args.cluster.plan.is_some() || args.cluster.merge.is_some() || args.cluster.slurm {
+                return Err(usage("--plan, --merge and --slurm run pada's own tasks: they do not take --robot yet"));
+            }
+            let task = pada_sim::urdf::UrdfTask::new(&f).map_err(|e| usage(e.to_string()))?;
+            RunVisitor(args).visit(&task)
+        }
+        None => visit_task(args.task, RunVisitor(args)),
+    }
 }
 
 /// `pada run --board`: the board's own learner ([`crate::board`]).
-fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
-    let robot = robot_of_task(args.task).map_err(usage)?;
+fn run_on_board(args: RunArgs, board: Board, sim: crate::robots::SimRobot) -> Result<(), CliError> {
+    let robot = sim.robot;
     for (flag, given) in [
         ("--telemetry", args.telemetry.is_some()),
         ("--mcap", args.mcap.is_some()),
@@ -155,7 +177,10 @@ fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
             "--plan, --merge and --slurm run the host's learner: they do not combine with --board yet",
         ));
     }
-    let mut profile = board.profile(robot).map_err(|e| usage(e.to_string()))?;
+    let mut profile = board.profile(robot).map_err(|e| match &args.robot {
+        Some(p) => usage(format!("{}: {e}", p.display())),
+        None => usage(e.to_string()),
+    })?;
     let format = match args.weight_bits.as_deref() {
         Some("16") => WeightFormat::Half { shift: robot.half_shift },
         Some(_) => WeightFormat::Q16,
@@ -190,7 +215,7 @@ fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
     let policy = policy_of(&args)?;
     // The task as the runner describes it, with the board's table: the
     // summary's keys and parameters are `pada run`'s.
-    let task_spec = crate::robots::board_task_spec(profile).map_err(|e| usage(e.to_string()))?;
+    let task_spec = sim.task_spec(profile).map_err(|e| usage(e.to_string()))?;
     let weights = table_len(&profile, policy).map_err(|e| usage(format!("{e}")))?;
     if let Err(e) = robot.check::<TILINGS>(policy, profile.layout, weights) {
         return Err(usage(format!(
@@ -212,7 +237,7 @@ fn run_on_board(args: RunArgs, board: Board) -> Result<(), CliError> {
         * cfg.expected_steps(task_spec.control_period_s, task_spec.episode_steps, task_spec.test_interval);
     let bar = steps_bar(total, &format!("{} {} on {}", task_spec.name, label(&policy), board.name()));
     let start = Instant::now();
-    let trials = run_board(profile, &cfg, &|n| bar.inc(n))?;
+    let trials = run_board(profile, &sim, &cfg, &|n| bar.inc(n))?;
     let wall = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
     let summary = BoardSummary::new(&task_spec, &cfg, &profile, &trials, wall);
@@ -419,7 +444,10 @@ impl TaskVisitor for RunVisitor {
 /// The command line that describes a run, with every value explicit (a
 /// plan's identity, and the merge command it prints).
 fn command_line(args: &RunArgs, cfg: &RunConfig) -> String {
-    let mut c = format!("pada run --task {} --algo {}", args.task, args.algo);
+    let mut c = match &args.robot {
+        Some(p) => format!("pada run --robot {} --algo {}", p.display(), args.algo),
+        None => format!("pada run --task {} --algo {}", args.task, args.algo),
+    };
     match parameter_of(&cfg.policy) {
         Some(a) if args.algo.takes_alpha() => c += &format!(" --alpha {a}"),
         Some(d) => c += &format!(" --delta {d}"),

@@ -73,8 +73,14 @@ pub struct SilArgs {
     #[arg(long, value_name = "SPEC")]
     pub power_cut: Vec<String>,
     /// Save a checkpoint every S seconds of learning (`Pause`,
-    /// `SaveCheckpoint`, `Start` between learning episodes); default 20 with
-    /// `--power-cut` or `--fault hang`, else none.
+    /// `SaveCheckpoint`, `Start` between learning episodes). Default with
+    /// `--power-cut` or `--fault hang`, else none: 20 s for a checkpoint in
+    /// flash; for one streamed to the host (LEO on f429-sdram, whose 8 MiB
+    /// table fits no flash), three times the link time of a full table's
+    /// save (the learner stands still while it streams over the 921 600-baud
+    /// telemetry link: about 2 min) plus two of the robot's longest
+    /// episodes, so that saves hold learning for at most a quarter of the
+    /// time (LEO on f429-sdram: 403 s).
     #[arg(long, value_name = "S")]
     pub checkpoint_every: Option<f64>,
     /// The firmware ELF built for the emulated board (default: build it
@@ -149,9 +155,18 @@ pub fn run(args: SilArgs) -> Result<(), CliError> {
             return Err(usage(format!("--checkpoint-every {s}: at least 1 s of learning")));
         }
     }
-    let save_every_s = args
-        .checkpoint_every
-        .or((!power_cuts.is_empty() || !hangs_s.is_empty()).then_some(20.0));
+    let spec = args.task.robot();
+    let profile = board.profile(spec).map_err(|e| usage(e.to_string()))?;
+    let save_every_s = args.checkpoint_every.or((!power_cuts.is_empty() || !hangs_s.is_empty()).then(|| {
+        // The interval follows the time a save of this image takes on the
+        // link: 20 s between LEO's 2-minute streams stopped learning most of
+        // the time.
+        sil::power_cut::default_save_every_s(
+            sil::power_cut::checkpoint_bytes(profile.weights().unwrap_or(0), profile.entry_bytes()),
+            pada_firmware::sil::CHECKPOINT_SLOT_LEN,
+            spec.episode_steps as f64 * spec.period_us as f64 * 1e-6,
+        )
+    }));
     sil::bus::check_faults(args.task.robot(), &faults).map_err(usage)?;
     if !(1..=3600).contains(&args.hang_timeout) {
         return Err(usage(format!(
@@ -289,4 +304,19 @@ fn print_summary(s: &SilSummary, policy: &str) -> Result<(), CliError> {
         )?;
     }
     Ok(())
+}
+
+/// The help of `--checkpoint-every`, as `pada sil --help` prints it (a test
+/// checks that the default it names is the one computed).
+#[cfg(test)]
+pub(crate) fn checkpoint_every_help() -> String {
+    use clap::Args as _;
+    let cmd = SilArgs::augment_args(clap::Command::new("sil"));
+    let help = cmd
+        .get_arguments()
+        .find(|a| a.get_id() == "checkpoint_every")
+        .and_then(|a| a.get_long_help().or(a.get_help()))
+        .map(|h| h.to_string())
+        .unwrap_or_default();
+    help
 }

@@ -184,7 +184,8 @@ pub fn run(args: WatchArgs) -> Result<(), CliError> {
         std::thread::sleep(Duration::from_millis(10));
     }
     let mut rec = recorder.lock().unwrap_or_else(|e| e.into_inner());
-    rec.flush()
+    rec.end()
+        .and_then(|()| rec.flush())
         .context("cannot write the CSV")
         .map_err(CliError::Runtime)?;
     let closed = rec.close_tap();

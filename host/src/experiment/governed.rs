@@ -11,7 +11,7 @@
 use crate::experiment::task::TaskSpec;
 use anyhow::anyhow;
 use pada_core::episodes::wear;
-use pada_core::fatigue::{FatigueCounter, GearboxParams};
+use pada_core::fatigue::FatigueCounter;
 use pada_core::governor::{Governor, GovernorConfig, GOVERNED_JOINTS};
 use pada_core::policy::PolicyKind;
 use serde::{Deserialize, Serialize};
@@ -92,7 +92,7 @@ impl TrialGovernor {
         let config = GovernorConfig {
             budget_s,
             period_s: spec.control_period_s,
-            gearbox: GearboxParams::TABLE_I,
+            gearbox: spec.weakest_gearbox(),
             worst_torque_nm: spec.worst_torque_nm,
             joints: gearboxes as u8,
         };

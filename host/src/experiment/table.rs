@@ -11,7 +11,7 @@
 
 use pada_core::claim_table::{Claim, ClaimTable, InitialWeights, Occupancy, Tags16, Tags32};
 use pada_core::fixed::Q16;
-use pada_core::weights::{Half, WeightFormat, WeightStore};
+use pada_core::weights::{Added, Half, WeightFormat, WeightStore};
 
 /// A claim table on the heap: Q16 weights, 32-bit tags.
 pub type HostClaimTable = ClaimTable<Box<[Q16]>, Tags32<Box<[u32]>>>;
@@ -130,21 +130,24 @@ impl WeightStore for HostTable {
         each!(self, t => WeightStore::read(t, feature))
     }
 
-    /// Every host table is in cached memory, and LEO's are far larger
-    /// than the cache.
     #[inline]
-    fn touches_before_reading(&self) -> bool {
-        true
-    }
-
-    #[inline]
-    fn touch(&self, feature: u32) -> u32 {
-        each!(self, t => t.touch(feature))
+    fn read_each(&self, buf: &mut [u32]) {
+        each!(self, t => t.read_each(buf))
     }
 
     #[inline]
     fn claim(&mut self, feature: u32) -> Claim {
         each!(self, t => WeightStore::claim(t, feature))
+    }
+
+    #[inline]
+    fn read_then_claim(&mut self, features: &[u32], claims: &mut [Claim]) -> i64 {
+        each!(self, t => t.read_then_claim(features, claims))
+    }
+
+    #[inline]
+    fn add_each<D: FnMut() -> u32>(&mut self, slots: &[u32], inc: Q16, dither: D) -> Added {
+        each!(self, t => t.add_each(slots, inc, dither))
     }
 
     fn reset_claims(&mut self, init: InitialWeights) {

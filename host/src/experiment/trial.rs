@@ -32,7 +32,7 @@ use pada_core::agent::Mode;
 use pada_core::episodes::record::Stamp;
 use pada_core::episodes::wear::damage_raws;
 use pada_core::episodes::{Episodes, Transition};
-use pada_core::fatigue::{FatigueCounter, GearboxParams, PAPER_WINDOW_STEPS};
+use pada_core::fatigue::{FatigueCounter, PAPER_WINDOW_STEPS};
 use pada_core::tile_coding::MAX_STATE_DIMS;
 use pada_core::wire::{self, RunMode, StepKind, ToHost};
 use rand_pcg::Pcg64;
@@ -160,8 +160,8 @@ pub fn run_trial_observed<T: Task>(
     let mut rng = trial_rng(cfg.seed, trial);
     let mut agent = build_agent(spec, cfg.policy)?;
     agent.reset_weights(&mut rng);
-    let fatigue = FatigueCounter::new(
-        GearboxParams::TABLE_I,
+    let fatigue = FatigueCounter::with_gearboxes(
+        |c| spec.gearbox(c),
         spec.control_period_s,
         Some(PAPER_WINDOW_STEPS),
     )

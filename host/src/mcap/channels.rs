@@ -16,15 +16,17 @@
 //! | `/safety/fault` | `Fault` | `pada.Fault` |
 //! | `/policy` | `Policy` | `pada.Policy` |
 //! | `/governor` | `Policy` with a wear governor | `pada.Governor` |
-//! | `/event` | checkpoint, log, warning, weights, ack, nack | `pada.Event` |
+//! | `/event` | checkpoint report, log, warning, weights, ack, nack | `pada.Event` |
 //! | `/link` | lost frame, sequence gap, `Health`, the end | `pada.Link` |
 //! | `/scene` | `Step` of a known robot | `foxglove.SceneUpdate` |
+//! | `/checkpoint` | save or restore of a checkpoint the host keeps (its chunks, requests and report) | `pada.Checkpoint` |
 //!
 //! A new record kind is one [`Topic`] variant, its view, its schema in
 //! [`super::schemas`] and a line in [`Channelizer::frame`], as `/claims`
 //! (the claim table's occupancy, from `Health`) shows.
 
 use super::scene::SceneBuilder;
+use crate::capture::transfer::{Direction, Transfer, Transfers};
 use crate::capture::{describe, loss_name, mode_name, step_kind_name};
 use pada_core::wire::{Decoded, FrameError, Hello, LinkStats, SeqGap, ToHost, MAX_GEARBOXES};
 use serde::{Deserialize, Serialize};
@@ -60,6 +62,10 @@ pub enum Topic {
     Link,
     /// The robot drawn from the joint angles (`foxglove.SceneUpdate`).
     Scene,
+    /// One save or restore of a checkpoint the host keeps, from its
+    /// frames (`crate::capture::transfer`; appended last, so the other
+    /// channels keep their ids).
+    Checkpoint,
 }
 
 impl Topic {
@@ -79,6 +85,7 @@ impl Topic {
             Topic::Event,
             Topic::Link,
             Topic::Scene,
+            Topic::Checkpoint,
         ]);
         v
     }
@@ -104,6 +111,7 @@ impl Topic {
             Topic::Event => "/event".into(),
             Topic::Link => "/link".into(),
             Topic::Scene => "/scene".into(),
+            Topic::Checkpoint => "/checkpoint".into(),
         }
     }
 
@@ -283,6 +291,54 @@ pub struct EventView {
     pub kind: String,
     /// One line of what it says.
     pub detail: String,
+}
+
+/// `/checkpoint`: one save or restore of a checkpoint the host keeps
+/// ([`Transfer`] without the host's clock, which stays out of a recording).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CheckpointView {
+    /// `save` or `restore`.
+    pub direction: Direction,
+    /// The checkpoint's generation (null: a restore that loaded none).
+    pub generation: Option<u32>,
+    /// Bytes of the image.
+    pub bytes: u32,
+    /// A save's chunks received; a restore's chunks loaded (or sent).
+    pub chunks: u32,
+    /// A restore's requests.
+    pub requests: u32,
+    /// Frame bytes from the board.
+    pub board_bytes: u64,
+    /// Frame bytes of the host's answers to a restore (0 when the
+    /// recorder did not answer).
+    pub host_bytes: u64,
+    /// Seconds on the telemetry link.
+    pub link_s: f64,
+    /// How it ended (`telemetry.csv`'s `outcome`).
+    pub outcome: String,
+    /// The board's closing report came.
+    pub reported: bool,
+    /// Chunks the board said it sent (a save's report).
+    pub reported_chunks: Option<u32>,
+}
+
+impl CheckpointView {
+    /// The view of `t`.
+    pub fn of(t: &Transfer) -> CheckpointView {
+        CheckpointView {
+            direction: t.direction,
+            generation: t.generation,
+            bytes: t.bytes,
+            chunks: t.chunks,
+            requests: t.requests,
+            board_bytes: t.board_bytes,
+            host_bytes: t.host_bytes,
+            link_s: t.link_s,
+            outcome: t.outcome.clone(),
+            reported: t.reported,
+            reported_chunks: t.reported_chunks,
+        }
+    }
 }
 
 /// `/link`: the link's counters after an event.
@@ -481,11 +537,19 @@ impl Channelizer {
                     }));
                 }
             }
+            // A checkpoint transfer's frames are one `/checkpoint` message
+            // when it ends ([`Channelizer::transfer`]).
+            other if Transfers::is_transfer_frame(other) => {}
             other => {
                 let (kind, detail) = describe(other);
                 push(Topic::Event, self.clock.now(), json(&EventView { kind: kind.into(), detail }));
             }
         }
+    }
+
+    /// The `/checkpoint` message of a save or restore that ended.
+    pub fn transfer(&mut self, t: &Transfer) -> ChannelMessage {
+        ChannelMessage { topic: Topic::Checkpoint, log_time: self.clock.now(), sequence: 0, data: json(&CheckpointView::of(t)) }
     }
 
     /// The `/link` message of a lost frame.
@@ -523,4 +587,39 @@ impl Channelizer {
 /// this cannot fail; an empty object stands in if it ever did).
 pub fn json<T: Serialize>(v: &T) -> Vec<u8> {
     serde_json::to_vec(v).unwrap_or_else(|_| b"{}".to_vec())
+}
+
+#[cfg(test)]
+mod checkpoint_view_tests {
+    use super::*;
+
+    #[test]
+    fn the_checkpoint_view_has_exactly_its_schemas_fields() {
+        let t = crate::capture::transfer::Transfer {
+            direction: Direction::Restore,
+            generation: None,
+            bytes: 1,
+            chunks: 2,
+            requests: 3,
+            board_bytes: 4,
+            host_bytes: 5,
+            link_s: 0.5,
+            outcome: "cut-off".into(),
+            reported: false,
+            reported_chunks: None,
+            started_s: 1.0,
+            ended_s: 2.0,
+        };
+        let view: serde_json::Value = serde_json::from_slice(&json(&CheckpointView::of(&t))).unwrap();
+        let (_, schema) = super::super::schemas::of(Topic::Checkpoint);
+        let schema: serde_json::Value = serde_json::from_str(schema).unwrap();
+        let mut fields: Vec<&str> = view.as_object().unwrap().keys().map(|k| k.as_str()).collect();
+        let mut required: Vec<&str> = schema["required"].as_array().unwrap().iter().map(|v| v.as_str().unwrap()).collect();
+        fields.sort_unstable();
+        required.sort_unstable();
+        assert_eq!(fields, required);
+        assert_eq!(view["direction"], "restore");
+        // The host's clock stays out of a recording.
+        assert!(view.get("started_s").is_none());
+    }
 }

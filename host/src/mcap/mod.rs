@@ -57,6 +57,12 @@ impl crate::capture::FrameTap for Tap {
         Tap::lost(self, e, stats)
     }
 
+    fn transfer(&mut self, t: &crate::capture::transfer::Transfer, _stats: LinkStats) -> std::io::Result<()> {
+        let m = self.channels.transfer(t);
+        self.out.push(m);
+        self.flush()
+    }
+
     fn finish(&mut self, stats: LinkStats) -> std::io::Result<()> {
         Tap::finish(self, stats)
     }

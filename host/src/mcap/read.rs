@@ -99,6 +99,16 @@ pub fn replay(bytes: &[u8]) -> Result<Replayed, String> {
                 latest.fault = Some(f.cause);
             }
             Some(Topic::Policy | Topic::Event) => messages.other += 1,
+            Some(Topic::Checkpoint) => {
+                // One message for a save's chunks or a restore's requests,
+                // and the board's report that closed it.
+                let t: super::channels::CheckpointView = parse(name, data)?;
+                match t.direction {
+                    crate::capture::transfer::Direction::Save => messages.checkpoint_chunk += t.chunks as u64,
+                    crate::capture::transfer::Direction::Restore => messages.restore_wanted += t.requests as u64,
+                }
+                messages.other += t.reported as u64;
+            }
             Some(Topic::Link) => link = Some(parse::<LinkView>(name, data)?.stats),
             Some(Topic::Governor | Topic::Claims | Topic::Scene) | None => {}
         }

@@ -23,7 +23,7 @@ use crate::leo::constants::{
 };
 use crate::leo::model::{assemble, Body, InitialPose};
 use pada_core::robot::leo::Leg;
-use crate::robots::{sim_robot, Body as RobotBody};
+use crate::robots::{sim_robot, Body as SimBody};
 use pada_core::robot::RobotSpec;
 use pada_core::wire::{Step, StepKind};
 
@@ -72,6 +72,13 @@ const FLOOR: Color = Color { r: 0.17, g: 0.63, b: 0.17, a: 1.0 };
 /// Half a leg's lateral offset \[m\].
 const LEG_Y: f64 = 0.03;
 
+/// The bodies a scene draws: pada's two hand-built robots.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum RobotBody {
+    Pendulum,
+    Leo,
+}
+
 /// Draws the robot of a stream, step after step.
 #[derive(Debug, Clone, Default)]
 pub struct SceneBuilder {
@@ -86,7 +93,12 @@ pub struct SceneBuilder {
 impl SceneBuilder {
     /// The robot is now this one (a `Hello`), or unknown.
     pub fn robot(&mut self, robot: Option<&'static RobotSpec>) {
-        let robot = robot.and_then(|r| Some((sim_robot(r).ok()?.body, r.name)));
+        let body = |r| match sim_robot(r).ok()?.body {
+            SimBody::Leo => Some(RobotBody::Leo),
+            SimBody::Pendulum => Some(RobotBody::Pendulum),
+            SimBody::Urdf(_) => None,
+        };
+        let robot = robot.and_then(|r| Some((body(r)?, r.name)));
         *self = SceneBuilder { robot, ..SceneBuilder::default() };
     }
 

@@ -14,6 +14,7 @@ enum T {
     Int,
     Num,
     NumOrNull,
+    IntOrNull,
     Str,
     Bool,
     Nums,
@@ -25,6 +26,7 @@ fn ty(t: T) -> Value {
         T::Int => json!({"type": "integer"}),
         T::Num => json!({"type": "number"}),
         T::NumOrNull => json!({"type": ["number", "null"]}),
+        T::IntOrNull => json!({"type": ["integer", "null"]}),
         T::Str => json!({"type": "string"}),
         T::Bool => json!({"type": "boolean"}),
         T::Nums => json!({"type": "array", "items": {"type": "number"}}),
@@ -110,11 +112,16 @@ fn build(topic: Topic) -> (&'static str, String) {
             ("rungs", T::Int), ("window_steps", T::Int), ("damage_rate", T::Num), ("window_mtbf_s", T::NumOrNull),
             ("moves", T::Int), ("over_budget_steps", T::Int),
         ])),
-        Topic::Event => ("pada.Event", object("pada.Event", "A checkpoint, log, warning, weights, ack or nack report", &[
+        Topic::Event => ("pada.Event", object("pada.Event", "A checkpoint report, log, warning, weights, ack or nack", &[
             ("kind", T::Str), ("detail", T::Str),
         ])),
         Topic::Link => ("pada.Link", object("pada.Link", "The link's counters after a lost frame, a sequence gap, a health report or the end", LINK_FIELDS)),
         Topic::Scene => ("foxglove.SceneUpdate", scene_update()),
+        Topic::Checkpoint => ("pada.Checkpoint", object("pada.Checkpoint", "One save or restore of a checkpoint the host keeps, from its chunks, requests and report", &[
+            ("direction", T::Str), ("generation", T::IntOrNull), ("bytes", T::Int), ("chunks", T::Int), ("requests", T::Int),
+            ("board_bytes", T::Int), ("host_bytes", T::Int), ("link_s", T::Num), ("outcome", T::Str), ("reported", T::Bool),
+            ("reported_chunks", T::IntOrNull),
+        ])),
     }
 }
 

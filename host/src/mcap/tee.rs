@@ -61,7 +61,11 @@ impl McapTee {
     /// failed. Returns the frames recorded and the file.
     pub fn finish(self) -> anyhow::Result<(u64, PathBuf)> {
         let totals = self.sink.finish()?;
-        let closed = self.recorder.lock().unwrap_or_else(|e| e.into_inner()).close_tap();
+        let closed = {
+            let mut rec = self.recorder.lock().unwrap_or_else(|e| e.into_inner());
+            // A checkpoint transfer cut short by the end gets its message.
+            rec.end().and_then(|()| rec.close_tap())
+        };
         closed.map_err(|e| anyhow::anyhow!("the MCAP file {} failed: {e}", self.path.display()))?;
         Ok((totals.frames, self.path))
     }

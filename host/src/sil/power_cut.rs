@@ -57,6 +57,36 @@ pub enum CutSpec {
     DuringSave(u32),
 }
 
+/// The save interval with power cuts or hangs and no `--checkpoint-every`
+/// \[s of learning\] for a checkpoint that fits a flash slot.
+pub const FLASH_SAVE_EVERY_S: f64 = 20.0;
+
+/// A checkpoint streamed to the host is saved at least this many times its
+/// longest save's link time apart, so that saves stop learning for at most
+/// a quarter of the time spent learning and saving.
+pub const LINK_TIME_FACTOR: f64 = 3.0;
+
+/// The save interval with power cuts or hangs and no `--checkpoint-every`
+/// \[s of learning\], for a checkpoint of `checkpoint_bytes` and flash
+/// slots of `slot_bytes`, on a robot whose episodes last up to
+/// `max_episode_s`. One that fits a slot: [`FLASH_SAVE_EVERY_S`] (an erase
+/// and a write stall the loop about a second). One streamed to the host
+/// (LEO on the F429): the learning loop stands still while its image
+/// streams, up to [`full_save_link_s`] (a full table: about 2 minutes for
+/// LEO's 8 MiB at 921 600 baud), so the interval is [`LINK_TIME_FACTOR`]
+/// times that, plus two of the robot's longest episodes (a save comes up
+/// to two episodes before the interval is over: `Session::maybe_save`),
+/// rounded up to a whole second.
+///
+/// [`full_save_link_s`]: crate::capture::transfer::full_save_link_s
+pub fn default_save_every_s(checkpoint_bytes: usize, slot_bytes: usize, max_episode_s: f64) -> f64 {
+    if checkpoint_bytes <= slot_bytes {
+        return FLASH_SAVE_EVERY_S;
+    }
+    let link_s = crate::capture::transfer::full_save_link_s(checkpoint_bytes.min(u32::MAX as usize) as u32);
+    (LINK_TIME_FACTOR * link_s + 2.0 * max_episode_s).ceil().max(FLASH_SAVE_EVERY_S)
+}
+
 /// Parses a `--power-cut` value.
 pub fn parse(spec: &str) -> Result<CutSpec, String> {
     let bad = || format!("--power-cut {spec}: expected at=SECONDS, random:N[:in-save=M][:seed=K] or during-save:K");
@@ -316,9 +346,33 @@ pub struct PowerReport {
     pub first_chunk_refusal: Option<String>,
     /// `Streamed` reports whose checkpoint the host did not keep.
     pub streams_not_kept: u32,
+    /// Seconds the saves streamed to the host held the telemetry link
+    /// (`telemetry.csv`'s `checkpoint-save` rows): the control loop stands
+    /// still meanwhile. QEMU gives a stream no emulated time; a real board's
+    /// link does.
+    pub save_link_s: f64,
+    /// Seconds the restores from the host held the link (`checkpoint-restore`
+    /// rows; the round trip of each request comes on top): the board waits
+    /// at boot meanwhile.
+    pub restore_link_s: f64,
+    /// The share of the run a real board spends with learning stopped by
+    /// those transfers: their link time over the emulated time plus it.
+    pub paused_fraction: f64,
 }
 
 impl PowerReport {
+    /// Takes the link time of the run's checkpoint transfers (the
+    /// recorder's, one per save and restore) over `emulated_s` of run.
+    pub fn note_transfers(&mut self, transfers: &[crate::capture::transfer::Transfer], emulated_s: f64) {
+        use crate::capture::transfer::Direction;
+        // (A fold from +0: an empty f64 sum is -0, which summary.json would show.)
+        let sum = |d: Direction| transfers.iter().filter(|t| t.direction == d).fold(0.0, |a, t| a + t.link_s);
+        self.save_link_s = sum(Direction::Save);
+        self.restore_link_s = sum(Direction::Restore);
+        let paused = self.save_link_s + self.restore_link_s;
+        self.paused_fraction = if paused > 0.0 { paused / (emulated_s + paused) } else { 0.0 };
+    }
+
     /// Cuts inside a save.
     pub fn cuts_in_save(&self) -> usize {
         self.cuts.iter().filter(|c| c.in_save.is_some()).count()
@@ -358,6 +412,55 @@ mod tests {
         assert_eq!(parse_hang("hang"), Some(Ok(10.0)));
         assert!(parse_hang("hang:when=2").unwrap().is_err());
         assert_eq!(parse_hang("drop:at=2"), None);
+    }
+
+    #[test]
+    fn the_paused_fraction_is_the_transfers_link_time_over_the_run_with_it() {
+        use crate::capture::transfer::{Direction, Transfer};
+        let t = |direction, link_s| Transfer {
+            direction,
+            generation: Some(1),
+            bytes: 8,
+            chunks: 1,
+            requests: 0,
+            board_bytes: 0,
+            host_bytes: 0,
+            link_s,
+            outcome: "streamed".into(),
+            reported: true,
+            reported_chunks: Some(1),
+            started_s: 0.0,
+            ended_s: 0.0,
+        };
+        let mut p = PowerReport::default();
+        p.note_transfers(&[], 100.0);
+        // No transfer: +0 s (an empty float sum is -0, printed as such).
+        assert_eq!((p.save_link_s.to_bits(), p.paused_fraction), (0f64.to_bits(), 0.0));
+        p.note_transfers(&[t(Direction::Save, 30.0), t(Direction::Restore, 50.0), t(Direction::Save, 20.0)], 300.0);
+        assert_eq!((p.save_link_s, p.restore_link_s, p.paused_fraction), (50.0, 50.0, 0.25));
+    }
+
+    #[test]
+    fn the_default_save_interval_follows_the_images_link_time() {
+        use crate::capture::transfer::full_save_link_s;
+        // A checkpoint in flash: 20 s, whatever the robot.
+        assert_eq!(default_save_every_s(100_368, 131_072, 3.0), FLASH_SAVE_EVERY_S);
+        // LEO on f429-sdram (its image, 25 s episodes): three full saves'
+        // link time between two saves even when one comes two episodes
+        // early, so saves stop learning at most a quarter of the time.
+        let profile = pada_core::profile::Board::F429Sdram.profile(&pada_core::robot::leo::SPEC).unwrap();
+        let image = checkpoint_bytes(profile.weights().unwrap(), profile.entry_bytes());
+        let spec = &pada_core::robot::leo::SPEC;
+        let episode_s = spec.episode_steps as f64 * spec.period_us as f64 * 1e-6;
+        let every = default_save_every_s(image, 131_072, episode_s);
+        let link = full_save_link_s(image as u32);
+        eprintln!("LEO f429-sdram: a full save {link:.1} s on the link, default interval {every} s");
+        assert!(every - 2.0 * episode_s >= LINK_TIME_FACTOR * link, "{every} s for {link} s saves");
+        assert!(every - 2.0 * episode_s < LINK_TIME_FACTOR * link + 1.0);
+        assert_eq!(every, every.round(), "whole seconds");
+        // `pada sil --help` names it.
+        let help = crate::commands::sil::checkpoint_every_help();
+        assert!(help.contains(&format!("LEO on f429-sdram: {every} s")), "{help}");
     }
 
     #[test]
@@ -431,15 +534,17 @@ pub fn checks(p: &mut PowerReport, period_ms: f64, emulated_s: f64, checkpoint_f
             name: "checkpoints kept by the host: every save streamed whole was kept, no chunk refused",
             ok: p.chunks_refused == 0 && p.streams_not_kept == 0 && p.saves_too_large == 0,
             detail: format!(
-                "{} of {} save attempts kept ({} cut off inside), last image {} bytes in up to {} chunks, {} encoded bytes streamed for them ({:.1} s of a 921,600-baud link); {} restores asked; {} chunks refused{}; {} streams reported but not kept",
+                "{} of {} save attempts kept ({} cut off inside), last image {} bytes in up to {} chunks, {} encoded bytes streamed for them; {} restores asked; saves held the 921,600-baud link {:.1} s, restores {:.1} s: learning stopped {:.1} % of the run; {} chunks refused{}; {} streams reported but not kept",
                 p.saves,
                 p.save_attempts,
                 p.cuts_in_save(),
                 p.kept_bytes,
                 p.kept_chunks,
                 p.streamed_bytes,
-                p.streamed_bytes as f64 * 10.0 / 921_600.0,
                 p.restores_asked,
+                p.save_link_s,
+                p.restore_link_s,
+                p.paused_fraction * 100.0,
                 p.chunks_refused,
                 p.first_chunk_refusal.as_deref().map(|r| format!(" (first: {r})")).unwrap_or_default(),
                 p.streams_not_kept

@@ -304,7 +304,7 @@ fn compare(cfg: &SilConfig, episodes: &[Episode]) -> anyhow::Result<HostComparis
     let none = |_| {};
     match cfg.task {
         SilTask::Leo => {
-            let t = run_board_trial(profile, &run(1), 0, &none)?;
+            let t = run_board_trial(profile, &crate::robots::sim_robot(profile.robot)?, &run(1), 0, &none)?;
             let first = first_difference(episodes, &t.episodes);
             Ok(HostComparison {
                 what: format!(
@@ -327,7 +327,7 @@ fn compare(cfg: &SilConfig, episodes: &[Episode]) -> anyhow::Result<HostComparis
                 .into_par_iter()
                 .map(|i| {
                     let mut rig = PendulumRig::new(PhysicalPendulumParams::default());
-                    run_board_trial_on(profile, &cfg8, i, &mut rig, &none)
+                    run_board_trial_on(profile, &crate::robots::sim_robot(profile.robot)?, &cfg8, i, &mut rig, &none)
                 })
                 .collect::<anyhow::Result<Vec<_>>>()?;
             Ok(HostComparison {

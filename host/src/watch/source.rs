@@ -166,6 +166,8 @@ pub fn decode(
             for line in k.frames(&frames, port) {
                 eprintln!("watch: {line}");
             }
+            let (chunks, bytes) = k.take_answered();
+            recorder.lock().unwrap_or_else(|e| e.into_inner()).answered(chunks, bytes);
         }
         shared
             .state

@@ -23,18 +23,21 @@
 //! [`Agent::restore_state`] puts it back after [`Agent::check_state`].
 
 use crate::action_space::{ActionSpace, Levels, Output, MAX_ACTION_DIMS};
-use crate::action_tiles::{ActionTiles, MAX_ACTION_COMBOS};
-use crate::claim_table::{Claim, InitialWeights};
+use crate::claim_table::InitialWeights;
 use crate::error::{check_range, ConfigError, StepError};
 use crate::fixed::{Frac, Q16};
-use crate::policy::{uniform_below, Candidates, Exploration, Policy, PolicyKind, PolicyState};
-use crate::tile_coding::{Layout, StateCode, StateDim, TileCoder, MAX_STATE_DIMS};
+use crate::policy::{Candidates, Policy, PolicyKind, PolicyState};
+use crate::tile_coding::{Layout, StateDim, TileCoder};
 use crate::trace::Trace;
-use crate::weights::{entry_factor, WeightStore};
+use crate::weights::WeightStore;
 use rand_core::RngCore;
+use tiled::TileBoxes;
 
+mod choice;
 mod coder;
 mod params;
+mod tiled;
+mod update;
 pub use coder::{coder_for, exact_table_len};
 pub use params::{SarsaParams, WeightInit};
 
@@ -126,7 +129,7 @@ pub struct AgentState {
 }
 
 #[derive(Debug, Clone, Copy)]
-struct Current<const TILINGS: usize> {
+pub(super) struct Current<const TILINGS: usize> {
     /// Feature indices of the (state, action) pair being played.
     features: [u32; TILINGS],
 }
@@ -157,6 +160,10 @@ pub struct Agent<W, const TILINGS: usize, const TRACE: usize> {
     /// ([`WeightStore::checksum`]); `None` after the weights were handed
     /// out mutably, until [`rehash`](Agent::rehash).
     checksum: Option<u32>,
+    /// With action tiles, the tiled greedy choice's boxes and the
+    /// candidates they were made for: SARSA's candidates are the same at
+    /// every step, PADA's move with its previous action.
+    boxes: Option<(Candidates, TileBoxes<TILINGS>)>,
 }
 
 impl<W, const TILINGS: usize, const TRACE: usize> Agent<W, TILINGS, TRACE>
@@ -203,6 +210,7 @@ where
             current: None,
             stats: AgentStats::default(),
             checksum: None,
+            boxes: None,
         })
     }
 
@@ -215,6 +223,7 @@ where
     /// unchanged then.
     pub fn generalise_actions(&mut self, widths: &[f32]) -> Result<(), ConfigError> {
         self.coder = self.coder.clone().with_action_tiles(self.policy.learner_space(), widths)?;
+        self.boxes = None;
         Ok(())
     }
 
@@ -531,219 +540,6 @@ where
         }
     }
 
-    /// The state code of `obs` plus the policy's extension.
-    fn code(&self, obs: &[f32]) -> StateCode<TILINGS> {
-        let mut x = [0.0f32; MAX_STATE_DIMS];
-        x[..obs.len()].copy_from_slice(obs);
-        let ext = self.policy.extension();
-        x[obs.len()..obs.len() + ext.len()].copy_from_slice(ext);
-        self.coder.encode(&x[..obs.len() + ext.len()])
-    }
-
-    /// Sum of the active weights of (state, action): `TILINGS · Q`.
-    #[inline]
-    fn q_sum(&self, code: &StateCode<TILINGS>, action: u32) -> i64 {
-        let w = &self.weights;
-        let mut sum = 0i64;
-        // The action-tile test once, not per tiling (the greedy loop's
-        // inner body on the chip).
-        match self.coder.action_tiles() {
-            None => {
-                for j in 0..TILINGS {
-                    sum += w.read(self.coder.action_feature(code, j, action)).0 as i64;
-                }
-            }
-            Some(at) => {
-                for j in 0..TILINGS {
-                    sum += w.read(self.coder.combo_feature(code, j, at.combo_of_action(j, action))).0 as i64;
-                }
-            }
-        }
-        sum
-    }
-
-    /// `Q` of a feature set: the mean of its weights.
-    fn q_of(&self, features: &[u32; TILINGS]) -> Q16 {
-        let sum: i64 = features.iter().map(|&f| self.weights.read(f).0 as i64).sum();
-        Q16::from_wide(sum / TILINGS as i64)
-    }
-
-    /// The next action by the policy's way of exploring
-    /// ([`Policy::exploration`]): ε-greedy among its candidates (ε-PADA:
-    /// the greedy choice among all actions, the exploratory draw within Δ
-    /// of the previous one), or, for the noise explorations, the greedy
-    /// action moved by the policy's noise while learning. Testing is always
-    /// greedy. Changes nothing but the noise process;
-    /// [`commit`](Self::commit) applies the choice.
-    fn decide<R: RngCore + ?Sized>(
-        &mut self,
-        obs: &[f32],
-        rng: &mut R,
-    ) -> (Decision, [u32; TILINGS]) {
-        let code = self.code(obs);
-        let learning = self.mode == Mode::Learning;
-        let (levels, explore) = match self.policy.exploration() {
-            Exploration::EpsilonGreedy | Exploration::EpsilonLocal => {
-                let explore = learning && (rng.next_u32() as u64) < self.epsilon;
-                let levels = if explore {
-                    self.policy.explore_candidates().random(rng)
-                } else {
-                    self.greedy(&code, &self.policy.candidates(), self.policy.learner_space(), rng)
-                };
-                (levels, explore)
-            }
-            Exploration::Noise => {
-                let greedy = self.greedy(&code, &self.policy.candidates(), self.policy.learner_space(), rng);
-                if learning {
-                    let moved = self.policy.perturb(&greedy, rng);
-                    (moved, moved != greedy)
-                } else {
-                    (greedy, false)
-                }
-            }
-        };
-        let action = self.policy.learner_space().encode(&levels);
-        let features = self.coder.features(&code, action);
-        let q = self.q_of(&features);
-        (Decision { action, levels, output: [0.0; MAX_ACTION_DIMS], explored: explore, q }, features)
-    }
-
-    /// The best candidate; ties broken uniformly at random (reservoir
-    /// sampling: the k-th tie replaces the choice with probability 1/k).
-    fn greedy<R: RngCore + ?Sized>(
-        &self,
-        code: &StateCode<TILINGS>,
-        candidates: &Candidates,
-        space: &ActionSpace,
-        rng: &mut R,
-    ) -> Levels {
-        if let Some(at) = self.coder.action_tiles() {
-            // Fewer combinations than candidates: load each combination's
-            // weight once per tiling. Same sums, same order, same ties.
-            if at.combos() < candidates.count() {
-                return self.greedy_tiled(code, candidates, at, rng);
-            }
-        }
-        let mut best = candidates.lo;
-        let mut best_sum = i64::MIN;
-        let mut ties = 0u32;
-        candidates.for_each(|levels| {
-            let sum = self.q_sum(code, space.encode(levels));
-            if sum > best_sum {
-                best_sum = sum;
-                best = *levels;
-                ties = 1;
-            } else if sum == best_sum {
-                ties += 1;
-                if uniform_below(rng, ties) == 0 {
-                    best = *levels;
-                }
-            }
-        });
-        best
-    }
-
-    /// [`greedy`](Self::greedy) with action tiles: a table of the
-    /// `TILINGS × combos` active weights, then per candidate one table read
-    /// per tiling. The candidates are visited in `Candidates::for_each`'s
-    /// order (first dimension fastest), so ties break exactly as there;
-    /// the other dimensions' share of each tiling's combination index is
-    /// summed once per run of the first dimension.
-    fn greedy_tiled<R: RngCore + ?Sized>(
-        &self,
-        code: &StateCode<TILINGS>,
-        candidates: &Candidates,
-        at: &ActionTiles<TILINGS>,
-        rng: &mut R,
-    ) -> Levels {
-        const MASK: usize = MAX_ACTION_COMBOS - 1;
-        let combos = at.combos() as usize;
-        // The features first (their bits), then, where the table is larger
-        // than a cache, one load of each (independent loads, whose misses
-        // overlap), then the reads, whose probes now hit the cache. (Three
-        // passes: the touch folded into the hashing loop measured 25·10³
-        // more instructions per choice.)
-        let mut table = [[0i32; MAX_ACTION_COMBOS]; TILINGS];
-        for (j, row) in table.iter_mut().enumerate() {
-            for (c, slot) in row.iter_mut().enumerate().take(combos) {
-                *slot = self.coder.combo_feature(code, j, c as u32) as i32;
-            }
-        }
-        if self.weights.touches_before_reading() {
-            let mut touched = 0u32;
-            for row in &table {
-                for &feature in row.iter().take(combos) {
-                    touched ^= self.weights.touch(feature as u32);
-                }
-            }
-            core::hint::black_box(touched);
-        }
-        for row in table.iter_mut() {
-            for slot in row.iter_mut().take(combos) {
-                *slot = self.weights.read(*slot as u32).0;
-            }
-        }
-        // Unused dimensions have lo = hi = 0 and contribute 0.
-        let (lo, hi) = (candidates.lo, candidates.hi);
-        let mut best = lo;
-        let mut best_sum = i64::MIN;
-        let mut ties = 0u32;
-        let mut base = [0u32; TILINGS];
-        for l3 in lo[3]..=hi[3] {
-            for l2 in lo[2]..=hi[2] {
-                for l1 in lo[1]..=hi[1] {
-                    for (j, b) in base.iter_mut().enumerate() {
-                        *b = at.part(j, 1, l1) + at.part(j, 2, l2) + at.part(j, 3, l3);
-                    }
-                    for l0 in lo[0]..=hi[0] {
-                        let mut sum = 0i64;
-                        for (j, row) in table.iter().enumerate() {
-                            // base + part < combos ≤ MAX_ACTION_COMBOS (a
-                            // power of two): the mask only drops the check.
-                            sum += row[(base[j] + at.part(j, 0, l0)) as usize & MASK] as i64;
-                        }
-                        if sum > best_sum {
-                            best_sum = sum;
-                            best = [l0, l1, l2, l3];
-                            ties = 1;
-                        } else if sum == best_sum {
-                            ties += 1;
-                            if uniform_below(rng, ties) == 0 {
-                                best = [l0, l1, l2, l3];
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        best
-    }
-
-    /// The slots a learning update of `features` writes. A plain table's
-    /// features are its slots. A claim table claims each feature's slot now
-    /// (a fresh claim enters the running checksum); a refused claim gets
-    /// `u32::MAX`, outside the table, so its update is dropped (and the
-    /// table counts it).
-    #[inline]
-    fn claim_slots(&mut self, features: &[u32; TILINGS]) -> [u32; TILINGS] {
-        if !self.weights.claims() {
-            return *features;
-        }
-        let mut slots = [u32::MAX; TILINGS];
-        for (slot, &f) in slots.iter_mut().zip(features) {
-            if let Claim::Slot { slot: s, fresh } = self.weights.claim(f) {
-                *slot = s;
-                if fresh {
-                    if let Some(c) = self.checksum.as_mut() {
-                        let i = s as usize;
-                        *c = c.wrapping_add(self.weights.raw(i).wrapping_mul(entry_factor(i)));
-                    }
-                }
-            }
-        }
-        slots
-    }
-
     fn commit(&mut self, mut decision: Decision, features: [u32; TILINGS]) -> Decision {
         decision.output = self.policy.apply(&decision.levels);
         self.current = Some(Current { features });
@@ -752,53 +548,5 @@ where
             self.stats.explorations += 1;
         }
         decision
-    }
-
-    /// The SARSA(λ) update for the pair `current` that earned `reward`;
-    /// `q_next` is `Q(s', a')`, or `None` at an absorbing end. A table that
-    /// rounds stochastically gets one dither from `rng` per weight write.
-    ///
-    /// The reward learned from is the plant's less the policy's penalty for
-    /// the action that earned it ([`Policy::penalty`]: the action-change
-    /// penalty, 0 for the other kinds); the caller's returns stay the
-    /// plant's.
-    fn update<R: RngCore + ?Sized>(&mut self, current: &Current<TILINGS>, reward: f32, q_next: Option<Q16>, rng: &mut R) {
-        let reward = reward - self.policy.penalty();
-        let q = self.q_of(&current.features);
-        let mut delta = Q16::from_f32(reward).0 as i64 - q.0 as i64;
-        if let Some(qn) = q_next {
-            delta += qn.mul_frac(self.gamma).0 as i64;
-        }
-        let delta = Q16::from_wide(delta);
-        self.stats.last_td_error = delta;
-        let step = delta.mul_frac(self.alpha);
-        let slots = self.claim_slots(&current.features);
-        self.trace.push(&slots);
-        let dithered = self.weights.dithered();
-        let weights = &mut self.weights;
-        let checksum = &mut self.checksum;
-        let mut saturations = 0u32;
-        self.trace.for_each_entry(|entry, eligibility| {
-            let inc = step.mul_frac(eligibility);
-            if inc == Q16::ZERO {
-                return;
-            }
-            for &f in entry {
-                // Replaced slots hold u32::MAX: outside the table, so the
-                // store writes nothing (and no dither is drawn for them).
-                let i = f as usize;
-                if i < weights.len() {
-                    let dither = if dithered { rng.next_u32() } else { 0 };
-                    let old = weights.raw(i);
-                    saturations += weights.add(i, inc, dither) as u32;
-                    if let Some(c) = checksum.as_mut() {
-                        let change = weights.raw(i).wrapping_sub(old);
-                        *c = c.wrapping_add(change.wrapping_mul(entry_factor(i)));
-                    }
-                }
-            }
-        });
-        self.stats.saturations = self.stats.saturations.saturating_add(saturations);
-        self.stats.updates += 1;
     }
 }

@@ -345,3 +345,111 @@ fn the_longest_probe_counts_claims_and_not_reads() {
     t.restore_claims(t.initial_weights(), 0);
     assert_eq!((t.occupancy().claimed, t.occupancy().longest_probe), (4, 0));
 }
+
+/// `pre`'s claims (each followed by a write of its increment), then checks
+/// that `read_then_claim` of `batch` sums, claims, counts and leaves the
+/// slots as reading every key and then claiming each in order does.
+fn batch_is_the_reads_then_the_claims<W, T>(mut t: ClaimTable<W, T>, pre: &[(u32, i32)], batch: &[u32]) -> Result<(), TestCaseError>
+where
+    W: WeightStore + Clone,
+    T: TagStore + Clone,
+{
+    for &(k, inc) in pre {
+        if let Claim::Slot { slot, .. } = t.claim(k) {
+            t.add(slot as usize, Q16(inc << 8), 0);
+        }
+    }
+    let mut one_by_one = t.clone();
+    let want_sum: i64 = batch.iter().map(|&k| one_by_one.read(k).0 as i64).sum();
+    let want: Vec<Claim> = batch.iter().map(|&k| one_by_one.claim(k)).collect();
+    let mut claims = vec![Claim::Refused; batch.len()];
+    let sum = t.read_then_claim(batch, &mut claims);
+    prop_assert_eq!(sum, want_sum);
+    prop_assert_eq!(claims, want);
+    prop_assert_eq!(t.occupancy(), one_by_one.occupancy());
+    for i in 0..WeightStore::len(&t) {
+        prop_assert_eq!((t.tag(i), t.get(i)), (one_by_one.tag(i), one_by_one.get(i)), "slot {}", i);
+    }
+    Ok(())
+}
+
+/// What `add_each` must do: `add` of each slot in the table in order, one
+/// dither per weight written if the table is dithered, the checksum's
+/// change taken from `raw` before and after.
+fn add_one_by_one<S: WeightStore>(t: &mut S, slots: &[u32], inc: Q16, rng: &mut rand_pcg::Pcg32) -> crate::weights::Added {
+    use rand_core::RngCore;
+    let mut out = crate::weights::Added::default();
+    for &s in slots {
+        let i = s as usize;
+        if i < t.len() {
+            let d = if t.dithered() { rng.next_u32() } else { 0 };
+            let old = t.raw(i);
+            out.saturations += t.add(i, inc, d) as u32;
+            let change = t.raw(i).wrapping_sub(old).wrapping_mul(crate::weights::entry_factor(i));
+            out.checksum_change = out.checksum_change.wrapping_add(change);
+        }
+    }
+    out
+}
+
+/// `pre`'s claims, then checks `add_each` of `slots` (claimed, free or
+/// outside the table) against `add_one_by_one`: the weights, what it
+/// returns, the table's checksum and the dithers drawn.
+fn add_each_is_one_by_one<W, T>(mut t: ClaimTable<W, T>, pre: &[(u32, i32)], slots: &[u32], inc: i32, seed: u64) -> Result<(), TestCaseError>
+where
+    W: WeightStore + Clone,
+    T: TagStore + Clone,
+{
+    use rand_core::{RngCore, SeedableRng};
+    for &(k, _) in pre {
+        t.claim(k);
+    }
+    let mut one_by_one = t.clone();
+    let (mut r1, mut r2) = (rand_pcg::Pcg32::seed_from_u64(seed), rand_pcg::Pcg32::seed_from_u64(seed));
+    let before = t.checksum();
+    let want = add_one_by_one(&mut one_by_one, slots, Q16(inc), &mut r2);
+    let got = t.add_each(slots, Q16(inc), || r1.next_u32());
+    prop_assert_eq!(got, want);
+    prop_assert_eq!(before.wrapping_add(got.checksum_change), t.checksum());
+    prop_assert_eq!(r1.next_u32(), r2.next_u32(), "the same dithers drawn");
+    for i in 0..WeightStore::len(&t) {
+        prop_assert_eq!(t.raw(i), one_by_one.raw(i), "slot {}", i);
+    }
+    Ok(())
+}
+
+/// Slots of a 16-slot table, and some outside it (a refused claim's).
+fn slot16() -> impl Strategy<Value = u32> {
+    prop_oneof![4 => 0u32..16, 1 => Just(u32::MAX)]
+}
+
+proptest! {
+    /// One probe per key for a learning update's read and claims changes
+    /// nothing: keys of few homes (probe runs that meet, wrap and fill the
+    /// table), repeated keys, a batch that takes the free slot another of
+    /// its keys stopped at, full tables that refuse.
+    #[test]
+    fn the_batch_read_and_claim_is_the_reads_then_the_claims(
+        pre in prop::collection::vec((0u32..16, 0u32..6, -100i32..100), 0..24),
+        batch in prop::collection::vec((0u32..16, 0u32..6), 1..20),
+    ) {
+        let pre: Vec<(u32, i32)> = pre.iter().map(|&(h, n, inc)| (key_at(h, n, 16), inc)).collect();
+        let batch: Vec<u32> = batch.iter().map(|&(h, n)| key_at(h, n, 16)).collect();
+        batch_is_the_reads_then_the_claims(table(16), &pre, &batch)?;
+        batch_is_the_reads_then_the_claims(chip_table(16), &pre, &batch)?;
+    }
+
+    /// A trace entry's writes in one call are the writes one by one, for
+    /// full-width and 16-bit (dithered) weights, claimed and free slots.
+    #[test]
+    fn a_trace_entry_s_writes_are_the_writes_one_by_one(
+        pre in prop::collection::vec((0u32..16, 0u32..6), 0..12),
+        slots in prop::collection::vec(slot16(), 0..20),
+        inc in prop_oneof![-70_000i32..70_000, Just(i32::MAX), Just(i32::MIN)],
+        seed in any::<u64>(),
+    ) {
+        let pre: Vec<(u32, i32)> = pre.iter().map(|&(h, n)| (key_at(h, n, 16), 0)).collect();
+        add_each_is_one_by_one(table(16), &pre, &slots, inc, seed)?;
+        add_each_is_one_by_one(chip_table(16), &pre, &slots, inc, seed)?;
+    }
+}

@@ -381,6 +381,24 @@ impl<const JOINTS: usize> FatigueCounter<JOINTS> {
         })
     }
 
+    /// A fresh counter whose joint `j` has the gearbox `gearbox(j)` (a
+    /// robot of several servo models); otherwise as [`new`](Self::new).
+    /// [`params`](Self::params) gives joint 0's.
+    pub fn with_gearboxes(
+        gearbox: impl Fn(usize) -> GearboxParams,
+        control_period_s: f64,
+        window_steps: Option<u32>,
+    ) -> Result<Self, FatigueError> {
+        let mut counter = Self::new(gearbox(0), control_period_s, window_steps)?;
+        for (j, joint) in counter.joints.iter_mut().enumerate().skip(1) {
+            let params = gearbox(j);
+            if params != counter.params {
+                *joint = JointFatigue::with_model(FatigueModel::new(&params)?, window_steps)?;
+            }
+        }
+        Ok(counter)
+    }
+
     /// One control step with the applied torque of every joint \[N·m\].
     /// Returns how many joints re-engaged in this step.
     ///

@@ -308,6 +308,41 @@ impl RobotSpec {
         }
     }
 
+    /// The gearbox of counted joint `counted` (Eqs. 3–7): its servo's
+    /// ([`crate::servo::ServoModel::gearbox`]); Table I where the servo
+    /// names none.
+    pub fn gearbox(&self, counted: usize) -> crate::fatigue::GearboxParams {
+        self.joints
+            .get(self.counted.start as usize + counted)
+            .and_then(|j| j.servo.gearbox().ok())
+            .map_or(crate::fatigue::GearboxParams::TABLE_I, |g| g.params)
+    }
+
+    /// The gearbox of joint `joint` (any joint, counted or not).
+    pub fn joint_gearbox(&self, joint: usize) -> crate::fatigue::GearboxParams {
+        self.joints
+            .get(joint)
+            .and_then(|j| j.servo.gearbox().ok())
+            .map_or(crate::fatigue::GearboxParams::TABLE_I, |g| g.params)
+    }
+
+    /// The counted gearbox one worst re-engagement damages most: the wear
+    /// governor's reserve is taken for it.
+    pub fn weakest_gearbox(&self) -> crate::fatigue::GearboxParams {
+        let worst = self.worst_commanded_torque() as f64;
+        let damage = |g: &crate::fatigue::GearboxParams| {
+            crate::fatigue::FatigueModel::new(g).map_or(0.0, |m| m.damage(worst))
+        };
+        let mut weakest = self.gearbox(0);
+        for c in 1..self.gearboxes() {
+            let g = self.gearbox(c);
+            if damage(&g) > damage(&weakest) {
+                weakest = g;
+            }
+        }
+        weakest
+    }
+
     /// The largest gearbox torque one learning action can command \[N·m\]:
     /// the paper's torque law ([`RobotSpec::paper_torque`]) at the level of
     /// largest magnitude, on the counted joint where it is largest. Its

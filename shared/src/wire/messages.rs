@@ -26,9 +26,11 @@ pub use crate::safety::RunMode;
 /// [`ToChip::RestoreChunk`] and [`ToChip::RestoreNone`], all appended
 /// last; `ToChip` is no longer `Copy`); 9: [`Hello`] names the robot
 /// and its definition's hash instead of leaving it to be guessed from its
-/// dimensions (a robot is a definition, not a case of a closed list);
-/// 10: [`FaultCause::HardwareAlert`], a Protocol 2.0 servo's Alert bit
-/// with its Hardware Error Status, appended last.
+/// dimensions (a robot is a definition, not a case of a closed list), and
+/// a restore's batch is [`RESTORE_BATCH`] = 24 chunks, not 3, which a
+/// protocol 8 board's 512-byte command buffer cannot hold; 10:
+/// [`FaultCause::HardwareAlert`], a Protocol 2.0 servo's Alert bit with
+/// its Hardware Error Status, appended last.
 pub const PROTOCOL_VERSION: u16 = 10;
 /// The capacities of a [`Step`] (state dimensions, motor outputs and
 /// counted gearboxes) and of a [`Health`] report (servos): pada-core's own
@@ -295,10 +297,18 @@ pub struct RestoreRequest {
     pub offset: u32,
 }
 
-/// Chunks the host sends per [`RestoreRequest`]: three of the largest
-/// frames (about 170 bytes each) fit the board's 512-byte command buffer,
-/// so a restore never overruns it.
-pub const RESTORE_BATCH: usize = 3;
+/// Chunks the host sends per [`RestoreRequest`]: 24 of the largest frames
+/// (about 170 bytes each) fit the board's [`CHIP_RX_BUFFER`], so a restore
+/// never overruns it. Each request is a round trip on the link (on a USB
+/// serial adapter 1–16 ms): LEO's table on the F429 (65 543 chunks) is
+/// 2 731 requests (protocol 9; with the 3 chunks of protocol 8, 21 848).
+pub const RESTORE_BATCH: usize = 24;
+
+/// Bytes of the board's command receive buffer (the telemetry USART's
+/// circular DMA buffer on a real board, the input queue on the emulated
+/// ones): it holds a whole batch of [`RESTORE_BATCH`] of the largest
+/// restore chunks (protocol 9; 512 bytes and 3 chunks before).
+pub const CHIP_RX_BUFFER: usize = 4096;
 
 /// Why the host sends no checkpoint ([`ToChip::RestoreNone`]); the host
 /// logs the file and the values, the board reports the cause.

@@ -25,8 +25,8 @@ fn cargo() -> Command {
 /// The firmware image for the emulated board of board profile `board`
 /// (`f405`: QEMU's netduinoplus2; `f429-sdram`: mps2-an386) and `robot`
 /// (`pendulum` or `leo`), built once per test binary with `cargo xtask
-/// qemu` (which needs a toolchain for thumbv7em-none-eabihf; CI installs
-/// Debian's).
+/// qemu` (which needs a toolchain for thumbv7em-none-eabihf; `cargo xtask
+/// test` installs Debian's).
 pub fn image(board: &str, robot: &str) -> PathBuf {
     static BUILT: Mutex<Option<HashMap<String, PathBuf>>> = Mutex::new(None);
     let mut built = BUILT.lock().unwrap_or_else(|e| e.into_inner());
@@ -42,7 +42,7 @@ pub fn image(board: &str, robot: &str) -> PathBuf {
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
         out.status.success(),
-        "cargo xtask qemu --board {board} --robot {robot} failed (a thumbv7em-none-eabihf toolchain is needed, see .ci/run):\n{stdout}\n{}",
+        "cargo xtask qemu --board {board} --robot {robot} failed (a thumbv7em-none-eabihf toolchain is needed: `cargo xtask test` installs Debian's, or `sudo .ci/install firmware-toolchain`):\n{stdout}\n{}",
         String::from_utf8_lossy(&out.stderr)
     );
     let elf = stdout
@@ -55,14 +55,27 @@ pub fn image(board: &str, robot: &str) -> PathBuf {
     elf
 }
 
-/// `qemu-system-arm` is there (10 or later; CI installs it from
-/// bookworm-backports). Panics with what to do otherwise: the SIL tests
-/// are meant to run, not to be skipped.
+/// `qemu-system-arm` 10 or later is there (an older one does not model the
+/// F405's CCM RAM, where the firmware keeps its weight table: the image
+/// would fault, not fail clearly). Panics with what to do otherwise: the
+/// SIL tests are meant to run, not to be skipped. `cargo xtask test`
+/// installs it (`.ci/install qemu`: QEMU 10 from bookworm-backports).
 pub fn require_qemu() {
+    const FIX: &str = "`cargo xtask test` installs QEMU 10 from bookworm-backports (as root; or run `sudo .ci/install qemu`)";
     let out = Command::new("qemu-system-arm").arg("--version").output();
-    let ok = out.as_ref().is_ok_and(|o| o.status.success());
+    let version = match out {
+        Ok(o) if o.status.success() => String::from_utf8_lossy(&o.stdout).into_owned(),
+        _ => panic!("qemu-system-arm is not installed: {FIX}"),
+    };
+    let major = version
+        .lines()
+        .next()
+        .and_then(|l| l.strip_prefix("QEMU emulator version "))
+        .and_then(|v| v.split('.').next())
+        .and_then(|m| m.parse::<u32>().ok());
     assert!(
-        ok,
-        "qemu-system-arm is not installed: install QEMU 10 from bookworm-backports (DESIGN.md, .ci/run)"
+        major.is_some_and(|m| m >= 10),
+        "qemu-system-arm is too old or unrecognised ({:?}; 10 or later models the F405's CCM RAM): {FIX}",
+        version.lines().next().unwrap_or("")
     );
 }

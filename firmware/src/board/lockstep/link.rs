@@ -15,8 +15,9 @@ use pada_firmware::sil::{self, Channel, FromBoard, ToBoard, CHUNK_LEN, CLOCK_FRA
 
 /// Bytes of the servo bus's receive buffer.
 const SERVO_RX_BUF: usize = 256;
-/// Bytes of the command receive buffer.
-const TELEMETRY_RX_BUF: usize = 512;
+/// Bytes of the command receive buffer: a restore's batch arrives at one
+/// instant, so it holds a whole one (the wire's).
+const TELEMETRY_RX_BUF: usize = pada_core::wire::CHIP_RX_BUFFER;
 /// Bus writes buffered until the next report (a LEO period writes 8 reads,
 /// a SYNC_WRITE and a torque broadcast).
 const BUS_CHUNKS: usize = 16;

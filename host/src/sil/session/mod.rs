@@ -207,6 +207,8 @@ impl<'a> Session<'a> {
 
     /// Writes out the recorded files.
     pub fn flush(&mut self) -> anyhow::Result<()> {
+        // A save or restore the run ended inside gets its row too.
+        self.recorder.end()?;
         self.recorder.flush()?;
         self.recorder.close_tap().context("cannot write telemetry.mcap")?;
         self.episodes_csv.flush()?;
@@ -470,7 +472,12 @@ impl<'a> Session<'a> {
         }
         for (_, cmd) in self.commands.drain(..due).collect::<Vec<_>>() {
             let mut buf = [0u8; MAX_FRAME_LEN];
-            tele_in.extend_from_slice(self.encoder.encode(&cmd, &mut buf).map_err(|e| anyhow!("{e:?}"))?);
+            let frame = self.encoder.encode(&cmd, &mut buf).map_err(|e| anyhow!("{e:?}"))?;
+            if let ToChip::RestoreChunk(_) | ToChip::RestoreNone(_) = cmd {
+                // The host's half of a restore's link time.
+                self.recorder.answered(matches!(cmd, ToChip::RestoreChunk(_)) as u32, frame.len() as u64);
+            }
+            tele_in.extend_from_slice(frame);
         }
         self.queue_input(Channel::Telemetry, &tele_in)?;
         self.now_us = next;
@@ -704,7 +711,11 @@ impl<'a> Session<'a> {
             messages: self.recorder.counts(),
             latest: self.recorder.latest().clone(),
             sink: self.sink.take(),
-            power: std::mem::take(&mut self.power.report),
+            power: {
+                let mut power = std::mem::take(&mut self.power.report);
+                power.note_transfers(self.recorder.transfers(), self.now_s());
+                power
+            },
         };
         report::summarize(self.cfg, facts)
     }

@@ -8,7 +8,7 @@ use crate::board::RunProtocol;
 use crate::sil::power_cut::{CutPlan, CutRecord, PowerReport, OFF_US};
 use crate::sil::replay::Record;
 use crate::sil::wall::Account;
-use anyhow::bail;
+use anyhow::{bail, Context};
 use pada_core::wire::{self, FrameEncoder, RunMode, StepKind, ToChip};
 use pada_firmware::sil::{ResetCause, ToBoard};
 
@@ -176,7 +176,7 @@ impl Session<'_> {
                 // The servos keep their last command while the chip is hung.
                 self.wall.time(Account::Plant, || self.rig.advance_to(reset_us));
                 self.bus.watch_torque_off(reset_us);
-                self.reboot_at(reset_us.max(self.now_us));
+                self.reboot_at(reset_us.max(self.now_us))?;
             }
             (_, reboot, reset) => bail!(
                 "the board booted unexpectedly ({reset:?}; the host expected {}): a reset nobody caused",
@@ -228,7 +228,7 @@ impl Session<'_> {
     /// The board's state is gone (a power cut or a reset) and it boots
     /// again at `now_us`: the run goes on from the last completed save (or
     /// from the start, with none), as the board will.
-    fn reboot_at(&mut self, now_us: u64) {
+    fn reboot_at(&mut self, now_us: u64) -> anyhow::Result<()> {
         self.now_us = now_us;
         self.horizon_us = now_us;
         self.protocol = match &self.power.last_save {
@@ -249,8 +249,9 @@ impl Session<'_> {
         self.to_board_seq = 0;
         self.encoder = FrameEncoder::new();
         self.last_step_kind = StepKind::Start;
-        self.recorder.restarted();
+        self.recorder.restarted().context("cannot write telemetry.csv")?;
         self.records.push(Record::Boot);
+        Ok(())
     }
 
     /// Cuts the power at `at_us` (`in_save`: the save attempt and the
@@ -286,7 +287,7 @@ impl Session<'_> {
             rig.episode_ended(at_us);
         });
         self.now_us = at_us;
-        self.reboot_at(at_us + OFF_US);
+        self.reboot_at(at_us + OFF_US)?;
         self.power.awaiting_boot = Some(Reboot::Cut(self.power.report.cuts.len() - 1));
         Ok(())
     }

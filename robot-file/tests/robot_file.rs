@@ -1,0 +1,135 @@
+//! Robots read from their files: a two-joint reacher (`tests/data/reacher`,
+//! an arm in a vertical plane), a new robot's template, and every kind of
+//! bad file, each refused in one line that names the file, the line, the
+//! field and the valid values.
+
+use pada_core::profile::{Board, TILINGS};
+use pada_core::robot::vocabulary::{RewardTerm, Signal};
+use pada_core::robot::{RobotRules, TableNeed};
+use pada_robot_file::{load, template};
+use std::path::{Path, PathBuf};
+
+fn reacher() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/reacher/robot.toml")
+}
+
+/// The arm's files copied into a fresh directory, `edit` applied to its
+/// `robot.toml` (and `urdf_edit` to its URDF); the error of loading it.
+fn refused(edit: impl Fn(String) -> String, urdf_edit: impl Fn(String) -> String) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let src = reacher();
+    let toml = std::fs::read_to_string(&src).unwrap();
+    let urdf = std::fs::read_to_string(src.with_file_name("reacher.urdf")).unwrap();
+    std::fs::write(dir.path().join("robot.toml"), edit(toml)).unwrap();
+    std::fs::write(dir.path().join("reacher.urdf"), urdf_edit(urdf)).unwrap();
+    let e = load(&dir.path().join("robot.toml")).expect_err("a bad file is refused").to_string();
+    assert_eq!(e.lines().count(), 1, "one line: {e}");
+    assert!(e.contains("robot.toml"), "names the file: {e}");
+    e
+}
+
+#[test]
+fn the_arm_reads_as_its_files_say() {
+    let r = load(&reacher()).unwrap();
+    let s = r.spec;
+    assert_eq!((s.name, s.period_us, s.episode_steps, s.test_interval), ("reacher", 30_000, 200, 10));
+    assert_eq!(s.joints.iter().map(|j| (j.name, j.servo.name, j.id)).collect::<Vec<_>>(), [("shoulder", "XM430-W350", 1), ("elbow", "XL330-M288", 2)]);
+    assert_eq!((s.counted.start, s.counted.end, s.motor_dims), (0, 2, 2));
+    // 11 × 15 tiles of the two angles, 16 tilings, 3 × 3 actions: an exact
+    // table that fits an F405.
+    assert_eq!(s.exact_table_len::<TILINGS>(pada_core::policy::PolicyKind::Sarsa), Ok(23_760));
+    assert_eq!(s.table, TableNeed::Exact { weights: 23_760 });
+    assert!(r.profile(Board::F405).is_ok());
+    let v = r.vocabulary();
+    assert_eq!(v.observation, [Signal::Angle(0), Signal::Angle(1)]);
+    assert!(matches!(v.rewards[0], RewardTerm::Distance { point: 0, weight, .. } if weight == -10.0));
+    // The tip, straight up: 46 mm + 120 mm + 100 mm above the base.
+    let mut rules = r.rules();
+    let mut angles = [None; pada_core::limits::MAX_SERVOS];
+    angles[0] = Some(0.0);
+    angles[1] = Some(0.0);
+    rules.sense(&pada_core::robot::Sensed { angles, encoder_angle: None, contacts: 0, applied: [0.0; 8] });
+    let tip = rules.point(0).unwrap();
+    assert!((tip[2] - 0.266).abs() < 1e-6 && tip[0].abs() < 1e-6, "{tip:?}");
+    // Read twice, the same definition.
+    assert_eq!(load(&reacher()).unwrap().spec.definition_hash(), s.definition_hash());
+}
+
+#[test]
+fn a_new_robots_template_reads_as_it_is() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("robot.toml"), template::robot_toml("my-arm")).unwrap();
+    std::fs::write(dir.path().join("my-arm.urdf"), template::urdf("my-arm")).unwrap();
+    let r = load(&dir.path().join("robot.toml")).unwrap();
+    assert_eq!((r.spec.name, r.spec.joints.len(), r.spec.state.len(), r.substeps, r.solver_iterations), ("my-arm", 1, 2, 1, 2));
+    assert!(r.profile(Board::F405).is_ok() && r.profile(Board::F429Sdram).is_ok());
+}
+
+#[test]
+fn an_unknown_servo_model_names_the_valid_ones() {
+    let e = refused(|t| t.replace("\"XL330-M288\"", "\"XL999\""), |u| u);
+    assert!(e.contains(":25:9:") && e.contains("joint[1].servo"), "{e}");
+    assert!(e.contains("XL999") && e.contains("XM430-W350, XL430-W250, XL330-M288"), "{e}");
+}
+
+#[test]
+fn a_joint_the_urdf_lacks_names_the_urdfs_joints() {
+    let e = refused(|t| t.replace("urdf = \"elbow\"", "urdf = \"wrist\""), |u| u);
+    assert!(e.contains("joint[1].urdf") && e.contains("\"wrist\" is no joint") && e.contains("shoulder, elbow"), "{e}");
+}
+
+#[test]
+fn a_floating_or_planar_joint_is_no_servos() {
+    for kind in ["floating", "planar", "prismatic"] {
+        let e = refused(|t| t, |u| u.replace("<joint name=\"elbow\" type=\"revolute\">", &format!("<joint name=\"elbow\" type=\"{kind}\">")));
+        assert!(e.contains("joint[1].urdf") && e.contains("revolute or continuous"), "{kind}: {e}");
+    }
+}
+
+#[test]
+fn a_range_with_min_not_below_max_is_refused() {
+    let e = refused(|t| t.replace("range = [-1.6, 1.6]", "range = [1.6, -1.6]"), |u| u);
+    assert!(e.contains("observe[0].range") && e.contains("min < max"), "{e}");
+    let e = refused(|t| t.replace("soft_limit_rad = [-2.5, 2.5]", "soft_limit_rad = [2.5, 2.5]"), |u| u);
+    assert!(e.contains("joint[1].soft_limit_rad"), "{e}");
+}
+
+#[test]
+fn more_actions_than_a_boards_table_holds_is_refused_for_that_board() {
+    // Five levels and finer tiles: an exact table of 16 × 15 × 29 × 25
+    // weights, 696 KB, fits no memory of the F405 or the F429's SRAM.
+    let dir = tempfile::tempdir().unwrap();
+    let src = reacher();
+    let toml = std::fs::read_to_string(&src).unwrap()
+        .replace("levels_v = [-2.0, 0.0, 2.0]", "levels_v = [-2.0, -1.0, 0.0, 1.0, 2.0]")
+        .replace("tile = 0.35\n\n[[observe]]", "tile = 0.35\n\n[[observe]]")
+        .replace("range = [-2.4, 2.4]\ntile = 0.35", "range = [-2.4, 2.4]\ntile = 0.17")
+        .replace("[robot]\n", "[robot]\ntable = \"exact\"\n");
+    std::fs::write(dir.path().join("robot.toml"), toml).unwrap();
+    std::fs::copy(src.with_file_name("reacher.urdf"), dir.path().join("reacher.urdf")).unwrap();
+    let r = load(&dir.path().join("robot.toml")).unwrap();
+    let e = r.profile(Board::F405).unwrap_err().to_string();
+    assert!(e.contains("robot.toml") && e.contains("does not fit board f405") && e.contains("weights"), "{e}");
+    assert!(r.profile(Board::Host).is_ok());
+}
+
+#[test]
+fn an_unknown_field_a_missing_servo_and_a_bad_signal_are_refused_where_they_are() {
+    let e = refused(|t| t.replace("period_ms = 30", "period_ms = 30\nperiod_hz = 33"), |u| u);
+    assert!(e.contains(":10:1:") && e.contains("period_hz") && e.contains("period_ms"), "{e}");
+    let e = refused(
+        |t| {
+            let second = t.find("[[joint]]\nurdf = \"elbow\"").unwrap();
+            let end = t.find("# The tip").unwrap();
+            format!("{}{}", &t[..second], &t[end..])
+        },
+        |u| u,
+    );
+    assert!(e.contains("\"elbow\" moves") && e.contains("no [[joint]]"), "{e}");
+    let e = refused(|t| t.replace("signal = \"elbow.angle\"", "signal = \"elbow.torque\""), |u| u);
+    assert!(e.contains("observe[1].signal") && e.contains("elbow.angle, elbow.rate"), "{e}");
+    let e = refused(|t| t.replace("point = \"tip\"", "point = \"hand\""), |u| u);
+    assert!(e.contains("reward[0].point") && e.contains("\"hand\" is no point"), "{e}");
+    let e = refused(|t| t.replace("name = \"reacher\"", "name = \"leo\""), |u| u);
+    assert!(e.contains("robot.name") && e.contains("pada's own"), "{e}");
+}
