@@ -180,7 +180,10 @@ pub trait WeightStore {
     /// One call per trace entry, so that a table behind a dispatch (the
     /// host's one type for every table) dispatches once per entry rather
     /// than three times per weight.
-    fn add_each<D: FnMut() -> u32>(&mut self, slots: &[u32], inc: Q16, mut dither: D) -> Added {
+    fn add_each<D: FnMut() -> u32>(&mut self, slots: &[u32], inc: Q16, mut dither: D) -> Added
+    where
+        Self: Sized,
+    {
         let dithered = self.dithered();
         let mut out = Added::default();
         for &slot in slots {
