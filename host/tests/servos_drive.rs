@@ -205,3 +205,25 @@ fn a_servo_of_another_model_and_a_missing_servo_are_one_line_each() {
     let o = drive(&["--port", dir.path().join("nothing").to_str().unwrap(), "--robot", "pendulum", "--out", out]);
     bad_input(&o, &["no such device"]);
 }
+
+#[test]
+fn a_hardware_alert_turns_every_servos_torque_off_in_its_period_and_is_in_the_telemetry() {
+    let dir = tempfile::tempdir().unwrap();
+    let arm = arm();
+    // The elbow's overload at 3 s of bus time (period 100 of 30 ms).
+    let servos = Servos::start(dir.path(), &["--robot", &arm, "--lockstep", "--fault", "error-bits:at=3:servo=2:bits=overload"]);
+    let out = dir.path().join("drive");
+    let o = drive(&["--port", servos.port(), "--robot", &arm, "--lockstep", "--seconds", "30", "--out", out.to_str().unwrap()]);
+    bad_input(&o, &["servo 2 (elbow)", "hardware alert", "overload", "torque is off on every servo"]);
+    let summary = servos.stop();
+    let at = |id: u64, what: &str| {
+        summary["events"].as_array().unwrap().iter().find(|e| e["id"] == id && e["what"] == what).map(|e| e["at_us"].as_u64().unwrap())
+    };
+    let alert = at(2, "alert").expect("the alert was raised");
+    assert_eq!(alert, 3_000_000);
+    // Servo 1 (no alert of its own) off within one period of the alert.
+    let off = at(1, "torque-off").expect("servo 1's torque went off");
+    assert!(off >= alert && off - alert <= 30_000, "alert at {alert} µs, servo 1 off at {off} µs");
+    let csv = std::fs::read_to_string(out.join("telemetry.csv")).unwrap();
+    assert!(csv.lines().any(|l| l.contains(",fault,") && l.contains("hardware-alert") && l.contains("servo: 2")), "{csv}");
+}

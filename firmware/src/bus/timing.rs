@@ -127,5 +127,15 @@ mod tests {
         // 235 bytes: 2.40 ms at 1 Mbps (8 % of 30 ms), 40.8 ms at 57,600 (more than the period).
         assert!((t.time_us(1_000_000, 50) - 2400.0).abs() < 1e-9);
         assert!((t.time_us(57_600, 50) - 40_848.6).abs() < 0.1);
+        // The arm's two: 16 + 13 + 20 out, 11 + 2·27 − 3 back: 111 bytes,
+        // 1.16 ms at 1 Mbps (3.9 % of 30 ms), 19.3 ms at 57,600 (64 %).
+        static X2: [JointSpec; 2] = {
+            let j = JointSpec { name: "x", servo: &pada_core::servo::XM430_W350, id: 1, zero: 2048, sign: 1, soft_limit: None };
+            [j, JointSpec { id: 2, servo: &pada_core::servo::XL430_W250, ..j }]
+        };
+        let t = PeriodTraffic::of(&with_servo(&leo::SPEC, &X2), false);
+        assert_eq!(t, PeriodTraffic { packets_out: 3, bytes_out: 16 + 13 + 20, packets_in: 1, bytes_in: 11 + 2 * 27 - 3 });
+        assert!((t.time_us(1_000_000, 50) - 1160.0).abs() < 1e-9);
+        assert!((t.time_us(57_600, 50) - 19_320.8).abs() < 0.1);
     }
 }
