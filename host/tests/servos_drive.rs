@@ -116,6 +116,7 @@ fn drive_on_virtual_servos_in_lock_step_learns_as_pada_run_board() {
     let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("drive.json")).unwrap()).unwrap();
     assert_eq!(report["ended"]["kind"], "done");
     assert_eq!(report["bus"]["checksum_errors"], 0);
+    assert_eq!(report["bus"]["timeouts"], 0, "every request answered");
     assert!(report["clock"]["periods"].as_u64().unwrap() >= 1000, "{}", report["clock"]);
 }
 
@@ -132,6 +133,7 @@ fn the_arm_of_files_on_protocol_2_in_lock_step() {
     // One FAST SYNC READ (16 B out, 62 B back), Torque Enable (13 B) and one
     // SYNC WRITE of Goal PWM (20 B) a period: 111 bytes.
     assert_eq!(report["bus"]["fast_sync_read"], true);
+    assert_eq!(report["bus"]["timeouts"], 0, "every request answered");
     let per_period = report["bus"]["bytes_per_period"].as_f64().unwrap();
     assert!((per_period - 111.0).abs() < 1.0, "{per_period}");
     for id in [1, 2] {

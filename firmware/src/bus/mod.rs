@@ -29,6 +29,7 @@ pub use robot::{OperatorCall, RobotBus};
 use crate::io::{BusPort, PortError};
 use pada_core::dynamixel::control_table::x_series::HardwareError;
 use pada_core::dynamixel::{v2 as dxl2, ErrorFlags, StatusDecoder, StatusPacket};
+use pada_core::servo::Present;
 
 /// Longest Protocol 1.0 status packet the firmware reads (header to
 /// checksum).
@@ -106,6 +107,25 @@ impl Exchange {
     pub fn error(&self) -> ErrorFlags {
         self.status.as_ref().map_or(ErrorFlags::NONE, |s| s.error)
     }
+}
+
+/// One servo's part of a period's readings (what [`RobotBus::read`]
+/// gives the controller; `crate::control` re-exports it).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ServoRead {
+    /// Present Position … Temperature in its model's units, if the servo
+    /// answered.
+    pub state: Option<Present>,
+    /// Error bits of its answer (a Protocol 2.0 Error Number as Protocol
+    /// 1.0's bits: [`v2::flags_of`]).
+    pub error: ErrorFlags,
+    /// A Protocol 2.0 servo's Alert: its Hardware Error Status (empty if
+    /// that read failed); `None` without an alert.
+    pub hardware_error: Option<HardwareError>,
+    /// Attempts that got no answer.
+    pub timeouts: u8,
+    /// Answers with a bad checksum.
+    pub checksum_errors: u8,
 }
 
 /// One servo's settings that the firmware relies on.

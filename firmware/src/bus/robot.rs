@@ -20,9 +20,8 @@
 //! silent, so the safety machine faults on it and torque stays off.
 
 use super::v2::{fast_read_firmware, flags_of, watchdog_units, Read2};
-use super::{BusConfig, BusStats, ServoBus, ServoSetup, SetupError};
+use super::{BusConfig, BusStats, ServoBus, ServoRead, ServoSetup, SetupError};
 use crate::config::MAX_ROBOT_SERVOS;
-use crate::control::ServoRead;
 use crate::io::BusPort;
 use crate::sensor_device::{parse_sensor_read, sensor_table, SENSOR_ID};
 use heapless::Vec;

@@ -6,36 +6,16 @@
 //! thresholds.
 
 use super::{Controller, Phase};
-use crate::bus::BusConfig;
+use crate::bus::{BusConfig, ServoRead};
 use crate::config::MAX_ROBOT_SERVOS;
 use crate::io::CycleCounter;
 use pada_core::robot::{RobotRules, Sensed};
 use heapless::Vec;
-use pada_core::dynamixel::control_table::x_series::HardwareError;
-use pada_core::dynamixel::ErrorFlags;
-use pada_core::servo::{Drive, Present};
+use pada_core::servo::Drive;
 use pada_core::safety::{Event, RunMode, Safety, SafetyConfig, Transition};
 use pada_core::episodes::{is_learning_action, wear};
 use pada_core::weights::WeightStore;
 use pada_core::wire;
-
-/// One servo's part of a period's readings.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct ServoRead {
-    /// Present Position … Temperature in its model's units, if the servo
-    /// answered.
-    pub state: Option<Present>,
-    /// Error bits of its answer (a Protocol 2.0 Error Number as Protocol
-    /// 1.0's bits: `crate::bus::v2::flags_of`).
-    pub error: ErrorFlags,
-    /// A Protocol 2.0 servo's Alert: its Hardware Error Status (empty if
-    /// that read failed); `None` without an alert.
-    pub hardware_error: Option<HardwareError>,
-    /// Attempts that got no answer.
-    pub timeouts: u8,
-    /// Answers with a bad checksum.
-    pub checksum_errors: u8,
-}
 
 /// Everything the control loop read in one period.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -234,6 +214,7 @@ mod tests {
     use core::cell::Cell;
     use pada_core::policy::PolicyKind;
     use pada_core::safety::{FaultCause, State};
+    use pada_core::dynamixel::ErrorFlags;
     use pada_core::wire::NackReason;
 
     #[test]

@@ -155,8 +155,12 @@ impl P1Servo {
                 self.answer(broadcast, 1, error, data)
             }
             Instruction::Write { addr, data } => {
+                // Answered at the level in force when it arrived: a WRITE
+                // of Status Return Level 1 is still answered (the firmware
+                // listens for it, so the answer cannot collide).
+                let level = self.level();
                 let error = self.write(addr, data).map_or(ErrorFlags::RANGE, |()| ErrorFlags::NONE);
-                self.answer(broadcast, 2, error, Vec::new())
+                (!broadcast && level >= 2).then_some((error, Vec::new()))
             }
             Instruction::RegWrite { addr, data } => {
                 let error = match RX28.check_write(addr as u16, data, &self.table) {
@@ -234,6 +238,11 @@ mod tests {
         assert_eq!(s.table[table::REGISTERED as usize], 1);
         assert_eq!(s.execute(&Instruction::Action, true), None);
         assert_eq!((s.table[25], s.table[table::REGISTERED as usize]), (1, 0));
+        // The WRITE that lowers the level to 1 is answered at the level it
+        // came at (2); the next WRITE is not.
+        let lower = Instruction::Write { addr: table::STATUS_RETURN_LEVEL, data: &[1] };
+        assert_eq!(s.execute(&lower, false), Some((ErrorFlags::NONE, vec![])));
+        assert_eq!(s.execute(&Instruction::Write { addr: 25, data: &[1] }, false), None);
         // Level 1: reads only.
         s.table[table::STATUS_RETURN_LEVEL as usize] = 1;
         assert_eq!(s.execute(&Instruction::Write { addr: 25, data: &[0] }, false), None);

@@ -277,8 +277,11 @@ impl P2Servo {
                 self.answer(broadcast, 1, number, data)
             }
             Instruction::Write { addr, data } => {
+                // Answered at the level in force when it arrived (a WRITE
+                // of Status Return Level 1 is still answered).
+                let level = self.level();
                 let number = done(self.write(addr, data));
-                self.answer(broadcast, 2, number, Vec::new())
+                (!broadcast && level >= 2).then(|| (self.status(number), Vec::new()))
             }
             Instruction::RegWrite { addr, data } => {
                 let number = self.table.check_write(addr, data, &self.memory).map_err(TableError::error_number).err();
