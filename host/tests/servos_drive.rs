@@ -229,3 +229,50 @@ fn a_hardware_alert_turns_every_servos_torque_off_in_its_period_and_is_in_the_te
     let csv = std::fs::read_to_string(out.join("telemetry.csv")).unwrap();
     assert!(csv.lines().any(|l| l.contains(",fault,") && l.contains("hardware-alert") && l.contains("servo: 2")), "{csv}");
 }
+
+#[test]
+fn a_storm_of_damaged_answers_faults_with_torque_off_in_its_period() {
+    let dir = tempfile::tempdir().unwrap();
+    let servos = Servos::start(dir.path(), &["--robot", "pendulum", "--lockstep", "--fault", "corrupt:at=2:for=5:servo=1"]);
+    let out = dir.path().join("drive");
+    let o = drive(&["--port", servos.port(), "--robot", "pendulum", "--lockstep", "--seconds", "30", "--out", out.to_str().unwrap()]);
+    bad_input(&o, &["damaged answers", "torque is off on every servo"]);
+    let summary = servos.stop();
+    let at = |what: &str| {
+        summary["events"].as_array().unwrap().iter().find(|e| e["id"] == 1 && e["what"] == what).map(|e| e["at_us"].as_u64().unwrap())
+    };
+    let (corrupt, off) = (at("corrupt").expect("the fault began"), at("torque-off").expect("torque went off"));
+    assert!(off >= corrupt && off - corrupt <= 30_000, "corrupted from {corrupt} µs, torque off at {off} µs");
+    assert!(out.join("telemetry.csv").is_file() && out.join("checkpoint.bin").is_file());
+}
+
+#[test]
+fn a_port_that_goes_away_mid_run_is_one_line_and_the_log_is_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut servos = Servos::start(dir.path(), &["--robot", "pendulum", "--lockstep"]);
+    let out = dir.path().join("drive");
+    let child = Command::new(PADA)
+        .args(["drive", "--port", servos.port(), "--robot", "pendulum", "--lockstep", "--seconds", "100000"])
+        .args(["--out", out.to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let csv = out.join("telemetry.csv");
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while std::fs::metadata(&csv).map_or(0, |m| m.len()) < 20_000 {
+        assert!(Instant::now() < deadline, "pada drive did not get going");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    // The adapter pulled: the virtual servos' process killed outright.
+    let mut s = servos.child.take().unwrap();
+    s.kill().unwrap();
+    s.wait().unwrap();
+    let o = child.wait_with_output().unwrap();
+    bad_input(&o, &["went away", "power", "the checkpoint and the log are saved"]);
+    for f in ["drive.json", "checkpoint.bin", "trial-000.csv"] {
+        assert!(out.join(f).is_file(), "{f}");
+    }
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("drive.json")).unwrap()).unwrap();
+    assert_eq!(report["ended"]["kind"], "port-gone", "{}", report["ended"]);
+}
