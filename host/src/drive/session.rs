@@ -182,12 +182,25 @@ pub fn drive(setup: &DriveSetup, telemetry: TelemetryPipe) -> anyhow::Result<Dri
 /// timer twice (its bytes, then the next request's turnaround), plus 2 ms
 /// (the ROBOTIS SDK's own allowance) and a 30-byte answer's wire time; in
 /// lock step, where a loaded machine must not turn a late answer into a
-/// fault, a generous 200 ms.
+/// fault, a generous 200 ms. On a pseudo-terminal (`pada servos` in real
+/// time) at least [`VIRTUAL_REPLY_US`]: the answer comes from a process the
+/// scheduler may hold back, and 2.3 ms faulted within seconds on a machine
+/// with a load average of 5.
 fn bus_config(setup: &DriveSetup) -> BusConfig {
     let byte_us = (10_000_000 / setup.baud.max(1)).max(1);
-    let reply_timeout_us = if setup.lock_step { 200_000 } else { 2 * setup.latency.ms() * 1000 + 2000 + 30 * byte_us };
+    let wire = 2 * setup.latency.ms() * 1000 + 2000 + 30 * byte_us;
+    let virtual_port = std::fs::canonicalize(&setup.port).is_ok_and(|p| p.starts_with("/dev/pts"));
+    let reply_timeout_us = match (setup.lock_step, virtual_port) {
+        (true, _) => 200_000,
+        (false, true) => wire.max(VIRTUAL_REPLY_US),
+        (false, false) => wire,
+    };
     BusConfig { reply_timeout_us, attempts: 2, byte_us }
 }
+
+/// The reply timeout of virtual servos on a pseudo-terminal in real time
+/// \[µs\].
+const VIRTUAL_REPLY_US: u32 = 10_000;
 
 /// One line for a servo's set-up.
 fn setup_line(robot: &RobotArg, id: u8, r: &Result<pada_firmware::bus::ServoSetup, SetupError>, baud: u32) -> String {
