@@ -21,6 +21,7 @@ pub mod foxglove;
 pub mod gait;
 pub mod gearbox_spec;
 pub mod mcap;
+pub mod motion;
 pub mod output;
 pub mod paper;
 pub mod plan;

@@ -84,55 +84,119 @@ impl clap::ValueEnum for TaskName {
     }
 }
 
-/// The robots `pada sil` runs, by the names `pada sil --task` and
-/// `cargo xtask --robot` give them. `pendulum` here is the physical
-/// pendulum (robot `physical-pendulum`, also accepted by that name), not
-/// `pada run --task pendulum`'s simulated one.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "kebab-case")]
+/// The robots `pada sil` runs: pada's, by the names `pada sil --task` and
+/// `cargo xtask --robot` give them, and a robot of files (`pada sil
+/// --robot FILE`). `pendulum` here is the physical pendulum (robot
+/// `physical-pendulum`, also accepted by that name), not `pada run --task
+/// pendulum`'s simulated one.
+#[derive(Debug, Clone, Copy)]
 pub enum SilTask {
     /// The physical pendulum at 33 Hz (robot `physical-pendulum`) against
     /// the host's model of it.
     Pendulum,
     /// LEO (robot `leo`) against the rapier3d LEO.
     Leo,
+    /// A robot of files against its URDF in rapier3d ([`SilTask::of_file`]).
+    File(&'static FileRobot),
+}
+
+/// A robot of files as `pada sil` runs it: where its `robot.toml` is (the
+/// firmware's build reads the same file) and the simulator's entry.
+#[derive(Debug)]
+pub struct FileRobot {
+    /// Its `robot.toml`, as an absolute path.
+    pub path: std::path::PathBuf,
+    /// What the simulator runs.
+    pub sim: SimRobot,
+}
+
+impl PartialEq for SilTask {
+    fn eq(&self, other: &Self) -> bool {
+        match (self, other) {
+            (SilTask::File(a), SilTask::File(b)) => a.path == b.path && a.sim.robot == b.sim.robot,
+            (SilTask::Pendulum, SilTask::Pendulum) | (SilTask::Leo, SilTask::Leo) => true,
+            _ => false,
+        }
+    }
+}
+
+impl Eq for SilTask {}
+
+/// As the summary's `task`: the name ([`SilTask::name`]).
+impl Serialize for SilTask {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
 }
 
 impl SilTask {
-    /// Every robot `pada sil` runs.
+    /// Every one of pada's robots `pada sil` runs.
     pub const ALL: [SilTask; 2] = [SilTask::Pendulum, SilTask::Leo];
+
+    /// The robot of the `robot.toml` at `path` (relative to the current
+    /// directory), read and checked, with its URDF body. It lives for the
+    /// rest of the process, as the definitions of pada's robots do.
+    pub fn of_file(path: &std::path::Path) -> anyhow::Result<SilTask> {
+        // Absolute, because `cargo xtask` builds the image elsewhere.
+        let path = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+        let file = pada_robot_file::load(&path).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let sim = from_file(&file)?;
+        Ok(SilTask::File(Box::leak(Box::new(FileRobot { path, sim }))))
+    }
 
     /// The firmware's robot.
     pub fn robot(self) -> &'static RobotSpec {
         match self {
             SilTask::Pendulum => &pendulum::SPEC_33HZ,
             SilTask::Leo => &leo::SPEC,
+            SilTask::File(f) => f.sim.robot,
         }
     }
 
-    /// The name on the command line (and `cargo xtask --robot`'s).
+    /// The name on the command line (and `cargo xtask --robot`'s); a robot
+    /// of files' own name.
     pub fn name(self) -> &'static str {
         match self {
             SilTask::Pendulum => "pendulum",
             SilTask::Leo => "leo",
+            SilTask::File(f) => f.sim.robot.name,
+        }
+    }
+
+    /// What `cargo xtask qemu --robot` takes for it: the name, or the path
+    /// of a robot of files.
+    pub fn xtask_robot(self) -> String {
+        match self {
+            SilTask::File(f) => f.path.display().to_string(),
+            _ => self.name().to_string(),
+        }
+    }
+
+    /// The simulator's entry.
+    pub fn sim(self) -> anyhow::Result<SimRobot> {
+        match self {
+            SilTask::File(f) => Ok(f.sim.clone()),
+            _ => sim_robot(self.robot()),
         }
     }
 
     /// The board each robot is built for when `--board` is not given: the
-    /// F405 for the pendulum, the F429I-DISC1 with its SDRAM for LEO.
+    /// F405 for the pendulum and a robot of files, the F429I-DISC1 with its
+    /// SDRAM for LEO.
     pub fn default_board(self) -> Board {
-        sim_robot(self.robot()).map_or(Board::F405, |e| e.default_board)
+        self.sim().map_or(Board::F405, |e| e.default_board)
     }
 
     /// The robot behind the bus ([`SimRobot::sil_rig`]).
     pub fn rig(self) -> anyhow::Result<Box<dyn Rig>> {
-        sim_robot(self.robot())?.sil_rig()
+        self.sim()?.sil_rig()
     }
 
     fn help(self) -> &'static str {
         match self {
             SilTask::Pendulum => "the physical pendulum (robot physical-pendulum; not `pada run --task pendulum`, the simulated one) against its model",
             SilTask::Leo => "LEO against the rapier3d LEO, with an operator who sets it up between episodes",
+            SilTask::File(_) => "a robot of files",
         }
     }
 }
@@ -143,6 +207,10 @@ impl clap::ValueEnum for SilTask {
     }
 
     fn to_possible_value(&self) -> Option<PossibleValue> {
+        // A robot of files is named by `--robot FILE`, not by `--task`.
+        if let SilTask::File(_) = self {
+            return None;
+        }
         let value = PossibleValue::new(self.name()).help(self.help());
         // The robot's own name is accepted too, so one name means one robot.
         Some(if self.robot().name == self.name() { value } else { value.alias(self.robot().name) })

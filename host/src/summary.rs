@@ -98,6 +98,10 @@ pub struct RunSummary {
     /// What the wear governor did, over the trials (with `--mtbf-budget`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub governor: Option<GovernorSummary>,
+    /// Each counted joint's gearbox and its MTBFs over the trials (a robot
+    /// with more than one counted joint; the robot's MTBF is the weakest's).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub gearboxes: Vec<GearboxWear>,
     /// Falls (absorbing ends) in learning episodes, per trial.
     pub learning_falls: Estimate,
     /// Falls in greedy test runs, per trial.
@@ -161,6 +165,46 @@ impl GovernorSummary {
     }
 }
 
+/// One counted joint's gearbox wear over the trials.
+#[derive(Debug, Clone, Serialize)]
+pub struct GearboxWear {
+    /// The joint's name.
+    pub joint: String,
+    /// Its servo's gearbox (`pada_core::servo`).
+    pub gearbox: String,
+    /// Whether the gearbox's geometry is an estimate (not measured).
+    pub estimate: bool,
+    /// MTBF from the first 1200 actions, the paper's torques \[s\].
+    pub mtbf_s: Estimate,
+    /// The same from the simulated gear torques \[s\].
+    pub physical_mtbf_s: Estimate,
+}
+
+impl GearboxWear {
+    /// Per joint, when every trial measured every counted joint of a robot
+    /// with more than one.
+    fn of(spec: &TaskSpec, results: &[TrialResult]) -> Vec<GearboxWear> {
+        let Some(robot) = spec.profile.map(|p| p.robot) else { return Vec::new() };
+        let dims = spec.motor.dims();
+        if dims < 2 || results.is_empty() || results.iter().any(|r| r.joint_mtbf_s.len() != dims || r.physical_joint_mtbf_s.len() != dims) {
+            return Vec::new();
+        }
+        (0..dims)
+            .map(|c| {
+                let joint = robot.joints.get(robot.counted.start as usize + c);
+                let gearbox = joint.and_then(|j| j.servo.gearbox().ok());
+                GearboxWear {
+                    joint: joint.map_or_else(|| format!("joint {c}"), |j| j.name.to_string()),
+                    gearbox: gearbox.map_or("Table I (RX-28)", |g| g.name).to_string(),
+                    estimate: gearbox.is_some_and(|g| g.estimate),
+                    mtbf_s: Estimate::of(&results.iter().map(|r| r.joint_mtbf_s[c]).collect::<Vec<_>>()),
+                    physical_mtbf_s: Estimate::of(&results.iter().map(|r| r.physical_joint_mtbf_s[c]).collect::<Vec<_>>()),
+                }
+            })
+            .collect()
+    }
+}
+
 impl RunSummary {
     /// Summarises `results` of `cfg` on a task with `spec`.
     pub fn new(
@@ -221,6 +265,7 @@ impl RunSummary {
             end_walked_m: walking.then(|| Estimate::of(&col(|r| r.end_walked_m.unwrap_or(f64::NAN)))),
             end_speed_m_s: walking.then(|| Estimate::of(&col(|r| r.end_speed_m_s.unwrap_or(f64::NAN)))),
             governor: GovernorSummary::of(results),
+            gearboxes: GearboxWear::of(spec, results),
             learning_falls: Estimate::of(&col(|r| r.learning_falls as f64)),
             test_falls: Estimate::of(&col(|r| r.test_falls as f64)),
             wall_s,

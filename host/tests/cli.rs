@@ -580,3 +580,39 @@ fn the_gentle_explorations_parameters_name_their_range() {
     assert_bad_input(&["run", "--algo", "pink", "--theta", "0.2"], &["--theta applies only to ou", "not to pink"]);
     assert_bad_input(&["run", "--algo", "sarsa", "--weight", "1"], &["--weight applies only to action-penalty"]);
 }
+
+/// `pada sil --robot FILE`: a path that is no file, a file with a bad
+/// field, a robot.toml whose URDF is missing, `--robot` with `--task`,
+/// and a calibration the board cannot read are each one line and exit
+/// code 2, before anything is built or booted; `--help` says what the
+/// path is.
+#[test]
+fn sil_robot_file_errors_are_one_line_and_the_help_says_what_the_path_is() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("nothing/robot.toml");
+    let missing = missing.to_str().unwrap();
+    assert_bad_input(&["sil", "--robot", missing], &["--robot", missing, "cannot read it"]);
+    // The example arm with a servo pada does not know.
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/robots/arm2");
+    let toml = std::fs::read_to_string(example.join("robot.toml")).unwrap();
+    assert!(toml.contains("servo = \"XM430-W350\""));
+    std::fs::copy(example.join("arm2.urdf"), dir.path().join("arm2.urdf")).unwrap();
+    let bad = write(dir.path(), "robot.toml", &toml.replacen("servo = \"XM430-W350\"", "servo = \"XM999\"", 1));
+    assert_bad_input(&["sil", "--robot", &bad], &[&bad, "joint[0].servo", "XM999", "valid are", "XM430-W350"]);
+    // Its URDF missing.
+    let lost = write(dir.path(), "lost.toml", &toml.replacen("urdf = \"arm2.urdf\"", "urdf = \"nowhere.urdf\"", 1));
+    assert_bad_input(&["sil", "--robot", &lost], &["nowhere.urdf"]);
+    assert_bad_input(&["sil", "--robot", &bad, "--task", "leo"], &["--robot", "--task"]);
+    // The example arm as written: its X-series zero count 2048 lies past
+    // the position counts the board reads, so it could never start an
+    // episode; refused before any image is built, here and on the host's
+    // board run.
+    let arm2 = example.join("robot.toml");
+    let arm2 = arm2.to_str().unwrap();
+    assert_bad_input(&["sil", "--robot", arm2], &["joint shoulder", "zero count 2048", "0..=1023"]);
+    assert_bad_input(&["run", "--board", "f405", "--robot", arm2, "--algo", "pada"], &["joint shoulder", "zero count 2048"]);
+    let help = String::from_utf8_lossy(&pada(&["sil", "--help"]).stdout).into_owned();
+    for needle in ["--robot <robot.toml>", "the path of its robot.toml", "relative to the current directory", "cargo xtask qemu --robot FILE"] {
+        assert!(help.contains(needle), "pada sil --help lacks {needle:?}:\n{help}");
+    }
+}

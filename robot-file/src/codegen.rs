@@ -6,9 +6,13 @@
 //! `this_robot()` and `ROBOT`.
 //!
 //! Capacities are checked where the code is compiled: the statics are
-//! arrays of fixed length, and `pada_core::profile::Board::profile` of the
-//! definition runs in a `const` (a table too large for the board stops
-//! the build).
+//! arrays whose lengths are named constants, each asserted in a `const`
+//! against pada-core's capacity for it (`pada_core::limits`, the
+//! vocabulary's points and chains), and the firmware's
+//! `pada_core::profile::Board::profile` of the definition runs in a
+//! `const` (a table too large for the board stops the build). The reader
+//! refuses such a file first; the asserts keep an edited or stale
+//! generated file from reaching the chip.
 
 use pada_core::robot::vocabulary::{ChainJoint, Point, RewardTerm, Signal, Vocabulary};
 use pada_core::robot::{MotorLevels, RobotSpec, TableNeed, TorqueLaw};
@@ -87,9 +91,10 @@ pub fn rust_source(spec: &RobotSpec, origin: &str) -> Result<String, String> {
     let _ = writeln!(w, "use pada_core::agent::{{SarsaParams, WeightInit}};");
     let _ = writeln!(w, "use pada_core::trace::TraceKind;");
     let _ = writeln!(w, "use pada_core::safety::SoftLimit;\n");
+    capacities(w, spec, v);
 
     // Joints.
-    let _ = writeln!(w, "static JOINTS: [JointSpec; {}] = [", spec.joints.len());
+    let _ = writeln!(w, "static JOINTS: [JointSpec; N_JOINTS] = [");
     for j in spec.joints {
         let limit = match j.soft_limit {
             None => "None".to_string(),
@@ -107,7 +112,7 @@ pub fn rust_source(spec: &RobotSpec, origin: &str) -> Result<String, String> {
     }
     let _ = writeln!(w, "];");
     // State.
-    let _ = writeln!(w, "static STATE: [StateDim; {}] = [", spec.state.len());
+    let _ = writeln!(w, "static STATE: [StateDim; N_STATE] = [");
     for d in spec.state {
         let _ = writeln!(w, "    {},", state_dim(d));
     }
@@ -115,7 +120,7 @@ pub fn rust_source(spec: &RobotSpec, origin: &str) -> Result<String, String> {
     // Levels.
     let levels = match spec.levels {
         MotorLevels::Listed(l) => {
-            let _ = writeln!(w, "static LEVELS: [f32; {}] = [{}];", l.len(), l.iter().map(|x| f(*x)).collect::<Vec<_>>().join(", "));
+            let _ = writeln!(w, "static LEVELS: [f32; N_LEVELS] = [{}];", l.iter().map(|x| f(*x)).collect::<Vec<_>>().join(", "));
             "MotorLevels::Listed(&LEVELS)".to_string()
         }
         MotorLevels::Uniform { min, max, count } => {
@@ -179,9 +184,41 @@ pub fn rust_source(spec: &RobotSpec, origin: &str) -> Result<String, String> {
     Ok(s)
 }
 
+/// The lengths of the definition's arrays as named constants, each
+/// asserted against the capacity that bounds it, so that the compiler
+/// refuses a definition the chip cannot hold.
+fn capacities(w: &mut String, spec: &RobotSpec, v: &Vocabulary) {
+    let levels = match spec.levels {
+        MotorLevels::Listed(l) => l.len(),
+        MotorLevels::Uniform { count, .. } => count as usize,
+    };
+    let gearboxes = spec.counted.end.saturating_sub(spec.counted.start) as usize;
+    let _ = writeln!(w, "// Capacities: each length, and pada-core's room for it.");
+    let consts: [(&str, usize, &str, &str); 7] = [
+        ("N_JOINTS", spec.joints.len(), "pada_core::limits::MAX_SERVOS", "joints (servos on the bus)"),
+        ("N_STATE", spec.state.len(), "pada_core::limits::MAX_STATE_DIMS", "observed state dimensions"),
+        ("N_MOTORS", spec.motor_dims as usize, "pada_core::limits::MAX_ACTION_DIMS", "learned motor dimensions"),
+        ("N_LEVELS", levels, "pada_core::limits::MAX_LEVELS", "levels of an action dimension"),
+        ("N_GEARBOXES", gearboxes, "pada_core::limits::MAX_GEARBOXES", "counted gearboxes"),
+        ("N_NAME", spec.name.len(), "pada_core::limits::MAX_ROBOT_NAME", "bytes of the robot's name"),
+        ("N_POINTS", v.points.len(), "pada_core::robot::vocabulary::MAX_POINTS", "points"),
+    ];
+    for (name, n, cap, what) in consts {
+        let _ = writeln!(w, "const {name}: usize = {n};");
+        let message = format!("{}: more {what} than pada-core holds", spec.name);
+        let _ = writeln!(w, "const _: () = assert!({name} <= {cap}, {message:?});");
+    }
+    for (k, p) in v.points.iter().enumerate() {
+        let _ = writeln!(w, "const N_CHAIN_{k}: usize = {};", p.chain.len());
+        let message = format!("{}: point {} hangs on more joints than pada-core follows", spec.name, p.name);
+        let _ = writeln!(w, "const _: () = assert!(N_CHAIN_{k} <= pada_core::robot::vocabulary::MAX_CHAIN, {message:?});");
+    }
+    let _ = writeln!(w);
+}
+
 fn vocabulary(w: &mut String, v: &Vocabulary) {
-    let _ = writeln!(w, "static OBSERVATION: [Signal; {}] = [{}];", v.observation.len(), v.observation.iter().map(signal).collect::<Vec<_>>().join(", "));
-    let _ = writeln!(w, "static LEARNED: [u8; {}] = {:?};", v.learned.len(), v.learned);
+    let _ = writeln!(w, "static OBSERVATION: [Signal; N_STATE] = [{}];", v.observation.iter().map(signal).collect::<Vec<_>>().join(", "));
+    let _ = writeln!(w, "static LEARNED: [u8; N_MOTORS] = {:?};", v.learned);
     let _ = writeln!(w, "static HELD: [Hold; {}] = [", v.held.len());
     for h in v.held {
         let _ = writeln!(w, "    Hold {{ joint: {}, target: {}, gain_v_per_rad: {} }},", h.joint, f(h.target), f(h.gain_v_per_rad));
@@ -189,13 +226,13 @@ fn vocabulary(w: &mut String, v: &Vocabulary) {
     let _ = writeln!(w, "];");
     let _ = writeln!(w, "static START: [f32; {}] = [{}];", v.start.len(), v.start.iter().map(|x| f(*x)).collect::<Vec<_>>().join(", "));
     for (k, p) in v.points.iter().enumerate() {
-        let _ = writeln!(w, "static CHAIN_{k}: [ChainJoint; {}] = [", p.chain.len());
+        let _ = writeln!(w, "static CHAIN_{k}: [ChainJoint; N_CHAIN_{k}] = [");
         for c in p.chain {
             let _ = writeln!(w, "    {},", chain_joint(c));
         }
         let _ = writeln!(w, "];");
     }
-    let _ = writeln!(w, "static POINTS: [Point; {}] = [", v.points.len());
+    let _ = writeln!(w, "static POINTS: [Point; N_POINTS] = [");
     for (k, p) in v.points.iter().enumerate() {
         let Point { name, offset, .. } = p;
         let _ = writeln!(w, "    Point {{ name: {name:?}, chain: &CHAIN_{k}, offset: {} }},", f3(*offset));

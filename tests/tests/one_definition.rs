@@ -10,6 +10,11 @@
 //! fail. The episodes' rules (length,
 //! test cadence, footstep remap), the control period and the counted
 //! gearboxes are compared directly.
+//!
+//! A robot of files comes to the chip as generated constants
+//! (`pada_robot_file::rust_source`, run by the firmware's build.rs); the
+//! example arm's are compiled here (tests/build.rs) and their learner must
+//! hash as the one the host builds from the same files.
 
 use pada::experiment::algo::{algo_of, policy_kind_of, Algo, PolicyFlags};
 use pada::experiment::build_agent;
@@ -23,6 +28,13 @@ use pada_core::robot::{leo, pendulum, registry, RobotRules};
 use pada_core::tile_coding::Layout;
 use pada_core::weights::WeightStore;
 use pada_firmware::control::Controller;
+
+/// The constants an image of the example arm holds: `ROBOT`, `ThisRobot`,
+/// `this_robot()` (tests/build.rs generates them as the firmware's
+/// build.rs does).
+mod arm2 {
+    include!(concat!(env!("OUT_DIR"), "/arm2_robot.rs"));
+}
 
 /// Every policy of `--algo`, each with its default parameters (and PADA
 /// with LEO's Δ = 1/6 besides).
@@ -163,4 +175,46 @@ fn the_hash_tells_boards_robots_and_learners_apart() {
     let default = LeoTask::with_profile(profile, leo_params());
     let same = config_hash(&profile, &build_agent(default.spec(), PolicyKind::Sarsa).unwrap());
     assert_ne!(other, same);
+}
+
+#[test]
+fn the_firmware_constants_of_a_robot_of_files_learn_as_the_host_reads_the_files() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/robots/arm2/robot.toml");
+    let file = pada_robot_file::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    // The same definition, every float by its bits (the hash reads them).
+    assert_eq!(arm2::ROBOT, file.spec);
+    assert_eq!(arm2::ROBOT.definition_hash(), file.spec.definition_hash());
+    let sim = pada::robots::from_file(&file).unwrap();
+    let mut compared = 0;
+    for board in [Board::F405, Board::F429Sdram] {
+        // The firmware's profile comes from its constants, the host's from
+        // the file it read.
+        let chip = board.profile(arm2::ROBOT).unwrap();
+        let host_profile = file.profile(board).unwrap();
+        let task = sim.task_spec(host_profile).unwrap();
+        assert_eq!(task.episode_rules(), arm2::ROBOT.episode_rules(), "{}: episodes", board.name());
+        assert_eq!(task.control_period_s, arm2::ROBOT.period_s(), "{}: control period", board.name());
+        assert_eq!(task.gearboxes, arm2::ROBOT.gearboxes(), "{}: counted gearboxes", board.name());
+        for policy in policies() {
+            let weights = chip.weights().expect("a board's table has a size");
+            let firmware = Controller::new(arm2::this_robot(), chip, policy, table_of(chip, weights), 1);
+            let host = match build_agent(&task, policy) {
+                Ok(host) => host,
+                Err(e) => {
+                    assert!(firmware.is_err(), "arm2 on {}: the host refuses {policy:?} ({e}) but the firmware builds it", board.name());
+                    continue;
+                }
+            };
+            let firmware = firmware.unwrap_or_else(|e| panic!("arm2 on {}: the firmware refuses {policy:?}: {e}", board.name()));
+            assert_eq!(host.weights().len(), weights, "arm2 on {}: table size", board.name());
+            assert_eq!(
+                config_hash(&host_profile, &host),
+                firmware.config_hash(),
+                "arm2 on {} with {policy:?}: the host's learner and the generated firmware's differ",
+                board.name()
+            );
+            compared += 1;
+        }
+    }
+    assert!(compared >= 2 * (policies().len() - 2), "{compared} learners compared");
 }

@@ -1,7 +1,8 @@
 //! Software in the loop: the firmware image in QEMU against the simulated
 //! plant (`pada sil`): the pendulum on the F405's emulation
 //! (netduinoplus2), LEO on the F429I-DISC1's (mps2-an386, its 8 MiB table in
-//! PSRAM) and the F405's. Each test boots the real image in
+//! PSRAM) and the F405's, and the example arm of files
+//! (examples/robots/arm2) on the F405's. Each test boots the real image in
 //! qemu-system-arm; none is skipped when QEMU is missing.
 
 mod common;
@@ -49,11 +50,17 @@ impl Run {
         }
     }
 
+    /// The example arm of files, learning with PADA ([`arm2_on_protocol1`]).
+    fn arm2(seconds: f64) -> Run {
+        let task = SilTask::of_file(&arm2_on_protocol1()).unwrap_or_else(|e| panic!("{e:#}"));
+        Run { board: Board::F405, task, policy: PolicyKind::Pada { delta: 0.5 }, seconds, faults: vec![], forecast: true, compare: false, mtbf_budget_s: None }
+    }
+
     fn config(&self, out: &Path) -> SilConfig {
         common::require_qemu();
         SilConfig {
             qemu: "qemu-system-arm".into(),
-            elf: common::image(self.board.name(), self.task.name()),
+            elf: common::image(self.board.name(), &self.task.xtask_robot()),
             task: self.task,
             board: self.board,
             policy: self.policy,
@@ -76,6 +83,36 @@ impl Run {
     fn go(&self, out: &Path) -> SilSummary {
         run(&self.config(out)).unwrap_or_else(|e| panic!("SIL run failed: {e:#}"))
     }
+}
+
+/// The example arm (examples/robots/arm2) as today's servo bus reads it:
+/// its robot.toml and URDF, with each servo's zero count at 512 instead of
+/// 2048. Why: the firmware speaks Protocol 1.0 and reads every servo's
+/// Present Position in the RX-28's units (1023 counts over 300°,
+/// `pada_core::robot::hardware`), in which the X-series' centre 2048 is
+/// past the end; the first reading of the arm as written is then −5.2 rad,
+/// a soft-limit fault (in `pada run --board` as in `pada sil`). Until the
+/// firmware reads X-series positions, the same arm re-centred is what both
+/// can run. Written under the tests' target directory and only when it
+/// changes, so that its image is built once.
+fn arm2_on_protocol1() -> std::path::PathBuf {
+    let example = common::root().join("examples/robots/arm2");
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("arm2-protocol1");
+    std::fs::create_dir_all(&dir).unwrap();
+    let toml = std::fs::read_to_string(example.join("robot.toml")).unwrap();
+    let zeros = toml.lines().filter(|l| l.starts_with("zero_count = 2048")).count();
+    assert_eq!(zeros, 2, "the example arm's two servos are centred at 2048");
+    let toml: String = toml
+        .lines()
+        .map(|l| if l.starts_with("zero_count = 2048") { l.replacen("2048", "512", 1) } else { l.to_string() } + "\n")
+        .collect();
+    for (name, text) in [("robot.toml", toml), ("arm2.urdf", std::fs::read_to_string(example.join("arm2.urdf")).unwrap())] {
+        let path = dir.join(name);
+        if std::fs::read_to_string(&path).ok().as_deref() != Some(text.as_str()) {
+            std::fs::write(&path, text).unwrap();
+        }
+    }
+    dir.join("robot.toml")
 }
 
 fn check_failures(s: &SilSummary) -> Vec<String> {
@@ -333,4 +370,38 @@ fn an_image_for_another_robot_is_refused_with_what_to_build() {
     cfg.task = SilTask::Leo;
     let e = format!("{:#}", run(&cfg).map(|_| ()).unwrap_err());
     assert!(e.contains("drives physical-pendulum") && e.contains("cargo xtask qemu --board f405 --robot leo"), "{e}");
+}
+
+#[test]
+fn a_robot_of_files_in_qemu_replays_bit_for_bit_and_equals_pada_run_board() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut run = Run::arm2(30.0);
+    run.compare = true;
+    let s = run.go(dir.path());
+    assert!(s.passed, "{:#?}", check_failures(&s));
+    assert_eq!((s.robot, s.board, s.machine), ("arm2", "f405", "netduinoplus2"));
+    // The image's agent, replayed on the host.
+    assert!(s.replay.identical && s.replay.actions_compared >= 500 && s.replay.checksums_compared >= 3, "{:?}", s.replay);
+    // The same run as `pada run --board f405 --robot examples/robots/arm2/robot.toml --seed 1`'s
+    // trial 0: every episode and the final weights.
+    let host = s.host.as_ref().expect("the host comparison ran");
+    assert_eq!(host.identical, Some(true), "{host:?}");
+    assert!(host.episodes_compared >= 5, "{host:?}");
+    assert_eq!(Some(host.weights_checksum), s.replay.final_checksum_firmware);
+    // The image generated from the files says it learns what the host
+    // builds from them: its Hello's configuration hash.
+    let stream = std::fs::read(dir.path().join("telemetry.bin")).unwrap();
+    let hello = HostDecoder::new()
+        .feed(&stream)
+        .into_iter()
+        .find_map(|f| match f.ok()?.msg {
+            ToHost::Hello(h) => Some(h),
+            _ => None,
+        })
+        .expect("the image says Hello");
+    let profile = run.config(dir.path()).profile();
+    let task = run.task.sim().unwrap().task_spec(profile).unwrap();
+    let host_agent = pada::experiment::build_agent(&task, run.policy).unwrap();
+    assert_eq!(hello.config_hash, pada_core::profile::config_hash(&profile, &host_agent), "{hello:?}");
+    assert_eq!((hello.robot.as_str(), hello.robot_hash), ("arm2", run.task.robot().definition_hash()));
 }

@@ -47,11 +47,16 @@ tasks:
         (`firmware-test`) and the Python package's (pytest in a venv), all
         with CI=true (a test whose tool is missing fails, never skips)
   firmware [--release] [--board f405|f429-sdram] [--chip f405|f407|f429]
-           [--robot pendulum|pendulum-20hz|leo]
+           [--robot pendulum|pendulum-20hz|leo|PATH/robot.toml]
         build the firmware ELF of a board's learner profile for
         thumbv7em-none-eabihf (debug unless --release; board f405 unless
         --board; the 33 Hz pendulum unless --robot) and print its use of
         flash, SRAM, CCM and SDRAM and where the weight table lies.
+        --robot takes a robot of pada's by name, or a robot of your own by
+        the path of its robot.toml (a value ending in .toml or holding a
+        /; relative to the current directory): its constants are
+        generated at build time, and a bad file or a table the board
+        cannot hold stops the build with one line naming the file.
         --board f405 builds the STM32F405RG (--chip f407: the
         STM32F4-Discovery's F407VG, same profile); --board f429-sdram the
         STM32F429I-DISC1 (--chip f429)
@@ -67,12 +72,13 @@ tasks:
         f429-sdram: QEMU's mps2-an386, a Cortex-M4F whose PSRAM holds LEO's
         8 MiB table, feature `mps2`; f405 unless --board) into
         target/firmware-emulated/images/<board>-<robot>.elf, release unless
-        --debug; its ELF path is the last line printed
+        --debug; its ELF path is the last line printed; --robot as for
+        `firmware`
   sil [--debug] [--board ...] [--robot ...] [-- <pada sil options>]
         build as `qemu`, then run it in qemu-system-arm against the
         simulated plant: `pada sil --elf <ELF> <options>` (release build
         of the host); the robot's task and the board are passed on
-        (--task, --board)
+        (--task, or --robot for a robot.toml; --board)
   fuzz [--seconds S] [--seed K]
         fuzz every decoder that faces untrusted bytes (wire frames of host
         and chip, Dynamixel status and instruction packets, checkpoint load
@@ -170,29 +176,89 @@ impl Chip {
 
 /// The robot `--robot` names: a robot of pada's registry
 /// (`pada_core::robot::registry`), by its full name (`physical-pendulum`,
-/// `physical-pendulum-20hz`, `leo`) or the short one its images carry.
-fn parse_robot(s: &str) -> Result<Robot, String> {
-    registry::find(&s.to_ascii_lowercase()).ok_or_else(|| {
+/// `physical-pendulum-20hz`, `leo`) or the short one its images carry; or
+/// a robot of files, by the path of its `robot.toml` ([`Robot::is_path`]),
+/// relative to `cwd` unless absolute.
+fn parse_robot(s: &str, cwd: &Path) -> Result<Robot, String> {
+    if Robot::is_path(s) {
+        let path = cwd.join(s);
+        if !path.is_file() {
+            return Err(format!("--robot {s}: no such file ({}); a robot of files is the path of its robot.toml", path.display()));
+        }
+        return Ok(Robot::File(path));
+    }
+    registry::find(&s.to_ascii_lowercase()).map(Robot::BuiltIn).ok_or_else(|| {
         let names: Vec<&str> = registry::BUILT_IN.iter().map(|b| b.short_name).collect();
-        format!("unknown robot `{s}`: expected {}", names.join(", "))
+        format!("unknown robot `{s}`: expected {}, or the path of a robot.toml", names.join(", "))
     })
 }
 
-/// A robot of the registry.
-type Robot = &'static BuiltIn;
+/// The robot an image drives.
+#[derive(Debug, Clone, PartialEq, Eq)]
+enum Robot {
+    /// One of pada's robots.
+    BuiltIn(&'static BuiltIn),
+    /// A robot of files: its `robot.toml`, as an absolute path (the
+    /// firmware's build script runs in `firmware/`, not where the user
+    /// typed the path).
+    File(PathBuf),
+}
+
+impl Robot {
+    /// Whether `--robot`'s value is a path: it ends in `.toml` or has a
+    /// directory in it (no built-in robot's name does either; the
+    /// firmware's build.rs tells them apart the same way).
+    fn is_path(s: &str) -> bool {
+        s.ends_with(".toml") || s.contains('/') || s.contains(std::path::MAIN_SEPARATOR)
+    }
+
+    /// `PADA_ROBOT` for the firmware's build.rs.
+    fn env(&self) -> std::ffi::OsString {
+        match self {
+            Robot::BuiltIn(b) => b.spec.name.into(),
+            Robot::File(p) => p.clone().into_os_string(),
+        }
+    }
+
+    /// How messages name it.
+    fn label(&self) -> String {
+        match self {
+            Robot::BuiltIn(b) => b.spec.name.to_string(),
+            Robot::File(p) => p.display().to_string(),
+        }
+    }
+
+    /// Its part of an emulated image's file name: the short name of a
+    /// built-in; for a robot of files its folder's name and a hash of its
+    /// path, so that two robots in folders of the same name never share
+    /// an image.
+    fn image_name(&self) -> String {
+        match self {
+            Robot::BuiltIn(b) => b.short_name.to_string(),
+            Robot::File(p) => {
+                let folder = p.parent().and_then(Path::file_name).map(|f| f.to_string_lossy().into_owned());
+                let stem = folder.unwrap_or_else(|| "robot".into());
+                // FNV-1a of the path: stable across runs and builds (std's
+                // hasher is seeded per process).
+                let hash = p.to_string_lossy().bytes().fold(0x811c_9dc5u32, |h, b| (h ^ b as u32).wrapping_mul(0x0100_0193));
+                format!("{stem}-{hash:08x}")
+            }
+        }
+    }
+}
 
 /// The robot when `--robot` is not given: the 33 Hz pendulum.
 fn pendulum() -> Robot {
-    registry::find("pendulum").expect("the registry has the 33 Hz pendulum (xtask's tests check it)")
+    Robot::BuiltIn(registry::find("pendulum").expect("the registry has the 33 Hz pendulum (xtask's tests check it)"))
 }
 
 #[cfg(test)]
 fn leo() -> Robot {
-    registry::find("leo").unwrap()
+    Robot::BuiltIn(registry::find("leo").unwrap())
 }
 
 /// What to build.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 struct Build {
     release: bool,
     chip: Chip,
@@ -234,6 +300,7 @@ fn parse_emulated(task: &str, rest: &[String]) -> Result<Task, String> {
             key @ ("--robot" | "--board") => {
                 let robots: Vec<&str> = registry::BUILT_IN.iter().map(|b| b.short_name).collect();
                 let robots = robots.join(", ");
+                let robots = format!("{robots} or the path of a robot.toml");
                 let choices = if key == "--robot" { robots.as_str() } else { PROFILES };
                 (key, own.next().ok_or_else(|| format!("{key} needs a value: {choices}"))?.as_str())
             }
@@ -248,7 +315,7 @@ fn parse_emulated(task: &str, rest: &[String]) -> Result<Task, String> {
         if key == "--board" {
             build.chip = Chip::for_profile(value).ok_or_else(|| format!("unknown board `{value}`: expected {PROFILES}"))?;
         } else {
-            build.robot = parse_robot(value)?;
+            build.robot = parse_robot(value, &cwd()?)?;
         }
     }
     Ok(if task == "sil" { Task::Sil(build, passed) } else { Task::Qemu(build) })
@@ -275,7 +342,7 @@ fn parse_args(args: &[String]) -> Result<Task, String> {
                         let choices = match key {
                             "--board" => PROFILES,
                             "--chip" => "f405, f407 or f429",
-                            _ => "pendulum, pendulum-20hz or leo",
+                            _ => "pendulum, pendulum-20hz, leo or the path of a robot.toml",
                         };
                         (key, rest.next().ok_or_else(|| format!("{key} needs a value: {choices}"))?.as_str())
                     }
@@ -300,9 +367,7 @@ fn parse_args(args: &[String]) -> Result<Task, String> {
                                 .ok_or_else(|| format!("unknown chip `{value}`: expected f405, f407 or f429"))?,
                         )
                     }
-                    _ => {
-                        robot = parse_robot(value)?
-                    }
+                    _ => robot = parse_robot(value, &cwd()?)?,
                 }
             }
             let chip = match (board, chip) {
@@ -360,6 +425,12 @@ fn parse_args(args: &[String]) -> Result<Task, String> {
     }
 }
 
+/// Where the user ran `cargo xtask`: a relative `--robot` path is theirs
+/// (`cargo run` keeps the caller's directory).
+fn cwd() -> Result<PathBuf, String> {
+    env::current_dir().map_err(|e| format!("cannot read the current directory: {e}"))
+}
+
 /// The repository root (the directory holding the workspace Cargo.toml).
 fn workspace_root() -> PathBuf {
     // `cargo run` sets CARGO_MANIFEST_DIR for the program as well; fall back
@@ -378,7 +449,9 @@ fn main() -> ExitCode {
     let task = match parse_args(&args) {
         Ok(task) => task,
         Err(e) => {
-            eprintln!("xtask: error: {e}\n\n{USAGE}");
+            // One line: the mistake and where the usage is (the usage
+            // itself is longer than a screen and buried the mistake).
+            eprintln!("xtask: error: {e} (`cargo xtask help` prints the usage)");
             return ExitCode::from(2);
         }
     };
@@ -390,12 +463,15 @@ fn main() -> ExitCode {
             Ok(())
         }
         Task::Firmware(build) => firmware(&workspace_root(), build).map(|_| ()),
-        Task::Flash(build) => firmware(&workspace_root(), build).and_then(|elf| flash(&elf, build.chip)),
+        Task::Flash(build) => {
+            let chip = build.chip;
+            firmware(&workspace_root(), build).and_then(|elf| flash(&elf, chip))
+        }
         Task::FirmwareTest => firmware_test(&workspace_root()),
         Task::Fuzz(args) => fuzz(&workspace_root(), &args),
         Task::Qemu(build) => qemu_image(&workspace_root(), build).map(|_| ()),
         Task::Sil(build, args) => {
-            qemu_image(&workspace_root(), build).and_then(|elf| sil(&workspace_root(), &elf, build, &args))
+            qemu_image(&workspace_root(), build.clone()).and_then(|elf| sil(&workspace_root(), &elf, build, &args))
         }
     };
     match result {
@@ -439,14 +515,14 @@ fn firmware(root: &Path, build: Build) -> Result<PathBuf, String> {
         cmd.args(["--features", &features.join(",")]);
     }
     // The image's robot: firmware/build.rs reads it.
-    cmd.env("PADA_ROBOT", robot.spec.name);
+    cmd.env("PADA_ROBOT", robot.env());
 
     println!(
         "xtask: building pada-firmware ({profile}, board profile {}: {} on {}, robot {}) for {TARGET}",
         chip.profile(),
         chip.feature(),
         chip.board(),
-        robot.spec.name
+        robot.label()
     );
     let started = Instant::now();
     let status = cmd
@@ -520,14 +596,14 @@ fn qemu_image(root: &Path, build: Build) -> Result<PathBuf, String> {
         .arg("--target-dir")
         .arg(&target_dir)
         .args(["--no-default-features", "--features", &features.join(",")])
-        .env("PADA_ROBOT", build.robot.spec.name);
+        .env("PADA_ROBOT", build.robot.env());
     if build.release {
         cmd.arg("--release");
     }
     println!(
         "xtask: building pada-firmware ({profile}, board profile {} emulated on QEMU's {machine}, robot {}) for {TARGET}",
         build.chip.profile(),
-        build.robot.spec.name
+        build.robot.label()
     );
     let started = Instant::now();
     let status = cmd
@@ -538,7 +614,7 @@ fn qemu_image(root: &Path, build: Build) -> Result<PathBuf, String> {
     }
     let built = target_dir.join(TARGET).join(profile).join("pada-firmware");
     let debug = if build.release { "" } else { "-debug" };
-    let elf = images.join(format!("{}-{}{debug}.elf", build.chip.profile(), build.robot.short_name));
+    let elf = images.join(format!("{}-{}{debug}.elf", build.chip.profile(), build.robot.image_name()));
     std::fs::copy(&built, &elf).map_err(|e| format!("cannot copy {} to {}: {e}", built.display(), elf.display()))?;
     drop(lock);
     println!("xtask: built in {:.1} s", started.elapsed().as_secs_f64());
@@ -553,7 +629,8 @@ fn qemu_image(root: &Path, build: Build) -> Result<PathBuf, String> {
 }
 
 /// Runs `pada sil --elf <elf> --task <robot's task> --board <profile> <args>`
-/// (release build).
+/// (release build); a robot of files is `--robot <robot.toml>` instead of
+/// `--task`.
 fn sil(root: &Path, elf: &Path, build: Build, args: &[String]) -> Result<(), String> {
     let cargo = env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
     let mut cmd = std::process::Command::new(&cargo);
@@ -562,8 +639,14 @@ fn sil(root: &Path, elf: &Path, build: Build, args: &[String]) -> Result<(), Str
         .args(["run", "--release", "--quiet", "--package", "pada", "--", "sil", "--elf"])
         .arg(elf);
     let given = |flag: &str| args.iter().any(|a| a == flag || a.starts_with(&format!("{flag}=")));
-    if !given("--task") {
-        cmd.args(["--task", build.robot.short_name]);
+    match &build.robot {
+        Robot::BuiltIn(b) if !given("--task") && !given("--robot") => {
+            cmd.args(["--task", b.short_name]);
+        }
+        Robot::File(p) if !given("--robot") => {
+            cmd.arg("--robot").arg(p);
+        }
+        _ => {}
     }
     if !given("--board") {
         cmd.args(["--board", build.chip.profile()]);
@@ -715,7 +798,7 @@ mod tests {
         );
         assert_eq!(
             parse_args(&args("firmware --robot=pendulum-20hz --chip=f407")),
-            Ok(Task::Firmware(Build { release: false, chip: Chip::F407, robot: registry::find("pendulum-20hz").unwrap() }))
+            Ok(Task::Firmware(Build { release: false, chip: Chip::F407, robot: Robot::BuiltIn(registry::find("pendulum-20hz").unwrap()) }))
         );
         assert_eq!(parse_args(&args("firmware-test")), Ok(Task::FirmwareTest));
         assert_eq!(parse_args(&args("test")), Ok(Task::Test));
@@ -727,14 +810,14 @@ mod tests {
     #[test]
     fn emulated_board_builds_release_by_default_and_passes_sil_options_on() {
         let release = Build { release: true, chip: Chip::F405, robot: pendulum() };
-        assert_eq!(parse_args(&args("qemu")), Ok(Task::Qemu(release)));
+        assert_eq!(parse_args(&args("qemu")), Ok(Task::Qemu(release.clone())));
         assert_eq!(
             parse_args(&args("qemu --debug --robot leo")),
             Ok(Task::Qemu(Build { release: false, chip: Chip::F405, robot: leo() }))
         );
         assert_eq!(
             parse_args(&args("sil -- --seconds 60 --json")),
-            Ok(Task::Sil(release, args("--seconds 60 --json")))
+            Ok(Task::Sil(release.clone(), args("--seconds 60 --json")))
         );
         assert_eq!(parse_args(&args("sil --robot=leo")), Ok(Task::Sil(Build { robot: leo(), ..release }, vec![])));
         assert!(parse_args(&args("qemu --release")).is_err());
@@ -742,12 +825,31 @@ mod tests {
         assert!(parse_args(&args("sil --robot")).is_err());
         // The f429-sdram profile is emulated on mps2-an386.
         let f429_leo = Build { release: true, chip: Chip::F429, robot: leo() };
-        assert_eq!(parse_args(&args("qemu --board f429-sdram --robot leo")), Ok(Task::Qemu(f429_leo)));
+        assert_eq!(parse_args(&args("qemu --board f429-sdram --robot leo")), Ok(Task::Qemu(f429_leo.clone())));
         assert_eq!(parse_args(&args("sil --robot=leo --board=f429-sdram -- --seconds 5")), Ok(Task::Sil(f429_leo, args("--seconds 5"))));
         assert_eq!(Chip::F429.emulated(), ("mps2", "mps2-an386", "firmware/memory-mps2.x"));
         assert_eq!(Chip::F405.emulated().1, "netduinoplus2");
         assert!(parse_args(&args("qemu --board host")).unwrap_err().contains("f405 or f429-sdram"));
         assert!(parse_args(&args("qemu --board")).is_err());
+    }
+
+    #[test]
+    fn a_robot_toml_is_a_path_from_the_current_directory() {
+        let root = workspace_root();
+        let arm2 = root.join("examples/robots/arm2/robot.toml");
+        // Relative to where the user stands, whatever directory cargo
+        // builds the firmware in.
+        assert_eq!(parse_robot("robots/arm2/robot.toml", &root.join("examples")), Ok(Robot::File(arm2.clone())));
+        assert_eq!(parse_robot(&arm2.display().to_string(), Path::new("/")), Ok(Robot::File(arm2.clone())));
+        let e = parse_robot("no/such/robot.toml", &root).unwrap_err();
+        assert!(e.contains("no such file") && e.contains("robot.toml"), "{e}");
+        assert!(parse_robot("walker", &root).unwrap_err().contains("path of a robot.toml"));
+        assert_eq!(parse_robot("leo", &root), Ok(leo()));
+        let arm2 = Robot::File(arm2);
+        assert_eq!(arm2.env(), root.join("examples/robots/arm2/robot.toml").into_os_string());
+        assert!(arm2.image_name().starts_with("arm2-"), "{}", arm2.image_name());
+        assert_ne!(arm2.image_name(), Robot::File("/elsewhere/arm2/robot.toml".into()).image_name());
+        assert_eq!(leo().image_name(), "leo");
     }
 
     #[test]

@@ -357,6 +357,8 @@ fn run<R: RobotRules, W: WeightStore>(
         run_mtbf_s: paper.robot_mtbf_s(),
         physical_mtbf_s: simulated.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
         physical_window_reengagements: simulated.joints().iter().filter_map(|j| j.window_reengagements()).sum(),
+        joint_mtbf_s: (0..ids.len()).map(|j| paper.windowed_mtbf_s(j).unwrap_or(f64::INFINITY)).collect(),
+        physical_joint_mtbf_s: (0..ids.len()).map(|j| simulated.windowed_mtbf_s(j).unwrap_or(f64::INFINITY)).collect(),
         learning_steps,
         test_steps,
         learning_falls,

@@ -181,6 +181,9 @@ fn run_on_board(args: RunArgs, board: Board, sim: crate::robots::SimRobot) -> Re
         Some(p) => usage(format!("{}: {e}", p.display())),
         None => usage(e.to_string()),
     })?;
+    if let Some(p) = &args.robot {
+        crate::board::readable::check_readable(robot).map_err(|e| usage(format!("{}: {e}", p.display())))?;
+    }
     let format = match args.weight_bits.as_deref() {
         Some("16") => WeightFormat::Half { shift: robot.half_shift },
         Some(_) => WeightFormat::Q16,
@@ -488,6 +491,16 @@ pub fn print_summary(s: &RunSummary, label: &str) -> Result<(), CliError> {
         "  physical MTBF        {} (from the simulated gear torques)",
         fmt_mtbf(s.physical_mtbf_s.mean, s.physical_mtbf_s.ci95)
     )?;
+    for g in &s.gearboxes {
+        outln!(
+            "    {:<18} {} (physical {}), gearbox {}{}",
+            g.joint,
+            fmt_mtbf(g.mtbf_s.mean, g.mtbf_s.ci95),
+            fmt_mtbf(g.physical_mtbf_s.mean, g.physical_mtbf_s.ci95),
+            g.gearbox,
+            if g.estimate { " (geometry estimated)" } else { "" }
+        )?;
+    }
     if let Some(g) = &s.governor {
         outln!(
             "  wear governor        budget {} s: held in {:.0} % of trials (physical MTBF: {:.0} %); mean {} {}, at the floor {:.0} % of the time, {:.0} moves per trial",

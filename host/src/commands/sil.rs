@@ -21,6 +21,14 @@ pub struct SilArgs {
     /// rapier3d LEO, with an operator who sets it up between episodes).
     #[arg(long, value_enum, default_value_t = SilTask::Pendulum)]
     pub task: SilTask,
+    /// A robot of your own instead of --task: the path of its robot.toml
+    /// (relative to the current directory; the URDF it names is read from
+    /// beside it). The image is built for it (`cargo xtask qemu --robot
+    /// FILE`, unless --elf), and the emulated bus answers with the physics
+    /// of its URDF in rapier3d, as `pada run --board B --robot FILE`
+    /// simulates it (default board f405).
+    #[arg(long, value_name = "robot.toml", conflicts_with = "task")]
+    pub robot: Option<PathBuf>,
     /// The board learner profile the image is built for, and so the
     /// emulated board: f405 (QEMU's netduinoplus2, an STM32F405) or
     /// f429-sdram (QEMU's mps2-an386, whose PSRAM holds LEO's 8 MiB table
@@ -40,7 +48,7 @@ pub struct SilArgs {
     #[arg(long)]
     pub no_compare: bool,
     /// Learning time to reach [s of emulated learning episodes] (default:
-    /// 600 for the pendulum, 60 for LEO).
+    /// 600 for the pendulum, 60 for LEO and a robot of files).
     #[arg(long, value_name = "S")]
     pub seconds: Option<f64>,
     /// The algorithm the firmware learns with (Section V).
@@ -116,12 +124,17 @@ pub fn run(args: SilArgs) -> Result<(), CliError> {
             .map_err(usage)?;
     }
     let policy = policy_kind(args.algo, args.alpha, args.delta).map_err(|e| usage(e.0))?;
-    let default_seconds = match args.task {
+    // A bad robot file is the user's mistake: one line, exit code 2.
+    let task = match &args.robot {
+        Some(path) => SilTask::of_file(path).map_err(|e| usage(format!("--robot: {e:#}")))?,
+        None => args.task,
+    };
+    let default_seconds = match task {
         SilTask::Pendulum => 600.0,
-        SilTask::Leo => 60.0,
+        SilTask::Leo | SilTask::File(_) => 60.0,
     };
     let seconds = check_seconds("--seconds", args.seconds.unwrap_or(default_seconds))?;
-    let board = args.board.unwrap_or(args.task.default_board());
+    let board = args.board.unwrap_or(task.default_board());
     if sil::machine(board).is_none() {
         return Err(usage(format!(
             "--board {}: no emulated board; valid are f405 (netduinoplus2) and f429-sdram (mps2-an386)",
@@ -155,8 +168,14 @@ pub fn run(args: SilArgs) -> Result<(), CliError> {
             return Err(usage(format!("--checkpoint-every {s}: at least 1 s of learning")));
         }
     }
-    let spec = args.task.robot();
-    let profile = board.profile(spec).map_err(|e| usage(e.to_string()))?;
+    let spec = task.robot();
+    let profile = board.profile(spec).map_err(|e| match &args.robot {
+        Some(path) => usage(format!("--robot {}: {e} on board {}", path.display(), board.name())),
+        None => usage(e.to_string()),
+    })?;
+    if let Some(path) = &args.robot {
+        crate::board::readable::check_readable(spec).map_err(|e| usage(format!("--robot {}: {e}", path.display())))?;
+    }
     let save_every_s = args.checkpoint_every.or((!power_cuts.is_empty() || !hangs_s.is_empty()).then(|| {
         // The interval follows the time a save of this image takes on the
         // link: 20 s between LEO's 2-minute streams stopped learning most of
@@ -167,7 +186,7 @@ pub fn run(args: SilArgs) -> Result<(), CliError> {
             spec.episode_steps as f64 * spec.period_us as f64 * 1e-6,
         )
     }));
-    sil::bus::check_faults(args.task.robot(), &faults).map_err(usage)?;
+    sil::bus::check_faults(task.robot(), &faults).map_err(usage)?;
     if !(1..=3600).contains(&args.hang_timeout) {
         return Err(usage(format!(
             "--hang-timeout {} is out of range: valid is 1..=3600 s",
@@ -182,17 +201,17 @@ pub fn run(args: SilArgs) -> Result<(), CliError> {
     let out_path = args
         .out
         .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("pada-out/sil-{}-{}-{}", args.task.name(), args.algo, board.name())));
+        .unwrap_or_else(|| PathBuf::from(format!("pada-out/sil-{}-{}-{}", task.name(), args.algo, board.name())));
     OutDir::check(&out_path)?;
     let elf = match &args.elf {
         Some(p) if p.is_file() => p.clone(),
         Some(p) => return Err(usage(format!("--elf {}: no such file", p.display()))),
-        None => build_image(args.task, board)?,
+        None => build_image(task, board)?,
     };
     let cfg = SilConfig {
         qemu: args.qemu.clone(),
         elf,
-        task: args.task,
+        task,
         board,
         policy,
         mtbf_budget_s: args.mtbf_budget,
@@ -249,12 +268,12 @@ fn build_image(task: SilTask, board: pada_core::profile::Board) -> Result<PathBu
             root.display()
         )));
     }
-    let (robot, board) = (task.name(), board.name());
+    let (robot, board) = (task.xtask_robot(), board.name());
     errln!("pada sil: building the firmware for the emulated board (cargo xtask qemu --board {board} --robot {robot})");
     let output =
         std::process::Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()))
             .current_dir(&root)
-            .args(["xtask", "qemu", "--board", board, "--robot", robot])
+            .args(["xtask", "qemu", "--board", board, "--robot", &robot])
             .stderr(std::process::Stdio::inherit())
             .output()
             .context("cannot start cargo to build the firmware (pass --elf FILE instead)")?;

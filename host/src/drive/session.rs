@@ -39,7 +39,7 @@ use crate::robot_arg::RobotArg;
 use crate::seed::trial_seed;
 use pada_core::checkpoint::LoadOutcome;
 use pada_core::episodes::is_learning_action;
-use pada_core::fatigue::{FatigueCounter, GearboxParams, PAPER_WINDOW_STEPS};
+use pada_core::fatigue::{FatigueCounter, PAPER_WINDOW_STEPS};
 use pada_core::policy::PolicyKind;
 use pada_core::profile::LearnerProfile;
 use pada_core::robot::RobotRules;
@@ -310,8 +310,11 @@ fn run<W: WeightStore>(setup: &DriveSetup, table: W, mut tm: TelemetryPipe) -> a
     let mut clock = PeriodClock::new(period_us, !setup.lock_step);
     let mut protocol = RunProtocol::new(cfg.seconds, period_us);
     let counted = spec.counted.range();
+    let n_counted = counted.len().min(COUNTED);
     let window = Some(PAPER_WINDOW_STEPS);
-    let fatigue = || FatigueCounter::<COUNTED>::new(GearboxParams::TABLE_I, period_s, window);
+    // Each counted joint's own servo's gearbox (Table I's for the RX-28), as
+    // `pada run --board`'s trial counts.
+    let fatigue = || FatigueCounter::<COUNTED>::with_gearboxes(|c| spec.gearbox(c), period_s, window);
     let mut paper = fatigue().map_err(|e| anyhow::anyhow!("{e}"))?;
     let mut estimated = fatigue().map_err(|e| anyhow::anyhow!("{e}"))?;
     let mut governed = GovernorStats::default();
@@ -498,6 +501,8 @@ fn run<W: WeightStore>(setup: &DriveSetup, table: W, mut tm: TelemetryPipe) -> a
         // estimate stands in.
         physical_mtbf_s: estimated.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
         physical_window_reengagements: estimated.joints().iter().filter_map(|j| j.window_reengagements()).sum(),
+        joint_mtbf_s: (0..n_counted).map(|j| paper.windowed_mtbf_s(j).unwrap_or(f64::INFINITY)).collect(),
+        physical_joint_mtbf_s: (0..n_counted).map(|j| estimated.windowed_mtbf_s(j).unwrap_or(f64::INFINITY)).collect(),
         learning_steps,
         test_steps,
         learning_falls,

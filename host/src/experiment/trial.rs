@@ -86,6 +86,14 @@ pub struct TrialResult {
     pub physical_mtbf_s: f64,
     /// Re-engagements of the simulated gear torques within those actions.
     pub physical_window_reengagements: u64,
+    /// Each counted gearbox's `mtbf_s`, in the robot's counted-joint order
+    /// (the robot's is the smallest); empty where not measured (results
+    /// stored by a plan).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub joint_mtbf_s: Vec<f64>,
+    /// Each counted gearbox's `physical_mtbf_s`, as `joint_mtbf_s`.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub physical_joint_mtbf_s: Vec<f64>,
     /// Learning steps taken.
     pub learning_steps: u64,
     /// Test-run steps taken.
@@ -114,6 +122,14 @@ pub struct TrialResult {
     /// The learning curve.
     #[serde(skip)]
     pub curve: Vec<TestPoint>,
+}
+
+/// The windowed MTBF of each of the first `dims` gearboxes of `counter`
+/// \[s\] (`+∞` where nothing re-engaged).
+pub fn joint_mtbf_s(counter: &FatigueCounter<MAX_ACTION_DIMS>, dims: usize) -> Vec<f64> {
+    (0..dims.min(MAX_ACTION_DIMS))
+        .map(|j| counter.windowed_mtbf_s(j).unwrap_or(f64::INFINITY))
+        .collect()
 }
 
 /// Receives the trial as telemetry: a `Step` for every agent call and an
@@ -233,6 +249,8 @@ pub fn run_trial_observed<T: Task>(
         mtbf_s,
         physical_mtbf_s,
         run_mtbf_s: t.fatigue.robot_mtbf_s(),
+        joint_mtbf_s: joint_mtbf_s(&t.fatigue, t.spec.motor.dims()),
+        physical_joint_mtbf_s: joint_mtbf_s(&t.physical, t.spec.motor.dims()),
         physical_window_reengagements: t
             .physical
             .joints()

@@ -130,6 +130,8 @@ mod tests {
                     window_reengagements: 0,
                     physical_mtbf_s: 2.0,
                     run_mtbf_s: 2.5,
+                    joint_mtbf_s: Vec::new(),
+                    physical_joint_mtbf_s: Vec::new(),
                     governor: None,
                     physical_window_reengagements: 0,
                     learning_steps: 0,

@@ -95,6 +95,12 @@ struct StoredTrial {
     /// written before the wear governor: NaN, unknown).
     #[serde(default = "nan", with = "super::exact::f64")]
     run_mtbf_s: f64,
+    /// Each counted gearbox's MTBFs (absent in results written before
+    /// them: empty, and the summary shows the robot's only).
+    #[serde(default, skip_serializing_if = "Vec::is_empty", with = "super::exact::vec_f64")]
+    joint_mtbf_s: Vec<f64>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty", with = "super::exact::vec_f64")]
+    physical_joint_mtbf_s: Vec<f64>,
     /// The wear governor's record, when one ran.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     governor: Option<crate::experiment::governed::GovernorTrial>,
@@ -147,6 +153,8 @@ impl From<&TrialResult> for StoredTrial {
             physical_mtbf_s: r.physical_mtbf_s,
             physical_window_reengagements: r.physical_window_reengagements,
             run_mtbf_s: r.run_mtbf_s,
+            joint_mtbf_s: r.joint_mtbf_s.clone(),
+            physical_joint_mtbf_s: r.physical_joint_mtbf_s.clone(),
             governor: r.governor.clone(),
             learning_steps: r.learning_steps,
             test_steps: r.test_steps,
@@ -187,6 +195,8 @@ impl From<StoredTrial> for TrialResult {
             physical_mtbf_s: r.physical_mtbf_s,
             physical_window_reengagements: r.physical_window_reengagements,
             run_mtbf_s: r.run_mtbf_s,
+            joint_mtbf_s: r.joint_mtbf_s,
+            physical_joint_mtbf_s: r.physical_joint_mtbf_s,
             governor: r.governor.clone(),
             learning_steps: r.learning_steps,
             test_steps: r.test_steps,
@@ -392,6 +402,8 @@ mod tests {
             window_reengagements: 349,
             physical_mtbf_s: 1.0e-300,
             run_mtbf_s: f64::INFINITY,
+            joint_mtbf_s: vec![f64::INFINITY, 1234.5],
+            physical_joint_mtbf_s: vec![1.0e-300, f64::INFINITY],
             governor: Some(crate::experiment::governed::GovernorTrial { budget_s: 2600.0, held: true, physical_held: false, final_parameter: 0.834, mean_parameter: 0.1 + 0.2, floor_fraction: 1.0 / 3.0, moves: 7, over_budget_steps: 2 }),
             physical_window_reengagements: 7,
             learning_steps: 1800,

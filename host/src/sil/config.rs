@@ -11,7 +11,8 @@ use pada_core::profile::{Board, LearnerProfile};
 use std::path::PathBuf;
 use std::time::Duration;
 
-/// The robots `pada sil` runs (the registry's, [`crate::robots`]).
+/// The robots `pada sil` runs (the registry's and robots of files,
+/// [`crate::robots`]).
 pub use crate::robots::SilTask;
 
 /// The QEMU machine that emulates `board`: netduinoplus2 (an STM32F405)
@@ -75,9 +76,11 @@ pub struct SilConfig {
 impl SilConfig {
     /// The learner the image runs.
     pub fn profile(&self) -> LearnerProfile {
-        // `pada sil`'s robots are pada's own, whose tables fit every board
-        // (pada-core's profile tests check it).
-        self.board.profile(self.task.robot()).expect("a built-in robot's table fits every board")
+        // pada's own robots' tables fit every board (pada-core's profile
+        // tests check it); a robot of files' table was checked against the
+        // board before the run (`pada sil`), and its image would not have
+        // built otherwise.
+        self.board.profile(self.task.robot()).expect("the robot's table fits the board (checked before the run)")
     }
 
     /// The seed of the board's learner.

@@ -303,12 +303,18 @@ fn compare(cfg: &SilConfig, episodes: &[Episode]) -> anyhow::Result<HostComparis
     let run = |trials| RunConfig { policy: cfg.policy, switch_at_s: None, mtbf_budget_s: cfg.mtbf_budget_s, seconds: cfg.seconds, trials, seed: cfg.seed };
     let none = |_| {};
     match cfg.task {
-        SilTask::Leo => {
-            let t = run_board_trial(profile, &crate::robots::sim_robot(profile.robot)?, &run(1), 0, &none)?;
+        // The same rig behind the bus as behind `pada run --board`'s
+        // controller: the same trial, bit for bit.
+        SilTask::Leo | SilTask::File(_) => {
+            let t = run_board_trial(profile, &cfg.task.sim()?, &run(1), 0, &none)?;
             let first = first_difference(episodes, &t.episodes);
+            let (what, body) = match cfg.task {
+                SilTask::File(f) => (format!("--robot {}", f.path.display()), "the same URDF in rapier3d"),
+                _ => ("--task leo".to_string(), "the same rapier3d LEO"),
+            };
             Ok(HostComparison {
                 what: format!(
-                    "trial 0 of `pada run --board {} --task leo` with the same seed and policy (the firmware's controller on the host, the same rapier3d LEO)",
+                    "trial 0 of `pada run --board {} {what}` with the same seed and policy (the firmware's controller on the host, {body})",
                     cfg.board.name()
                 ),
                 trials: 1,
@@ -481,7 +487,7 @@ pub fn summarize(cfg: &SilConfig, facts: Facts<'_>) -> SilSummary {
     } else {
         None
     };
-    if let (SilTask::Leo, Some(h), true) = (cfg.task, &host, cfg.faults.is_empty()) {
+    if let (SilTask::Leo | SilTask::File(_), Some(h), true) = (cfg.task, &host, cfg.faults.is_empty()) {
         checks.push(Check {
             name: "equals `pada run --board`: every episode and the final weight checksum",
             ok: h.identical == Some(true),

@@ -321,14 +321,14 @@ impl<'a> Session<'a> {
             bail!(
                 "the image drives {robot} on board {board} ({machine}), the run is for {} on {want_board}: build it with `cargo xtask qemu --board {want_board} --robot {}`",
                 want.name,
-                self.cfg.task.name()
+                self.cfg.task.xtask_robot()
             );
         }
         if robot_hash != want.definition_hash() {
             bail!(
                 "the image drives another definition of {robot} (hash {robot_hash:08x}, the host's is {:08x}): rebuild it with `cargo xtask qemu --board {want_board} --robot {}`",
                 want.definition_hash(),
-                self.cfg.task.name()
+                self.cfg.task.xtask_robot()
             );
         }
         if calibration.abs_diff(CALIBRATION_INSTRUCTIONS) > resolution as u32 + 16 {
