@@ -61,7 +61,6 @@ pub mod opt_f64 {
     }
 }
 
-/// One exactly stored `f64`.
 /// A list of f64, each exact as [`f64`](mod@self::f64) writes it.
 pub mod vec_f64 {
     use super::*;
@@ -77,6 +76,7 @@ pub mod vec_f64 {
     }
 }
 
+/// One exactly stored `f64`.
 struct Exact(f64);
 
 impl Serialize for Exact {
