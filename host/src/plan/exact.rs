@@ -61,20 +61,22 @@ pub mod opt_f64 {
     }
 }
 
-/// One exactly stored `f64`.
 /// A list of f64, each exact as [`f64`](mod@self::f64) writes it.
 pub mod vec_f64 {
     use super::*;
 
+    /// Writes each value as [`f64`](mod@super::f64) does.
     pub fn serialize<S: Serializer>(x: &[::core::primitive::f64], s: S) -> Result<S::Ok, S::Error> {
         s.collect_seq(x.iter().map(|v| Exact(*v)))
     }
 
+    /// Reads each value as [`f64`](mod@super::f64) does.
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<::core::primitive::f64>, D::Error> {
         Ok(Vec::<Exact>::deserialize(d)?.into_iter().map(|e| e.0).collect())
     }
 }
 
+/// One exactly stored `f64`.
 struct Exact(f64);
 
 impl Serialize for Exact {
