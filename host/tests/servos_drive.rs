@@ -121,12 +121,15 @@ fn drive_on_virtual_servos_in_lock_step_learns_as_pada_run_board() {
 }
 
 #[test]
-fn the_arm_of_files_on_protocol_2_in_lock_step() {
+fn the_arm_of_files_on_protocol_2_in_lock_step_learns_as_pada_run_board() {
     let dir = tempfile::tempdir().unwrap();
     let arm = arm();
     let servos = Servos::start(dir.path(), &["--robot", &arm, "--lockstep"]);
     let out = dir.path().join("drive");
-    let o = drive(&["--port", servos.port(), "--robot", &arm, "--lockstep", "--seconds", "12", "--json", "--out", out.to_str().unwrap()]);
+    let o = drive(&[
+        "--port", servos.port(), "--robot", &arm, "--lockstep", "--board", "f405", "--algo", "pada", "--seed", "1", "--seconds", "30",
+        "--json", "--out", out.to_str().unwrap(),
+    ]);
     let report: serde_json::Value = serde_json::from_str(&ok(&o)).expect("drive.json on stdout");
     let summary = servos.stop();
     assert_eq!(report["ended"]["kind"], "done");
@@ -140,7 +143,17 @@ fn the_arm_of_files_on_protocol_2_in_lock_step() {
         let servo = events(&summary, id);
         assert_eq!(servo.last().map(String::as_str), Some("torque-off"), "servo {id}: {servo:?}");
     }
-    assert!(summary["stats"]["sync_writes"].as_u64().unwrap() >= 400);
+    assert!(summary["stats"]["sync_writes"].as_u64().unwrap() >= 1000);
+    // The learning curve of `pada run --board` on the same arm: the X-series
+    // servos' own units on both paths, and the operator's calls heard.
+    let run = dir.path().join("run");
+    ok(&common::pada(&[
+        "run", "--board", "f405", "--robot", &arm, "--algo", "pada", "--seed", "1", "--seconds", "30", "--trials", "1",
+        "--out", run.to_str().unwrap(),
+    ]));
+    let curve = |d: &Path| std::fs::read_to_string(d.join("trial-000.csv")).unwrap();
+    assert!(curve(&out).lines().count() >= 3);
+    assert_eq!(curve(&out), curve(&run), "the arm over the pty learns as pada run --board's, episode for episode");
 }
 
 #[test]

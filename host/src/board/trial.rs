@@ -46,6 +46,7 @@ use crate::robots::{DynRules, SimRobot};
 use pada_core::claim_table::{ClaimTable, Tags16, Tags32};
 use pada_core::profile::{LearnerProfile, TILINGS};
 use pada_core::robot::RobotRules;
+use pada_core::servo::ServoProtocol;
 use pada_core::tile_coding::Layout;
 use pada_core::weights::{Half, WeightFormat, WeightStore};
 use pada_core::wire::{Episode, RunMode, StepKind, ToChip};
@@ -265,7 +266,12 @@ fn run<R: RobotRules, W: WeightStore>(
         // 1. Read.
         let mut readings = Readings { time_ms: (t / 1000) as u32, ..Readings::default() };
         for (i, joint) in joints.iter().enumerate() {
-            readings.servos[i].state = Some(rig.present(t, joint.id).into());
+            // Each servo in its own model's units: an RX-28's Present
+            // Position … Temperature, an X-series servo's present block.
+            readings.servos[i].state = Some(match joint.servo.protocol {
+                ServoProtocol::V1 => rig.present(t, joint.id).into(),
+                ServoProtocol::V2 => crate::rig::x_reading(joint, rig.joint_state(t, joint.id), 0, rig.supply_v()).into(),
+            });
         }
         let (count, contacts) = rig.sensors(t);
         readings.encoder = Some(count);

@@ -99,6 +99,9 @@ pub struct VirtualBus {
     supply_v: f64,
     devices: Vec<Device>,
     sensor: Option<SensorDevice>,
+    /// Whether the sensor device answers (a robot with sensors off the
+    /// servos); otherwise it only hears the operator's calls, silently.
+    sensor_answers: bool,
     dec1: dxl1::InstructionDecoder<PACKET_LEN>,
     dec2: dxl2::InstructionDecoder<PACKET_LEN>,
     clock: Clock,
@@ -145,16 +148,18 @@ impl VirtualBus {
                 return Err(format!("--fault {f}: no servo {} on {}'s bus (its servos: {})", f.servo, robot.name, ids.join(", ")));
             }
         }
-        // The sensor device, for a robot with sensors off the servos (the
-        // pendulum's and LEO's encoders, LEO's foot switches).
-        let sensor = robot.encoder.is_some();
+        // The sensor device answers for a robot with sensors off the
+        // servos (the pendulum's and LEO's encoders, LEO's foot switches);
+        // every robot's operator hears the controller's calls at its ID.
+        let sensor_answers = robot.encoder.is_some();
         let supply_v = rig.supply_v();
         Ok(VirtualBus {
             rig,
             supply_v,
             driven: vec![(false, 0.0); devices.len()],
             devices,
-            sensor: sensor.then(SensorDevice::new),
+            sensor: Some(SensorDevice::new()),
+            sensor_answers,
             dec1: dxl1::InstructionDecoder::new(),
             dec2: dxl2::InstructionDecoder::new(),
             clock,
@@ -557,7 +562,7 @@ impl VirtualBus {
             };
             self.events.push(Event { at_us: self.now_us, id: SENSOR_ID, what });
         }
-        if let Some(bytes) = answer {
+        if let (Some(bytes), true) = (answer, self.sensor_answers) {
             let at_us = self.now_us + self.wire_us(bytes.len(), 50);
             replies.push(Reply { at_us, bytes });
         }
