@@ -37,7 +37,8 @@ pub struct DriveArgs {
     /// (/dev/ttyUSB0, /dev/serial/by-id/…) or `pada servos`' port.
     #[arg(long, value_name = "DEVICE")]
     pub port: PathBuf,
-    /// The robot: a built-in robot (pendulum, pendulum-20hz, leo).
+    /// The robot: a built-in robot (pendulum, pendulum-20hz, leo) or the
+    /// path of a robot's robot.toml.
     #[arg(long, value_name = "R", value_parser = RobotArg::parser())]
     pub robot: RobotArg,
     /// Every joint's servo of this model instead of the definition's (the

@@ -2,7 +2,7 @@
 //! (`--port PATH --robot R`), or `--scan` of a real port.
 //!
 //! ```text
-//! pada servos --port /tmp/dxl --robot pendulum [--servo XM430-W350] [--baud 1000000] [--lockstep] [--fault SPEC]… [--seconds S] [--json]
+//! pada servos --port /tmp/dxl --robot pendulum|PATH/robot.toml [--servo XM430-W350] [--baud 1000000] [--lockstep] [--fault SPEC]… [--seconds S] [--json]
 //! pada servos --scan --port /dev/ttyUSB0 [--baud 57600,1000000] [--protocol 1|2] [--ids 0-252] [--timeout-ms 5] [--json]
 //! ```
 
@@ -26,7 +26,7 @@ pub struct ServosArgs {
     #[arg(long, value_name = "PATH")]
     pub port: PathBuf,
     /// The robot whose servos to emulate: a built-in robot (pendulum,
-    /// pendulum-20hz, leo).
+    /// pendulum-20hz, leo) or the path of a robot's robot.toml.
     #[arg(long, value_name = "R", value_parser = RobotArg::parser())]
     pub robot: Option<RobotArg>,
     /// Every joint's servo of this model instead of the definition's (the
@@ -80,7 +80,7 @@ pub fn run(args: ServosArgs) -> Result<(), CliError> {
         }
     }
     let Some(mut robot) = args.robot else {
-        return Err(usage("give --robot R (the robot whose servos to emulate; valid are pendulum, pendulum-20hz, leo) or --scan"));
+        return Err(usage("give --robot R (the robot whose servos to emulate; valid are pendulum, pendulum-20hz, leo, or the path of a robot.toml) or --scan"));
     };
     if let Some(name) = &args.servo {
         let model = pada_core::servo::servo(name).map_err(|e| usage(format!("--servo: {e}")))?;
