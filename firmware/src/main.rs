@@ -1,5 +1,6 @@
 //! pada firmware: the pada-core learner on an STM32F4, driving Dynamixel
-//! RX-28 servos, without breaking the robot while it learns.
+//! servos (Protocol 1.0 or 2.0, as the robot's definition names them),
+//! without breaking the robot while it learns.
 //!
 //! Boot: clocks, pins and the table's memory ([`board`]: the F429's SDRAM is
 //! started and checked here), the weight table where the board's learner
@@ -55,8 +56,7 @@ async fn main(spawner: Spawner) {
     // boot (a watchdog reset leaves them turning at their last Moving
     // Speed), they stop before the weight table is filled — about 0.7 s on
     // the F429's 8 MiB table.
-    let joints = ROBOT.joints;
-    spawner.spawn(unwrap!(tasks::servo_bus(board.servo_port, joints)));
+    spawner.spawn(unwrap!(tasks::servo_bus(board.servo_port, ROBOT)));
     tasks::SERVOS_OFF.wait().await;
 
     let table_memory = match board.table_memory {

@@ -251,34 +251,8 @@ pub const CHECKPOINT_FILE: &str = "pada-checkpoint.bin";
 /// the F429) is refused here too.
 pub const CHECKPOINT_SLOT_LEN: usize = 128 * 1024;
 
-/// Dynamixel ID of the emulated sensor device (encoder and foot switches).
-/// Above every servo ID the robots use (1–7) and below the broadcast ID.
-pub const SENSOR_ID: u8 = 100;
-
-/// The sensor device's control table (Dynamixel Protocol 1.0 addresses).
-pub mod sensor_table {
-    /// Model number, 2 bytes (read-only): [`MODEL`].
-    pub const MODEL_NUMBER: u8 = 0;
-    /// The encoder's counter, 2 bytes little endian (a 16-bit quadrature
-    /// counter after ×4 decoding, wrapping, as the timer's CNT).
-    pub const ENCODER_COUNT: u8 = 36;
-    /// Foot contacts, 1 byte: bits of `pada_firmware::leo::contact`.
-    pub const CONTACTS: u8 = 38;
-    /// Bytes read every control period: encoder count and contacts.
-    pub const READ_LEN: u8 = 3;
-    /// The model number the device reports ("SE" for sensors).
-    pub const MODEL: u16 = 0x5345;
-    /// Bytes of the table.
-    pub const TABLE_LEN: usize = 40;
-}
-
-/// Encoder count and contacts from the sensor device's READ answer.
-pub fn parse_sensor_read(params: &[u8]) -> Option<(u16, u8)> {
-    match params {
-        [lo, hi, contacts] => Some((u16::from_le_bytes([*lo, *hi]), *contacts)),
-        _ => None,
-    }
-}
+// The sensor device is the emulated board's and the PC's alike.
+pub use crate::sensor_device::{parse_sensor_read, sensor_table, SENSOR_ID};
 
 #[cfg(test)]
 mod tests {
@@ -338,11 +312,4 @@ mod tests {
         ]);
     }
 
-    #[test]
-    fn sensor_reads() {
-        assert_eq!(parse_sensor_read(&[0x34, 0x12, 0b0101]), Some((0x1234, 0b0101)));
-        assert_eq!(parse_sensor_read(&[1, 2]), None);
-        assert!((sensor_table::CONTACTS as usize) < sensor_table::TABLE_LEN);
-        assert_eq!(sensor_table::ENCODER_COUNT + 2, sensor_table::CONTACTS);
-    }
 }

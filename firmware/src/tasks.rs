@@ -1,7 +1,7 @@
 //! The firmware's tasks, one per concern, and the channels between them.
 //!
 //! ```text
-//!            BUS_REQUESTS ──▶ servo_bus ──▶ USART1 (RS-485, 1 Mbps) ──▶ RX-28 ×1…7
+//!            BUS_REQUESTS ──▶ servo_bus ──▶ USART1 (RS-485, 1 Mbps) ──▶ Dynamixel ×1…8 (Protocol 1.0 or 2.0)
 //! control ◀── BUS_REPLIES ───┘
 //!    │  ▲
 //!    │  └── FROM_HOST ◀── telemetry_rx ◀── USART2 ◀── host
@@ -22,13 +22,14 @@ use heapless::Vec;
 use pada_core::checkpoint::{CheckpointStore, LoadOutcome, SaveError};
 use pada_core::safety::Transition;
 use pada_core::wire::{self, FrameEncoder, NackReason, ToChip, ToHost, MAX_FRAME_LEN};
-use pada_firmware::bus::{BusConfig, BusStats, ServoBus};
+use pada_firmware::bus::{BusConfig, BusStats, RobotBus};
 use crate::table::Ctl;
 use pada_firmware::config::MAX_ROBOT_SERVOS;
 use pada_core::weights::WeightStore;
 use pada_firmware::control::{CheckpointError, PeriodOutput, Readings, ServoRead};
 use pada_firmware::io::{ByteSink, ByteSource, CycleCounter, Sensors};
-use pada_core::robot::JointSpec as Joint;
+use pada_core::robot::RobotSpec;
+use pada_core::servo::Drive;
 use pada_firmware::timing::LoopTiming;
 
 use crate::channels::{
@@ -39,12 +40,15 @@ use crate::channels::{
 pub enum BusRequest {
     /// Read every servo's present state.
     Read,
-    /// Apply torque enable and Moving Speeds.
+    /// Apply torque enable and each servo's command.
     Write {
         /// Torque Enable for all servos.
         torque: bool,
-        /// (ID, Moving Speed) per servo.
-        speeds: Vec<(u8, u16), MAX_ROBOT_SERVOS>,
+        /// (ID, Moving Speed or Goal PWM) per servo.
+        commands: Vec<(u8, Drive), MAX_ROBOT_SERVOS>,
+        /// The last period overran: re-arm the servos' Bus Watchdog, which
+        /// the delay may have tripped.
+        rearm: bool,
     },
 }
 
@@ -64,49 +68,35 @@ pub static BUS_REPLIES: Channel<Mutex, BusReply, 1> = Channel::new();
 /// table is filled, which takes about 0.7 s on the F429's 8 MiB table).
 pub static SERVOS_OFF: Signal<Mutex, ()> = Signal::new();
 
-/// The servo bus: boot-time set-up, then reads and writes on request.
+/// The servo bus: boot-time set-up, then reads and writes on request, in
+/// each servo's protocol ([`RobotBus`]).
 #[embassy_executor::task]
-pub async fn servo_bus(port: ServoPort, joints: &'static [Joint]) -> ! {
-    let mut bus = ServoBus::new(port, BusConfig::default());
+pub async fn servo_bus(port: ServoPort, robot: &'static RobotSpec) -> ! {
+    let mut bus = RobotBus::new(port, BusConfig::default(), robot);
     // Whatever the servos did before this boot (wheel mode keeps turning
     // at the last Moving Speed): torque off first, a few times.
     for _ in 0..3 {
-        bus.torque_all(false).await.ok();
-        bus.stop_all().await.ok();
+        bus.stop_all().await;
     }
     SERVOS_OFF.signal(());
-    for joint in joints {
-        match bus.setup(joint.id).await {
-            Ok(s) => info!("servo {=u8}: model {=u16}, settings {}", joint.id, s.model, if s.wrote { "written" } else { "ok" }),
-            Err(e) => warn!("servo {=u8}: {}", joint.id, defmt::Debug2Format(&e)),
+    for (id, result) in bus.setup().await {
+        match result {
+            Ok(s) => info!("servo {=u8}: model {=u16}, settings {}", id, s.model, if s.wrote { "written" } else { "ok" }),
+            // The servo is refused: read as silent, so the safety machine
+            // faults and torque stays off.
+            Err(e) => warn!("servo {=u8}: {}", id, defmt::Debug2Format(&e)),
         }
     }
     loop {
         match BUS_REQUESTS.receive().await {
             BusRequest::Read => {
                 let mut servos = [ServoRead::default(); MAX_ROBOT_SERVOS];
-                for (read, joint) in servos.iter_mut().zip(joints) {
-                    let (state, exchange) = bus.read_present(joint.id).await;
-                    *read = ServoRead {
-                        state,
-                        error: exchange.error(),
-                        timeouts: exchange.timeouts,
-                        checksum_errors: exchange.checksum_errors,
-                    };
-                }
+                bus.read(&mut servos).await;
                 BUS_REPLIES.send(BusReply { servos, stats: bus.stats() }).await;
             }
-            BusRequest::Write { torque, speeds } => {
-                // Sent every period, so a servo that missed a packet (or
-                // browned out) gets it again one period later.
-                if torque {
-                    bus.write_speeds(&speeds).await.ok();
-                    bus.torque_all(true).await.ok();
-                } else {
-                    bus.torque_all(false).await.ok();
-                    bus.stop_all().await.ok();
-                }
-            }
+            // Sent every period, so a servo that missed a packet (or
+            // browned out) gets it again one period later.
+            BusRequest::Write { torque, commands, rearm } => bus.write(torque, &commands, rearm).await,
         }
     }
 }
@@ -257,7 +247,8 @@ pub async fn control(mut cl: ControlLoop) -> ! {
         cl.ctl.period(&readings, &cl.cycles, &mut out);
 
         // Write.
-        BUS_REQUESTS.send(BusRequest::Write { torque: out.torque, speeds: out.speeds.clone() }).await;
+        let rearm = readings.last_period_overran;
+        BUS_REQUESTS.send(BusRequest::Write { torque: out.torque, commands: out.commands.clone(), rearm }).await;
 
         // Time.
         let spent = cl.cycles.cycles().wrapping_sub(t0);

@@ -190,7 +190,7 @@ impl TableOccupancy {
 fn foreign_protocol(found: u16) -> std::io::Error {
     let this = pada_core::wire::PROTOCOL_VERSION;
     let why = if found < this {
-        "an older pada wrote it (protocol 9 names the robot and its definition in `Hello`); read it with that version"
+        "an older pada wrote it (protocol 10 reports a servo's hardware alert); read it with that version"
     } else {
         "a newer pada wrote it; update this one"
     };

@@ -43,6 +43,13 @@ pub enum Command {
     /// simulated plant (docs/sil.md).
     #[command(allow_negative_numbers = true)]
     Sil(commands::sil::SilArgs),
+    /// Learn on a real robot from this PC: the firmware's controller over a
+    /// serial port (a USB adapter to the servos, or `pada servos`).
+    #[command(allow_negative_numbers = true)]
+    Drive(commands::drive::DriveArgs),
+    /// Virtual servos of a robot on a pseudo-terminal, answering with its
+    /// simulated physics; or --scan a real port for what answers.
+    Servos(commands::servos::ServosArgs),
     /// Decode telemetry from a board's serial port or a recorded stream.
     Capture(commands::capture::CaptureArgs),
     /// A live page in the browser of a board's, a recording's or a live
@@ -128,7 +135,7 @@ where
                     )))
                 }
                 ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => Err(usage(
-                    "no command given: valid commands are run, demo, paper, mtbf, render, sil, capture, watch, leo, trial (see pada --help)",
+                    "no command given: valid commands are run, demo, paper, mtbf, claims, render, sil, drive, servos, capture, watch, leo, trial (see pada --help)",
                 )),
                 _ => Err(usage(clap_one_line(&e))),
             };
@@ -141,6 +148,8 @@ where
         Command::Mtbf(a) => commands::mtbf::run(a),
         Command::Claims(a) => commands::claims::run(a),
         Command::Sil(a) => commands::sil::run(a),
+        Command::Drive(a) => commands::drive::run(a),
+        Command::Servos(a) => commands::servos::run(a),
         Command::Capture(a) => commands::capture::run(a),
         Command::Watch(a) => commands::watch::run(a),
         Command::Render(a) => commands::render::run(a),

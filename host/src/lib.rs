@@ -1,7 +1,8 @@
 //! pada on the host: the experiment runner of Section VI, the paper's
 //! experiments (Sections VII and VIII), plots, the fatigue check of a
-//! recorded torque log, telemetry capture, the software-in-the-loop run
-//! and the `pada` command. The simulator (the pendulums, LEO in rapier3d,
+//! recorded torque log, telemetry capture, the software-in-the-loop run,
+//! learning on a real robot from the PC (`pada drive`), virtual servos on
+//! a pseudo-terminal (`pada servos`) and the `pada` command. The simulator (the pendulums, LEO in rapier3d,
 //! the rigs) is the crate `pada_sim`, re-exported here under its module
 //! names.
 
@@ -13,6 +14,7 @@ pub mod checkpoint_keeper;
 pub mod cli;
 pub mod commands;
 pub mod display;
+pub mod drive;
 pub mod error;
 pub mod experiment;
 pub mod foxglove;
@@ -25,9 +27,11 @@ pub mod paper;
 pub mod plan;
 pub mod plot;
 pub mod progress;
+pub mod robot_arg;
 pub mod robots;
 pub mod seed;
 pub mod serial_link;
+pub mod servos;
 pub mod sil;
 pub mod stats;
 pub mod console;

@@ -45,10 +45,14 @@
 //!   CHECKSUM bit says a servo received a corrupted instruction);
 //! - a status packet with an error bit in `servo_fault_mask`
 //!   (at least input voltage, overheating and overload);
+//! - a Protocol 2.0 status packet with its Alert bit (bit 7) set: the
+//!   servo has a hardware error, whose Hardware Error Status the fault
+//!   carries ([`FaultCause::HardwareAlert`]);
 //! - a joint position outside its soft limit, or not finite;
 //! - `overrun_streak` consecutive control periods that overran;
 //! - a reset by the independent watchdog (reported at boot).
 
+use crate::dynamixel::control_table::x_series::HardwareError;
 use crate::dynamixel::ErrorFlags;
 use crate::error::ConfigError;
 use heapless::Vec;
@@ -112,6 +116,17 @@ pub enum FaultCause {
     },
     /// The independent watchdog reset the chip.
     WatchdogReset,
+    /// A Protocol 2.0 servo's status packet had its Alert bit set: a
+    /// hardware error, which the servo's Shutdown setting may already have
+    /// answered by switching its own torque off (wire protocol 10;
+    /// appended last).
+    HardwareAlert {
+        /// Dynamixel ID of the servo.
+        servo: u8,
+        /// Its Hardware Error Status (address 70) as read after the alert;
+        /// empty if that read failed.
+        error: HardwareError,
+    },
 }
 
 impl FaultCause {
@@ -119,7 +134,9 @@ impl FaultCause {
     /// servo faults, a joint index for soft limits).
     pub fn joint(&self) -> Option<u8> {
         match *self {
-            FaultCause::ServoTimeout { servo, .. } | FaultCause::ServoError { servo, .. } => Some(servo),
+            FaultCause::ServoTimeout { servo, .. }
+            | FaultCause::ServoError { servo, .. }
+            | FaultCause::HardwareAlert { servo, .. } => Some(servo),
             FaultCause::SoftLimit { joint, .. } => Some(joint),
             _ => None,
         }
@@ -134,6 +151,7 @@ impl FaultCause {
             FaultCause::SoftLimit { .. } => "soft-limit",
             FaultCause::OverrunStreak { .. } => "overrun-streak",
             FaultCause::WatchdogReset => "watchdog-reset",
+            FaultCause::HardwareAlert { .. } => "hardware-alert",
         }
     }
 }
@@ -245,6 +263,13 @@ pub enum Event {
     },
     /// At boot: the reset was caused by the independent watchdog.
     WatchdogReset,
+    /// A Protocol 2.0 servo raised its Alert bit (counts as a reply too).
+    HardwareAlert {
+        /// Dynamixel ID.
+        servo: u8,
+        /// Its Hardware Error Status, as read (empty if unread).
+        error: HardwareError,
+    },
 }
 
 /// Why a command was refused.
@@ -525,6 +550,10 @@ impl Safety {
                     .then_some(FaultCause::OverrunStreak { count: self.overruns })
             }
             Event::WatchdogReset => Some(FaultCause::WatchdogReset),
+            Event::HardwareAlert { servo, error } => {
+                self.timeouts[servo as usize] = 0;
+                Some(FaultCause::HardwareAlert { servo, error })
+            }
         }
     }
 

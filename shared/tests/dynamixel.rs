@@ -78,6 +78,17 @@ fn unknown_instructions_and_bad_params_are_typed() {
     assert_eq!(Instruction::parse(0x01, &[1]), Err(InstructionError::BadParams { code: 1, len: 1 }));
     assert_eq!(Instruction::parse(0x83, &[32, 2, 1, 0]), Err(InstructionError::BadParams { code: 0x83, len: 4 }));
     assert_eq!(Instruction::parse(0x83, &[32, 0]), Err(InstructionError::BadParams { code: 0x83, len: 2 }));
+    // BULK_READ: 0x00, then length, ID, address per servo (the Protocol
+    // 1.0 page's example: two bytes at 30 of ID 1, two at 36 of ID 2).
+    let bulk = Instruction::parse(0x92, &[0x00, 2, 1, 0x1E, 2, 2, 0x24]).unwrap();
+    assert_eq!(bulk.bulk_read_entries().collect::<Vec<_>>(), vec![(1, 0x1E, 2), (2, 0x24, 2)]);
+    let mut buf = [0u8; 32];
+    assert_eq!(bulk.encode(BROADCAST_ID, &mut buf).unwrap(), &[0xFF, 0xFF, 0xFE, 0x09, 0x92, 0x00, 0x02, 0x01, 0x1E, 0x02, 0x02, 0x24, 0x1D]);
+    assert_eq!(Instruction::parse(0x92, &[0x01, 2, 1, 30]), Err(InstructionError::BadParams { code: 0x92, len: 4 }));
+    assert_eq!(Instruction::parse(0x92, &[0x00, 2, 1]), Err(InstructionError::BadParams { code: 0x92, len: 3 }));
+    // An ID named twice: the first counts.
+    let twice = Instruction::parse(0x92, &[0x00, 2, 1, 30, 4, 1, 36]).unwrap();
+    assert_eq!(twice.bulk_read_entries().collect::<Vec<_>>(), vec![(1, 30, 2)]);
 }
 
 #[test]

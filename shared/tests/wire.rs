@@ -200,6 +200,7 @@ fn all_to_host() -> Vec<ToHost> {
         FaultCause::SoftLimit { joint: 1, position: -2.5 },
         FaultCause::OverrunStreak { count: 3 },
         FaultCause::WatchdogReset,
+        FaultCause::HardwareAlert { servo: 4, error: pada_core::dynamixel::control_table::x_series::HardwareError::OVERLOAD },
     ];
     for cause in causes {
         v.push(ToHost::Fault(Fault { step: 1000, time_ms: 33_000, cause }));
@@ -310,18 +311,19 @@ fn the_protocol_version_changes_with_the_layout() {
     // A change of any message's layout changes this fingerprint: then bump
     // PROTOCOL_VERSION and put the new pair here (with the docs that name
     // the version: docs/sil.md, docs/core.md, firmware/README.md).
-    assert_eq!((PROTOCOL_VERSION, layout_fingerprint()), (9, EXPECTED_FINGERPRINT), "{:#010x}", layout_fingerprint());
+    assert_eq!((PROTOCOL_VERSION, layout_fingerprint()), (10, EXPECTED_FINGERPRINT), "{:#010x}", layout_fingerprint());
 }
 
-/// [`layout_fingerprint`] of protocol 9 (`Hello` names the robot and its
-/// definition's hash, and a restore's batch grew from 3 to 24 chunks,
-/// which only the board's receive buffer sees; 8 was 0xaca4_4e73) and 8
-/// (the checkpoint the host keeps:
+/// [`layout_fingerprint`] of protocol 10 (`FaultCause::HardwareAlert`, a
+/// Protocol 2.0 servo's Alert with its Hardware Error Status); 9 (`Hello`
+/// names the robot and its definition's hash, and a restore's batch grew
+/// from 3 to 24 chunks, which only the board's receive buffer sees; 8 was
+/// 0xaca4_4e73) and 8 (the checkpoint the host keeps:
 /// `CheckpointChunk`, `RestoreWanted`, `Restored`, `Streamed`,
 /// `RestoreChunk`, `RestoreNone`; 7 the claim table's occupancy in
 /// `Health`; 6 added the gentle explorations in `PolicyKind`, the governor
 /// in `PolicyReport`, `SetMtbfBudget`; 5 `Step::footstep`).
-const EXPECTED_FINGERPRINT: u32 = 0xa210_acaf;
+const EXPECTED_FINGERPRINT: u32 = 0x5283_00f9;
 
 #[test]
 fn every_chip_message_round_trips() {

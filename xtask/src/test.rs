@@ -46,8 +46,10 @@ const COMPONENTS: [&str; 5] = ["firmware-toolchain", "qemu", "chromium", "slurm"
 /// The Python packages the tests import beyond the wheel's own
 /// dependencies: the build backend, the test runner, and what
 /// python/tests/test_mcap.py reads and validates with (the `mcap` reader,
-/// JSON Schema validation, a WebSocket client).
-const PYTHON_PACKAGES: &[&str] = &["maturin", "numpy", "gymnasium", "pytest", "mcap", "jsonschema", "websockets"];
+/// JSON Schema validation, a WebSocket client), and the ROBOTIS SDK that
+/// python/tests/test_servos_sdk.py drives `pada servos` with (PyPI's
+/// `dynamixel-sdk`, the vendor's own, not written from pada).
+const PYTHON_PACKAGES: &[&str] = &["maturin", "numpy", "gymnasium", "pytest", "mcap", "jsonschema", "websockets", "dynamixel-sdk"];
 
 struct Phase {
     name: &'static str,

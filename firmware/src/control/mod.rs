@@ -70,7 +70,8 @@ mod test_support;
 mod tests;
 
 pub use commands::CommandResult;
-pub use period::{safety_config, PeriodOutput, Readings, ServoRead};
+pub use crate::bus::ServoRead;
+pub use period::{safety_config, PeriodOutput, Readings};
 pub use host_kept::{HostSave, Misaligned, RestoreSink};
 pub use persist::CheckpointError;
 

@@ -6,29 +6,16 @@
 //! thresholds.
 
 use super::{Controller, Phase};
-use crate::bus::BusConfig;
+use crate::bus::{BusConfig, ServoRead};
 use crate::config::MAX_ROBOT_SERVOS;
 use crate::io::CycleCounter;
 use pada_core::robot::{RobotRules, Sensed};
 use heapless::Vec;
-use pada_core::dynamixel::{table::PresentState, ErrorFlags};
+use pada_core::servo::Drive;
 use pada_core::safety::{Event, RunMode, Safety, SafetyConfig, Transition};
 use pada_core::episodes::{is_learning_action, wear};
 use pada_core::weights::WeightStore;
 use pada_core::wire;
-
-/// One servo's part of a period's readings.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct ServoRead {
-    /// Present Position … Temperature, if the servo answered.
-    pub state: Option<PresentState>,
-    /// Error bits of its answer.
-    pub error: ErrorFlags,
-    /// Attempts that got no answer.
-    pub timeouts: u8,
-    /// Answers with a bad checksum.
-    pub checksum_errors: u8,
-}
 
 /// Everything the control loop read in one period.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -50,8 +37,9 @@ pub struct Readings {
 pub struct PeriodOutput {
     /// Torque Enable for every servo.
     pub torque: bool,
-    /// Moving Speed per servo (ID, value); all zero while torque is off.
-    pub speeds: Vec<(u8, u16), MAX_ROBOT_SERVOS>,
+    /// The command of each servo (ID, Moving Speed or Goal PWM); all zero
+    /// while torque is off.
+    pub commands: Vec<(u8, Drive), MAX_ROBOT_SERVOS>,
     /// The agent's step, if one was taken (`loop_us` is the caller's to
     /// fill in).
     pub step: Option<wire::Step>,
@@ -98,7 +86,7 @@ where
         out.step = None;
         out.episode = None;
         out.transitions.clear();
-        out.speeds.clear();
+        out.commands.clear();
         out.agent_cycles = None;
         out.torques = [0.0; MAX_ROBOT_SERVOS];
         out.policy = None;
@@ -125,12 +113,15 @@ where
             for _ in 0..read.timeouts {
                 feed(&mut self.safety, &mut out.transitions, Event::ServoTimeout { servo: joint.id });
             }
+            if let Some(error) = read.hardware_error {
+                feed(&mut self.safety, &mut out.transitions, Event::HardwareAlert { servo: joint.id, error });
+            }
             if let Some(state) = read.state {
                 let status = Event::ServoStatus { servo: joint.id, error: read.error, at_ms: now };
                 feed(&mut self.safety, &mut out.transitions, status);
                 self.supply[i] = Some(state.voltage_v());
                 self.temps[i] = state.temperature;
-                let angle = joint.angle(state.position);
+                let angle = joint.angle_of(state.position);
                 angles[i] = Some(angle);
                 if joint.soft_limit.is_some() {
                     let position = Event::JointPosition { joint: i as u8, position: angle };
@@ -184,14 +175,15 @@ where
             }
         }
 
-        // 5. Voltages → Moving Speeds of the measured supply.
+        // 5. Voltages → each servo's command (Moving Speed, Goal PWM) as
+        // a fraction of its measured supply.
         let nominal = self.spec.supply_nominal_v;
         for (i, joint) in joints.iter().enumerate() {
             let v = if torque { volts[i] } else { 0.0 };
             let supply = self.supply[i].filter(|s| *s >= 5.0).unwrap_or(nominal);
-            let speed = joint.moving_speed(v, self.supply[i], nominal);
-            self.applied[i] = joint.voltage_of(speed, supply);
-            let _ = out.speeds.push((joint.id, speed));
+            let drive = joint.drive(v, self.supply[i], nominal);
+            self.applied[i] = joint.voltage_of_drive(drive, supply);
+            let _ = out.commands.push((joint.id, drive));
         }
 
         // 6. Fatigue from the estimated gearbox torque (servos past the
@@ -222,6 +214,7 @@ mod tests {
     use core::cell::Cell;
     use pada_core::policy::PolicyKind;
     use pada_core::safety::{FaultCause, State};
+    use pada_core::dynamixel::ErrorFlags;
     use pada_core::wire::NackReason;
 
     #[test]
@@ -230,7 +223,7 @@ mod tests {
         let mut out = PeriodOutput::default();
         c.period(&pendulum_readings(0, 0), &Clock(Cell::new(0)), &mut out);
         assert!(!out.torque);
-        assert_eq!(out.speeds.as_slice(), &[(1, 0)]);
+        assert_eq!(out.commands.as_slice(), &[(1, Drive::MovingSpeed(0))]);
         assert!(out.step.is_none());
     }
 
@@ -251,7 +244,7 @@ mod tests {
         r.servos[0] = ServoRead { state: None, timeouts: 2, ..ServoRead::default() };
         c.period(&r, &clock, &mut out);
         assert!(!out.torque, "torque off in the period the fault is found");
-        assert_eq!(out.speeds.as_slice(), &[(1, 0)]);
+        assert_eq!(out.commands.as_slice(), &[(1, Drive::MovingSpeed(0))]);
         let t = out.transitions.iter().find_map(|t| t.entered_fault()).unwrap();
         assert_eq!(t, FaultCause::ServoTimeout { servo: 1, attempts: 2 });
         // Start is refused until the host clears the fault.
@@ -309,11 +302,11 @@ mod tests {
         let mut out = PeriodOutput::default();
         let mut r = Readings { encoder: Some(0), contacts: leo::contact::LEFT, ..Readings::default() };
         for s in r.servos.iter_mut() {
-            s.state = Some(PresentState { position: 512, speed: 0, load: 0, voltage: 140, temperature: 30 });
+            s.state = Some(pada_core::dynamixel::table::PresentState { position: 512, speed: 0, load: 0, voltage: 140, temperature: 30 }.into());
         }
         c.period(&r, &clock, &mut out);
         assert!(out.torque);
-        assert_eq!(out.speeds.len(), 7);
+        assert_eq!(out.commands.len(), 7);
         // Right knee bent forward by 40 counts ≈ +0.2 rad: beyond +2° + margin.
         let knee_r = pada_core::robot::leo::Joint::KneeRight as usize;
         r.servos[knee_r].state.as_mut().unwrap().position = 512 + 40;

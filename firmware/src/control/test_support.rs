@@ -60,7 +60,7 @@ pub(super) fn leo_table() -> LeoTable {
 /// A healthy pendulum reading: the servo answers, the encoder at `counts`.
 pub(super) fn pendulum_readings(counts: u16, time_ms: u32) -> Readings {
     let mut r = Readings { encoder: Some(counts), time_ms, ..Readings::default() };
-    r.servos[0].state = Some(PresentState { position: 512, speed: 0, load: 0, voltage: 120, temperature: 35 });
+    r.servos[0].state = Some(PresentState { position: 512, speed: 0, load: 0, voltage: 120, temperature: 35 }.into());
     r
 }
 

@@ -11,7 +11,7 @@
 //!    from the rig at `t` (the state at the period boundary, see
 //!    [`crate::rig::leo`]);
 //! 2. the controller runs its period, as on the chip;
-//! 3. its Moving Speeds (ratios of the rig's supply) drive the rig from
+//! 3. its commands (Moving Speeds: ratios of the rig's supply) drive the rig from
 //!    `t`; an episode's end or start tells the rig's operator at `t`;
 //! 4. the rig advances to `t + T`; if the period applied a learning action,
 //!    the gearbox torques of the learned joints over it go to the MTBF
@@ -46,6 +46,7 @@ use crate::robots::{DynRules, SimRobot};
 use pada_core::claim_table::{ClaimTable, Tags16, Tags32};
 use pada_core::profile::{LearnerProfile, TILINGS};
 use pada_core::robot::RobotRules;
+use pada_core::servo::ServoProtocol;
 use pada_core::tile_coding::Layout;
 use pada_core::weights::{Half, WeightFormat, WeightStore};
 use pada_core::wire::{Episode, RunMode, StepKind, ToChip};
@@ -139,6 +140,38 @@ macro_rules! with_half_weights {
     }};
 }
 
+/// What runs on a board's table once its type is known: the profile
+/// chooses the table's layout, weight format and tags at run time, and
+/// each combination is a type of its own ([`with_table`]).
+pub trait TableVisitor {
+    /// What the visit gives.
+    type Output;
+    /// Runs with `table`.
+    fn visit<W: WeightStore>(self, table: W) -> anyhow::Result<Self::Output>;
+}
+
+/// Builds `profile`'s table of `n` weights (on the host a table split over
+/// CCM and SRAM is one slice: `Split` addresses the same weights in the
+/// same order) and hands it to `v`.
+pub fn with_table<V: TableVisitor>(profile: &LearnerProfile, n: usize, v: V) -> anyhow::Result<V::Output> {
+    match (profile.layout, profile.format) {
+        (Layout::Claimed, WeightFormat::Q16) => claim_on(profile, vec![Q16::ZERO; n].into_boxed_slice(), n, v),
+        (Layout::Claimed, WeightFormat::Half { shift }) => with_half_weights!(shift, n, |w| claim_on(profile, w, n, v)),
+        (_, WeightFormat::Q16) => v.visit(vec![Q16::ZERO; n].into_boxed_slice()),
+        (_, WeightFormat::Half { shift }) => with_half_weights!(shift, n, |w| v.visit(w)),
+    }
+}
+
+/// A claim table over `weights` with the profile's tags (16 or 32 bits) of
+/// `n` slots, handed to `v`.
+fn claim_on<W: WeightStore, V: TableVisitor>(profile: &LearnerProfile, weights: W, n: usize, v: V) -> anyhow::Result<V::Output> {
+    let err = |e: pada_core::claim_table::ClaimTableError| anyhow!("{e}");
+    match profile.tag_bytes {
+        2 => v.visit(ClaimTable::new(weights, Tags16(vec![0u16; n].into_boxed_slice())).map_err(err)?),
+        _ => v.visit(ClaimTable::new(weights, Tags32(vec![0u32; n].into_boxed_slice())).map_err(err)?),
+    }
+}
+
 /// Trial `trial` of `cfg` with `profile`'s learner against `rig`.
 pub fn run_board_trial_on(
     profile: LearnerProfile,
@@ -152,51 +185,26 @@ pub fn run_board_trial_on(
     let seed = trial_seed(cfg.seed, trial);
     anyhow::ensure!(robot.robot == profile.robot, "the profile is {}'s, the robot {}", profile.robot.name, robot.robot.name);
     let rules = robot.rules();
-    // On the host a table split over CCM and SRAM is one slice: `Split`
-    // addresses the same weights in the same order.
-    match (profile.layout, profile.format) {
-        (Layout::Claimed, WeightFormat::Q16) => {
-            claim_on(profile, vec![Q16::ZERO; n].into_boxed_slice(), n, rules, rig, cfg, trial, seed, progress)
-        }
-        (Layout::Claimed, WeightFormat::Half { shift }) => {
-            with_half_weights!(shift, n, |w| claim_on(profile, w, n, rules, rig, cfg, trial, seed, progress))
-        }
-        (_, WeightFormat::Q16) => run(profile, vec![Q16::ZERO; n].into_boxed_slice(), rules, rig, cfg, trial, seed, progress),
-        (_, WeightFormat::Half { shift }) => {
-            with_half_weights!(shift, n, |w| run(profile, w, rules, rig, cfg, trial, seed, progress))
+    struct Visit<'a> {
+        profile: LearnerProfile,
+        rules: DynRules,
+        rig: &'a mut dyn Rig,
+        cfg: &'a RunConfig,
+        trial: u32,
+        seed: u64,
+        progress: &'a (dyn Fn(u64) + Sync),
+    }
+    impl TableVisitor for Visit<'_> {
+        type Output = BoardTrial;
+        fn visit<W: WeightStore>(self, table: W) -> anyhow::Result<BoardTrial> {
+            run(self.profile, table, self.rules, self.rig, self.cfg, self.trial, self.seed, self.progress)
         }
     }
+    with_table(&profile, n, Visit { profile, rules, rig, cfg, trial, seed, progress })
 }
 
-
-/// A trial on a claim table over `weights` with the profile's tags (16 or
-/// 32 bits) of `n` slots.
-#[allow(clippy::too_many_arguments)]
-fn claim_on<W: WeightStore>(
-    profile: LearnerProfile,
-    weights: W,
-    n: usize,
-    rules: DynRules,
-    rig: &mut dyn Rig,
-    cfg: &RunConfig,
-    trial: u32,
-    seed: u64,
-    progress: &(dyn Fn(u64) + Sync),
-) -> anyhow::Result<BoardTrial> {
-    let err = |e: pada_core::claim_table::ClaimTableError| anyhow!("{e}");
-    match profile.tag_bytes {
-        2 => {
-            let table = ClaimTable::new(weights, Tags16(vec![0u16; n].into_boxed_slice())).map_err(err)?;
-            run(profile, table, rules, rig, cfg, trial, seed, progress)
-        }
-        _ => {
-            let table = ClaimTable::new(weights, Tags32(vec![0u32; n].into_boxed_slice())).map_err(err)?;
-            run(profile, table, rules, rig, cfg, trial, seed, progress)
-        }
-    }
-}
-
-fn command<W: WeightStore, R: RobotRules>(ctl: &mut Controller<W, R>, cmd: ToChip) -> anyhow::Result<()> {
+/// Carries out a host command, as the board would; a refusal is an error.
+pub fn command<W: WeightStore, R: RobotRules>(ctl: &mut Controller<W, R>, cmd: ToChip) -> anyhow::Result<()> {
     ctl.command(&cmd).0.map_err(|e| anyhow!("{cmd:?} refused: {e:?}"))
 }
 
@@ -258,7 +266,12 @@ fn run<R: RobotRules, W: WeightStore>(
         // 1. Read.
         let mut readings = Readings { time_ms: (t / 1000) as u32, ..Readings::default() };
         for (i, joint) in joints.iter().enumerate() {
-            readings.servos[i].state = Some(rig.present(t, joint.id));
+            // Each servo in its own model's units: an RX-28's Present
+            // Position … Temperature, an X-series servo's present block.
+            readings.servos[i].state = Some(match joint.servo.protocol {
+                ServoProtocol::V1 => rig.present(t, joint.id).into(),
+                ServoProtocol::V2 => crate::rig::x_reading(joint, rig.joint_state(t, joint.id), 0, rig.supply_v()).into(),
+            });
         }
         let (count, contacts) = rig.sensors(t);
         readings.encoder = Some(count);
@@ -267,8 +280,8 @@ fn run<R: RobotRules, W: WeightStore>(
         ctl.period(&readings, &NoCycles, &mut out);
         // 3. Drive, and tell the operator.
         let supply = rig.supply_v();
-        for &(id, speed) in &out.speeds {
-            let volts = pada_core::dynamixel::table::ratio_from_moving_speed(speed) as f64 * supply;
+        for &(id, drive) in &out.commands {
+            let volts = drive.ratio() as f64 * supply;
             rig.drive(t, id, out.torque, volts);
             volts_of[id as usize] = if out.torque { volts as f32 } else { 0.0 };
         }

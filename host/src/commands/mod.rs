@@ -3,6 +3,7 @@
 pub mod capture;
 pub mod claims;
 pub mod demo;
+pub mod drive;
 pub mod leo;
 pub mod mtbf;
 pub mod options;
@@ -13,6 +14,7 @@ pub mod paper_wear;
 pub mod new_robot;
 pub mod render;
 pub mod run;
+pub mod servos;
 pub mod sil;
 pub mod stream_args;
 pub mod trial;

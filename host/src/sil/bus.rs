@@ -387,7 +387,7 @@ impl BusEmulator {
                 }
                 None
             }
-            Instruction::Action | Instruction::Reset => None,
+            Instruction::Action | Instruction::Reset | Instruction::BulkRead { .. } => None,
         }
     }
 

@@ -38,6 +38,10 @@ pub enum InstructionCode {
     Reset = 0x06,
     /// Writes the same addresses of several servos (broadcast, no answer).
     SyncWrite = 0x83,
+    /// Reads each servo its own address and length (broadcast; the servos
+    /// answer in turn). The Protocol 1.0 page defines it; the MX series
+    /// answers it.
+    BulkRead = 0x92,
 }
 
 impl InstructionCode {
@@ -51,6 +55,7 @@ impl InstructionCode {
             0x05 => Self::Action,
             0x06 => Self::Reset,
             0x83 => Self::SyncWrite,
+            0x92 => Self::BulkRead,
             _ => return None,
         })
     }
@@ -245,6 +250,12 @@ pub enum Instruction<'a> {
         /// `ID, data…` per servo, concatenated.
         entries: &'a [u8],
     },
+    /// BULK_READ: per servo, `length, ID, address` (after the leading
+    /// 0x00 parameter); see [`Instruction::bulk_read_entries`].
+    BulkRead {
+        /// `len, id, addr` per servo, concatenated.
+        entries: &'a [u8],
+    },
 }
 
 impl<'a> Instruction<'a> {
@@ -258,7 +269,23 @@ impl<'a> Instruction<'a> {
             Instruction::Action => InstructionCode::Action,
             Instruction::Reset => InstructionCode::Reset,
             Instruction::SyncWrite { .. } => InstructionCode::SyncWrite,
+            Instruction::BulkRead { .. } => InstructionCode::BulkRead,
         }
+    }
+
+    /// The `(id, addr, len)` of each servo a BULK_READ asks, in its order
+    /// (empty for other instructions). An ID named twice: only the first
+    /// counts (e-Manual, "Bulk Read").
+    pub fn bulk_read_entries(&self) -> impl Iterator<Item = (u8, u8, u8)> + 'a {
+        let entries: &'a [u8] = match *self {
+            Instruction::BulkRead { entries } => entries,
+            _ => &[],
+        };
+        entries
+            .chunks_exact(3)
+            .enumerate()
+            .filter(move |(i, c)| !entries.chunks_exact(3).take(*i).any(|e| e[1] == c[1]))
+            .map(|(_, c)| (c[1], c[2], c[0]))
     }
 
     /// The `(id, data)` pairs of a SYNC_WRITE (empty for other instructions;
@@ -295,6 +322,12 @@ impl<'a> Instruction<'a> {
                 }
                 write_packet(id, code, &[&[addr, data_len], entries], out)
             }
+            Instruction::BulkRead { entries } => {
+                if entries.is_empty() || entries.len() % 3 != 0 {
+                    return Err(EncodeError::SyncDataLength { entry: entries.len() / 3, expected: 3, got: entries.len() % 3 });
+                }
+                write_packet(id, code, &[&[0x00], entries], out)
+            }
         }
     }
 
@@ -324,6 +357,9 @@ impl<'a> Instruction<'a> {
                     return Err(bad);
                 }
                 Instruction::SyncWrite { addr, data_len, entries }
+            }
+            InstructionCode::BulkRead if params.len() >= 4 && params[0] == 0x00 && (params.len() - 1) % 3 == 0 => {
+                Instruction::BulkRead { entries: &params[1..] }
             }
             _ => return Err(bad),
         })

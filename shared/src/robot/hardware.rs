@@ -7,7 +7,7 @@
 
 use crate::dynamixel::table;
 use crate::safety::SoftLimit;
-use crate::servo::ServoModel;
+use crate::servo::{CommandKind, Drive, PositionScale, ServoModel};
 
 /// Position unit of the RX-28: 300° over 1023 counts \[rad\].
 pub const POSITION_UNIT_RAD: f32 = table::POSITION_RANGE_RAD / table::POSITION_MAX as f32;
@@ -47,6 +47,64 @@ impl JointSpec {
         let unit = table::POSITION_RANGE_RAD as f64 / table::POSITION_MAX as f64;
         let counts = self.zero as f64 + self.sign as f64 * angle / unit;
         libm::round(counts).clamp(0.0, table::POSITION_MAX as f64) as u16
+    }
+
+    /// Joint angle \[rad\] of a Present Position in the counts of the
+    /// joint's servo model ([`crate::servo::encoding`]); for the RX-28 the
+    /// same value as [`angle`](Self::angle), bit for bit.
+    pub fn angle_of(&self, counts: i32) -> f32 {
+        let scale = self.servo.encoding.position;
+        match scale {
+            PositionScale::Span { max, .. } => {
+                let counts = counts.clamp(0, max as i32) - self.zero as i32;
+                self.sign as f32 * counts as f32 * scale.unit_rad()
+            }
+            PositionScale::Turns { per_turn } => {
+                // In f64: a multi-turn count loses no turn to rounding.
+                let counts = counts as i64 - self.zero as i64;
+                (self.sign as f64 * counts as f64 * core::f64::consts::TAU / per_turn as f64) as f32
+            }
+        }
+    }
+
+    /// The Present Position, in the counts of the joint's servo model, at
+    /// joint angle `angle` \[rad\]: the inverse of
+    /// [`angle_of`](Self::angle_of), rounded to the nearest count (an
+    /// absolute sensor's range clamps); for the RX-28 the value of
+    /// [`position_of`](Self::position_of). What a simulated servo reads.
+    pub fn counts_of(&self, angle: f64) -> i32 {
+        let unit = match self.servo.encoding.position {
+            PositionScale::Span { max, range_rad } => range_rad as f64 / max as f64,
+            PositionScale::Turns { per_turn } => core::f64::consts::TAU / per_turn as f64,
+        };
+        self.servo.encoding.position.counts(self.zero as f64, self.sign as f64 * angle / unit)
+    }
+
+    /// The command that applies `voltage` \[V\] in the joint's positive
+    /// direction with `supply` \[V\] on the servo, in the servo model's
+    /// kind ([`CommandKind`]): Moving Speed as [`moving_speed`](Self::moving_speed)
+    /// gives it, or Goal PWM of the same ratio. A missing or implausible
+    /// supply reading (below 5 V) uses `fallback`.
+    pub fn drive(&self, voltage: f32, supply: Option<f32>, fallback: f32) -> Drive {
+        match self.servo.encoding.command {
+            CommandKind::MovingSpeed => Drive::MovingSpeed(self.moving_speed(voltage, supply, fallback)),
+            kind => {
+                let supply = match supply {
+                    Some(v) if v >= 5.0 && v.is_finite() => v,
+                    _ => fallback,
+                };
+                Drive::from_ratio(kind, self.sign as f32 * voltage / supply)
+            }
+        }
+    }
+
+    /// The voltage \[V\] a command applies in the joint's direction with
+    /// `supply` \[V\] (for Moving Speed, [`voltage_of`](Self::voltage_of)).
+    pub fn voltage_of_drive(&self, drive: Drive, supply: f32) -> f32 {
+        match drive {
+            Drive::MovingSpeed(v) => self.voltage_of(v, supply),
+            _ => self.sign as f32 * drive.ratio() * supply,
+        }
     }
 
     /// Moving Speed (wheel mode) that applies `voltage` \[V\] in the joint's
@@ -166,6 +224,39 @@ mod tests {
         // And back.
         assert!((J.voltage_of(512, 12.0) - 6.0).abs() < 0.01);
         assert!((J.voltage_of(1024 | 512, 12.0) + 6.0).abs() < 0.01);
+    }
+
+    #[test]
+    fn counts_of_each_model_invert_the_angle_and_the_rx28_is_unchanged() {
+        for raw in 0u16..=1023 {
+            assert_eq!(J.angle_of(raw as i32).to_bits(), J.angle(raw).to_bits(), "{raw}");
+            assert_eq!(J.counts_of(J.angle(raw) as f64), raw as i32);
+        }
+        assert_eq!(J.angle_of(5000), J.angle(1023));
+        assert_eq!(J.angle_of(-3), J.angle(0));
+        let x = JointSpec { servo: &crate::servo::XM430_W350, zero: 2048, sign: -1, ..J };
+        for counts in [-100_000, -4097, 0, 1, 2048, 4095, 4096 * 30 + 7] {
+            assert_eq!(x.counts_of(x.angle_of(counts) as f64), counts, "{counts}");
+        }
+        // A whole turn is 4096 counts, past the single turn's range.
+        assert!((x.angle_of(2048 - 4096) - core::f32::consts::TAU).abs() < 1e-6);
+        let mx = JointSpec { servo: &crate::servo::MX28, zero: 2048, ..J };
+        assert!((mx.angle_of(3072) - core::f32::consts::FRAC_PI_2).abs() < 1e-6);
+        assert_eq!(mx.counts_of(10.0), 4095);
+    }
+
+    #[test]
+    fn commands_are_the_models_own() {
+        for v in [-14.0f32, -6.0, -0.01, 0.0, 3.0, 6.0, 30.0] {
+            let d = J.drive(v, Some(12.0), 14.0);
+            assert_eq!(d, Drive::MovingSpeed(J.moving_speed(v, Some(12.0), 14.0)));
+            assert_eq!(J.voltage_of_drive(d, 12.0).to_bits(), J.voltage_of(J.moving_speed(v, Some(12.0), 14.0), 12.0).to_bits());
+        }
+        let x = JointSpec { servo: &crate::servo::XL430_W250, zero: 2048, sign: -1, ..J };
+        assert_eq!(x.drive(6.0, Some(12.0), 14.0), Drive::GoalPwm { pwm: -443, full: 885 });
+        assert_eq!(x.drive(6.0, None, 12.0), Drive::GoalPwm { pwm: -443, full: 885 });
+        assert_eq!(x.drive(99.0, Some(12.0), 12.0), Drive::GoalPwm { pwm: -885, full: 885 });
+        assert!((x.voltage_of_drive(x.drive(6.0, Some(12.0), 14.0), 12.0) - 6.0).abs() < 12.0 / 885.0);
     }
 
     #[test]

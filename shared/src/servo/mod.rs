@@ -56,6 +56,7 @@
 //! The supply clip is the top of the datasheet's input-voltage range (the
 //! RX-28 keeps GRL's 13.6 V).
 
+pub mod encoding;
 pub mod gearbox;
 #[cfg(test)]
 mod tests;
@@ -63,6 +64,7 @@ mod tests;
 use crate::rx28;
 use core::fmt;
 
+pub use encoding::{CommandKind, Drive, Encoding, PositionScale, Present};
 pub use gearbox::{gearbox, Gearbox, GearboxSources, GEARBOXES};
 
 /// The Dynamixel protocol a servo model speaks (its firmware's default).
@@ -140,6 +142,9 @@ pub struct ServoModel {
     pub protocol: ServoProtocol,
     /// The Model Number its control table reads (address 0).
     pub model_number: u16,
+    /// How its control table says position, speed and the voltage command
+    /// ([`encoding`]).
+    pub encoding: Encoding,
     /// The e-Manual page every datasheet figure (and the model number) is
     /// taken from.
     pub source: &'static str,
@@ -366,6 +371,7 @@ pub const RX28: ServoModel = ServoModel {
     name: "RX-28",
     protocol: ServoProtocol::V1,
     model_number: 28,
+    encoding: encoding::RX28,
     source: RX28_PAGE,
     datasheet: Datasheet {
         rated_voltage_v: 18.5,
@@ -391,6 +397,7 @@ pub const MX28: ServoModel = ServoModel {
     name: "MX-28",
     protocol: ServoProtocol::V1,
     model_number: 29,
+    encoding: encoding::MX28,
     source: MX28_PAGE,
     datasheet: Datasheet {
         rated_voltage_v: 12.0,
@@ -415,6 +422,7 @@ pub const XM430_W350: ServoModel = ServoModel {
     name: "XM430-W350",
     protocol: ServoProtocol::V2,
     model_number: 1020,
+    encoding: encoding::X_SERIES,
     source: XM430_W350_PAGE,
     datasheet: Datasheet {
         rated_voltage_v: 12.0,
@@ -439,6 +447,7 @@ pub const XL430_W250: ServoModel = ServoModel {
     name: "XL430-W250",
     protocol: ServoProtocol::V2,
     model_number: 1060,
+    encoding: encoding::X_SERIES,
     source: XL430_W250_PAGE,
     datasheet: Datasheet {
         rated_voltage_v: 11.1,
@@ -463,6 +472,7 @@ pub const XL330_M288: ServoModel = ServoModel {
     name: "XL330-M288",
     protocol: ServoProtocol::V2,
     model_number: 1200,
+    encoding: encoding::X_SERIES,
     source: XL330_M288_PAGE,
     datasheet: Datasheet {
         rated_voltage_v: 5.0,

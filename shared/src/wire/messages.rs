@@ -28,8 +28,10 @@ pub use crate::safety::RunMode;
 /// and its definition's hash instead of leaving it to be guessed from its
 /// dimensions (a robot is a definition, not a case of a closed list), and
 /// a restore's batch is [`RESTORE_BATCH`] = 24 chunks, not 3, which a
-/// protocol 8 board's 512-byte command buffer cannot hold.
-pub const PROTOCOL_VERSION: u16 = 9;
+/// protocol 8 board's 512-byte command buffer cannot hold; 10:
+/// [`FaultCause::HardwareAlert`], a Protocol 2.0 servo's Alert bit with
+/// its Hardware Error Status, appended last.
+pub const PROTOCOL_VERSION: u16 = 10;
 /// The capacities of a [`Step`] (state dimensions, motor outputs and
 /// counted gearboxes) and of a [`Health`] report (servos): pada-core's own
 /// ([`crate::limits`]).

@@ -35,7 +35,7 @@
 //! - **Torque off** (a fault, Stop): modelled as 0 V, the motor shorted,
 //!   which brakes the joint a little more than the RX-28's open winding.
 
-use super::{joint_volts, servo_reading, Rig, TEMPERATURE_C};
+use super::{joint_volts, servo_reading, JointState, Rig, TEMPERATURE_C};
 use crate::leo::model::{InitialPose, LeoModel, ModelOptions, Snapshot, NUM_JOINTS};
 use pada_core::dynamixel::table::PresentState;
 use pada_core::robot::leo::{ankle_x, Leg, StanceTracker, CONTROL_PERIOD_US, JOINTS};
@@ -163,12 +163,18 @@ impl LeoRig {
         self.stance.update(s.contacts[0] || s.contacts[1], s.contacts[2] || s.contacts[3], ankle(Leg::Left), ankle(Leg::Right));
     }
 
-    /// Servo `k`'s reading now.
-    fn reading(&self, k: usize) -> PresentState {
+    /// Joint `k` as its servo senses it now.
+    fn sensed(&self, k: usize) -> JointState {
         let (q, qd) = self.model.joint_state();
         let stall = Rx28::LEO.estimate_joint_torque(self.hw.supply_nominal_v, 0.0);
         let load = (self.torques[k] / stall).clamp(-1.0, 1.0);
-        servo_reading(&self.hw.joints[k], q[k] as f64, qd[k] as f64, load, self.supply_v())
+        JointState { angle: q[k] as f64, rate: qd[k] as f64, load }
+    }
+
+    /// Servo `k`'s reading now.
+    fn reading(&self, k: usize) -> PresentState {
+        let s = self.sensed(k);
+        servo_reading(&self.hw.joints[k], s.angle, s.rate, s.load, self.supply_v())
     }
 
     /// The boom's encoder and the foot switches now.
@@ -214,6 +220,11 @@ impl Rig for LeoRig {
             Some(k) => self.reading(k),
             None => PresentState { position: 0, speed: 0, load: 0, voltage: 0, temperature: TEMPERATURE_C },
         }
+    }
+
+    fn joint_state(&mut self, t_us: u64, id: u8) -> JointState {
+        self.advance_to(t_us);
+        self.joint_of(id).map_or_else(JointState::default, |k| self.sensed(k))
     }
 
     fn sensors(&mut self, t_us: u64) -> (u16, u8) {

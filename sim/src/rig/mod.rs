@@ -22,6 +22,7 @@ pub mod pendulum;
 pub use leo::LeoRig;
 pub use pendulum::PendulumRig;
 
+use pada_core::dynamixel::control_table::{self, x_series};
 use pada_core::dynamixel::table::{self, PresentState};
 use pada_core::robot::JointSpec as Joint;
 
@@ -44,8 +45,16 @@ pub trait Rig: Send {
     /// (its Moving Speed times its supply; ignored without torque).
     fn drive(&mut self, t_us: u64, id: u8, torque: bool, volts: f64);
 
-    /// What servo `id` reads at `t_us` (Present Position … Temperature).
+    /// What servo `id` reads at `t_us` (Present Position … Temperature)
+    /// as an RX-28 (the definition's servo of both built-in robots).
     fn present(&mut self, t_us: u64, id: u8) -> PresentState;
+
+    /// The state of servo `id`'s joint at `t_us`, whatever the servo's
+    /// model: what a virtual servo of any model reads in its own units
+    /// ([`x_reading`] for the X series; [`present`](Self::present) is
+    /// [`servo_reading`] of it). Reading it changes nothing, as
+    /// [`present`](Self::present).
+    fn joint_state(&mut self, t_us: u64, id: u8) -> JointState;
 
     /// The encoder's 16-bit count and the foot contacts at `t_us`.
     fn sensors(&mut self, t_us: u64) -> (u16, u8);
@@ -83,6 +92,48 @@ pub trait Rig: Send {
     fn gear_torque(&self, id: u8) -> f32;
 }
 
+/// A joint as its servo senses it.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct JointState {
+    /// The joint's angle \[rad\], in the joint's frame (the definition's
+    /// zero and sign apply on the way to the servo's counts).
+    pub angle: f64,
+    /// Its rate \[rad/s\].
+    pub rate: f64,
+    /// The load: a fraction of the stall torque, in the joint's direction.
+    pub load: f32,
+}
+
+/// What an X-series servo in PWM Control Mode reads (addresses 124–146)
+/// with its joint in `s` on a `supply_v` supply: Present Position in 4096
+/// counts per turn through the joint's calibration
+/// ([`Joint::counts_of`]), Present Velocity in 0.229 rev/min, Present
+/// Current as the load's share of the model's stall current in the unit
+/// its control table gives (XM430-W350: 2.69 mA, XL330-M288: 1 mA), or
+/// Present Load in 0.1 % (XL430-W250, which has no current sensor);
+/// Present PWM as `pwm`; no trajectory (PWM mode has none).
+pub fn x_reading(joint: &Joint, s: JointState, pwm: i16, supply_v: f64) -> x_series::PresentState {
+    let sign = joint.sign as f64;
+    let rpm = s.rate * 60.0 / std::f64::consts::TAU;
+    let velocity = (sign * rpm / joint.servo.encoding.speed_unit_rpm as f64).round();
+    let load = (sign * s.load as f64).clamp(-1.0, 1.0);
+    let model = control_table::by_model_number(joint.servo.model_number);
+    let current = match model.and_then(|t| t.item_named("Present Current")) {
+        Some(item) => load * joint.servo.datasheet.stall_current_a as f64 * 1000.0 / item.unit.per_count as f64,
+        None => load * 1000.0,
+    };
+    x_series::PresentState {
+        pwm,
+        current: current.round().clamp(i16::MIN as f64, i16::MAX as f64) as i16,
+        velocity: velocity.clamp(i32::MIN as f64, i32::MAX as f64) as i32,
+        position: joint.counts_of(s.angle),
+        velocity_trajectory: 0,
+        position_trajectory: 0,
+        input_voltage: (supply_v * 10.0).round() as u16,
+        temperature: TEMPERATURE_C,
+    }
+}
+
 /// What servo `joint` reads with its joint at `angle` \[rad\] turning at
 /// `rate` \[rad/s\] under `load` (a fraction of the stall torque, in the
 /// joint's direction) on a `supply_v` supply. The rigs read in the servo's
@@ -111,6 +162,21 @@ pub fn joint_volts(joint: &Joint, servo_volts: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_x_series_reading_is_in_its_own_units() {
+        let joint = Joint { name: "x", servo: &pada_core::servo::XM430_W350, id: 1, zero: 2048, sign: -1, soft_limit: None };
+        let s = JointState { angle: 7.0, rate: 2.0, load: 0.5 };
+        let r = x_reading(&joint, s, 100, 12.0);
+        assert!((joint.angle_of(r.position) as f64 - 7.0).abs() < 0.002, "more than a turn, no clamp");
+        // 2 rad/s = 19.1 rev/min = 83 units, turning against the counts.
+        assert_eq!(r.velocity, -83);
+        // Half the stall current (2.3 A) in 2.69 mA units, against the counts.
+        assert_eq!(r.current, -428);
+        assert_eq!((r.pwm, r.input_voltage, r.temperature), (100, 120, TEMPERATURE_C));
+        let xl = Joint { servo: &pada_core::servo::XL430_W250, sign: 1, ..joint };
+        assert_eq!(x_reading(&xl, s, 0, 12.0).current, 500, "Present Load in 0.1 %");
+    }
 
     #[test]
     fn a_reading_is_in_the_servos_frame_and_the_calibration_undoes_it() {

@@ -1,6 +1,6 @@
 //! The physical pendulum behind the bus.
 
-use super::{joint_volts, servo_reading, Rig};
+use super::{joint_volts, servo_reading, JointState, Rig};
 use crate::pendulum::PhysicalPendulumParams;
 use pada_core::dynamixel::table::PresentState;
 use pada_core::robot::pendulum::gearbox_torque;
@@ -104,10 +104,18 @@ impl PendulumRig {
         self.t_us = self.t_us.max(t_us);
     }
 
-    /// The servo's reading (its position measured from hanging; no load
-    /// is modelled).
+    /// The joint as the servo senses it: its angle measured from hanging,
+    /// counting whole turns (an X-series servo's encoder does); no load is
+    /// modelled.
+    fn sensed(&self, x: [f64; 2]) -> JointState {
+        JointState { angle: x[0] - PI, rate: x[1], load: 0.0 }
+    }
+
+    /// The servo's reading as an RX-28, whose potentiometer reads the
+    /// angle within a turn.
     fn reading(&self, x: [f64; 2]) -> PresentState {
-        servo_reading(&self.hw.joints[0], crate::pendulum::wrap_angle(x[0] - PI), x[1], 0.0, self.supply_v())
+        let s = self.sensed(x);
+        servo_reading(&self.hw.joints[0], crate::pendulum::wrap_angle(s.angle), s.rate, s.load, self.supply_v())
     }
 
     /// The firmware takes the pose at boot (hanging, θ = π) as count 0.
@@ -146,6 +154,11 @@ impl Rig for PendulumRig {
     fn present(&mut self, t_us: u64, _id: u8) -> PresentState {
         self.advance_to(t_us);
         self.reading(self.state_at(t_us))
+    }
+
+    fn joint_state(&mut self, t_us: u64, _id: u8) -> JointState {
+        self.advance_to(t_us);
+        self.sensed(self.state_at(t_us))
     }
 
     fn sensors(&mut self, t_us: u64) -> (u16, u8) {

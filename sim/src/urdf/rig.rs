@@ -5,7 +5,7 @@
 //! until the next one starts.
 
 use super::body::{UrdfBody, UrdfModel};
-use crate::rig::{joint_volts, servo_reading, Rig};
+use crate::rig::{joint_volts, servo_reading, JointState, Rig};
 use pada_core::dynamixel::table::PresentState;
 use pada_core::limits::MAX_SERVOS;
 use pada_core::robot::RobotSpec;
@@ -84,11 +84,16 @@ impl UrdfRig {
         self.body = UrdfBody::new(&self.model).unwrap_or_else(|e| unreachable!("the body built at load: {e}"));
     }
 
-    fn reading(&self, k: usize) -> PresentState {
+    /// Joint `k` as its servo senses it now.
+    fn sensed(&self, k: usize) -> JointState {
         let (q, qd, t) = (self.body.angles(), self.body.rates(), self.body.gear_torques());
         let stall = self.hw.joints[k].servo.motor().stall_torque(self.supply_v() as f32).abs().max(1e-6);
-        let load = (t[k] / stall).clamp(-1.0, 1.0);
-        servo_reading(&self.hw.joints[k], q[k] as f64, qd[k] as f64, load, self.supply_v())
+        JointState { angle: q[k] as f64, rate: qd[k] as f64, load: (t[k] / stall).clamp(-1.0, 1.0) }
+    }
+
+    fn reading(&self, k: usize) -> PresentState {
+        let s = self.sensed(k);
+        servo_reading(&self.hw.joints[k], s.angle, s.rate, s.load, self.supply_v())
     }
 
     fn settled_until(&self, t_us: u64) -> bool {
@@ -128,6 +133,11 @@ impl Rig for UrdfRig {
             Some(k) => self.reading(k),
             None => PresentState { position: 0, speed: 0, load: 0, voltage: 0, temperature: crate::rig::TEMPERATURE_C },
         }
+    }
+
+    fn joint_state(&mut self, t_us: u64, id: u8) -> JointState {
+        self.advance_to(t_us);
+        self.joint_of(id).map_or_else(JointState::default, |k| self.sensed(k))
     }
 
     /// A robot of files has no encoder and no foot switches.

@@ -11,6 +11,7 @@
 //! | XL430-W250 | 1060 | 2.0 | [`x_series::XL430_W250`] |
 //! | XL330-M288 | 1200 | 2.0 | [`x_series::XL330_M288`] |
 //! | MX-28 (2.0 firmware) | 30 | 2.0 | [`mx28::MX28_V2`] |
+//! | RX-28 | 28 | 1.0 | [`rx28::RX28`] (not in [`TABLES`], the Protocol 2.0 ones) |
 //!
 //! A table is about the bus only; a robot's servo-model entry (stall
 //! torque, speed, gear ratio) refers to one as `&'static ControlTable`,
@@ -29,6 +30,7 @@ use super::Protocol;
 use core::fmt;
 
 pub mod mx28;
+pub mod rx28;
 pub mod x_series;
 
 /// Who may access an item.

@@ -1,136 +1,18 @@
-//! Dynamixel Protocol 1.0 transactions on a [`BusPort`], with bounded
-//! timeouts and retries.
-//!
-//! The packets come from `pada_core::dynamixel`; this module adds the
-//! conversation: send an instruction, listen for the status packet of the
-//! servo that was asked until a deadline, retry a bounded number of times,
-//! and report every timeout, checksum error and error bit so the safety
-//! machine can count them (`pada_core::safety`).
+//! Dynamixel Protocol 1.0 transactions (the RX and MX series as shipped):
+//! READ, PING, WRITE, SYNC_WRITE of Moving Speed, and the set-up of a
+//! servo for the control loop (wheel mode, return delay, status return
+//! level). The packets come from `pada_core::dynamixel`.
 //!
 //! Worst case per period with the defaults (1 Mbps, 7 servos, 2 attempts of
 //! at most 1 ms each): 14 ms of a 33 ms LEO period; a healthy read takes
 //! about 0.25 ms per servo (8-byte READ, 14-byte status, 50 µs return
 //! delay).
 
+use super::{Exchange, ServoBus, ServoSetup, SetupError, Status, RETURN_DELAY, STATUS_RETURN_LEVEL};
 use crate::io::{BusPort, PortError};
-use pada_core::dynamixel::{self, table, DecodeError, ErrorFlags, Reply, StatusDecoder, StatusPacket, BROADCAST_ID};
-
-/// Longest status packet the firmware reads (header to checksum).
-pub const STATUS_LEN: usize = 32;
-/// A status packet as the bus returns it.
-pub type Status = StatusPacket<STATUS_LEN>;
-
-/// Return delay the servos are set to: 25 × 2 µs = 50 µs, time for the
-/// driver-enable line to drop after the last stop bit.
-pub const RETURN_DELAY: u8 = 25;
-/// Status return level: answer READ (and PING) only, so WRITE and
-/// SYNC_WRITE never put a reply on the bus.
-pub const STATUS_RETURN_LEVEL: u8 = 1;
-
-/// Timing of the conversation.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct BusConfig {
-    /// How long to wait for a status packet after the instruction \[µs\].
-    pub reply_timeout_us: u32,
-    /// Attempts per request within one control period (1 + retries).
-    pub attempts: u8,
-}
-
-impl Default for BusConfig {
-    fn default() -> Self {
-        BusConfig { reply_timeout_us: 1000, attempts: 2 }
-    }
-}
-
-/// Counters for health telemetry.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct BusStats {
-    /// Instruction packets sent.
-    pub requests: u32,
-    /// Status packets received from the servo asked.
-    pub replies: u32,
-    /// Attempts without an answer before the deadline.
-    pub timeouts: u32,
-    /// Status packets with a bad checksum.
-    pub checksum_errors: u32,
-    /// Status packets from another ID, or with an impossible length.
-    pub stray_packets: u32,
-    /// UART errors (overrun, framing, noise).
-    pub line_errors: u32,
-}
-
-/// What one request to one servo came to, with everything the safety
-/// machine counts.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Exchange {
-    /// The servo's answer, if one came.
-    pub status: Option<Status>,
-    /// Attempts that ended without an answer.
-    pub timeouts: u8,
-    /// Bad checksums seen (received status packets).
-    pub checksum_errors: u8,
-}
-
-impl Exchange {
-    /// The servo's error bits (empty without an answer).
-    pub fn error(&self) -> ErrorFlags {
-        self.status.as_ref().map_or(ErrorFlags::NONE, |s| s.error)
-    }
-}
-
-/// One servo's EEPROM settings that the firmware relies on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct ServoSetup {
-    /// Model number (28 for an RX-28).
-    pub model: u16,
-    /// Whether anything had to be written (EEPROM writes are counted: they
-    /// wear the servo's EEPROM, so only differences are written).
-    pub wrote: bool,
-}
-
-/// Why a servo could not be set up.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SetupError {
-    /// It did not answer.
-    NoAnswer {
-        /// Dynamixel ID.
-        id: u8,
-    },
-    /// It answered with error bits.
-    Error {
-        /// Dynamixel ID.
-        id: u8,
-        /// The bits.
-        error: ErrorFlags,
-    },
-}
-
-/// The servo bus: a port, a decoder, the transmit buffer and the counters.
-pub struct ServoBus<P> {
-    port: P,
-    config: BusConfig,
-    decoder: StatusDecoder<STATUS_LEN>,
-    tx: [u8; 64],
-    rx: [u8; 64],
-    stats: BusStats,
-}
+use pada_core::dynamixel::{self, table, DecodeError, ErrorFlags, Reply, BROADCAST_ID};
 
 impl<P: BusPort> ServoBus<P> {
-    /// A bus on `port`.
-    pub fn new(port: P, config: BusConfig) -> Self {
-        ServoBus { port, config, decoder: StatusDecoder::new(), tx: [0; 64], rx: [0; 64], stats: BusStats::default() }
-    }
-
-    /// Counters since start.
-    pub fn stats(&self) -> BusStats {
-        self.stats
-    }
-
-    /// The port (for the board's own checks).
-    pub fn port_mut(&mut self) -> &mut P {
-        &mut self.port
-    }
-
     /// READ `len` bytes at `addr` of servo `id`, with up to
     /// [`BusConfig::attempts`] attempts.
     pub async fn read(&mut self, id: u8, addr: u8, len: u8) -> Exchange {
@@ -206,7 +88,9 @@ impl<P: BusPort> ServoBus<P> {
     /// Prepares servo `id` for the control loop: checks that it answers,
     /// then writes (only where different) wheel mode (both angle limits 0),
     /// the return delay and the status return level. Torque is left as it
-    /// is (the caller switches it off for every servo first).
+    /// is (the caller switches it off for every servo first). Its model
+    /// number is returned; [`super::robot::RobotBus`] compares it with the
+    /// robot's definition.
     pub async fn setup(&mut self, id: u8) -> Result<ServoSetup, SetupError> {
         // Model number.
         let model = self.read(id, table::MODEL_NUMBER, 2).await;
@@ -243,7 +127,7 @@ impl<P: BusPort> ServoBus<P> {
             self.write_no_reply(id, table::CW_ANGLE_LIMIT, &[0, 0, 0, 0]).await.ok();
             wrote = true;
         }
-        Ok(ServoSetup { model, wrote })
+        Ok(ServoSetup { model, firmware: 0, wrote })
     }
 
     async fn write_maybe_reply(&mut self, id: u8, addr: u8, data: &[u8], reply: bool) {
@@ -256,16 +140,6 @@ impl<P: BusPort> ServoBus<P> {
         } else {
             self.write_no_reply(id, addr, data).await.ok();
         }
-    }
-
-    /// Sends the first `n` bytes of the transmit buffer.
-    async fn send(&mut self, n: usize) -> Result<(), PortError> {
-        self.stats.requests = self.stats.requests.wrapping_add(1);
-        let result = self.port.send(&self.tx[..n]).await;
-        if result.is_err() {
-            self.stats.line_errors = self.stats.line_errors.wrapping_add(1);
-        }
-        result
     }
 
     /// One attempt: send the first `n` bytes of the transmit buffer, listen
@@ -324,6 +198,7 @@ impl<P: BusPort> ServoBus<P> {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::bus::BusConfig;
     use embassy_futures::block_on;
     use pada_core::dynamixel::{Instruction, InstructionDecoder};
     use std::collections::VecDeque;
@@ -475,7 +350,7 @@ pub(crate) mod tests {
 
     #[test]
     fn a_missing_servo_times_out_within_the_attempt_budget() {
-        let mut bus = ServoBus::new(FakeBus::with_servos(&[1]), BusConfig { reply_timeout_us: 1000, attempts: 3 });
+        let mut bus = ServoBus::new(FakeBus::with_servos(&[1]), BusConfig { reply_timeout_us: 1000, attempts: 3, ..BusConfig::default() });
         let before = bus.port_mut().now;
         let (state, ex) = block_on(bus.read_present(9));
         assert!(state.is_none());
@@ -531,7 +406,7 @@ pub(crate) mod tests {
     fn setup_writes_wheel_mode_once() {
         let mut bus = ServoBus::new(FakeBus::with_servos(&[3]), BusConfig::default());
         let s = block_on(bus.setup(3)).unwrap();
-        assert_eq!(s, ServoSetup { model: 28, wrote: true });
+        assert_eq!(s, ServoSetup { model: 28, firmware: 0, wrote: true });
         let t = *bus.port_mut().table(3);
         assert_eq!(&t[6..10], &[0, 0, 0, 0]);
         assert_eq!(t[table::STATUS_RETURN_LEVEL as usize], STATUS_RETURN_LEVEL);

@@ -1,0 +1,203 @@
+//! `pada servos`: a robot's servos as virtual servos on a pseudo-terminal
+//! (`--port PATH --robot R`), or `--scan` of a real port.
+//!
+//! ```text
+//! pada servos --port /tmp/dxl --robot pendulum|PATH/robot.toml [--servo XM430-W350] [--baud 1000000] [--lockstep] [--fault SPEC]… [--seconds S] [--json]
+//! pada servos --scan --port /dev/ttyUSB0 [--baud 57600,1000000] [--protocol 1|2] [--ids 0-252] [--timeout-ms 5] [--json]
+//! ```
+
+use crate::console::{errln, outln};
+use crate::error::{usage, CliError};
+use crate::robot_arg::RobotArg;
+use crate::servos::scan::{self, ScanConfig};
+use crate::servos::{pty::Pty, serve, Clock, VirtualBus};
+use clap::Args;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+
+/// `pada servos`.
+#[derive(Debug, Clone, Args)]
+pub struct ServosArgs {
+    /// The virtual servos' port: a path for the symbolic link to their
+    /// pseudo-terminal (open it as you would open /dev/ttyUSB0). With
+    /// --scan: the real port to scan.
+    #[arg(long, value_name = "PATH")]
+    pub port: PathBuf,
+    /// The robot whose servos to emulate: a built-in robot (pendulum,
+    /// pendulum-20hz, leo) or the path of a robot's robot.toml.
+    #[arg(long, value_name = "R", value_parser = RobotArg::parser())]
+    pub robot: Option<RobotArg>,
+    /// Every joint's servo of this model instead of the definition's (the
+    /// pendulum on an X-series servo): RX-28, XM430-W350, XL430-W250,
+    /// XL330-M288.
+    #[arg(long, value_name = "MODEL")]
+    pub servo: Option<String>,
+    /// The servos' baud rate (with --scan: the rates to try, comma
+    /// separated; default 57600,1000000,115200,2000000,3000000,4000000,9600).
+    #[arg(long, value_name = "BPS")]
+    pub baud: Option<String>,
+    /// Lock step: the physics advance one control period at each SYNC
+    /// WRITE instead of with the wall clock, so that a run over the port is
+    /// reproducible whatever the machine's speed.
+    #[arg(long)]
+    pub lockstep: bool,
+    /// A fault of `pada sil`'s kinds: drop, corrupt, delay, error-bits (on
+    /// an X-series servo: a hardware alert with these bits), past-limit;
+    /// KIND[:at=S][:for=S][:servo=ID][:ms=MS][:bits=NAME], bus time.
+    #[arg(long = "fault", value_name = "SPEC")]
+    pub faults: Vec<String>,
+    /// Stop after this many wall-clock seconds (default: until Ctrl-C).
+    #[arg(long, value_name = "S")]
+    pub seconds: Option<f64>,
+    /// Print the summary (with every servo event) as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Scan the port instead: which IDs and models answer, at which rate
+    /// and protocol.
+    #[arg(long)]
+    pub scan: bool,
+    /// With --scan: only this protocol (1 or 2).
+    #[arg(long, value_name = "1|2", value_parser = clap::value_parser!(u8).range(1..=2))]
+    pub protocol: Option<u8>,
+    /// With --scan: the Protocol 1.0 IDs to ping (default 0-253).
+    #[arg(long, value_name = "A-B")]
+    pub ids: Option<String>,
+    /// With --scan: how long to wait for an answer [ms].
+    #[arg(long, value_name = "MS", default_value_t = 5, value_parser = clap::value_parser!(u64).range(1..=1000))]
+    pub timeout_ms: u64,
+}
+
+/// Runs `pada servos`.
+pub fn run(args: ServosArgs) -> Result<(), CliError> {
+    if args.scan {
+        return run_scan(&args);
+    }
+    for (flag, given) in [("--protocol", args.protocol.is_some()), ("--ids", args.ids.is_some())] {
+        if given {
+            return Err(usage(format!("{flag} goes with --scan")));
+        }
+    }
+    let Some(mut robot) = args.robot else {
+        return Err(usage("give --robot R (the robot whose servos to emulate; valid are pendulum, pendulum-20hz, leo, or the path of a robot.toml) or --scan"));
+    };
+    if let Some(name) = &args.servo {
+        let model = pada_core::servo::servo(name).map_err(|e| usage(format!("--servo: {e}")))?;
+        robot = robot.with_servo(model).map_err(usage)?;
+    }
+    let bps = match args.baud.as_deref() {
+        None => 1_000_000,
+        Some(b) => b.parse::<u32>().ok().filter(|b| (9_600..=4_500_000).contains(b)).ok_or_else(|| {
+            usage(format!("--baud {b}: not a baud rate; valid is one of the servos' rates, 9600 to 4500000 (e.g. 57600, 1000000)"))
+        })?,
+    };
+    if let Some(s) = args.seconds {
+        if !(s.is_finite() && s > 0.0) {
+            return Err(usage(format!("--seconds {s} is out of range: valid is > 0")));
+        }
+    }
+    let faults = args.faults.iter().map(|f| crate::sil::fault::parse(f).map_err(usage)).collect::<Result<Vec<_>, _>>()?;
+    let rig = robot.rig().map_err(usage)?;
+    let clock = if args.lockstep { Clock::LockStep } else { Clock::RealTime };
+    let mut bus = VirtualBus::new(robot.spec, rig, bps, clock, faults).map_err(usage)?;
+    let pty = Pty::create(&args.port).map_err(|e| usage(format!("--port {}: cannot make the virtual port: {e}", args.port.display())))?;
+    let models: Vec<String> = robot.spec.joints.iter().map(|j| format!("{} (ID {}, {})", j.name, j.id, j.servo.name)).collect();
+    errln!(
+        "servos: {} at {} bps on {} -> {} ({}): {}",
+        robot.spec.name,
+        bps,
+        args.port.display(),
+        pty.device(),
+        if args.lockstep { "lock step: one period per SYNC WRITE" } else { "real time" },
+        models.join(", ")
+    );
+    if robot.spec.encoder.is_some() {
+        errln!("servos: the robot's encoder is the sensor device, ID {}", pada_firmware::sensor_device::SENSOR_ID);
+    }
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
+    }
+    let summary = serve::serve(&mut bus, &pty, bps, &stop, args.seconds, robot.spec.name, args.lockstep)
+        .map_err(|e| CliError::Runtime(anyhow::anyhow!("the virtual port failed: {e}")))?;
+    drop(pty);
+    if args.json {
+        outln!("{}", serde_json::to_string_pretty(&summary).map_err(|e| CliError::Runtime(e.into()))?)?;
+    } else {
+        errln!(
+            "servos: ended ({}): {} packets, {} answers, {} periods (sync writes), {:.3} s of bus time in {:.1} s",
+            summary.ended,
+            summary.stats.packets,
+            summary.stats.replies,
+            summary.stats.sync_writes,
+            summary.bus_s,
+            summary.wall_s
+        );
+    }
+    Ok(())
+}
+
+/// `--scan`.
+fn run_scan(args: &ServosArgs) -> Result<(), CliError> {
+    for (flag, given) in [
+        ("--robot", args.robot.is_some()),
+        ("--servo", args.servo.is_some()),
+        ("--lockstep", args.lockstep),
+        ("--fault", !args.faults.is_empty()),
+        ("--seconds", args.seconds.is_some()),
+    ] {
+        if given {
+            return Err(usage(format!("{flag} does not go with --scan (it scans a real port)")));
+        }
+    }
+    let rates = match args.baud.as_deref() {
+        None => scan::RATES.to_vec(),
+        Some(list) => list
+            .split(',')
+            .map(|b| b.trim().parse::<u32>().ok().filter(|b| (9_600..=4_500_000).contains(b)))
+            .collect::<Option<Vec<u32>>>()
+            .ok_or_else(|| usage(format!("--baud {list}: valid is a comma-separated list of rates from 9600 to 4500000")))?,
+    };
+    let ids = match args.ids.as_deref() {
+        None => 0..=253,
+        Some(r) => {
+            let bad = || usage(format!("--ids {r}: valid is A-B with 0 <= A <= B <= 253"));
+            let (a, b) = r.split_once('-').ok_or_else(bad)?;
+            let (a, b) = (a.trim().parse::<u8>().map_err(|_| bad())?, b.trim().parse::<u8>().map_err(|_| bad())?);
+            if a > b || b > 253 {
+                return Err(bad());
+            }
+            a..=b
+        }
+    };
+    let cfg = ScanConfig {
+        rates,
+        protocols: args.protocol.map_or(vec![2, 1], |p| vec![p]),
+        ids,
+        timeout: Duration::from_millis(args.timeout_ms),
+    };
+    crate::drive::port::check_access(&args.port).map_err(usage)?;
+    let found = scan::scan(&args.port, &cfg, &mut |baud, protocol| errln!("scan: {baud} bps, Protocol {protocol}.0"))
+        .map_err(|e| usage(format!("--port {}: {e}", args.port.display())))?;
+    if args.json {
+        outln!("{}", serde_json::to_string_pretty(&found).map_err(|e| CliError::Runtime(e.into()))?)?;
+        return Ok(());
+    }
+    if found.is_empty() {
+        outln!("no servo answered on {} (rates {:?}, Protocol {:?})", args.port.display(), cfg.rates, cfg.protocols)?;
+    }
+    for f in &found {
+        outln!(
+            "{:>8} bps  Protocol {}.0  ID {:>3}  {} (model {}){}",
+            f.baud,
+            f.protocol,
+            f.id,
+            f.model.unwrap_or("unknown model"),
+            f.model_number.map_or("?".to_string(), |m| m.to_string()),
+            f.firmware.map_or(String::new(), |v| format!(", firmware {v}"))
+        )?;
+    }
+    Ok(())
+}

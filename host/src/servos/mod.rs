@@ -1,0 +1,26 @@
+//! Virtual Dynamixel servos: `pada servos`. A robot's servos, each of the
+//! model its definition names (or another, `--servo`), answer on a
+//! pseudo-terminal in the protocol of their model, with the robot's
+//! simulated physics behind them, as `pada sil` answers the firmware; any
+//! program can open the port as it opens a USB adapter. And `pada servos
+//! --scan`, which finds what answers on a real port.
+//!
+//! | file | its one job |
+//! |---|---|
+//! | `p1.rs` | one virtual RX-28 (Protocol 1.0): its table, every instruction |
+//! | `p2.rs` | one virtual X-series servo (Protocol 2.0): its table, every instruction, alerts, the Bus Watchdog |
+//! | `sensor.rs` | the sensor device: encoder, foot contacts, the operator's call |
+//! | `bus.rs` | the bus: both protocols' decoders, the servos in their turn, time (real time or lock step), faults, the physics |
+//! | `pty.rs` | the pseudo-terminal behind a symbolic link |
+//! | `serve.rs` | the loop between them, and its summary |
+//! | `scan.rs` | `--scan`: which IDs and models answer on a port, at which rate and protocol |
+
+pub mod bus;
+pub mod p1;
+pub mod p2;
+pub mod pty;
+pub mod scan;
+pub mod sensor;
+pub mod serve;
+
+pub use bus::{Clock, VirtualBus};

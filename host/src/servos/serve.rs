@@ -1,0 +1,119 @@
+//! `pada servos`' loop: bytes from the pseudo-terminal into the virtual
+//! bus, its answers back when they are due, the Bus Watchdogs and the
+//! physics kept up with the wall clock (real time), until Ctrl-C or
+//! `--seconds`. Each servo event is a line on stderr as it happens; the
+//! summary says what the bus carried and what every servo did.
+
+use super::bus::{BusStats, Event, Reply, VirtualBus};
+use super::pty::Pty;
+use serde::Serialize;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+/// How long a read waits for the client at most: the Bus Watchdog's and
+/// the physics' resolution in real time.
+const POLL: Duration = Duration::from_millis(1);
+
+/// What a run of the virtual servos came to.
+#[derive(Debug, Clone, Serialize)]
+pub struct ServeSummary {
+    /// The robot.
+    pub robot: String,
+    /// The link the port was at, and its device.
+    pub port: String,
+    /// Its pseudo-terminal.
+    pub device: String,
+    /// The servos' rate \[bps\].
+    pub baud: u32,
+    /// `real-time` or `lock-step`.
+    pub clock: &'static str,
+    /// Why it ended.
+    pub ended: String,
+    /// Wall time \[s\].
+    pub wall_s: f64,
+    /// Bus time at the end \[s\].
+    pub bus_s: f64,
+    /// Bytes that came at another rate than the servos' (and were not
+    /// heard).
+    pub wrong_rate_bytes: u64,
+    /// The rates those bytes came at.
+    pub wrong_rates: Vec<u32>,
+    /// The bus's counters.
+    pub stats: BusStats,
+    /// What the servos did, in order.
+    pub events: Vec<Event>,
+}
+
+/// Serves `bus` on `pty` until `stop` or `seconds`; `name` is the robot's.
+pub fn serve(bus: &mut VirtualBus, pty: &Pty, bps: u32, stop: &AtomicBool, seconds: Option<f64>, name: &str, lock_step: bool) -> std::io::Result<ServeSummary> {
+    let started = Instant::now();
+    let mut pending: Vec<Reply> = Vec::new();
+    let mut out: Vec<u8> = Vec::new();
+    let mut buf = vec![0u8; 4096];
+    let (mut wrong_rate_bytes, mut wrong_rates) = (0u64, Vec::new());
+    let mut logged = 0;
+    let ended = loop {
+        if stop.load(Ordering::SeqCst) {
+            break "interrupted".to_string();
+        }
+        if seconds.is_some_and(|s| started.elapsed().as_secs_f64() >= s) {
+            break "time limit".to_string();
+        }
+        let now = started.elapsed().as_micros() as u64;
+        bus.tick(now);
+        // Answers due.
+        let bus_now = if lock_step { u64::MAX } else { now };
+        pending.sort_by_key(|r| r.at_us);
+        let due = pending.iter().take_while(|r| r.at_us <= bus_now).count();
+        for r in pending.drain(..due) {
+            out.extend_from_slice(&r.bytes);
+        }
+        if !out.is_empty() {
+            let n = pty.write(&out)?;
+            out.drain(..n);
+        }
+        let wait = pending.first().map_or(POLL, |r| Duration::from_micros(r.at_us.saturating_sub(now)).min(POLL));
+        let n = pty.read(&mut buf, wait)?;
+        for e in &bus.events()[logged..] {
+            crate::console::errln!("servos: {:.6} s: {} {}", e.at_us as f64 * 1e-6, device_name(e.id), e.what);
+        }
+        logged = bus.events().len();
+        if n == 0 {
+            continue;
+        }
+        let line = pty.line_bps();
+        if !bus.anyone_hears(line) {
+            // The servos hear garbage: nothing they decode, no answer.
+            wrong_rate_bytes += n as u64;
+            if !wrong_rates.contains(&line) {
+                crate::console::errln!("servos: bytes at {line} bps; no servo listens at that rate (they were started at {bps} bps): not heard");
+                wrong_rates.push(line);
+            }
+            continue;
+        }
+        let now = started.elapsed().as_micros() as u64;
+        pending.extend(bus.receive(&buf[..n], now, line));
+    };
+    Ok(ServeSummary {
+        robot: name.to_string(),
+        port: pty.link().display().to_string(),
+        device: pty.device().to_string(),
+        baud: bps,
+        clock: if lock_step { "lock-step" } else { "real-time" },
+        ended,
+        wall_s: started.elapsed().as_secs_f64(),
+        bus_s: bus.now_us() as f64 * 1e-6,
+        wrong_rate_bytes,
+        wrong_rates,
+        stats: bus.stats(),
+        events: bus.events().to_vec(),
+    })
+}
+
+fn device_name(id: u8) -> String {
+    if id == pada_firmware::sensor_device::SENSOR_ID {
+        "sensor device".to_string()
+    } else {
+        format!("servo {id}")
+    }
+}

@@ -1,0 +1,291 @@
+//! `pada drive` against `pada servos` over a pseudo-terminal, with no
+//! hardware: the PC's controller on virtual servos in lock step learns
+//! what `pada run --board` learns for the same seed, torque goes off at
+//! the end and on Ctrl-C, and bad input (a servo of another model, a
+//! missing servo) is one line with torque off.
+
+mod common;
+
+use common::ok;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+const PADA: &str = env!("CARGO_BIN_EXE_pada");
+
+fn arm() -> String {
+    format!("{}/../examples/robots/arm2/robot.toml", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// `pada servos --port DIR/dxl --json` with `args`, started and its port
+/// there.
+struct Servos {
+    child: Option<Child>,
+    port: PathBuf,
+}
+
+impl Servos {
+    fn start(dir: &Path, args: &[&str]) -> Servos {
+        let port = dir.join("dxl");
+        let child = Command::new(PADA)
+            .args(["servos", "--port", port.to_str().unwrap(), "--json", "--seconds", "600"])
+            .args(args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("pada servos starts");
+        let deadline = Instant::now() + Duration::from_secs(30);
+        while std::fs::symlink_metadata(&port).is_err() {
+            assert!(Instant::now() < deadline, "pada servos made no port");
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        Servos { child: Some(child), port }
+    }
+
+    fn port(&self) -> &str {
+        self.port.to_str().unwrap()
+    }
+
+    /// Stops it as Ctrl-C does; its summary.
+    fn stop(mut self) -> serde_json::Value {
+        let child = self.child.take().unwrap();
+        interrupt(&child);
+        let out = child.wait_with_output().unwrap();
+        let stdout = ok(&out);
+        serde_json::from_str(&stdout).expect("the summary is JSON")
+    }
+}
+
+impl Drop for Servos {
+    fn drop(&mut self) {
+        if let Some(mut c) = self.child.take() {
+            let _ = c.kill();
+            let _ = c.wait();
+        }
+    }
+}
+
+fn interrupt(child: &Child) {
+    let pid = rustix::process::Pid::from_child(child);
+    rustix::process::kill_process(pid, rustix::process::Signal::INT).expect("SIGINT");
+}
+
+/// What servo `id` did, in order (`torque-on`, `torque-off`, …).
+fn events(summary: &serde_json::Value, id: u64) -> Vec<String> {
+    summary["events"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|e| e["id"] == id)
+        .map(|e| e["what"].as_str().unwrap().to_string())
+        .collect()
+}
+
+fn drive(args: &[&str]) -> std::process::Output {
+    Command::new(PADA).arg("drive").args(args).output().expect("pada drive runs")
+}
+
+#[test]
+fn drive_on_virtual_servos_in_lock_step_learns_as_pada_run_board() {
+    let dir = tempfile::tempdir().unwrap();
+    let servos = Servos::start(dir.path(), &["--robot", "pendulum", "--lockstep"]);
+    let out = dir.path().join("drive");
+    let o = drive(&[
+        "--port", servos.port(), "--robot", "pendulum", "--lockstep", "--board", "f405", "--algo", "pada", "--seed", "3",
+        "--seconds", "30", "--out", out.to_str().unwrap(),
+    ]);
+    let stdout = ok(&o);
+    assert!(stdout.contains("0 overruns"), "{stdout}");
+    let summary = servos.stop();
+    // Torque on for the episodes, off at the end.
+    let servo = events(&summary, 1);
+    assert_eq!(servo.first().map(String::as_str), Some("torque-on"), "{servo:?}");
+    assert_eq!(servo.last().map(String::as_str), Some("torque-off"), "{servo:?}");
+    assert_eq!(summary["stats"]["damaged"], 0);
+
+    let run = dir.path().join("run");
+    ok(&common::pada(&[
+        "run", "--board", "f405", "--task", "physical-pendulum", "--algo", "pada", "--seed", "3", "--seconds", "30",
+        "--trials", "1", "--out", run.to_str().unwrap(),
+    ]));
+    let curve = |d: &Path| std::fs::read_to_string(d.join("trial-000.csv")).unwrap();
+    let (driven, simulated) = (curve(&out), curve(&run));
+    assert!(driven.lines().count() >= 3, "a test episode before and after learning: {driven}");
+    assert_eq!(driven, simulated, "the learning curve over the pty is pada run --board's, episode for episode");
+
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("drive.json")).unwrap()).unwrap();
+    assert_eq!(report["ended"]["kind"], "done");
+    assert_eq!(report["bus"]["checksum_errors"], 0);
+    assert_eq!(report["bus"]["timeouts"], 0, "every request answered");
+    assert!(report["clock"]["periods"].as_u64().unwrap() >= 1000, "{}", report["clock"]);
+}
+
+#[test]
+fn the_arm_of_files_on_protocol_2_in_lock_step_learns_as_pada_run_board() {
+    let dir = tempfile::tempdir().unwrap();
+    let arm = arm();
+    let servos = Servos::start(dir.path(), &["--robot", &arm, "--lockstep"]);
+    let out = dir.path().join("drive");
+    let o = drive(&[
+        "--port", servos.port(), "--robot", &arm, "--lockstep", "--board", "f405", "--algo", "pada", "--seed", "1", "--seconds", "30",
+        "--json", "--out", out.to_str().unwrap(),
+    ]);
+    let report: serde_json::Value = serde_json::from_str(&ok(&o)).expect("drive.json on stdout");
+    let summary = servos.stop();
+    assert_eq!(report["ended"]["kind"], "done");
+    // One FAST SYNC READ (16 B out, 62 B back), Torque Enable (13 B) and one
+    // SYNC WRITE of Goal PWM (20 B) a period: 111 bytes.
+    assert_eq!(report["bus"]["fast_sync_read"], true);
+    assert_eq!(report["bus"]["timeouts"], 0, "every request answered");
+    let per_period = report["bus"]["bytes_per_period"].as_f64().unwrap();
+    assert!((per_period - 111.0).abs() < 1.0, "{per_period}");
+    for id in [1, 2] {
+        let servo = events(&summary, id);
+        assert_eq!(servo.last().map(String::as_str), Some("torque-off"), "servo {id}: {servo:?}");
+    }
+    assert!(summary["stats"]["sync_writes"].as_u64().unwrap() >= 1000);
+    // The learning curve of `pada run --board` on the same arm: the X-series
+    // servos' own units on both paths, and the operator's calls heard.
+    let run = dir.path().join("run");
+    ok(&common::pada(&[
+        "run", "--board", "f405", "--robot", &arm, "--algo", "pada", "--seed", "1", "--seconds", "30", "--trials", "1",
+        "--out", run.to_str().unwrap(),
+    ]));
+    let curve = |d: &Path| std::fs::read_to_string(d.join("trial-000.csv")).unwrap();
+    assert!(curve(&out).lines().count() >= 3);
+    assert_eq!(curve(&out), curve(&run), "the arm over the pty learns as pada run --board's, episode for episode");
+}
+
+#[test]
+fn ctrl_c_turns_torque_off_and_keeps_the_log() {
+    let dir = tempfile::tempdir().unwrap();
+    let servos = Servos::start(dir.path(), &["--robot", "pendulum", "--lockstep"]);
+    let out = dir.path().join("drive");
+    let child = Command::new(PADA)
+        .args(["drive", "--port", servos.port(), "--robot", "pendulum", "--lockstep", "--seconds", "100000"])
+        .args(["--out", out.to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Until it learns (the telemetry log grows), then Ctrl-C.
+    let csv = out.join("telemetry.csv");
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while std::fs::metadata(&csv).map_or(0, |m| m.len()) < 20_000 {
+        assert!(Instant::now() < deadline, "pada drive did not get going");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    interrupt(&child);
+    let o = child.wait_with_output().unwrap();
+    ok(&o);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(stderr.contains("interrupted: torque off"), "{stderr}");
+    let summary = servos.stop();
+    let servo = events(&summary, 1);
+    assert_eq!(servo.last().map(String::as_str), Some("torque-off"), "{servo:?}");
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("drive.json")).unwrap()).unwrap();
+    assert_eq!(report["ended"]["kind"], "interrupted");
+    assert!(out.join("checkpoint.bin").is_file());
+    assert!(std::fs::metadata(&csv).unwrap().len() >= 20_000);
+}
+
+/// Exit code 2, one line, every needle.
+fn bad_input(o: &std::process::Output, needles: &[&str]) {
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error: ")).collect();
+    assert_eq!(errors.len(), 1, "{stderr}");
+    for n in needles {
+        assert!(errors[0].contains(n), "{:?} lacks {n:?}", errors[0]);
+    }
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
+#[test]
+fn a_servo_of_another_model_and_a_missing_servo_are_one_line_each() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o");
+    let out = out.to_str().unwrap();
+    // The pendulum on an XM430-W350, driven as if it were an XL430-W250.
+    let servos = Servos::start(dir.path(), &["--robot", "pendulum", "--servo", "XM430-W350"]);
+    let o = drive(&["--port", servos.port(), "--robot", "pendulum", "--servo", "XL430-W250", "--seconds", "5", "--out", out]);
+    bad_input(&o, &["servo 1", "XM430-W350", "XL430-W250", "torque is off"]);
+    // The RX-28 pendulum on a bus of X-series servos: nobody answers
+    // Protocol 1.0 at ID 1.
+    let o = drive(&["--port", servos.port(), "--robot", "pendulum", "--seconds", "5", "--out", out]);
+    bad_input(&o, &["servo 1", "does not answer", "--scan", "torque is off"]);
+    let summary = servos.stop();
+    assert!(events(&summary, 1).iter().all(|e| e != "torque-on"), "torque never went on: {}", summary["events"]);
+    // A port that is not there.
+    let o = drive(&["--port", dir.path().join("nothing").to_str().unwrap(), "--robot", "pendulum", "--out", out]);
+    bad_input(&o, &["no such device"]);
+}
+
+#[test]
+fn a_hardware_alert_turns_every_servos_torque_off_in_its_period_and_is_in_the_telemetry() {
+    let dir = tempfile::tempdir().unwrap();
+    let arm = arm();
+    // The elbow's overload at 3 s of bus time (period 100 of 30 ms).
+    let servos = Servos::start(dir.path(), &["--robot", &arm, "--lockstep", "--fault", "error-bits:at=3:servo=2:bits=overload"]);
+    let out = dir.path().join("drive");
+    let o = drive(&["--port", servos.port(), "--robot", &arm, "--lockstep", "--seconds", "30", "--out", out.to_str().unwrap()]);
+    bad_input(&o, &["servo 2 (elbow)", "hardware alert", "overload", "torque is off on every servo"]);
+    let summary = servos.stop();
+    let at = |id: u64, what: &str| {
+        summary["events"].as_array().unwrap().iter().find(|e| e["id"] == id && e["what"] == what).map(|e| e["at_us"].as_u64().unwrap())
+    };
+    let alert = at(2, "alert").expect("the alert was raised");
+    assert_eq!(alert, 3_000_000);
+    // Servo 1 (no alert of its own) off within one period of the alert.
+    let off = at(1, "torque-off").expect("servo 1's torque went off");
+    assert!(off >= alert && off - alert <= 30_000, "alert at {alert} µs, servo 1 off at {off} µs");
+    let csv = std::fs::read_to_string(out.join("telemetry.csv")).unwrap();
+    assert!(csv.lines().any(|l| l.contains(",fault,") && l.contains("hardware-alert") && l.contains("servo: 2")), "{csv}");
+}
+
+#[test]
+fn a_storm_of_damaged_answers_faults_with_torque_off_in_its_period() {
+    let dir = tempfile::tempdir().unwrap();
+    let servos = Servos::start(dir.path(), &["--robot", "pendulum", "--lockstep", "--fault", "corrupt:at=2:for=5:servo=1"]);
+    let out = dir.path().join("drive");
+    let o = drive(&["--port", servos.port(), "--robot", "pendulum", "--lockstep", "--seconds", "30", "--out", out.to_str().unwrap()]);
+    bad_input(&o, &["damaged answers", "torque is off on every servo"]);
+    let summary = servos.stop();
+    let at = |what: &str| {
+        summary["events"].as_array().unwrap().iter().find(|e| e["id"] == 1 && e["what"] == what).map(|e| e["at_us"].as_u64().unwrap())
+    };
+    let (corrupt, off) = (at("corrupt").expect("the fault began"), at("torque-off").expect("torque went off"));
+    assert!(off >= corrupt && off - corrupt <= 30_000, "corrupted from {corrupt} µs, torque off at {off} µs");
+    assert!(out.join("telemetry.csv").is_file() && out.join("checkpoint.bin").is_file());
+}
+
+#[test]
+fn a_port_that_goes_away_mid_run_is_one_line_and_the_log_is_kept() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut servos = Servos::start(dir.path(), &["--robot", "pendulum", "--lockstep"]);
+    let out = dir.path().join("drive");
+    let child = Command::new(PADA)
+        .args(["drive", "--port", servos.port(), "--robot", "pendulum", "--lockstep", "--seconds", "100000"])
+        .args(["--out", out.to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let csv = out.join("telemetry.csv");
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while std::fs::metadata(&csv).map_or(0, |m| m.len()) < 20_000 {
+        assert!(Instant::now() < deadline, "pada drive did not get going");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    // The adapter pulled: the virtual servos' process killed outright.
+    let mut s = servos.child.take().unwrap();
+    s.kill().unwrap();
+    s.wait().unwrap();
+    let o = child.wait_with_output().unwrap();
+    bad_input(&o, &["went away", "power", "the checkpoint and the log are saved"]);
+    for f in ["drive.json", "checkpoint.bin", "trial-000.csv"] {
+        assert!(out.join(f).is_file(), "{f}");
+    }
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("drive.json")).unwrap()).unwrap();
+    assert_eq!(report["ended"]["kind"], "port-gone", "{}", report["ended"]);
+}
