@@ -27,6 +27,7 @@ mod tasks;
 use core::fmt::Write as _;
 use defmt::{info, unwrap};
 use embassy_executor::Spawner;
+use static_cell::StaticCell;
 use pada_core::checkpoint::CheckpointStore;
 use pada_core::policy::PolicyKind;
 use pada_core::weights::WeightStore;
@@ -81,7 +82,9 @@ async fn main(spawner: Spawner) {
     };
 
     // DEFAULT_SEED on a real board; the emulated boards take the run's.
-    let mut ctl: Ctl = match Ctl::new(table::this_robot(), PROFILE, BOOT_POLICY, table::take(table_memory), board.seed) {
+    // In a static, built in place (Controller::new_in says why).
+    static CTL: StaticCell<Ctl> = StaticCell::new();
+    let ctl: &'static mut Ctl = match Ctl::new_in(CTL.uninit(), table::this_robot(), PROFILE, BOOT_POLICY, table::take(table_memory), board.seed) {
         Ok(ctl) => ctl,
         // The profiles are constants checked by the host tests.
         Err(e) => defmt::panic!("controller configuration: {}", defmt::Debug2Format(&e)),
@@ -109,9 +112,9 @@ async fn main(spawner: Spawner) {
             ctl.checkpoint_bytes(),
             board.flash.capacity()
         );
-        host_kept::restore_from_host(&mut ctl).await;
+        host_kept::restore_from_host(ctl).await;
     } else {
-        tasks::boot_checkpoint(&mut ctl, &board.flash).await;
+        tasks::boot_checkpoint(ctl, &board.flash).await;
     }
     // After the checkpoint, which may restore another policy or the switch.
     channels::send_reliable(ToHost::Policy(ctl.policy_report())).await;

@@ -168,8 +168,8 @@ pub async fn watchdog(mut wd: Watchdog, mut led: Led) -> ! {
 
 /// Everything the control loop owns.
 pub struct ControlLoop {
-    /// The controller on the image's table.
-    pub ctl: Ctl,
+    /// The controller on the image's table (in main's static).
+    pub ctl: &'static mut Ctl,
     /// Encoder and foot switches.
     pub sensors: BoardSensors,
     /// The checkpoint slots.

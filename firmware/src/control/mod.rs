@@ -161,6 +161,37 @@ where
     /// robot must be `robot`'s), learning with `policy` on `weights`,
     /// initialised from `seed` (also the generator of every action).
     pub fn new(robot: R, profile: LearnerProfile, policy: PolicyKind, weights: W, seed: u64) -> Result<Self, ConfigError> {
+        let mut controller = Self::without_agent(robot, profile, policy, &weights, seed)?;
+        controller.build(policy, weights)?;
+        Ok(controller)
+    }
+
+    /// The same as [`Controller::new`], written into `slot` (a static's
+    /// memory) before its agent is built and its weights initialised there.
+    ///
+    /// Why: the controller is as large as its agent (tens of KiB), and
+    /// `new` returns it by value, so its frame holds a whole controller
+    /// while the weights are initialised. On the F405 the stack ends where
+    /// the table's SRAM part begins, and that frame reached into the table:
+    /// the initialised weights and the controller overwrote each other
+    /// (the pendulum's SIL replay found it). Here the agent is built by
+    /// [`Controller::build`] on the controller in its final place, and the
+    /// weights are initialised after the largest frame has returned.
+    pub fn new_in(
+        slot: &mut core::mem::MaybeUninit<Self>,
+        robot: R,
+        profile: LearnerProfile,
+        policy: PolicyKind,
+        weights: W,
+        seed: u64,
+    ) -> Result<&mut Self, ConfigError> {
+        let controller = slot.write(Self::without_agent(robot, profile, policy, &weights, seed)?);
+        controller.build(policy, weights)?;
+        Ok(controller)
+    }
+
+    /// Everything but the agent (`None`), checked against `weights`.
+    fn without_agent(robot: R, profile: LearnerProfile, policy: PolicyKind, weights: &W, seed: u64) -> Result<Self, ConfigError> {
         let spec = robot.spec();
         if profile.robot != spec {
             return Err(ConfigError::new("profile.robot", profile.robot.definition_hash() as f32, "the controller's robot"));
@@ -174,7 +205,7 @@ where
         let safety = Safety::new(safety_config(soft_limits(spec)))?;
         let fatigue = FatigueCounter::with_gearboxes(|j| spec.joint_gearbox(j), spec.period_s(), Some(PAPER_WINDOW_STEPS))
             .map_err(|_| ConfigError::new("fatigue", 0.0, "valid gearbox parameters (Eqs. 3-7)"))?;
-        let mut controller = Controller {
+        let controller = Controller {
             profile,
             spec,
             robot,
@@ -204,7 +235,6 @@ where
             governor: None,
             host_generation: 0,
         };
-        controller.build(policy, weights)?;
         Ok(controller)
     }
 
