@@ -4,7 +4,7 @@
 //! mixed in; and the same stream from a file.
 //!
 //! `tests/data/sil-pendulum-3s.bin` (repository root) is the raw USART2 stream of
-//! `pada sil --task pendulum --seconds 3` (telemetry.bin; wire protocol 9).
+//! `pada sil --task pendulum --seconds 3` (telemetry.bin; wire protocol 10).
 //! Regenerate it with that command when the wire format changes.
 //! `tests/data/sil-pendulum-3s-protocol8.bin` is the same run recorded by
 //! an older pada (protocol 8), which a capture refuses in one line.
@@ -173,7 +173,7 @@ fn a_recording_of_an_older_protocol_is_refused_in_one_line() {
     let old = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/sil-pendulum-3s-protocol8.bin");
     common::assert_bad_input(
         &["capture", "--file", old],
-        &["telemetry protocol 8", "this pada reads protocol 9", "an older pada wrote it"],
+        &["telemetry protocol 8", "this pada reads protocol 10", "an older pada wrote it"],
     );
 }
 
