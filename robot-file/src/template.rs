@@ -30,7 +30,7 @@ servo = "XM430-W350"      # RX-28, MX-28, XM430-W350, XL430-W250 or XL330-M288
 id = 1                    # its bus ID
 zero_count = 2048         # its position count at joint angle 0
 sign = 1                  # 1 if the angle grows with the count, -1 if not
-soft_limit_rad = [-2.0, 2.0]   # past these the robot faults, torque off
+soft_limit_rad = [-2.5, 2.5]   # past these the robot faults, torque off
 start_rad = 0.0           # its angle in the start pose
 # learned = true          # the learner drives it (default); false: held by
 # hold_gain_v_per_rad = 5 #   a P law with this gain towards hold_target_rad
@@ -78,11 +78,13 @@ weight = -1.0
 term = "action"           # -0.01 per V squared
 weight = -0.01
 
-# Limits that end an episode, with their reward (optional).
-# [[end]]
-# signal = "tip.z"
-# range = [0.0, 1.0]
-# reward = -10.0
+# Limits that end an episode, with their reward (optional). Here the arm's
+# fall ends it well inside the soft limits: past those the robot faults and
+# waits for you, while an end lets the reset bring it back by itself.
+[[end]]
+signal = "shoulder.angle"
+range = [-1.9, 1.9]
+reward = -10.0
 
 # Between episodes on the robot: every joint held towards the start pose.
 [reset]
