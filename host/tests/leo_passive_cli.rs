@@ -140,14 +140,17 @@ fn help_explains_the_rollout() {
 
 #[test]
 fn a_closed_pipe_is_a_one_line_error() {
+    // A pipe whose reading end is closed before pada starts: every write
+    // fails, however fast pada is (closing it after the spawn raced a
+    // fast run, which wrote its rollout into the pipe's buffer first).
+    let (reader, writer) = std::io::pipe().expect("a pipe");
+    drop(reader);
     let mut child = Command::new(env!("CARGO_BIN_EXE_pada"))
         .args(["leo", "passive", "--json"])
-        .stdout(Stdio::piped())
+        .stdout(writer)
         .stderr(Stdio::piped())
         .spawn()
         .expect("pada runs");
-    // Close the reading end before pada has simulated anything.
-    drop(child.stdout.take());
     let mut stderr = String::new();
     child
         .stderr
