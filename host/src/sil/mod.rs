@@ -30,6 +30,7 @@
 //! them is `pada_firmware::sil`.
 
 pub mod bus;
+pub mod bus_v2;
 pub mod check;
 pub mod config;
 pub mod fault;
