@@ -217,3 +217,53 @@ pub fn drives(p: &dxl2::InstructionPacket<PACKET_LEN>) -> bool {
     !matches!(p.instruction(), Ok(I::Ping | I::Read { .. } | I::SyncRead { .. } | I::FastSyncRead { .. } | I::BulkRead { .. } | I::FastBulkRead { .. }))
         && p.id != SENSOR_ID
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::bus::{BusEmulator, BYTE_US};
+    use crate::robots::SilTask;
+    use crate::sil::fault;
+    use pada_core::dynamixel::control_table::x_series;
+    use pada_core::dynamixel::v2::encoders;
+    use pada_core::dynamixel::BROADCAST_ID;
+    use pada_firmware::bus::v2::{fast_reply_len, PRESENT_LEN};
+
+    fn arm() -> SilTask {
+        SilTask::of_file(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/robots/arm2/robot.toml")).unwrap()
+    }
+
+    fn packet(f: impl FnOnce(&mut [u8]) -> usize) -> Vec<u8> {
+        let mut buf = [0u8; 256];
+        let n = f(&mut buf);
+        buf[..n].to_vec()
+    }
+
+    #[test]
+    fn the_arms_x_series_servos_answer_a_fast_sync_read_and_drive_the_rig() {
+        let task = arm();
+        let mut rig = task.rig().unwrap();
+        let faults = vec![fault::parse("drop:at=1:for=1:servo=1").unwrap()];
+        let mut bus = BusEmulator::new(rig.as_ref(), task.robot(), faults).unwrap();
+        let read = packet(|b| encoders::fast_sync_read(x_series::PRESENT_BLOCK, PRESENT_LEN, &[1, 2], b).unwrap().len());
+        let replies = bus.receive(1000, &read, rig.as_mut());
+        assert_eq!(replies.len(), 1, "one reply for both servos");
+        let n = fast_reply_len(2);
+        assert_eq!(replies[0].bytes.len(), n);
+        // The factory Return Delay Time: 500 µs.
+        assert_eq!(replies[0].at_us, 1000 + read.len() as u64 * BYTE_US + 500 + n as u64 * BYTE_US);
+        assert!(bus.forecast(2000, &read, rig.as_ref()).is_none(), "no forecasts on Protocol 2.0");
+        // PWM mode, torque on, Goal PWM: the servos drive their joints.
+        let mode = packet(|b| encoders::write(BROADCAST_ID, x_series::OPERATING_MODE, &[16], b).unwrap().len());
+        let torque = packet(|b| encoders::write(BROADCAST_ID, x_series::TORQUE_ENABLE, &[1], b).unwrap().len());
+        let pwm = packet(|b| encoders::sync_write_values(x_series::GOAL_PWM, &[(1, 300i16.to_le_bytes()), (2, 0i16.to_le_bytes())], b).unwrap().len());
+        assert!(bus.receive(3000, &[mode, torque, pwm].concat(), rig.as_mut()).is_empty());
+        assert_eq!((bus.torque(1), bus.torque(2)), (Some(true), Some(true)));
+        assert!(rig.gear_torque(1).abs() > 0.0, "Goal PWM 300 turns the shoulder");
+        // servo 1's answers dropped from 1 s to 2 s: the fast reply (its
+        // first block) with them.
+        assert!(bus.receive(1_500_000, &read, rig.as_mut()).is_empty());
+        assert_eq!(bus.receive(2_500_000, &read, rig.as_mut()).len(), 1);
+        let stats = bus.stats();
+        assert_eq!((stats.packets, stats.replies, stats.dropped, stats.bad_packets), (6, 2, 1, 0));
+    }
+}
