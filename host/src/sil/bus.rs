@@ -560,15 +560,16 @@ impl BusEmulator {
         a
     }
 
-    /// A Protocol 2.0 answer at `t` after the faults in force then (its
-    /// hardware alert was raised by the servo itself); changes nothing.
+    /// A Protocol 2.0 answer at `t` after the faults in force then on any
+    /// servo whose answer it carries (a fast reply is lost with any block;
+    /// the hardware alert was raised by the servo itself); changes nothing.
     fn answer2(&self, t: u64, x: bus_v2::XAnswer, request: &[u8]) -> Answer {
         let mut a = Answer::default();
         let mut delay = 0;
         let mut bytes = x.bytes;
         if !x.sensor {
             for (k, (f, trace)) in self.faults.iter().zip(&self.traces).enumerate() {
-                if !f.applies(t, x.id) {
+                if !x.ids.iter().any(|&id| f.applies(t, id)) {
                     continue;
                 }
                 if trace.onset_us.is_none() {
@@ -581,7 +582,8 @@ impl BusEmulator {
                     }
                     FaultKind::Corrupt => a.corrupted = true,
                     FaultKind::Delay { us } => delay = delay.max(us),
-                    FaultKind::ErrorBits { .. } | FaultKind::PastLimit => {}
+                    FaultKind::PastLimit => a.past_limit = true,
+                    FaultKind::ErrorBits { .. } => {}
                 }
             }
         }

@@ -28,8 +28,9 @@ const BUS_BPS: u32 = 1_000_000;
 /// What a packet to the X-series servos gets.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct XAnswer {
-    /// The servo that answers (a fast read's: its first servo).
-    pub id: u8,
+    /// The servos whose answer it carries (a fast read's: every block's,
+    /// the first sends it).
+    pub ids: Vec<u8>,
     /// The status packet.
     pub bytes: Vec<u8>,
     /// That servo's Return Delay Time \[µs\] (the sensor device: 50).
@@ -135,7 +136,7 @@ impl XServos {
             }
             let (answer, _call) = self.sensor.execute(ServoProtocol::V2, p.instruction, &p.params);
             let answers = match (answer, self.sensor_answers) {
-                (Some(bytes), true) => vec![XAnswer { id: SENSOR_ID, bytes, return_delay_us: 50, alert: false, sensor: true }],
+                (Some(bytes), true) => vec![XAnswer { ids: vec![SENSOR_ID], bytes, return_delay_us: 50, alert: false, sensor: true }],
                 _ => Vec::new(),
             };
             return Some(answers);
@@ -172,7 +173,7 @@ impl XServos {
                 (Some((e, data)), true) => blocks.push((s.id(), e, data)),
                 (Some(a), false) => {
                     let alert = a.0.alert();
-                    answers.push(XAnswer { id: s.id(), bytes: p2::encode(s.id(), a), return_delay_us: s.return_delay_us(), alert, sensor: false });
+                    answers.push(XAnswer { ids: vec![s.id()], bytes: p2::encode(s.id(), a), return_delay_us: s.return_delay_us(), alert, sensor: false });
                 }
                 (None, _) => {}
             }
@@ -186,7 +187,8 @@ impl XServos {
             if let Some(bytes) = p2::fast_reply(&blocks) {
                 let first = at(&self.servos, blocks[0].0).unwrap_or(0);
                 let alert = blocks.iter().any(|b| b.1.alert());
-                answers.push(XAnswer { id: blocks[0].0, bytes, return_delay_us: self.servos[first].return_delay_us(), alert, sensor: false });
+                let ids = blocks.iter().map(|b| b.0).collect();
+                answers.push(XAnswer { ids, bytes, return_delay_us: self.servos[first].return_delay_us(), alert, sensor: false });
             }
         }
         Some(answers)
@@ -264,7 +266,7 @@ mod tests {
         rig.advance_to(300_000);
         assert!((rig.joint_state(300_000, 1).angle - before).abs() > 1e-3, "Goal PWM 300 turns the shoulder");
         // servo 1's answers dropped from 1 s to 2 s: the fast reply (its
-        // first block) with them.
+        // block) with them.
         assert!(bus.receive(1_500_000, &read, rig.as_mut()).is_empty());
         assert_eq!(bus.receive(2_500_000, &read, rig.as_mut()).len(), 1);
         let stats = bus.stats();
