@@ -140,23 +140,6 @@ impl SilTask {
         // Absolute, because `cargo xtask` builds the image elsewhere.
         let path = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
         let file = pada_robot_file::load(&path).map_err(|e| anyhow::anyhow!("{e}"))?;
-        // The firmware speaks each servo's protocol; the emulated bus of
-        // `pada sil` (crate::sil::bus) answers Protocol 1.0 only.
-        let v2: Vec<&str> = file
-            .spec
-            .joints
-            .iter()
-            .filter(|j| j.servo.protocol == pada_core::servo::ServoProtocol::V2)
-            .map(|j| j.servo.name)
-            .collect();
-        if !v2.is_empty() {
-            anyhow::bail!(
-                "{}: its servos ({}) speak Dynamixel Protocol 2.0, which pada sil's emulated bus does not answer yet; \
-                 run it against virtual servos on a pty: `pada servos --robot FILE --lockstep` and `pada drive --robot FILE --lockstep` (docs/servos.md)",
-                path.display(),
-                v2.join(", ")
-            );
-        }
         let sim = from_file(&file)?;
         Ok(SilTask::File(Box::leak(Box::new(FileRobot { path, sim }))))
     }
@@ -265,10 +248,13 @@ mod tests {
     }
 
     #[test]
-    fn pada_sil_refuses_a_robot_of_protocol_2_servos_in_one_line() {
+    fn pada_sil_takes_a_robot_of_protocol_2_servos() {
         let arm = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/robots/arm2/robot.toml");
-        let e = SilTask::of_file(&arm).err().expect("refused").to_string();
-        assert!(e.contains("XM430-W350, XL430-W250") && e.contains("Protocol 2.0") && e.contains("pada servos"), "{e}");
+        let task = SilTask::of_file(&arm).expect("the arm of X-series servos runs in pada sil");
+        assert_eq!(task.robot().name, "arm2");
+        assert!(task.robot().joints.iter().all(|j| j.servo.protocol == pada_core::servo::ServoProtocol::V2));
+        // A file that is not there stays one line.
+        let e = SilTask::of_file(std::path::Path::new("no/such/robot.toml")).err().expect("refused").to_string();
         assert!(!e.contains('\n'), "{e}");
     }
 

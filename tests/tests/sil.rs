@@ -50,9 +50,10 @@ impl Run {
         }
     }
 
-    /// The example arm of files, learning with PADA ([`arm2_on_protocol1`]).
+    /// The example arm of files (examples/robots/arm2: two X-series
+    /// servos on Protocol 2.0), learning with PADA.
     fn arm2(seconds: f64) -> Run {
-        let task = SilTask::of_file(&arm2_on_protocol1()).unwrap_or_else(|e| panic!("{e:#}"));
+        let task = SilTask::of_file(&common::root().join("examples/robots/arm2/robot.toml")).unwrap_or_else(|e| panic!("{e:#}"));
         Run { board: Board::F405, task, policy: PolicyKind::Pada { delta: 0.5 }, seconds, faults: vec![], forecast: true, compare: false, mtbf_budget_s: None }
     }
 
@@ -83,36 +84,6 @@ impl Run {
     fn go(&self, out: &Path) -> SilSummary {
         run(&self.config(out)).unwrap_or_else(|e| panic!("SIL run failed: {e:#}"))
     }
-}
-
-/// The example arm (examples/robots/arm2) as today's servo bus reads it:
-/// its robot.toml and URDF, with each servo's zero count at 512 instead of
-/// 2048. Why: the firmware speaks Protocol 1.0 and reads every servo's
-/// Present Position in the RX-28's units (1023 counts over 300°,
-/// `pada_core::robot::hardware`), in which the X-series' centre 2048 is
-/// past the end; the first reading of the arm as written is then −5.2 rad,
-/// a soft-limit fault (in `pada run --board` as in `pada sil`). Until the
-/// firmware reads X-series positions, the same arm re-centred is what both
-/// can run. Written under the tests' target directory and only when it
-/// changes, so that its image is built once.
-fn arm2_on_protocol1() -> std::path::PathBuf {
-    let example = common::root().join("examples/robots/arm2");
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("arm2-protocol1");
-    std::fs::create_dir_all(&dir).unwrap();
-    let toml = std::fs::read_to_string(example.join("robot.toml")).unwrap();
-    let zeros = toml.lines().filter(|l| l.starts_with("zero_count = 2048")).count();
-    assert_eq!(zeros, 2, "the example arm's two servos are centred at 2048");
-    let toml: String = toml
-        .lines()
-        .map(|l| if l.starts_with("zero_count = 2048") { l.replacen("2048", "512", 1) } else { l.to_string() } + "\n")
-        .collect();
-    for (name, text) in [("robot.toml", toml), ("arm2.urdf", std::fs::read_to_string(example.join("arm2.urdf")).unwrap())] {
-        let path = dir.join(name);
-        if std::fs::read_to_string(&path).ok().as_deref() != Some(text.as_str()) {
-            std::fs::write(&path, text).unwrap();
-        }
-    }
-    dir.join("robot.toml")
 }
 
 fn check_failures(s: &SilSummary) -> Vec<String> {
@@ -373,7 +344,6 @@ fn an_image_for_another_robot_is_refused_with_what_to_build() {
 }
 
 #[test]
-#[ignore = "the example arm's X-series servos: the firmware now speaks Protocol 2.0 to them, and pada sil's emulated bus answers Protocol 1.0 only (SilTask::of_file refuses it; docs/servos.md)"]
 fn a_robot_of_files_in_qemu_replays_bit_for_bit_and_equals_pada_run_board() {
     let dir = tempfile::tempdir().unwrap();
     let mut run = Run::arm2(30.0);

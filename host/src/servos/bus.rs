@@ -24,10 +24,10 @@
 use super::p1::P1Servo;
 use super::p2::P2Servo;
 use super::sensor::SensorDevice;
-use crate::rig::{x_reading, Rig};
+use crate::rig::Rig;
 use crate::sil::fault::{FaultKind, FaultSpec};
 use pada_core::dynamixel::control_table::{self, rx28, x_series::HardwareError};
-use pada_core::dynamixel::v2::{self as dxl2, fast::FastBlock, ErrorNumber, StatusError};
+use pada_core::dynamixel::v2::{self as dxl2, ErrorNumber, StatusError};
 use pada_core::dynamixel::{self as dxl1, ErrorFlags, BROADCAST_ID};
 use pada_core::robot::{JointSpec, RobotSpec};
 use pada_core::servo::{ServoModel, ServoProtocol};
@@ -35,7 +35,7 @@ use pada_firmware::sensor_device::SENSOR_ID;
 use serde::Serialize;
 
 /// Bytes a decoder holds: the longest instruction a client sends.
-const PACKET_LEN: usize = 1024;
+use super::p2::PACKET_LEN;
 
 /// An answer on its way to the line.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -368,12 +368,7 @@ impl VirtualBus {
             Device::P2(_) => {
                 let state = self.rig.joint_state(now, joint.id);
                 if let Device::P2(s) = &mut self.devices[i] {
-                    let pwm = if s.torque() { s.goal_pwm() } else { 0 };
-                    let mut r = x_reading(&joint, state, pwm, supply);
-                    r.position = r.position.wrapping_sub(s.cleared_counts);
-                    let at = pada_core::dynamixel::control_table::x_series::PRESENT_BLOCK as usize;
-                    let bytes = r.to_bytes();
-                    s.memory[at..at + bytes.len()].copy_from_slice(&bytes);
+                    s.set_present(&joint, state, supply);
                 }
             }
         }
@@ -521,15 +516,10 @@ impl VirtualBus {
             // A servo missing from the chain: its successors wait for its
             // block that never comes, so the combined reply never completes.
             if blocks.len() == expected && !blocks.is_empty() {
-                let parts: Vec<FastBlock<'_>> = blocks.iter().map(|(id, error, data)| FastBlock { id: *id, error: *error, data }).collect();
-                if let Ok(packet) = dxl2::StatusPacket::<PACKET_LEN>::fast_reply(&parts) {
-                    let mut buf = vec![0u8; PACKET_LEN + 16];
-                    if let Ok(bytes) = packet.encode(&mut buf) {
-                        let first = blocks[0].0;
-                        let i = self.devices.iter().position(|d| dev_id(d) == first).unwrap_or(0);
-                        let bytes = bytes.to_vec();
-                        self.push_reply(i, bytes, replies);
-                    }
+                if let Some(bytes) = super::p2::fast_reply(&blocks) {
+                    let first = blocks[0].0;
+                    let i = self.devices.iter().position(|d| dev_id(d) == first).unwrap_or(0);
+                    self.push_reply(i, bytes, replies);
                 }
             }
         }
@@ -671,7 +661,7 @@ fn dev_id(d: &Device) -> u8 {
 }
 
 /// The Hardware Error Status bit of an `error-bits` fault's name.
-fn hardware_error_of(bits: ErrorFlags) -> HardwareError {
+pub(crate) fn hardware_error_of(bits: ErrorFlags) -> HardwareError {
     match bits {
         ErrorFlags::OVERLOAD => HardwareError::OVERLOAD,
         ErrorFlags::INPUT_VOLTAGE => HardwareError::INPUT_VOLTAGE,
@@ -686,9 +676,6 @@ fn encode1(id: u8, (error, params): (ErrorFlags, Vec<u8>)) -> Vec<u8> {
         .unwrap_or_default()
 }
 
-fn encode2(id: u8, (error, params): (StatusError, Vec<u8>)) -> Vec<u8> {
-    let mut buf = vec![0u8; 2 * params.len() + 16];
-    dxl2::StatusPacket::<PACKET_LEN>::new(id, error, &params)
-        .and_then(|p| p.encode(&mut buf).map(<[u8]>::to_vec))
-        .unwrap_or_default()
+fn encode2(id: u8, answer: (StatusError, Vec<u8>)) -> Vec<u8> {
+    super::p2::encode(id, answer)
 }

@@ -29,9 +29,13 @@
 
 use pada_core::dynamixel::control_table::x_series::{self, mode, HardwareError};
 use pada_core::dynamixel::control_table::{ControlTable, TableError};
-use pada_core::dynamixel::v2::{ErrorNumber, Instruction, PingReply, ResetMode, StatusError};
+use pada_core::dynamixel::v2::{self as dxl2, fast::FastBlock, ErrorNumber, Instruction, PingReply, ResetMode, StatusError};
 use pada_core::robot::JointSpec;
 use pada_core::servo::ServoModel;
+use crate::rig::{x_reading, JointState};
+
+/// Bytes of the longest packet a virtual servo decodes or answers.
+pub const PACKET_LEN: usize = 1024;
 
 /// The firmware version the virtual servos report: new enough for Fast Sync
 /// Read (X430 from 45, X330 from 46).
@@ -360,11 +364,41 @@ impl P2Servo {
         }
     }
 
+    /// Its present values (addresses 124–146) with its joint in `state` on
+    /// a `supply_v` supply (`pada_sim::rig::x_reading`), less the turns
+    /// CLEAR took off.
+    pub fn set_present(&mut self, joint: &JointSpec, state: JointState, supply_v: f64) {
+        let pwm = if self.torque() { self.goal_pwm() } else { 0 };
+        let mut r = x_reading(joint, state, pwm, supply_v);
+        r.position = r.position.wrapping_sub(self.cleared_counts);
+        let at = x_series::PRESENT_BLOCK as usize;
+        let bytes = r.to_bytes();
+        self.memory[at..at + bytes.len()].copy_from_slice(&bytes);
+    }
+
     /// The answer to an instruction it cannot execute (an unknown code, bad
     /// parameters, a damaged packet), at level 2.
     pub fn refuse(&self, broadcast: bool, number: ErrorNumber) -> Answer {
         self.answer(broadcast, 2, Some(number), Vec::new())
     }
+}
+
+/// The status packet of servo `id`'s answer.
+pub fn encode(id: u8, (error, params): (StatusError, Vec<u8>)) -> Vec<u8> {
+    let mut buf = vec![0u8; 2 * params.len() + 16];
+    dxl2::StatusPacket::<PACKET_LEN>::new(id, error, &params)
+        .and_then(|p| p.encode(&mut buf).map(<[u8]>::to_vec))
+        .unwrap_or_default()
+}
+
+/// The one status packet of a FAST SYNC READ or FAST BULK READ: each
+/// servo's block (ID, ERROR byte, data) in turn; `None` if it does not
+/// encode.
+pub fn fast_reply(blocks: &[(u8, StatusError, Vec<u8>)]) -> Option<Vec<u8>> {
+    let parts: Vec<FastBlock<'_>> = blocks.iter().map(|(id, error, data)| FastBlock { id: *id, error: *error, data }).collect();
+    let packet = dxl2::StatusPacket::<PACKET_LEN>::fast_reply(&parts).ok()?;
+    let mut buf = vec![0u8; PACKET_LEN + 16];
+    packet.encode(&mut buf).ok().map(<[u8]>::to_vec)
 }
 
 #[cfg(test)]

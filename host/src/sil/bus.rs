@@ -1,4 +1,5 @@
-//! The Dynamixel bus emulator: RX-28 servos and the sensor device,
+//! The Dynamixel bus emulator: RX-28 servos (Protocol 1.0), X-series
+//! servos (Protocol 2.0, [`super::bus_v2`]) and the sensor device,
 //! answering the firmware's instruction packets at the times a real 1 Mbps
 //! bus would, backed by a [`Rig`], with `--fault` injection.
 //!
@@ -14,6 +15,7 @@
 //! request comes, with its effects (counters, fault traces, the present
 //! values in the control table).
 
+use super::bus_v2::{self, XServos};
 use super::fault::{FaultKind, FaultSpec};
 use crate::rig::Rig;
 use pada_core::dynamixel::table::PresentState;
@@ -196,6 +198,12 @@ pub fn check_faults(robot: &RobotSpec, faults: &[FaultSpec]) -> Result<(), Strin
 pub struct BusEmulator {
     decoder: InstructionDecoder<64>,
     servos: Vec<Servo>,
+    /// The Protocol 2.0 servos, if the robot has any.
+    x: Option<XServos>,
+    /// Whether Protocol 1.0 is spoken (an RX-28, or the sensor device).
+    p1: bool,
+    /// Where the Protocol 2.0 packet being received started in the bytes.
+    x_start: usize,
     sensor: [u8; sensor_table::TABLE_LEN],
     faults: Vec<FaultSpec>,
     traces: Vec<FaultTrace>,
@@ -210,8 +218,12 @@ impl BusEmulator {
     /// `robot`'s joints), the sensor device, and `faults`; the error says
     /// why a fault cannot apply.
     pub fn new(rig: &dyn Rig, robot: &RobotSpec, faults: Vec<FaultSpec>) -> Result<Self, String> {
-        let servos = servos(robot, rig.servo_ids());
+        let mut servos = servos(robot, rig.servo_ids());
         check_faults_on(&servos, robot, &faults)?;
+        let x = XServos::new(robot, rig.servo_ids(), rig.supply_v())?;
+        let v2 = |id: u8| robot.joints.iter().any(|j| j.id == id && j.servo.protocol == pada_core::servo::ServoProtocol::V2);
+        servos.retain(|s| !v2(s.id));
+        let p1 = x.is_none() || !servos.is_empty();
         let mut sensor = [0u8; sensor_table::TABLE_LEN];
         sensor[sensor_table::MODEL_NUMBER as usize..][..2].copy_from_slice(&sensor_table::MODEL.to_le_bytes());
         sensor[table::ID as usize] = SENSOR_ID;
@@ -219,6 +231,9 @@ impl BusEmulator {
         Ok(BusEmulator {
             decoder: InstructionDecoder::new(),
             servos,
+            x,
+            p1,
+            x_start: 0,
             sensor,
             faults,
             traces,
@@ -236,12 +251,22 @@ impl BusEmulator {
             *s = Servo::new(s.id, s.joint);
             rig.drive(t_us, s.id, false, 0.0);
         }
+        if let Some(x) = &mut self.x {
+            x.power_off(t_us, rig);
+        }
+    }
+
+    /// Every servo's torque (both protocols).
+    fn torques(&self) -> Vec<bool> {
+        let mut all: Vec<bool> = self.servos.iter().map(Servo::torque).collect();
+        all.extend(self.x.iter().flat_map(|x| x.torques().map(|(_, on)| on)));
+        all
     }
 
     /// From `t_us` on (a reset), notes the first instant every servo has
     /// torque off ([`all_off_since`](Self::all_off_since)).
     pub fn watch_torque_off(&mut self, t_us: u64) {
-        let now = self.servos.iter().all(|s| !s.torque()).then_some(t_us);
+        let now = self.torques().iter().all(|on| !on).then_some(t_us);
         self.off_watch = Some((t_us, now));
     }
 
@@ -263,7 +288,8 @@ impl BusEmulator {
 
     /// Whether servo `id` has torque.
     pub fn torque(&self, id: u8) -> Option<bool> {
-        self.servos.iter().find(|s| s.id == id).map(Servo::torque)
+        let x = self.x.iter().flat_map(|x| x.torques()).find(|s| s.0 == id).map(|s| s.1);
+        self.servos.iter().find(|s| s.id == id).map(Servo::torque).or(x)
     }
 
     /// Takes the bytes the firmware sent at `now_us`; returns the answers
@@ -271,8 +297,15 @@ impl BusEmulator {
     pub fn receive(&mut self, now_us: u64, bytes: &[u8], rig: &mut dyn Rig) -> Vec<Reply> {
         let mut replies = Vec::new();
         let mut start = 0;
+        self.x_start = 0;
         for (i, &b) in bytes.iter().enumerate() {
             self.stats.bytes_in += 1;
+            if let Some(reply) = self.receive2(now_us, bytes, i, rig) {
+                replies.extend(reply);
+            }
+            if !self.p1 {
+                continue;
+            }
             let Some(result) = self.decoder.push(b) else {
                 continue;
             };
@@ -301,7 +334,9 @@ impl BusEmulator {
     /// (one whole READ or PING of one device), without changing anything;
     /// `None` if it gets none or the rig cannot tell yet.
     pub fn forecast(&self, at_us: u64, request: &[u8], rig: &dyn Rig) -> Option<Reply> {
-        if self.decoder.buffered() > 0 {
+        // The rigs cannot tell an X-series reading without simulating
+        // ahead: no forecasts on Protocol 2.0.
+        if self.x.is_some() || self.decoder.buffered() > 0 {
             // Bytes of an unfinished packet would come first.
             return None;
         }
@@ -458,8 +493,15 @@ impl BusEmulator {
         self.servos[i].table[start..end].copy_from_slice(&data[..end - start]);
         let s = &self.servos[i];
         rig.drive(t, s.id, s.torque(), s.volts(self.supply_v));
-        let all_off = self.servos.iter().all(|s| !s.torque());
-        let all_on = self.servos.iter().all(Servo::torque);
+        self.torque_changed(t);
+    }
+
+    /// Notes every servo's torque at `t` for the reset watch and the fault
+    /// traces.
+    fn torque_changed(&mut self, t: u64) {
+        let torques = self.torques();
+        let all_off = torques.iter().all(|on| !on);
+        let all_on = torques.iter().all(|on| *on);
         if let Some((from, None)) = self.off_watch {
             if all_off && t >= from {
                 self.off_watch = Some((from, Some(t)));
@@ -518,9 +560,87 @@ impl BusEmulator {
         a
     }
 
+    /// A Protocol 2.0 answer at `t` after the faults in force then on any
+    /// servo whose answer it carries (a fast reply is lost with any block;
+    /// the hardware alert was raised by the servo itself); changes nothing.
+    fn answer2(&self, t: u64, x: bus_v2::XAnswer, request: &[u8]) -> Answer {
+        let mut a = Answer::default();
+        let mut delay = 0;
+        let mut bytes = x.bytes;
+        if !x.sensor {
+            for (k, (f, trace)) in self.faults.iter().zip(&self.traces).enumerate() {
+                if !x.ids.iter().any(|&id| f.applies(t, id)) {
+                    continue;
+                }
+                if trace.onset_us.is_none() {
+                    a.onsets.push(k);
+                }
+                match f.kind {
+                    FaultKind::Drop => {
+                        a.dropped = true;
+                        return a;
+                    }
+                    FaultKind::Corrupt => a.corrupted = true,
+                    FaultKind::Delay { us } => delay = delay.max(us),
+                    FaultKind::PastLimit => a.past_limit = true,
+                    FaultKind::ErrorBits { .. } => {}
+                }
+            }
+        }
+        if a.corrupted {
+            // The first parameter (or the ERROR byte): the CRC no longer
+            // matches.
+            let k = if bytes.len() > 11 { 9 } else { 8 };
+            bytes[k] ^= 0x5A;
+        }
+        a.delayed = delay > 0;
+        a.flagged = x.alert;
+        let at_us = t + x.return_delay_us + bytes.len() as u64 * BYTE_US + delay;
+        a.reply = Some(Reply { at_us, bytes, request: request.to_vec() });
+        a
+    }
+
+    /// Byte `i` of `bytes` (sent from `now_us`) to the Protocol 2.0
+    /// servos: the answers to the packet it ends, if it ends one.
+    fn receive2(&mut self, now_us: u64, bytes: &[u8], i: usize, rig: &mut dyn Rig) -> Option<Vec<Reply>> {
+        let x = self.x.as_mut()?;
+        let result = x.push(bytes[i])?;
+        let request = bytes[self.x_start.min(i)..=i].to_vec();
+        self.x_start = i + 1;
+        let Ok(packet) = result else {
+            self.stats.bad_packets += 1;
+            return None;
+        };
+        self.stats.packets += 1;
+        let done = now_us + (i as u64 + 1) * BYTE_US;
+        let answers = {
+            let rig_cell = std::cell::RefCell::new(&mut *rig);
+            let mut read = |id: u8| Some(rig_cell.borrow_mut().joint_state(done, id));
+            let mut sensors = || Some(rig_cell.borrow_mut().sensors(done));
+            x.execute(&packet, done, &self.faults, &mut read, &mut sensors).unwrap_or_default()
+        };
+        if bus_v2::drives(&packet) {
+            x.drive(done, rig);
+            self.torque_changed(done);
+        }
+        let mut replies = Vec::new();
+        for answer in answers {
+            let sensor = answer.sensor;
+            let a = self.answer2(done, answer, &request);
+            let reply = if sensor {
+                self.stats.replies += a.reply.is_some() as u64;
+                a.reply
+            } else {
+                self.apply(0, done, a)
+            };
+            replies.extend(reply);
+        }
+        Some(replies)
+    }
+
     /// Counts `a` and opens the fault windows it is the onset of.
     fn apply(&mut self, _i: usize, t: u64, a: Answer) -> Option<Reply> {
-        let all_on = self.servos.iter().all(Servo::torque);
+        let all_on = self.torques().iter().all(|on| *on);
         for k in a.onsets {
             self.traces[k].onset_us = Some(t);
             self.traces[k].torque_at_onset = all_on;
