@@ -378,7 +378,7 @@ impl VirtualBus {
     fn plant(&self, t: u64, joint: JointSpec, mut p: pada_core::dynamixel::table::PresentState) -> pada_core::dynamixel::table::PresentState {
         let past = self.faults.iter().any(|f| f.kind == FaultKind::PastLimit && f.applies(t, joint.id));
         if let (true, Some(limit)) = (past, joint.soft_limit) {
-            p.position = joint.position_of((limit.max + crate::sil::bus::PAST_LIMIT_RAD) as f64);
+            p.position = joint.position_of((limit.max + crate::sil::fault::PAST_LIMIT_RAD) as f64);
         }
         p
     }

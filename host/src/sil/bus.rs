@@ -22,7 +22,6 @@ use pada_core::dynamixel::table::PresentState;
 use pada_core::dynamixel::{table, ErrorFlags, Instruction, InstructionDecoder, StatusPacket, BROADCAST_ID};
 use pada_core::robot::RobotSpec;
 use pada_core::safety::SoftLimit;
-use pada_core::robot::hardware::POSITION_UNIT_RAD;
 use pada_core::robot::JointSpec as Joint;
 use pada_firmware::sil::{sensor_table, SENSOR_ID};
 use serde::Serialize;
@@ -30,10 +29,7 @@ use serde::Serialize;
 /// Microseconds per byte at 1 Mbps, 8N1.
 pub const BYTE_US: u64 = 10;
 
-/// How far past its soft limit a `past-limit` fault drives a joint \[rad\]:
-/// ten of the servo's position counts, so the reading is past the limit
-/// whatever the rounding.
-pub const PAST_LIMIT_RAD: f32 = 10.0 * POSITION_UNIT_RAD;
+pub use super::fault::PAST_LIMIT_RAD;
 
 /// A status packet on its way to the firmware.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -3,7 +3,7 @@
 //! table, every instruction, alerts, the Bus Watchdog), and the sensor
 //! device in Protocol 2.0. This file decides which servos an instruction
 //! concerns and what they answer; when the answer arrives, the faults and
-//! the counters are the bus's ([`super::bus::BusEmulator`]).
+//! the counters are the bus's (the SIL bus emulator's, `BusEmulator` in sil/bus.rs).
 //!
 //! A FAST SYNC READ (the firmware's read of every servo, once a period)
 //! gets one status packet with each servo's block, after the first servo's

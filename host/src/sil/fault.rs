@@ -11,7 +11,7 @@
 //! | `corrupt` | arrive with one byte flipped (a bad checksum) |
 //! | `delay` | arrive `ms` late (default 5 ms, well past the 1 ms reply timeout) |
 //! | `error-bits` | carry error bits `bits` (`overheating` by default; `overload`, `input-voltage`) |
-//! | `past-limit` | read the servo's joint past its soft limit: the plant drives the joint [`PAST_LIMIT_RAD`](super::bus::PAST_LIMIT_RAD) beyond the upper end of the limit the firmware enforces (a joint with a soft limit only: LEO's) |
+//! | `past-limit` | read the servo's joint past its soft limit: the plant drives the joint [`PAST_LIMIT_RAD`] beyond the upper end of the limit the firmware enforces (a joint with a soft limit only: LEO's) |
 //!
 //! `at` is the emulated time since boot at which the window opens (default
 //! 10 s), `for` its length (default 1 s), `servo` the Dynamixel ID whose
@@ -19,6 +19,12 @@
 
 use pada_core::dynamixel::ErrorFlags;
 use std::fmt;
+
+/// How far past its soft limit a `past-limit` fault drives a joint \[rad\]:
+/// ten of the servo's position counts, so the reading is past the limit
+/// whatever the rounding. (Here, beside the fault, so that `pada servos`'
+/// bus takes it without importing the SIL's bus, which imports it back.)
+pub const PAST_LIMIT_RAD: f32 = 10.0 * pada_core::robot::hardware::POSITION_UNIT_RAD;
 
 /// What goes wrong.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
