@@ -13,6 +13,7 @@
 //! row per save and per restore ([`transfer`]), not one per frame; the raw
 //! stream keeps every frame.
 
+pub mod digits;
 pub mod transfer;
 
 use pada_core::wire::{Decoded, FrameError, HostDecoder, LinkStats, RunMode, StepKind, ToHost};
@@ -26,7 +27,11 @@ use std::io::Write;
 /// (`checkpoint-restore`) with its `generation`, image `bytes`, `chunks`,
 /// `link_s` (seconds on the telemetry link) and `outcome`
 /// ([`transfer::Transfer`]). Vectors (`state`, `output`, `damage`,
-/// `reengagements`) are space-separated within their cell.
+/// `reengagements`) are space-separated within their cell. Numbers are
+/// written to the digits a person reads ([`digits`]): `state` and `output`
+/// to three decimals, `reward`, `td_error` (as a real number, not the wire's
+/// raw Q15.16) and `damage` to four significant digits; `telemetry.bin`
+/// keeps them exactly.
 pub const CSV_HEADER: &[&str] = &[
     "time_s",
     "seq",
@@ -518,13 +523,13 @@ impl Recorder {
                 r[5] = s.episode.to_string();
                 r[6] = mode_name(s.mode).into();
                 r[7] = step_kind_name(s.kind).into();
-                r[8] = join(&mut s.state.iter().map(|x| x.to_string()));
+                r[8] = join(&mut s.state.iter().map(|&x| digits::fixed3(x as f64)));
                 r[9] = s.action.to_string();
-                r[10] = join(&mut s.output.iter().map(|x| x.to_string()));
-                r[11] = s.reward.to_string();
-                r[12] = s.td_error.to_string();
+                r[10] = join(&mut s.output.iter().map(|&x| digits::fixed3(x as f64)));
+                r[11] = digits::sig4(s.reward as f64);
+                r[12] = digits::sig4(s.td_error as f64 / (1u64 << pada_core::fixed::Q16_FRAC_BITS) as f64);
                 r[13] = (s.explored as u8).to_string();
-                r[14] = join(&mut s.joints.iter().map(|j| format!("{:e}", j.damage)));
+                r[14] = join(&mut s.joints.iter().map(|j| digits::sig4(j.damage)));
                 r[15] = join(&mut s.joints.iter().map(|j| j.reengagements.to_string()));
                 r[16] = s.loop_us.to_string();
                 r[17] = s.agent_cycles.to_string();
