@@ -75,3 +75,31 @@ fn a_new_robot_runs_as_written_on_the_host_and_as_the_board_would() {
     assert_bad_input(&["new-robot", "Flipper", "--dir", &parent], &["lowercase letters"]);
     assert_bad_input(&["new-robot", "leo", "--dir", &parent], &["pada's own robots"]);
 }
+
+/// A robot whose rules let it fall past a soft limit faults on the board,
+/// and nobody clears a fault in `pada run --board`: the run says so, with
+/// the cause and the way out, instead of running out its periods.
+#[test]
+fn a_robot_that_faults_on_the_board_is_told_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let parent = dir.path().display().to_string();
+    ok(&pada(&["new-robot", "faller", "--dir", &parent]));
+    let toml = dir.path().join("faller/robot.toml");
+    let text = std::fs::read_to_string(&toml).unwrap();
+    // The template's end keeps the arm inside its soft limits. Without it,
+    // and with limits narrower than the level arm the reward asks for, the
+    // arm swings past them.
+    let start = text.find("[[end]]").expect("the template has an end");
+    let stop = start + text[start..].find("\n\n").unwrap();
+    let text = format!("{}{}", &text[..start], &text[stop..]);
+    let narrow = text.replace("soft_limit_rad = [-2.5, 2.5]", "soft_limit_rad = [-0.5, 0.5]");
+    assert_ne!(narrow, text, "the template's soft limits moved");
+    std::fs::write(&toml, narrow).unwrap();
+    let (toml, out_dir) = (toml.display().to_string(), dir.path().join("run").display().to_string());
+    let out = pada(&["run", "--robot", &toml, "--board", "f405", "--algo", "sarsa", "--trials", "1", "--seconds", "120", "--out", &out_dir]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("soft-limit") && stderr.contains("shoulder"), "{stderr}");
+    assert!(stderr.contains("[[end]]"), "no way out named: {stderr}");
+    assert!(!stderr.contains("no end after"), "{stderr}");
+}
