@@ -178,20 +178,23 @@ mod tests {
 
     #[test]
     fn real_time_ticks_are_on_time_and_a_long_period_skips() {
-        let mut c = PeriodClock::new(5_000, true);
+        // A 50 ms period: long beside the few ms a loaded machine may take
+        // to wake a sleeping thread (a 5 ms period failed under load: the
+        // scheduler alone overran it).
+        let mut c = PeriodClock::new(50_000, true);
         for _ in 0..5 {
             c.tick();
             assert!(!c.done());
         }
         c.tick();
-        std::thread::sleep(Duration::from_millis(12));
-        assert!(c.done(), "12 ms of work in a 5 ms period");
+        std::thread::sleep(Duration::from_millis(120));
+        assert!(c.done(), "120 ms of work in a 50 ms period");
         let (k, _) = c.tick();
         assert!(k >= 7, "ticks missed are skipped: {k}");
         let r = c.report();
         assert_eq!(r.overruns, 1);
         assert!(r.skipped_ticks >= 1);
-        assert!(r.jitter_us.p50 < 2_000, "{:?}", r.jitter_us);
+        assert!(r.jitter_us.p50 < 10_000, "{:?}", r.jitter_us);
     }
 
     #[test]
