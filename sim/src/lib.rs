@@ -13,6 +13,7 @@
 //! | [`urdf`] | a robot of the user's own: its URDF in rapier, driven through its rules and servos |
 //! | [`integrator`] | RK4 for the pendulums |
 //! | [`model_presets`] | settings of LEO's model that its checks share |
+//! | [`world_state`] | a rapier world's state, copied and put back (LEO's snapshots, a URDF body's reset) |
 //!
 //! The robots' definitions (their rules, servos and gearboxes) are
 //! pada-core's (`pada_core::robot`, `pada_core::servo`), shared with the
@@ -26,3 +27,4 @@ pub mod rig;
 pub mod robots;
 pub mod task;
 pub mod urdf;
+pub mod world_state;

@@ -19,6 +19,7 @@ use pada_core::rx28::ReducedJoint;
 use pada_robot_file::RobotFile;
 use rapier3d::prelude::*;
 use rapier3d_urdf::{UrdfLoaderOptions, UrdfMultibodyOptions, UrdfRobot};
+use crate::world_state::WorldState;
 
 /// Gravity \[m/s²\], along −z.
 pub const GRAVITY: f32 = 9.81;
@@ -43,52 +44,13 @@ struct ServoJoint {
     servo: ReducedJoint,
 }
 
-/// The world's state as built (what a reset restores): every set and
-/// cache that a step changes.
-struct Built {
-    bodies: RigidBodySet,
-    colliders: ColliderSet,
-    impulse_joints: ImpulseJointSet,
-    multibody_joints: MultibodyJointSet,
-    islands: IslandManager,
-    broad_phase: BroadPhaseBvh,
-    narrow_phase: NarrowPhase,
-    ccd_solver: CCDSolver,
-}
-
-impl Built {
-    fn of(w: &PhysicsWorld) -> Built {
-        Built {
-            bodies: w.bodies.clone(),
-            colliders: w.colliders.clone(),
-            impulse_joints: w.impulse_joints.clone(),
-            multibody_joints: w.multibody_joints.clone(),
-            islands: w.islands.clone(),
-            broad_phase: w.broad_phase.clone(),
-            narrow_phase: w.narrow_phase.clone(),
-            ccd_solver: w.ccd_solver.clone(),
-        }
-    }
-
-    fn restore(&self, w: &mut PhysicsWorld) {
-        w.bodies.clone_from(&self.bodies);
-        w.colliders.clone_from(&self.colliders);
-        w.impulse_joints.clone_from(&self.impulse_joints);
-        w.multibody_joints.clone_from(&self.multibody_joints);
-        w.islands.clone_from(&self.islands);
-        w.broad_phase.clone_from(&self.broad_phase);
-        w.narrow_phase.clone_from(&self.narrow_phase);
-        w.ccd_solver.clone_from(&self.ccd_solver);
-    }
-}
-
 /// A robot's body, simulated.
 pub struct UrdfBody {
     world: PhysicsWorld,
     multibody: MultibodyIndex,
     joints: Vec<ServoJoint>,
     /// The world as built, before the start pose (restored at every reset).
-    built: Built,
+    built: WorldState,
     start: Vec<f32>,
     substeps: u32,
     volts: PerServo,
@@ -210,7 +172,7 @@ impl UrdfBody {
             mb.damping_mut()[j.dof] = j.servo.damping;
             mb.armature_mut()[j.dof] = j.servo.armature;
         }
-        let built = Built::of(&world);
+        let built = WorldState::of(&world);
         let mut body = UrdfBody {
             world,
             multibody,

@@ -2,6 +2,7 @@
 //! and the named constants, and the snapshots that reset it.
 
 use rapier3d::prelude::*;
+use crate::world_state::WorldState;
 
 use super::super::constants::*;
 use super::super::stiction::{FrictionState, Stiction};
@@ -235,17 +236,8 @@ impl LeoModel {
     /// put back with [`LeoModel::restore`]. Restoring a snapshot continues
     /// exactly (bit for bit) as the original did from that point.
     pub fn snapshot(&self) -> Snapshot {
-        let w = &self.world;
         Snapshot {
-            bodies: w.bodies.clone(),
-            colliders: w.colliders.clone(),
-            impulse_joints: w.impulse_joints.clone(),
-            multibody_joints: w.multibody_joints.clone(),
-            soft_bodies: w.soft_bodies.clone(),
-            islands: w.islands.clone(),
-            broad_phase: w.broad_phase.clone(),
-            narrow_phase: w.narrow_phase.clone(),
-            ccd_solver: w.ccd_solver.clone(),
+            world: WorldState::of(&self.world),
             voltages: self.voltages,
             time: self.time,
             stepped: self.stepped,
@@ -255,16 +247,7 @@ impl LeoModel {
 
     /// Puts a snapshot of this model back (see [`LeoModel::snapshot`]).
     pub fn restore(&mut self, snapshot: &Snapshot) {
-        let w = &mut self.world;
-        w.bodies.clone_from(&snapshot.bodies);
-        w.colliders.clone_from(&snapshot.colliders);
-        w.impulse_joints.clone_from(&snapshot.impulse_joints);
-        w.multibody_joints.clone_from(&snapshot.multibody_joints);
-        w.soft_bodies.clone_from(&snapshot.soft_bodies);
-        w.islands.clone_from(&snapshot.islands);
-        w.broad_phase.clone_from(&snapshot.broad_phase);
-        w.narrow_phase.clone_from(&snapshot.narrow_phase);
-        w.ccd_solver.clone_from(&snapshot.ccd_solver);
+        snapshot.world.restore(&mut self.world);
         self.voltages = snapshot.voltages;
         self.time = snapshot.time;
         self.stepped = snapshot.stepped;

@@ -66,6 +66,7 @@ pub use state::{Energy, RawState};
 
 use pada_core::rx28::ReducedJoint;
 use rapier3d::prelude::*;
+use crate::world_state::WorldState;
 
 use super::stiction::{FrictionState, Stiction};
 
@@ -105,15 +106,7 @@ pub struct LeoModel {
 /// A copy of a [`LeoModel`]'s state (see [`LeoModel::snapshot`]).
 #[derive(Clone)]
 pub struct Snapshot {
-    bodies: RigidBodySet,
-    colliders: ColliderSet,
-    impulse_joints: ImpulseJointSet,
-    multibody_joints: MultibodyJointSet,
-    soft_bodies: SoftBodySet,
-    islands: IslandManager,
-    broad_phase: BroadPhaseBvh,
-    narrow_phase: NarrowPhase,
-    ccd_solver: CCDSolver,
+    world: WorldState,
     voltages: [f32; NUM_JOINTS],
     time: f64,
     stepped: bool,
