@@ -262,6 +262,33 @@ fn a_hardware_alert_turns_every_servos_torque_off_in_its_period_and_is_in_the_te
     assert!(csv.lines().any(|l| l.contains(",fault,") && l.contains("hardware-alert") && l.contains("servo: 2")), "{csv}");
 }
 
+/// After a hardware alert the servo keeps its torque off until a REBOOT:
+/// `pada drive` names `pada servos --reboot`, which clears it, and the
+/// next run goes.
+#[test]
+fn a_hardware_alert_is_cleared_by_pada_servos_reboot_and_the_next_run_goes() {
+    let dir = tempfile::tempdir().unwrap();
+    let arm = arm();
+    let servos = Servos::start(dir.path(), &["--robot", &arm, "--lockstep", "--fault", "error-bits:at=1:servo=2:bits=overheating"]);
+    let out = dir.path().join("drive");
+    let out = out.to_str().unwrap();
+    let run = |seconds: &str| drive(&["--port", servos.port(), "--robot", &arm, "--lockstep", "--seconds", seconds, "--out", out]);
+    bad_input(&run("10"), &["servo 2 (elbow)", "hardware alert", "overheating", "pada servos --reboot 2"]);
+    // Still latched: the next run refuses at its set-up, with the same way out.
+    bad_input(&run("2"), &["servo 2 (elbow, XL430-W250)", "hardware error", "pada servos --reboot 2"]);
+    let reboot = |id: &str| Command::new(PADA).args(["servos", "--reboot", id, "--port", servos.port()]).output().unwrap();
+    let r = reboot("2");
+    let stdout = String::from_utf8_lossy(&r.stdout);
+    assert_eq!(r.status.code(), Some(0), "{}", String::from_utf8_lossy(&r.stderr));
+    assert!(stdout.contains("servo 2 (XL430-W250) rebooted at 1000000 bps; hardware error before: overheating"), "{stdout}");
+    // An ID nobody has is one line.
+    bad_input(&reboot("7"), &["servo 7 does not answer at 1000000 bps", "--scan"]);
+    let o = run("2");
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let summary = servos.stop();
+    assert!(events(&summary, 2).iter().filter(|e| *e == "torque-on").count() >= 2, "{}", summary["events"]);
+}
+
 #[test]
 fn a_storm_of_damaged_answers_faults_with_torque_off_in_its_period() {
     let dir = tempfile::tempdir().unwrap();

@@ -4,11 +4,13 @@
 //! ```text
 //! pada servos --port /tmp/dxl --robot pendulum|PATH/robot.toml [--servo XM430-W350] [--baud 1000000] [--lockstep] [--fault SPEC]… [--seconds S] [--json]
 //! pada servos --scan --port /dev/ttyUSB0 [--baud 57600,1000000] [--protocol 1|2] [--ids 0-252] [--timeout-ms 5] [--json]
+//! pada servos --reboot ID --port /dev/ttyUSB0 [--baud 1000000] [--timeout-ms 5] [--json]
 //! ```
 
 use crate::console::{errln, outln};
 use crate::error::{usage, CliError};
 use crate::robot_arg::RobotArg;
+use crate::servos::reboot;
 use crate::servos::scan::{self, ScanConfig};
 use crate::servos::{pty::Pty, serve, Clock, VirtualBus};
 use clap::Args;
@@ -64,15 +66,26 @@ pub struct ServosArgs {
     /// With --scan: the Protocol 1.0 IDs to ping (default 0-253).
     #[arg(long, value_name = "A-B")]
     pub ids: Option<String>,
-    /// With --scan: how long to wait for an answer [ms].
+    /// Reboot the Protocol 2.0 servo of this ID on a real port instead:
+    /// what clears a hardware alert (overload, overheating, …), which keeps
+    /// its torque off until then. --baud is its rate (default 1000000).
+    #[arg(long, value_name = "ID", value_parser = clap::value_parser!(u8).range(0..=252))]
+    pub reboot: Option<u8>,
+    /// With --scan or --reboot: how long to wait for an answer [ms].
     #[arg(long, value_name = "MS", default_value_t = 5, value_parser = clap::value_parser!(u64).range(1..=1000))]
     pub timeout_ms: u64,
 }
 
 /// Runs `pada servos`.
 pub fn run(args: ServosArgs) -> Result<(), CliError> {
+    if args.scan && args.reboot.is_some() {
+        return Err(usage("--scan and --reboot are two tasks: give one"));
+    }
     if args.scan {
         return run_scan(&args);
+    }
+    if let Some(id) = args.reboot {
+        return run_reboot(&args, id);
     }
     for (flag, given) in [("--protocol", args.protocol.is_some()), ("--ids", args.ids.is_some())] {
         if given {
@@ -135,6 +148,47 @@ pub fn run(args: ServosArgs) -> Result<(), CliError> {
             summary.bus_s,
             summary.wall_s
         );
+    }
+    Ok(())
+}
+
+/// `--reboot ID`.
+fn run_reboot(args: &ServosArgs, id: u8) -> Result<(), CliError> {
+    for (flag, given) in [
+        ("--robot", args.robot.is_some()),
+        ("--servo", args.servo.is_some()),
+        ("--lockstep", args.lockstep),
+        ("--fault", !args.faults.is_empty()),
+        ("--seconds", args.seconds.is_some()),
+        ("--protocol", args.protocol.is_some()),
+        ("--ids", args.ids.is_some()),
+    ] {
+        if given {
+            return Err(usage(format!("{flag} does not go with --reboot (it reboots one servo of a real port)")));
+        }
+    }
+    let bps = match args.baud.as_deref() {
+        None => 1_000_000,
+        Some(b) => b.parse::<u32>().ok().filter(|b| (9_600..=4_500_000).contains(b)).ok_or_else(|| {
+            usage(format!("--baud {b}: with --reboot, one rate from 9600 to 4500000 (the servo's, e.g. 57600 or 1000000)"))
+        })?,
+    };
+    crate::drive::port::check_access(&args.port).map_err(usage)?;
+    let r = reboot::reboot(&args.port, bps, id, Duration::from_millis(args.timeout_ms)).map_err(usage)?;
+    if args.json {
+        outln!("{}", serde_json::to_string_pretty(&r).map_err(|e| CliError::Runtime(e.into()))?)?;
+    } else {
+        let before = match r.hardware_error_before {
+            0 => "no hardware error before".to_string(),
+            bits => format!("hardware error before: {}", reboot::causes(bits).join(", ")),
+        };
+        let model = scan::model_name(r.model_number, 2).unwrap_or("model pada does not know");
+        outln!("servo {id} ({model}) rebooted at {bps} bps; {before}")?;
+    }
+    if r.alert_after {
+        return Err(CliError::Runtime(anyhow::anyhow!(
+            "servo {id} raised its alert again after the reboot: the cause persists (let it cool, check the supply and the load)"
+        )));
     }
     Ok(())
 }

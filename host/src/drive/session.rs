@@ -219,7 +219,7 @@ fn setup_line(robot: &RobotArg, id: u8, r: &Result<pada_firmware::bus::ServoSetu
         ),
         Err(SetupError::Error { error, .. }) => format!("servo {id} ({name}, {model}) refused its set-up: error bits {:?}", error.names().collect::<Vec<_>>()),
         Err(SetupError::Alert { error, .. }) => format!(
-            "servo {id} ({name}, {model}) has a hardware error: {:?}; only a REBOOT clears it (power it off and on)",
+            "servo {id} ({name}, {model}) has a hardware error: {:?}; only a REBOOT clears it: `pada servos --reboot {id} --port PORT` (or power it off and on)",
             error.names().collect::<Vec<_>>()
         ),
     }
@@ -555,7 +555,7 @@ fn fault_line(cause: &pada_core::safety::FaultCause, spec: &pada_core::robot::Ro
         }
         F::ServoError { servo, error } => format!("servo {servo} ({}) reported {:?}", joint_of(servo), error.names().collect::<Vec<_>>()),
         F::HardwareAlert { servo, error } => format!(
-            "servo {servo} ({}) raised a hardware alert: {:?} (Hardware Error Status {}); only a REBOOT clears it",
+            "servo {servo} ({}) raised a hardware alert: {:?} (Hardware Error Status {}); only a REBOOT clears it: `pada servos --reboot {servo} --port PORT` once the cause is gone",
             joint_of(servo),
             error.names().collect::<Vec<_>>(),
             error.0

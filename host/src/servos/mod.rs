@@ -19,6 +19,7 @@ pub mod bus;
 pub mod p1;
 pub mod p2;
 pub mod pty;
+pub mod reboot;
 pub mod scan;
 pub mod sensor;
 pub mod serve;

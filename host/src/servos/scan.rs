@@ -68,7 +68,7 @@ pub fn scan(path: &Path, cfg: &ScanConfig, progress: &mut dyn FnMut(u32, u8)) ->
 }
 
 /// Reads what arrives until `timeout` passes without a byte.
-fn listen(port: &mut dyn serialport::SerialPort, timeout: Duration) -> std::io::Result<Vec<u8>> {
+pub(crate) fn listen(port: &mut dyn serialport::SerialPort, timeout: Duration) -> std::io::Result<Vec<u8>> {
     let mut got = Vec::new();
     let mut buf = [0u8; 512];
     let mut quiet_since = Instant::now();
@@ -86,7 +86,7 @@ fn listen(port: &mut dyn serialport::SerialPort, timeout: Duration) -> std::io::
     Ok(got)
 }
 
-fn send(port: &mut dyn serialport::SerialPort, bytes: &[u8]) -> std::io::Result<()> {
+pub(crate) fn send(port: &mut dyn serialport::SerialPort, bytes: &[u8]) -> std::io::Result<()> {
     let _ = port.clear(serialport::ClearBuffer::Input);
     port.write_all(bytes)?;
     port.flush()
