@@ -20,7 +20,7 @@ use embassy_sync::signal::Signal;
 use embassy_time::{Duration, Instant, Ticker};
 use heapless::Vec;
 use pada_core::checkpoint::{CheckpointStore, LoadOutcome, SaveError};
-use pada_core::safety::Transition;
+use pada_core::safety::{State, Transition};
 use pada_core::wire::{self, FrameEncoder, NackReason, ToChip, ToHost, MAX_FRAME_LEN};
 use pada_firmware::bus::{BusConfig, BusStats, RobotBus};
 use crate::table::Ctl;
@@ -50,6 +50,9 @@ pub enum BusRequest {
         /// the delay may have tripped.
         rearm: bool,
     },
+    /// A fault was cleared: reboot and set up again every Protocol 2.0
+    /// servo that alerted (torque is off); nothing if none did.
+    RebootAlerted,
 }
 
 /// The servo bus's answer to [`BusRequest::Read`].
@@ -97,6 +100,15 @@ pub async fn servo_bus(port: ServoPort, robot: &'static RobotSpec) -> ! {
             // Sent every period, so a servo that missed a packet (or
             // browned out) gets it again one period later.
             BusRequest::Write { torque, commands, rearm } => bus.write(torque, &commands, rearm).await,
+            BusRequest::RebootAlerted => {
+                for (id, back) in bus.reboot_alerted().await {
+                    if back {
+                        info!("servo {=u8}: rebooted after its hardware alert, set up again", id);
+                    } else {
+                        warn!("servo {=u8}: rebooted after its hardware alert, but its set-up failed: refused", id);
+                    }
+                }
+            }
         }
     }
 }
@@ -471,6 +483,11 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
             // with torque off, so the pause harms nothing; the schedule
             // restarts after it, as after a flash operation.
             let rebuilds = matches!(cmd, ToChip::SetPolicy(_)) && !cl.ctl.torque_enabled();
+            // An X-series servo's alert holds its torque off until a REBOOT:
+            // clearing a fault reboots the servos that alerted (the fault
+            // may name the alert, or the silence of a servo refused at its
+            // set-up for one).
+            let reboots = matches!(cmd, ToChip::ClearFault) && matches!(cl.ctl.state(), State::Fault(_));
             let (result, transition) = if rebuilds {
                 stalled = true;
                 with_long_watchdog(|| cl.ctl.command(cmd)).await
@@ -479,6 +496,9 @@ async fn handle_command(cl: &mut ControlLoop, seq: u32, cmd: &ToChip, job: &mut 
             };
             if let Some(t) = transition.filter(|t| t.changed()) {
                 report_transition(&t, &cl.ctl, Instant::now().as_millis() as u32).await;
+            }
+            if reboots && result.is_ok() {
+                BUS_REQUESTS.send(BusRequest::RebootAlerted).await;
             }
             let changes_policy = matches!(cmd, ToChip::SetPolicy(_) | ToChip::SwitchToSarsa | ToChip::SetMtbfBudget(_));
             if changes_policy && result.is_ok() {

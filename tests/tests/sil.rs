@@ -263,6 +263,14 @@ fn servo_error_bits_fault_within_one_period_and_resume() {
     fault_test(Run::pendulum(PolicyKind::Sarsa, 9.0), "error-bits:at=12:for=1:bits=overheating", "servo-error");
 }
 
+/// An X-series servo's hardware alert latches until a REBOOT: the board
+/// faults within its period, and after the operator's ClearFault and
+/// Start it reboots the servo, sets it up again and learns on.
+#[test]
+fn an_x_series_hardware_alert_faults_within_one_period_and_the_board_reboots_the_servo_and_resumes() {
+    fault_test(Run::arm2(10.0), "error-bits:at=4:for=1:bits=overload:servo=2", "hardware-alert");
+}
+
 /// LEO's fault tests: on the F429's emulation, a servo other than 1 (the
 /// right knee, ID 4; the left knee, ID 5, for the soft limit), every
 /// servo's torque off within one 33 ms period.

@@ -18,6 +18,12 @@
 //! A joint whose servo failed its set-up (no answer, another model than
 //! the definition names, an alert) is never commanded and reads as
 //! silent, so the safety machine faults on it and torque stays off.
+//!
+//! An X-series servo that raised its Alert bit keeps its torque off until
+//! a REBOOT (e-Manual, "Shutdown"). The safety machine faults on the alert;
+//! when the operator clears that fault, each servo that alerted is
+//! rebooted and set up again ([`RobotBus::reboot_alerted`]). If its cause
+//! persists, it alerts again and the robot faults again.
 
 use super::v2::{fast_read_firmware, flags_of, watchdog_units, Read2};
 use super::{BusConfig, BusStats, ServoBus, ServoRead, ServoSetup, SetupError};
@@ -57,6 +63,9 @@ pub struct RobotBus<P> {
     watchdog: u8,
     /// Torque as last written.
     torque_was: bool,
+    /// Joints whose Protocol 2.0 servo raised its Alert bit since it was
+    /// last set up: rebooted when a fault is cleared.
+    alerted: [bool; MAX_ROBOT_SERVOS],
 }
 
 impl<P: BusPort> RobotBus<P> {
@@ -69,6 +78,7 @@ impl<P: BusPort> RobotBus<P> {
             fast: true,
             watchdog: watchdog_units(robot.period_us),
             torque_was: false,
+            alerted: [false; MAX_ROBOT_SERVOS],
         }
     }
 
@@ -140,6 +150,10 @@ impl<P: BusPort> RobotBus<P> {
             if let Some(r) = self.refused.get_mut(i) {
                 *r = result.is_err();
             }
+            // An alert found at set-up: rebooted when that fault is cleared.
+            if let Some(a) = self.alerted.get_mut(i) {
+                *a = matches!(result, Err(SetupError::Alert { .. }));
+            }
             let _ = report.push((joint.id, result));
         }
         report
@@ -184,6 +198,9 @@ impl<P: BusPort> RobotBus<P> {
                 (Some(_), true) => Some(self.bus.hardware_error(id).await.unwrap_or(HardwareError(0))),
                 _ => None,
             };
+            if hardware_error.is_some() {
+                self.alerted[i] = true;
+            }
             out[i] = ServoRead {
                 state: r.state.map(Into::into),
                 error: flags_of(r.error),
@@ -231,6 +248,27 @@ impl<P: BusPort> RobotBus<P> {
             self.bus.sync_write_pwm(&pwms).await.ok();
         }
         self.torque_was = torque;
+    }
+
+    /// Reboots every Protocol 2.0 servo that alerted (since its set-up, or
+    /// at it) and sets it up again; torque must be off (it is, in a fault,
+    /// and a REBOOT leaves it off). Returns each rebooted servo's ID and
+    /// whether it came back; one that did not is refused (never commanded,
+    /// read as silent: the safety machine faults on it) and is rebooted
+    /// again at the next call.
+    pub async fn reboot_alerted(&mut self) -> Vec<(u8, bool), MAX_ROBOT_SERVOS> {
+        let mut rebooted = Vec::new();
+        for (i, joint) in self.joints.iter().enumerate() {
+            if !self.alerted[i] || joint.servo.protocol != ServoProtocol::V2 {
+                continue;
+            }
+            self.bus.reboot2(joint.id).await.ok();
+            let back = self.bus.setup2(joint.id, joint.servo.model_number, self.watchdog).await.is_ok();
+            self.alerted[i] = !back;
+            self.refused[i] = !back;
+            let _ = rebooted.push((joint.id, back));
+        }
+        rebooted
     }
 
     /// The sensor device's encoder count and foot contacts, in the

@@ -252,6 +252,16 @@ impl<P: BusPort> ServoBus<P> {
         self.send(n).await
     }
 
+    /// REBOOT servo `id`: the one way, short of its power, out of a
+    /// hardware-error shutdown. Its RAM comes back at its initial values
+    /// (Torque Enable off, the Bus Watchdog disarmed), its EEPROM as it
+    /// was. No status is awaited: at pada's Status Return Level (1) a
+    /// servo sends none for it.
+    pub async fn reboot2(&mut self, id: u8) -> Result<(), PortError> {
+        let n = encoders::reboot(id, &mut self.tx).map(|p| p.len()).map_err(|_| PortError::Transmit)?;
+        self.send(n).await
+    }
+
     /// Hardware Error Status of servo `id` (after an alert); `None` if it
     /// did not answer.
     pub async fn hardware_error(&mut self, id: u8) -> Option<HardwareError> {

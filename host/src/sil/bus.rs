@@ -599,8 +599,7 @@ impl BusEmulator {
     /// Byte `i` of `bytes` (sent from `now_us`) to the Protocol 2.0
     /// servos: the answers to the packet it ends, if it ends one.
     fn receive2(&mut self, now_us: u64, bytes: &[u8], i: usize, rig: &mut dyn Rig) -> Option<Vec<Reply>> {
-        let x = self.x.as_mut()?;
-        let result = x.push(bytes[i])?;
+        let result = self.x.as_mut()?.push(bytes[i])?;
         let request = bytes[self.x_start.min(i)..=i].to_vec();
         self.x_start = i + 1;
         let Ok(packet) = result else {
@@ -609,6 +608,10 @@ impl BusEmulator {
         };
         self.stats.packets += 1;
         let done = now_us + (i as u64 + 1) * BYTE_US;
+        // Torque as the packet found it: an alert it raises shuts its servo
+        // down at once (Shutdown), and the onset is judged before that.
+        let all_on_before = self.torques().iter().all(|on| *on);
+        let x = self.x.as_mut()?;
         let answers = {
             let rig_cell = std::cell::RefCell::new(&mut *rig);
             let mut read = |id: u8| Some(rig_cell.borrow_mut().joint_state(done, id));
@@ -627,7 +630,7 @@ impl BusEmulator {
                 self.stats.replies += a.reply.is_some() as u64;
                 a.reply
             } else {
-                self.apply(0, done, a)
+                self.apply_with(done, a, all_on_before)
             };
             replies.extend(reply);
         }
@@ -637,6 +640,12 @@ impl BusEmulator {
     /// Counts `a` and opens the fault windows it is the onset of.
     fn apply(&mut self, _i: usize, t: u64, a: Answer) -> Option<Reply> {
         let all_on = self.torques().iter().all(|on| *on);
+        self.apply_with(t, a, all_on)
+    }
+
+    /// [`Self::apply`] with the torque at the onset given (`all_on`: every
+    /// servo's torque was on).
+    fn apply_with(&mut self, t: u64, a: Answer, all_on: bool) -> Option<Reply> {
         for k in a.onsets {
             self.traces[k].onset_us = Some(t);
             self.traces[k].torque_at_onset = all_on;
