@@ -13,11 +13,13 @@
 //!
 //! - [`protocol`]: the run protocol and seeds, shared with `pada sil`;
 //! - [`trial`]: one trial, the controller and the rig in lock step;
+//! - [`fault_line`]: a fault's cause as one line for a person;
 //! - [`readable`]: whether the board can read the robot's joints where
 //!   its episodes start (a robot of files' calibration);
 //! - [`run_board`]: the trials of a run in parallel, with the same
 //!   [`TrialResult`]s (and so the same `summary.json`) as `pada run`.
 
+pub mod fault_line;
 pub mod protocol;
 pub mod readable;
 pub mod trial;

@@ -207,19 +207,15 @@ pub fn run_board_trial_on(
 /// What a fault at `t_us` means for a run of the board on the host, and
 /// what to change.
 fn fault_explained(spec: &RobotSpec, cause: FaultCause, t_us: u64) -> String {
-    let at = format!("the board faulted {:.2} s into the run ({})", t_us as f64 * 1e-6, cause.name());
+    let line = super::fault_line::fault_line(&cause, spec);
+    let at = format!("the board faulted {:.2} s into the run ({}): {line}", t_us as f64 * 1e-6, cause.name());
     let waits = "torque went off, and a board waits there for its operator to clear the fault";
     match cause {
-        FaultCause::SoftLimit { joint, position } => {
-            let j = spec.joints.get(joint as usize);
-            let name = j.map_or("?", |j| j.name);
-            let limits = j.and_then(|j| j.soft_limit).map_or(String::new(), |l| format!(", outside its soft limits [{}, {}] rad", l.min, l.max));
-            format!(
-                "{at}: joint {name} at {position:.3} rad{limits}; {waits}. End an episode before a joint reaches its soft limits \
-                 (an [[end]] on its angle in robot.toml, inside the limits), or widen the limits if the joint can go further"
-            )
-        }
-        other => format!("{at}: {other:?}; {waits}"),
+        FaultCause::SoftLimit { .. } => format!(
+            "{at}; {waits}. End an episode before a joint reaches its soft limits \
+             (an [[end]] on its angle in robot.toml, inside the limits), or widen the limits if the joint can go further"
+        ),
+        _ => format!("{at}; {waits}"),
     }
 }
 

@@ -11,6 +11,7 @@ use crate::console::{errln, outln};
 use crate::error::{usage, CliError};
 use crate::robot_arg::RobotArg;
 use crate::servos::reboot;
+use pada_core::dynamixel::control_table::x_series::HardwareError;
 use crate::servos::scan::{self, ScanConfig};
 use crate::servos::{pty::Pty, serve, Clock, VirtualBus};
 use clap::Args;
@@ -99,12 +100,7 @@ pub fn run(args: ServosArgs) -> Result<(), CliError> {
         let model = pada_core::servo::servo(name).map_err(|e| usage(format!("--servo: {e}")))?;
         robot = robot.with_servo(model).map_err(usage)?;
     }
-    let bps = match args.baud.as_deref() {
-        None => 1_000_000,
-        Some(b) => b.parse::<u32>().ok().filter(|b| (9_600..=4_500_000).contains(b)).ok_or_else(|| {
-            usage(format!("--baud {b}: not a baud rate; valid is one of the servos' rates, 9600 to 4500000 (e.g. 57600, 1000000)"))
-        })?,
-    };
+    let bps = one_rate(args.baud.as_deref())?;
     if let Some(s) = args.seconds {
         if !(s.is_finite() && s > 0.0) {
             return Err(usage(format!("--seconds {s} is out of range: valid is > 0")));
@@ -152,27 +148,42 @@ pub fn run(args: ServosArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// `--reboot ID`.
-fn run_reboot(args: &ServosArgs, id: u8) -> Result<(), CliError> {
+/// The servos' one rate (`--baud`, default 1 000 000 bps).
+fn one_rate(baud: Option<&str>) -> Result<u32, CliError> {
+    match baud {
+        None => Ok(1_000_000),
+        Some(b) => b.parse::<u32>().ok().filter(|b| (9_600..=4_500_000).contains(b)).ok_or_else(|| {
+            usage(format!("--baud {b}: not a baud rate; valid is one of the servos' rates, 9600 to 4500000 (e.g. 57600, 1000000)"))
+        }),
+    }
+}
+
+/// Refuses the flags of the virtual servos in `task` (--scan, --reboot),
+/// which works on a real port (`why`).
+fn refuse_virtual_flags(args: &ServosArgs, task: &str, why: &str) -> Result<(), CliError> {
     for (flag, given) in [
         ("--robot", args.robot.is_some()),
         ("--servo", args.servo.is_some()),
         ("--lockstep", args.lockstep),
         ("--fault", !args.faults.is_empty()),
         ("--seconds", args.seconds.is_some()),
-        ("--protocol", args.protocol.is_some()),
-        ("--ids", args.ids.is_some()),
     ] {
+        if given {
+            return Err(usage(format!("{flag} does not go with {task} ({why})")));
+        }
+    }
+    Ok(())
+}
+
+/// `--reboot ID`.
+fn run_reboot(args: &ServosArgs, id: u8) -> Result<(), CliError> {
+    refuse_virtual_flags(args, "--reboot", "it reboots one servo of a real port")?;
+    for (flag, given) in [("--protocol", args.protocol.is_some()), ("--ids", args.ids.is_some())] {
         if given {
             return Err(usage(format!("{flag} does not go with --reboot (it reboots one servo of a real port)")));
         }
     }
-    let bps = match args.baud.as_deref() {
-        None => 1_000_000,
-        Some(b) => b.parse::<u32>().ok().filter(|b| (9_600..=4_500_000).contains(b)).ok_or_else(|| {
-            usage(format!("--baud {b}: with --reboot, one rate from 9600 to 4500000 (the servo's, e.g. 57600 or 1000000)"))
-        })?,
-    };
+    let bps = one_rate(args.baud.as_deref())?;
     crate::drive::port::check_access(&args.port).map_err(usage)?;
     let r = reboot::reboot(&args.port, bps, id, Duration::from_millis(args.timeout_ms)).map_err(usage)?;
     if args.json {
@@ -180,7 +191,7 @@ fn run_reboot(args: &ServosArgs, id: u8) -> Result<(), CliError> {
     } else {
         let before = match r.hardware_error_before {
             0 => "no hardware error before".to_string(),
-            bits => format!("hardware error before: {}", reboot::causes(bits).join(", ")),
+            bits => format!("hardware error before: {}", HardwareError(bits).names().collect::<Vec<_>>().join(", ")),
         };
         let model = scan::model_name(r.model_number, 2).unwrap_or("model pada does not know");
         outln!("servo {id} ({model}) rebooted at {bps} bps; {before}")?;
@@ -195,17 +206,7 @@ fn run_reboot(args: &ServosArgs, id: u8) -> Result<(), CliError> {
 
 /// `--scan`.
 fn run_scan(args: &ServosArgs) -> Result<(), CliError> {
-    for (flag, given) in [
-        ("--robot", args.robot.is_some()),
-        ("--servo", args.servo.is_some()),
-        ("--lockstep", args.lockstep),
-        ("--fault", !args.faults.is_empty()),
-        ("--seconds", args.seconds.is_some()),
-    ] {
-        if given {
-            return Err(usage(format!("{flag} does not go with --scan (it scans a real port)")));
-        }
-    }
+    refuse_virtual_flags(args, "--scan", "it scans a real port")?;
     let rates = match args.baud.as_deref() {
         None => scan::RATES.to_vec(),
         Some(list) => list

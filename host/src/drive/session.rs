@@ -436,7 +436,7 @@ fn run<W: WeightStore>(setup: &DriveSetup, table: W, mut tm: TelemetryPipe) -> a
             break Ended::Interrupted;
         }
         if let Some(cause) = ctl.state().fault() {
-            break Ended::Fault(fault_line(&cause, spec));
+            break Ended::Fault(crate::board::fault_line::fault_line(&cause, spec));
         }
         if protocol.done() {
             break Ended::Done;
@@ -540,33 +540,6 @@ fn zero(d: Drive) -> Drive {
 /// The policy as the command line names it.
 fn describe_policy(p: PolicyKind) -> String {
     crate::experiment::algo::label(&p)
-}
-
-/// A fault's line: the cause with the servo or joint it concerns.
-fn fault_line(cause: &pada_core::safety::FaultCause, spec: &pada_core::robot::RobotSpec) -> String {
-    use pada_core::safety::FaultCause as F;
-    let joint_of = |id: u8| spec.joints.iter().find(|j| j.id == id).map_or("?", |j| j.name);
-    match *cause {
-        F::ServoTimeout { servo, attempts } => {
-            format!("servo {servo} ({}) did not answer {attempts} requests in a row (unplugged? no power?)", joint_of(servo))
-        }
-        F::ChecksumErrors { count, window_ms } => {
-            format!("{count} damaged answers within {window_ms} ms: noise on the bus, a loose cable, or two servos at one ID")
-        }
-        F::ServoError { servo, error } => format!("servo {servo} ({}) reported {:?}", joint_of(servo), error.names().collect::<Vec<_>>()),
-        F::HardwareAlert { servo, error } => format!(
-            "servo {servo} ({}) raised a hardware alert: {:?} (Hardware Error Status {}); only a REBOOT clears it: `pada servos --reboot {servo} --port PORT` once the cause is gone",
-            joint_of(servo),
-            error.names().collect::<Vec<_>>(),
-            error.0
-        ),
-        F::SoftLimit { joint, position } => format!(
-            "joint {joint} ({}) at {position:.3} rad, past its soft limit",
-            spec.joints.get(joint as usize).map_or("?", |j| j.name)
-        ),
-        F::OverrunStreak { count } => format!("{count} control periods overran in a row: the PC is too slow or too loaded for the period"),
-        F::WatchdogReset => "the watchdog reset the board".to_string(),
-    }
 }
 
 /// A state change (and a fault) into the telemetry, as the firmware

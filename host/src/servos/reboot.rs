@@ -10,7 +10,7 @@
 //! it answers, and its Alert bit read once more.
 
 use super::scan::{listen, send};
-use pada_core::dynamixel::control_table::x_series::{self, HardwareError};
+use pada_core::dynamixel::control_table::x_series;
 use pada_core::dynamixel::v2::{self as dxl2, PingReply};
 use serde::Serialize;
 use std::path::Path;
@@ -74,9 +74,4 @@ pub fn reboot(path: &Path, baud: u32, id: u8, timeout: Duration) -> Result<Reboo
     };
     let after = ask(&read_error)?.ok_or_else(|| format!("servo {id} answered the PING after its REBOOT but not the READ of its Hardware Error Status"))?;
     Ok(Rebooted { id, model_number, hardware_error_before, alert_after: after.error.alert() || after.u8_at(0).unwrap_or(0) != 0 })
-}
-
-/// The causes in a Hardware Error Status, by name.
-pub fn causes(bits: u8) -> Vec<&'static str> {
-    HardwareError(bits).names().collect()
 }

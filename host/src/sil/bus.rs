@@ -514,14 +514,14 @@ impl BusEmulator {
         }
     }
 
-    /// Servo `i`'s status packet at `t`, after the faults in force then;
-    /// changes nothing ([`apply`](Self::apply) does).
-    fn answer(&self, i: usize, t: u64, mut error: ErrorFlags, params: &[u8], request: &[u8]) -> Answer {
-        let id = self.servos[i].id;
-        let mut a = Answer::default();
-        let mut delay = 0;
+    /// The faults in force on an answer, those `hit` says apply to it (at
+    /// its time, to its servos), in the order given, up to the first that drops it: the answer
+    /// with its onsets, `dropped`, `corrupted` and `past_limit` set, the
+    /// longest delay \[µs\] and the error bits of every `error-bits` fault.
+    fn in_force(&self, hit: impl Fn(&FaultSpec) -> bool) -> (Answer, u64, ErrorFlags) {
+        let (mut a, mut delay, mut bits) = (Answer::default(), 0, ErrorFlags::NONE);
         for (k, (f, trace)) in self.faults.iter().zip(&self.traces).enumerate() {
-            if !f.applies(t, id) {
+            if !hit(f) {
                 continue;
             }
             if trace.onset_us.is_none() {
@@ -530,15 +530,29 @@ impl BusEmulator {
             match f.kind {
                 FaultKind::Drop => {
                     a.dropped = true;
-                    return a;
+                    break;
                 }
                 FaultKind::Corrupt => a.corrupted = true,
                 FaultKind::Delay { us } => delay = delay.max(us),
-                FaultKind::ErrorBits { bits } => error = error | bits,
-                // The reading itself is past the limit (`plant_present`).
-                FaultKind::PastLimit => {}
+                FaultKind::ErrorBits { bits: b } => bits = bits | b,
+                FaultKind::PastLimit => a.past_limit = true,
             }
         }
+        (a, delay, bits)
+    }
+
+    /// Servo `i`'s status packet at `t`, after the faults in force then;
+    /// changes nothing ([`apply`](Self::apply) does).
+    fn answer(&self, i: usize, t: u64, mut error: ErrorFlags, params: &[u8], request: &[u8]) -> Answer {
+        let id = self.servos[i].id;
+        let (mut a, delay, bits) = self.in_force(|f| f.applies(t, id));
+        if a.dropped {
+            return a;
+        }
+        // On Protocol 1.0 the error bits ride on the answer; a `past-limit`
+        // fault makes the reading itself past the limit (`plant_present`).
+        error = error | bits;
+        a.past_limit = false;
         let Ok(status) = StatusPacket::<64>::new(id, error, params) else { return a };
         let mut buf = [0u8; 80];
         let Ok(bytes) = status.encode(&mut buf) else { return a };
@@ -560,29 +574,17 @@ impl BusEmulator {
     /// servo whose answer it carries (a fast reply is lost with any block;
     /// the hardware alert was raised by the servo itself); changes nothing.
     fn answer2(&self, t: u64, x: bus_v2::XAnswer, request: &[u8]) -> Answer {
-        let mut a = Answer::default();
-        let mut delay = 0;
-        let mut bytes = x.bytes;
-        if !x.sensor {
-            for (k, (f, trace)) in self.faults.iter().zip(&self.traces).enumerate() {
-                if !x.ids.iter().any(|&id| f.applies(t, id)) {
-                    continue;
-                }
-                if trace.onset_us.is_none() {
-                    a.onsets.push(k);
-                }
-                match f.kind {
-                    FaultKind::Drop => {
-                        a.dropped = true;
-                        return a;
-                    }
-                    FaultKind::Corrupt => a.corrupted = true,
-                    FaultKind::Delay { us } => delay = delay.max(us),
-                    FaultKind::PastLimit => a.past_limit = true,
-                    FaultKind::ErrorBits { .. } => {}
-                }
-            }
+        // The sensor device's answers are never faulted; a servo's hardware
+        // alert was raised by the servo itself (`bus_v2`), not here.
+        let (mut a, delay, _) = if x.sensor {
+            (Answer::default(), 0, ErrorFlags::NONE)
+        } else {
+            self.in_force(|f| x.ids.iter().any(|&id| f.applies(t, id)))
+        };
+        if a.dropped {
+            return a;
         }
+        let mut bytes = x.bytes;
         if a.corrupted {
             // The first parameter (or the ERROR byte): the CRC no longer
             // matches.
