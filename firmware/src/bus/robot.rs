@@ -20,7 +20,7 @@
 //! silent, so the safety machine faults on it and torque stays off.
 //!
 //! An X-series servo that raised its Alert bit keeps its torque off until
-//! a REBOOT (e-Manual, "Shutdown"). The safety machine faults on the alert;
+//! a REBOOT (docs/reference/dynamixel.md, "Shutdown"). The safety machine faults on the alert;
 //! when the operator clears that fault, each servo that alerted is
 //! rebooted and set up again ([`RobotBus::reboot_alerted`]). If its cause
 //! persists, it alerts again and the robot faults again.

@@ -4,7 +4,7 @@
 //! An X-series servo that raises its Alert bit (overload, overheating, an
 //! input voltage out of range, …) latches the cause in Hardware Error
 //! Status and, per its Shutdown setting, switches its own torque off; it
-//! refuses torque until rebooted (e-Manual, "Shutdown" and "Reboot").
+//! refuses torque until rebooted (docs/reference/dynamixel.md, "Shutdown").
 //! `pada drive` stops at the alert and names this command. The REBOOT's
 //! status comes before the servo restarts; the servo is then PINGed until
 //! it answers, and its Alert bit read once more.
