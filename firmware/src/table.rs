@@ -8,7 +8,8 @@
 //! | `exact_ccm` | an exact table of Q16 weights in the 64 KiB of CCM | — |
 //! | `exact_ccm_sram` | an exact table: all 64 KiB of CCM, then SRAM (`Split`) | the pendulum on F405/F407 and QEMU's netduinoplus2 (`stm32f405`, `stm32f407`, `qemu`) |
 //! | `exact_sram` | an exact table in SRAM | the pendulum on the F429I-DISC1 and QEMU's mps2-an386 (`stm32f429`, `mps2`) |
-//! | `claimed_ccm` | a claim table of 2^14 slots (16-bit weights and 16-bit tags) in CCM | LEO on the F405 |
+//! | `claimed_ccm` | a claim table of 2^14 slots (16-bit weights and 16-bit tags) in CCM | — |
+//! | `claimed_ccm_sram` | a claim table of 2^15 slots: 16-bit weights in all 64 KiB of CCM, 16-bit tags in 64 KiB of SRAM | LEO and robots of files on the F405 |
 //! | `claimed_sdram` | a claim table of 2^21 slots, all 8 MiB of the SDRAM (on mps2-an386: its PSRAM, `.sdram` in `memory-mps2.x`) | LEO on the F429 |
 //!
 //! The statics are NOLOAD (CCM, SDRAM) or `.uninit` (SRAM): the startup
@@ -130,11 +131,12 @@ mod layout {
     }
 }
 
-/// A claim table in one memory: 16-bit weights in one static, 16-bit tags
-/// in another, both in `$section` (`pada_core::claim_table`).
+/// A claim table: 16-bit weights in one static in `$section`, 16-bit tags
+/// in another in `$tag_section` (`pada_core::claim_table`), doing what the
+/// profile says when it is full.
 #[allow(unused_macros)]
 macro_rules! claim_table {
-    ($memory:pat, $section:literal, $weights:literal, $tags:literal) => {
+    ($memory:pat, $section:literal, $weights:literal, $tag_section:literal, $tags:literal) => {
         use super::*;
         use pada_core::claim_table::{ClaimTable, Tags16};
         use pada_core::weights::Half;
@@ -150,7 +152,7 @@ macro_rules! claim_table {
         #[link_section = $section]
         #[export_name = $weights]
         static mut WEIGHTS_16: MaybeUninit<[i16; WEIGHTS]> = MaybeUninit::uninit();
-        #[link_section = $section]
+        #[link_section = $tag_section]
         #[export_name = $tags]
         static mut TAGS_16: MaybeUninit<[u16; WEIGHTS]> = MaybeUninit::uninit();
 
@@ -163,7 +165,7 @@ macro_rules! claim_table {
             // statics; all-zero bits are valid i16 and u16.
             let (weights, tags) = unsafe { (zeroed(core::ptr::addr_of_mut!(WEIGHTS_16)), zeroed(core::ptr::addr_of_mut!(TAGS_16))) };
             match ClaimTable::new(Half::new(weights), Tags16(tags)) {
-                Ok(t) => t,
+                Ok(t) => t.on_full(PROFILE.when_full),
                 // Unreachable: both statics have WEIGHTS entries, a power
                 // of two (asserted at compile time above).
                 Err(_) => panic!("the claim table's statics disagree"),
@@ -172,10 +174,17 @@ macro_rules! claim_table {
     };
 }
 
-// A claim table in the 64 KiB of CCM, weights and tags (LEO on an F405).
+// A claim table in the 64 KiB of CCM, weights and tags.
 #[cfg(pada_table = "claimed_ccm")]
 mod layout {
-    claim_table!(Memory::Ccm, ".ccmram", "PADA_TABLE_CCM", "PADA_TABLE_TAGS_CCM");
+    claim_table!(Memory::Ccm, ".ccmram", "PADA_TABLE_CCM", ".ccmram", "PADA_TABLE_TAGS_CCM");
+}
+
+// A claim table's weights in all 64 KiB of CCM, its tags in SRAM (LEO and
+// robots of files on an F405).
+#[cfg(pada_table = "claimed_ccm_sram")]
+mod layout {
+    claim_table!(Memory::CcmWeightsSramTags, ".ccmram", "PADA_TABLE_CCM", ".uninit.pada_tags", "PADA_TABLE_TAGS_SRAM");
 }
 
 // An exact table in CCM (a small robot's).
@@ -195,7 +204,7 @@ mod layout {
 // F429).
 #[cfg(pada_table = "claimed_sdram")]
 mod layout {
-    claim_table!(Memory::Sdram, ".sdram", "PADA_TABLE_SDRAM", "PADA_TABLE_TAGS_SDRAM");
+    claim_table!(Memory::Sdram, ".sdram", "PADA_TABLE_SDRAM", ".sdram", "PADA_TABLE_TAGS_SDRAM");
 }
 
 pub use layout::Table;

@@ -24,8 +24,12 @@
 //!   keeps: [`ClaimTable::initial_weight`]), never another feature's
 //!   learned weight;
 //! - the probe is bounded ([`MAX_PROBE`] slots). A claim that finds neither
-//!   its tag nor an empty slot there is **refused**: the update for that
-//!   feature is dropped and counted, and lands in no other feature's slot.
+//!   its tag nor an empty slot there finds the table full, and the table
+//!   does what its [`WhenFull`] says: it **refuses** (the update for that
+//!   feature is dropped and counted, and lands in no other feature's
+//!   slot), or it **replaces** the least-learned feature among the probe's
+//!   slots ([`WhenFull::Replace`], module `evict`), which then reads its
+//!   initial weight again.
 //!
 //! # Where pada differs from the framework
 //!
@@ -95,7 +99,7 @@
 use crate::fixed::Q16;
 use crate::weights::{entry_factor, Added, WeightStore};
 
-pub use crate::claims::{Claim, InitialWeights, Occupancy};
+pub use crate::claims::{Claim, InitialWeights, Occupancy, WhenFull};
 
 /// The longest probe: slots looked at from a feature's home on. At a load
 /// of ½ a linear probe that misses looks at 2.5 slots on average, at 0.9
@@ -240,7 +244,9 @@ pub struct ClaimTable<W, T> {
     init: InitialWeights,
     claimed: u32,
     refused: u32,
+    replaced: u32,
     longest_probe: u32,
+    when_full: WhenFull,
 }
 
 /// Why a claim table could not be made.
@@ -290,10 +296,19 @@ impl<W: WeightStore, T: TagStore> ClaimTable<W, T> {
             init: InitialWeights { seed: 0, lo: 0, span: 1 },
             claimed: 0,
             refused: 0,
+            replaced: 0,
             longest_probe: 0,
+            when_full: WhenFull::Refuse,
         };
         t.reset(t.init);
         Ok(t)
+    }
+
+    /// The same table, doing `when_full` with a claim that finds it full
+    /// (a new table refuses).
+    pub fn on_full(mut self, when_full: WhenFull) -> Self {
+        self.when_full = when_full;
+        self
     }
 
     /// Frees every slot and sets the initial weights of unclaimed features.
@@ -305,6 +320,7 @@ impl<W: WeightStore, T: TagStore> ClaimTable<W, T> {
         self.init = init;
         self.claimed = 0;
         self.refused = 0;
+        self.replaced = 0;
         self.longest_probe = 0;
     }
 
@@ -320,6 +336,7 @@ impl<W: WeightStore, T: TagStore> ClaimTable<W, T> {
     pub fn recount(&mut self, refused: u32) {
         self.claimed = (0..self.tags.len()).filter(|&i| self.tags.get(i) != EMPTY).count() as u32;
         self.refused = refused;
+        self.replaced = 0;
         self.longest_probe = 0;
     }
 
@@ -330,6 +347,7 @@ impl<W: WeightStore, T: TagStore> ClaimTable<W, T> {
             claimed: self.claimed,
             slots: self.mask + 1,
             refused: self.refused,
+            replaced: self.replaced,
             longest_probe: self.longest_probe,
         }
     }
@@ -412,8 +430,12 @@ impl<W: WeightStore, T: TagStore> ClaimTable<W, T> {
     /// refused, and a key whose probe stopped at a free slot takes that
     /// slot if it is still free (the earlier keys' claims did not fill
     /// it) and probes again if not. So the weights, the claims and the
-    /// counts are those of the reads and claims one by one. Writes each
-    /// claim to `claims` and returns the sum of the weights read.
+    /// counts are those of the reads and claims one by one, but for one
+    /// thing: a table that replaces ([`WhenFull::Replace`]) spares every
+    /// slot the batch's features hold or take, so that no feature of an
+    /// update loses its slot to another feature of the same update.
+    /// Writes each claim to `claims` and returns the sum of the weights
+    /// read.
     pub fn read_then_claim(&mut self, keys: &[u32], claims: &mut [Claim]) -> i64 {
         let mut sum = 0i64;
         // The probes, their outcomes kept in `claims` for now: a free slot
@@ -428,8 +450,9 @@ impl<W: WeightStore, T: TagStore> ClaimTable<W, T> {
             *claim = c;
             sum += w.0 as i64;
         }
-        for (claim, &key) in claims.iter_mut().zip(keys) {
-            let probed = match *claim {
+        for i in 0..claims.len().min(keys.len()) {
+            let key = keys[i];
+            let probed = match claims[i] {
                 Claim::Slot { slot, fresh: true } if self.tags.get(slot as usize) == EMPTY => {
                     self.tags.set(slot as usize, self.tag_for(key));
                     self.weights.set(slot as usize, self.initial_weight(key));
@@ -438,12 +461,14 @@ impl<W: WeightStore, T: TagStore> ClaimTable<W, T> {
                 }
                 Claim::Slot { fresh: true, .. } => {
                     // An earlier key of this batch took the free slot.
-                    *claim = self.claim(key);
+                    claims[i] = self.claim_sparing(key, claims);
                     continue;
                 }
                 Claim::Slot { slot, fresh: false } => slot.wrapping_sub(key) & self.mask,
-                Claim::Refused => {
-                    self.refused = self.refused.saturating_add(1);
+                Claim::Refused | Claim::Replaced { .. } => {
+                    // A full probe stays full: claims fill free slots, and
+                    // a replacement leaves its slot held.
+                    claims[i] = self.when_full_sparing(key, claims);
                     MAX_PROBE
                 }
             };
@@ -459,6 +484,12 @@ impl<W: WeightStore, T: TagStore> ClaimTable<W, T> {
     /// and counted if the probe finds neither its tag nor a free slot. Its
     /// probe counts towards [`Occupancy::longest_probe`].
     pub fn claim(&mut self, key: u32) -> Claim {
+        self.claim_sparing(key, &[])
+    }
+
+    /// [`claim`](Self::claim), sparing the slots of `batch` if the table
+    /// is full ([`when_full_sparing`](Self::when_full_sparing)).
+    fn claim_sparing(&mut self, key: u32, batch: &[Claim]) -> Claim {
         let (found, probed) = self.probe(key);
         if probed > self.longest_probe {
             self.longest_probe = probed;
@@ -471,10 +502,35 @@ impl<W: WeightStore, T: TagStore> ClaimTable<W, T> {
                 self.claimed += 1;
                 Claim::Slot { slot: i, fresh: true }
             }
-            Probe::Exhausted => {
+            Probe::Exhausted => self.when_full_sparing(key, batch),
+        }
+    }
+
+    /// A claim of `key` whose probe found the table full: refused and
+    /// counted, or another feature's slot taken ([`WhenFull`]), never one
+    /// of the slots in `batch` (the claims of the update's other
+    /// features: each keeps its slot for the update).
+    fn when_full_sparing(&mut self, key: u32, batch: &[Claim]) -> Claim {
+        match self.when_full {
+            WhenFull::Refuse => {
                 self.refused = self.refused.saturating_add(1);
                 Claim::Refused
             }
+            WhenFull::Replace => match evict::victim(&self.weights, key & self.mask, self.mask, self.init.centre(), batch) {
+                Some(slot) => {
+                    let old_raw = WeightStore::raw(self, slot as usize);
+                    self.tags.set(slot as usize, self.tag_for(key));
+                    self.weights.set(slot as usize, self.initial_weight(key));
+                    self.replaced = self.replaced.saturating_add(1);
+                    Claim::Replaced { slot, old_raw }
+                }
+                // Every slot of the probe is the batch's own (at most
+                // TILINGS of MAX_PROBE: never with the boards' 16).
+                None => {
+                    self.refused = self.refused.saturating_add(1);
+                    Claim::Refused
+                }
+            },
         }
     }
 }
@@ -602,6 +658,10 @@ impl<W: WeightStore, T: TagStore> WeightStore for ClaimTable<W, T> {
         Some(ClaimTable::occupancy(self))
     }
 
+    fn when_full(&self) -> WhenFull {
+        self.when_full
+    }
+
     fn table_seed(&self) -> u64 {
         self.init.seed
     }
@@ -611,6 +671,8 @@ impl<W: WeightStore, T: TagStore> WeightStore for ClaimTable<W, T> {
         self.recount(refused);
     }
 }
+
+mod evict;
 
 #[cfg(test)]
 mod tests;

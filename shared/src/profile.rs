@@ -9,7 +9,7 @@
 //!
 //! | board | memory for the table | pendulum | LEO |
 //! |---|---|---|---|
-//! | `f405` | 64 KB CCM + 128 KB SRAM (STM32F405) | exact, 24 960 Q16 weights (CCM, then SRAM) | claim table, 2^14 slots of 16-bit weight + 16-bit tag (64 KiB of CCM) |
+//! | `f405` | 64 KB CCM + 64 KB of the 128 KB SRAM (STM32F405) | exact, 24 960 Q16 weights (CCM, then SRAM) | claim table, 2^15 slots of 16-bit weight (all 64 KiB of CCM) + 16-bit tag (64 KiB of SRAM), replacing when full |
 //! | `f429-sdram` | 8 MB SDRAM on the FMC (STM32F429I-DISC1) | exact, in SRAM | claim table, 2^21 slots of 16-bit weight + 16-bit tag (8 MiB) |
 //! | `host` | the heap | exact, as large as the policy needs | claim table, 2^22 slots of Q16 weight + 32-bit tag (32 MiB) |
 //!
@@ -18,6 +18,7 @@
 
 use crate::agent::Agent;
 use crate::checkpoint::ConfigHasher;
+use crate::claims::WhenFull;
 use crate::robot::{RobotSpec, TableNeed};
 use crate::tile_coding::Layout;
 use crate::weights::{WeightFormat, WeightStore};
@@ -91,13 +92,15 @@ impl Board {
                 };
                 (Layout::Exact, TableSize::Weights(weights), WeightFormat::Q16, memory, 0)
             }
-            // LEO in the 64 KB of CCM: a claim table of 2^14 slots, each
-            // a 16-bit weight and a 16-bit tag.
+            // A claim table over all the chip gives it: 2^15 slots, their
+            // 16-bit weights filling the 64 KB of CCM and their 16-bit
+            // tags 64 KB of SRAM (F405_SRAM_TABLE_BYTES), twice the slots
+            // of the CCM alone. (2^16 would need 256 KB.)
             (Board::F405, TableNeed::Claimed) => (
                 Layout::Claimed,
-                TableSize::Weights(1 << 14),
+                TableSize::Weights(F405_CLAIM_SLOTS),
                 WeightFormat::Half { shift: robot.half_shift },
-                Memory::Ccm,
+                Memory::CcmWeightsSramTags,
                 2,
             ),
             (Board::F429Sdram, TableNeed::Exact { weights }) => {
@@ -131,7 +134,16 @@ impl Board {
                 (Layout::Claimed, TableSize::Weights(1 << HOST_CLAIM_LOG2), WeightFormat::Q16, Memory::Heap, 4)
             }
         };
-        Ok(LearnerProfile { board: self, robot, layout, size, format, memory, tag_bytes })
+        // A full claim table on the F405 gives the least-learned slot to a
+        // new feature instead of refusing it (docs/board.md, "A full
+        // table", measures the three behaviours). The F429's and the host's
+        // tables do not fill with the paper's robots: they refuse, as
+        // before, so their runs are bit for bit as they were.
+        let when_full = match (self, layout) {
+            (Board::F405, Layout::Claimed) => WhenFull::Replace,
+            _ => WhenFull::Refuse,
+        };
+        Ok(LearnerProfile { board: self, robot, layout, size, format, memory, tag_bytes, when_full })
     }
 }
 
@@ -173,9 +185,14 @@ pub const HOST_CLAIM_LOG2: u32 = 22;
 
 /// Bytes of the F405's core-coupled RAM.
 pub const CCM_BYTES: usize = 64 * 1024;
-/// Bytes of the F405's 128 KB SRAM an exact table may take after all of
-/// CCM: the rest is the firmware's stack, buffers and executor.
-pub const F405_SRAM_TABLE_BYTES: usize = 48 * 1024;
+/// Bytes of the F405's 128 KB SRAM a table may take besides all of CCM
+/// (an exact table's rest, or a claim table's tags): the other 64 KB are
+/// the firmware's statics (about 32 KB: the images' sizes in docs/board.md)
+/// and its stack.
+pub const F405_SRAM_TABLE_BYTES: usize = 64 * 1024;
+/// Slots of the F405's claim table: 16-bit weights in all of CCM, their
+/// 16-bit tags in [`F405_SRAM_TABLE_BYTES`] of SRAM.
+pub const F405_CLAIM_SLOTS: usize = CCM_BYTES / 2;
 /// Bytes of the F429's 192 KB SRAM an exact table may take.
 pub const F429_SRAM_TABLE_BYTES: usize = 128 * 1024;
 
@@ -203,6 +220,9 @@ pub enum Memory {
         /// Weights in CCM.
         ccm_weights: usize,
     },
+    /// A claim table's weights in CCM, its tags in SRAM (the F405: the
+    /// weights, read by every choice, in the faster memory).
+    CcmWeightsSramTags,
     /// External SDRAM on the FMC.
     Sdram,
     /// The host's heap.
@@ -216,6 +236,7 @@ impl Memory {
             Memory::Ccm => "CCM",
             Memory::Sram => "SRAM",
             Memory::CcmThenSram { .. } => "CCM + SRAM",
+            Memory::CcmWeightsSramTags => "CCM (weights) + SRAM (tags)",
             Memory::Sdram => "SDRAM",
             Memory::Heap => "heap",
         }
@@ -241,6 +262,9 @@ pub struct LearnerProfile {
     /// Bytes of a claim tag beside each weight ([`Layout::Claimed`]: 2 or
     /// 4; 0 for the other layouts).
     pub tag_bytes: usize,
+    /// What a claim table does when a claim finds it full (a plain
+    /// table's is [`WhenFull::Refuse`] and means nothing).
+    pub when_full: WhenFull,
 }
 
 impl LearnerProfile {
@@ -288,9 +312,15 @@ impl LearnerProfile {
             Board::Host => Memory::Heap,
             Board::F429Sdram => Memory::Sdram,
             Board::F405 if bytes <= CCM_BYTES => Memory::Ccm,
+            Board::F405 if tag_bytes > 0 && weights * format.bytes() <= CCM_BYTES => Memory::CcmWeightsSramTags,
             Board::F405 => Memory::CcmThenSram { ccm_weights: CCM_BYTES / format.bytes() },
         };
         LearnerProfile { layout, size: TableSize::Weights(weights), format, memory, tag_bytes, ..self }
+    }
+
+    /// The same profile with a full claim table doing `when_full`.
+    pub const fn when_full(self, when_full: WhenFull) -> LearnerProfile {
+        LearnerProfile { when_full, ..self }
     }
 }
 
@@ -333,6 +363,12 @@ pub fn config_hash<W: WeightStore, const TILINGS_: usize, const TRACE_: usize>(
         // holds tags of other features and must be refused. Written only
         // for such a table, so every other hash stays as it was.
         h.write_str("claim key bits").write_u32(kept);
+    }
+    if w.claims() && w.when_full() != WhenFull::Refuse {
+        // The table's own behaviour, as the table's size and format are
+        // its own. Written only for a table that does not refuse, so every
+        // other hash stays as it was.
+        h.write_str("when full").write_u32(w.when_full().code());
     }
     agent.write_config(&mut h);
     h.finish()
@@ -396,7 +432,11 @@ mod tests {
                     assert!(ccm_weights * p.format.bytes() <= CCM_BYTES);
                     // The rest must leave most of the 128 KB SRAM to the
                     // firmware's stack, buffers and executor.
-                    assert!(bytes - ccm_weights * p.format.bytes() <= 48 * 1024, "{}", robot.name);
+                    assert!(bytes - ccm_weights * p.format.bytes() <= F405_SRAM_TABLE_BYTES, "{}", robot.name);
+                }
+                Memory::CcmWeightsSramTags => {
+                    assert_eq!(p.weights().unwrap() * p.format.bytes(), CCM_BYTES, "{}: the weights fill CCM", robot.name);
+                    assert!(p.weights().unwrap() * p.tag_bytes <= F405_SRAM_TABLE_BYTES, "{}", robot.name);
                 }
                 m => panic!("{}: {m:?} on an F405", robot.name),
             }
@@ -419,7 +459,8 @@ mod tests {
         assert_eq!((p.layout, p.weights(), p.format), (Layout::Exact, Some(24_960), WeightFormat::Q16));
         assert_eq!(p.memory, Memory::CcmThenSram { ccm_weights: 16_384 });
         let l = Board::F405.profile(&leo::SPEC).unwrap();
-        assert_eq!((l.layout, l.weights(), l.format, l.tag_bytes), (Layout::Claimed, Some(1 << 14), WeightFormat::Half { shift: 12 }, 2));
+        assert_eq!((l.layout, l.weights(), l.format, l.tag_bytes), (Layout::Claimed, Some(1 << 15), WeightFormat::Half { shift: 12 }, 2));
+        assert_eq!((l.memory, l.when_full), (Memory::CcmWeightsSramTags, WhenFull::Replace));
         let l = Board::F429Sdram.profile(&leo::SPEC).unwrap();
         assert_eq!((l.weights(), l.memory, l.tag_bytes), (Some(1 << 21), Memory::Sdram, 2));
         let h = Board::Host.profile(&leo::SPEC).unwrap();
@@ -431,7 +472,7 @@ mod tests {
     fn an_exact_table_too_large_for_a_board_is_refused_with_its_sizes() {
         static HUGE: RobotSpec = RobotSpec { table: TableNeed::Exact { weights: 40_000 }, ..pendulum::SPEC_33HZ };
         let e = Board::F405.profile(&HUGE).unwrap_err();
-        assert_eq!((e.weights, e.bytes, e.room), (40_000, 160_000, 112 * 1024));
+        assert_eq!((e.weights, e.bytes, e.room), (40_000, 160_000, 128 * 1024));
         let text = alloc_free_text(&e);
         assert!(text.contains("40000 weights") && text.contains("f405"), "{text}");
         assert!(Board::F429Sdram.profile(&HUGE).is_err());

@@ -130,6 +130,19 @@ impl<const TILINGS: usize, const CAP: usize> Trace<TILINGS, CAP> {
         let _ = self.entries.push_back(*features);
     }
 
+    /// Marks every entry's `slot` replaced (`u32::MAX`): the slot now
+    /// belongs to another feature (a full claim table gave it away), so no
+    /// older eligibility may be written into it.
+    pub fn forget(&mut self, slot: u32) {
+        for entry in self.entries.iter_mut() {
+            for s in entry.iter_mut() {
+                if *s == slot {
+                    *s = REPLACED;
+                }
+            }
+        }
+    }
+
     /// Visits every live feature with its eligibility, newest entry first:
     /// `(feature, (γλ)^k)`.
     pub fn for_each(&self, mut visit: impl FnMut(u32, Frac)) {

@@ -20,7 +20,7 @@
 //! nothing (the tile coder never produces one; this keeps the chip free of
 //! panics).
 
-use crate::claims::{Claim, InitialWeights, Occupancy};
+use crate::claims::{Claim, InitialWeights, Occupancy, WhenFull};
 use crate::fixed::Q16;
 
 /// How weights are stored: part of a board's learner profile and of the
@@ -207,6 +207,12 @@ pub trait WeightStore {
     /// After a claim table's slots were loaded: its initial weights and the
     /// refusals saved with it (nothing in a plain table).
     fn restore_claims(&mut self, _init: InitialWeights, _refused: u32) {}
+
+    /// What a claim table does when a claim finds it full
+    /// ([`WhenFull::Refuse`] for a plain table, which never claims).
+    fn when_full(&self) -> WhenFull {
+        WhenFull::Refuse
+    }
 
     /// A claim table's occupancy; `None` for a plain table.
     fn occupancy(&self) -> Option<Occupancy> {

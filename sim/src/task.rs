@@ -94,6 +94,8 @@ pub enum WeightTable {
         format: pada_core::weights::WeightFormat,
         /// Bytes per tag (2 or 4).
         tag_bytes: usize,
+        /// What a claim that finds the table full does.
+        when_full: pada_core::claim_table::WhenFull,
     },
 }
 
@@ -165,10 +167,14 @@ impl WeightTable {
                 log2_size: n.trailing_zeros(),
                 format: profile.format,
                 tag_bytes: profile.tag_bytes,
+                when_full: profile.when_full,
             },
-            (Layout::Claimed, TableSize::FitExact) => {
-                WeightTable::Claimed { log2_size: 0, format: profile.format, tag_bytes: profile.tag_bytes }
-            }
+            (Layout::Claimed, TableSize::FitExact) => WeightTable::Claimed {
+                log2_size: 0,
+                format: profile.format,
+                tag_bytes: profile.tag_bytes,
+                when_full: profile.when_full,
+            },
         }
     }
 }

@@ -63,7 +63,7 @@ fn every_policy_every_robot_and_every_board_is_checked() {
 /// of the profile's weight and tag widths, or a plain one.
 fn table_of(profile: LearnerProfile, weights: usize) -> HostTable {
     match profile.layout {
-        Layout::Claimed => HostTable::claimed(weights, profile.format, profile.tag_bytes).unwrap(),
+        Layout::Claimed => HostTable::claimed(weights, profile.format, profile.tag_bytes).unwrap().on_full(profile.when_full),
         Layout::Exact | Layout::Hashed => HostTable::plain(weights),
     }
 }

@@ -76,6 +76,7 @@ impl ProfileReport {
             memory: profile.memory.name(),
             split_bytes: match profile.memory {
                 Memory::CcmThenSram { ccm_weights } => Some([ccm_weights * bytes, (weights - ccm_weights) * bytes]),
+                Memory::CcmWeightsSramTags => Some([weights * profile.format.bytes(), weights * profile.tag_bytes]),
                 _ => None,
             },
         }

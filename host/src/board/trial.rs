@@ -168,8 +168,8 @@ pub fn with_table<V: TableVisitor>(profile: &LearnerProfile, n: usize, v: V) -> 
 fn claim_on<W: WeightStore, V: TableVisitor>(profile: &LearnerProfile, weights: W, n: usize, v: V) -> anyhow::Result<V::Output> {
     let err = |e: pada_core::claim_table::ClaimTableError| anyhow!("{e}");
     match profile.tag_bytes {
-        2 => v.visit(ClaimTable::new(weights, Tags16(vec![0u16; n].into_boxed_slice())).map_err(err)?),
-        _ => v.visit(ClaimTable::new(weights, Tags32(vec![0u32; n].into_boxed_slice())).map_err(err)?),
+        2 => v.visit(ClaimTable::new(weights, Tags16(vec![0u16; n].into_boxed_slice())).map_err(err)?.on_full(profile.when_full)),
+        _ => v.visit(ClaimTable::new(weights, Tags32(vec![0u32; n].into_boxed_slice())).map_err(err)?.on_full(profile.when_full)),
     }
 }
 

@@ -33,7 +33,7 @@ pub fn build_agent(spec: &TaskSpec, policy: PolicyKind) -> anyhow::Result<HostAg
         }
     };
     let weights = match spec.table {
-        WeightTable::Claimed { format, tag_bytes, .. } => HostTable::claimed(size, format, tag_bytes)?,
+        WeightTable::Claimed { format, tag_bytes, when_full, .. } => HostTable::claimed(size, format, tag_bytes)?.on_full(when_full),
         _ => HostTable::plain(size),
     };
     let mut agent = Agent::new(

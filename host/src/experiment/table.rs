@@ -9,7 +9,7 @@
 //! a whole run, so it costs next to nothing against the table read behind
 //! it.
 
-use pada_core::claim_table::{Claim, ClaimTable, InitialWeights, Occupancy, Tags16, Tags32};
+use pada_core::claim_table::{Claim, ClaimTable, InitialWeights, Occupancy, Tags16, Tags32, WhenFull};
 use pada_core::fixed::Q16;
 use pada_core::weights::{Added, Half, WeightFormat, WeightStore};
 
@@ -60,6 +60,18 @@ impl HostTable {
                  shifted by {LEO_SHIFT} with 16-bit tags)",
                 tag_bytes * 8
             ),
+        }
+    }
+}
+
+impl HostTable {
+    /// The same table, a claim table doing `when_full` with a claim that
+    /// finds it full (nothing for a plain table).
+    pub fn on_full(self, when_full: WhenFull) -> HostTable {
+        match self {
+            HostTable::Plain(t) => HostTable::Plain(t),
+            HostTable::Claimed(t) => HostTable::Claimed(t.on_full(when_full)),
+            HostTable::Chip(t) => HostTable::Chip(t.on_full(when_full)),
         }
     }
 }
@@ -160,6 +172,10 @@ impl WeightStore for HostTable {
 
     fn occupancy(&self) -> Option<Occupancy> {
         each!(self, t => WeightStore::occupancy(t))
+    }
+
+    fn when_full(&self) -> WhenFull {
+        each!(self, t => WeightStore::when_full(t))
     }
 
     fn table_seed(&self) -> u64 {

@@ -79,7 +79,7 @@ pub fn replay(profile: &LearnerProfile, policy: PolicyKind, seed: u64, records: 
     };
     let table = match profile.layout {
         Layout::Claimed => match HostTable::claimed(weights, profile.format, profile.tag_bytes) {
-            Ok(t) => t,
+            Ok(t) => t.on_full(profile.when_full),
             Err(e) => {
                 report.error = Some(format!("cannot build the table: {e}"));
                 return report;

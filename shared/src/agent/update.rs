@@ -25,14 +25,29 @@ where
         let sum = self.weights.read_then_claim(features, &mut claims);
         let mut slots = [u32::MAX; TILINGS];
         for (slot, claim) in slots.iter_mut().zip(claims) {
-            if let Claim::Slot { slot: s, fresh } = claim {
-                *slot = s;
-                if fresh {
-                    if let Some(c) = self.checksum.as_mut() {
-                        let i = s as usize;
-                        *c = c.wrapping_add(self.weights.raw(i).wrapping_mul(entry_factor(i)));
+            match claim {
+                Claim::Slot { slot: s, fresh } => {
+                    *slot = s;
+                    if fresh {
+                        if let Some(c) = self.checksum.as_mut() {
+                            let i = s as usize;
+                            *c = c.wrapping_add(self.weights.raw(i).wrapping_mul(entry_factor(i)));
+                        }
                     }
                 }
+                Claim::Replaced { slot: s, old_raw } => {
+                    *slot = s;
+                    let i = s as usize;
+                    if let Some(c) = self.checksum.as_mut() {
+                        let change = self.weights.raw(i).wrapping_sub(old_raw);
+                        *c = c.wrapping_add(change.wrapping_mul(entry_factor(i)));
+                    }
+                    // The slot's old feature is gone: the trace's older
+                    // entries must not credit the new one with its
+                    // eligibility.
+                    self.trace.forget(s);
+                }
+                Claim::Refused => {}
             }
         }
         (sum, slots)

@@ -183,6 +183,7 @@ proptest! {
                         prop_assert!(!m.weights.contains_key(&k), "a claimed key was refused");
                         prop_assert_eq!(m.weights.len(), 16, "refused with free slots");
                     }
+                    Claim::Replaced { .. } => prop_assert!(false, "a refusing table replaced"),
                 },
             }
             prop_assert_eq!(t.occupancy().claimed as usize, m.weights.len());
@@ -451,5 +452,113 @@ proptest! {
         let pre: Vec<(u32, i32)> = pre.iter().map(|&(h, n)| (key_at(h, n, 16), 0)).collect();
         add_each_is_one_by_one(table(16), &pre, &slots, inc, seed)?;
         add_each_is_one_by_one(chip_table(16), &pre, &slots, inc, seed)?;
+    }
+}
+
+/// A table of `slots` that replaces when full, with a constant initial
+/// weight of 0 (the centre is 0).
+fn replacing(slots: usize) -> ClaimTable<Vec<Q16>, Tags32<Vec<u32>>> {
+    let mut t = ClaimTable::new(vec![Q16::ZERO; slots], Tags32(vec![0u32; slots])).unwrap().on_full(WhenFull::Replace);
+    t.reset(InitialWeights { seed: 7, lo: 0, span: 1 });
+    t
+}
+
+#[test]
+fn a_full_table_that_replaces_gives_away_the_least_learned_slot() {
+    let mut t = replacing(8);
+    for n in 0..8u32 {
+        let Claim::Slot { slot, fresh: true } = t.claim(key_at(n, 1, 8)) else { panic!("not fresh") };
+        // Slot 5 has learned least (closest to the initial 0).
+        t.set(slot as usize, Q16(if slot == 5 { -3 } else { 100 + slot as i32 }));
+    }
+    let loser = key_at(5, 1, 8);
+    let before = t.checksum();
+    let stranger = key_at(3, 99, 8);
+    let old_raw = WeightStore::raw(&t, 5);
+    assert_eq!(t.claim(stranger), Claim::Replaced { slot: 5, old_raw });
+    assert_eq!(t.read(stranger), Q16::ZERO, "the new feature starts from its initial weight");
+    assert_eq!(t.read(loser), Q16::ZERO, "the evicted feature reads its initial weight again");
+    assert_eq!(t.claim(stranger), Claim::Slot { slot: 5, fresh: false }, "found again by its probe");
+    for n in [0u32, 1, 2, 3, 4, 6, 7] {
+        assert_eq!(t.read(key_at(n, 1, 8)), Q16(100 + n as i32), "key of home {n} keeps its weight");
+    }
+    let o = t.occupancy();
+    assert_eq!((o.claimed, o.refused, o.replaced), (8, 0, 1));
+    // The checksum's change is the slot's new raw less its old.
+    let change = WeightStore::raw(&t, 5).wrapping_sub(old_raw).wrapping_mul(entry_factor(5));
+    assert_eq!(t.checksum(), before.wrapping_add(change));
+    // A refusing table of the same content refuses instead.
+    let mut r = table(8);
+    for n in 0..8u32 {
+        r.claim(key_at(n, 1, 8));
+    }
+    assert_eq!(r.claim(stranger), Claim::Refused);
+}
+
+#[test]
+fn a_replacing_batch_never_takes_a_slot_of_its_own_features() {
+    // Slots 0..7 full; keys 0 and 1 of the batch hold 0 and 1 (both at
+    // the initial weight 0, the most attractive victims); two strangers
+    // must take other slots.
+    let mut t = replacing(8);
+    for n in 0..8u32 {
+        let Claim::Slot { slot, .. } = t.claim(key_at(n, 1, 8)) else { panic!() };
+        t.set(slot as usize, Q16(if slot < 2 { 0 } else { 50 + slot as i32 }));
+    }
+    let batch = [key_at(0, 1, 8), key_at(1, 1, 8), key_at(0, 7, 8), key_at(0, 8, 8)];
+    let mut claims = [Claim::Refused; 4];
+    t.read_then_claim(&batch, &mut claims);
+    assert_eq!(claims[0], Claim::Slot { slot: 0, fresh: false });
+    assert_eq!(claims[1], Claim::Slot { slot: 1, fresh: false });
+    let (Claim::Replaced { slot: a, .. }, Claim::Replaced { slot: b, .. }) = (claims[2], claims[3]) else {
+        panic!("{claims:?}")
+    };
+    assert!(a >= 2 && b >= 2 && a != b, "{claims:?}");
+    for (k, c) in batch.iter().zip(claims) {
+        assert_eq!(t.tag(c.slot().unwrap() as usize), t.tag_for(*k), "each feature of the batch holds its slot");
+    }
+    assert_eq!(t.occupancy().replaced, 2);
+}
+
+proptest! {
+    /// A replacing table against a model that knows which feature each
+    /// slot holds: a feature that holds a slot reads its own weight, one
+    /// that lost it (or never had one) reads its initial weight, and no
+    /// claim ever lands in another held feature's slot.
+    #[test]
+    fn a_replacing_table_reads_what_its_features_learned(
+        ops in proptest::collection::vec((0u32..40, -50i32..50), 1..400),
+    ) {
+        let slots = 16usize;
+        let mut t = replacing(slots);
+        let mut owner: HashMap<u32, u32> = HashMap::new(); // slot -> key
+        let mut learned: HashMap<u32, i32> = HashMap::new(); // key -> weight
+        for (k, inc) in ops {
+            // Keys spread over a few homes, so that probes run long.
+            let key = key_at(k % 5, k, slots as u32);
+            match t.claim(key) {
+                Claim::Slot { slot, fresh } => {
+                    if fresh {
+                        prop_assert!(!owner.contains_key(&slot));
+                    } else {
+                        prop_assert_eq!(owner.get(&slot), Some(&key));
+                    }
+                    owner.insert(slot, key);
+                }
+                Claim::Replaced { slot, .. } => {
+                    let old = owner.insert(slot, key).expect("a replaced slot was held");
+                    prop_assert_ne!(old, key);
+                    learned.remove(&old);
+                }
+                Claim::Refused => prop_assert!(false, "a replacing table refused"),
+            }
+            let slot = owner.iter().find(|(_, &v)| v == key).map(|(&s, _)| s).unwrap();
+            t.add(slot as usize, Q16(inc), 0);
+            *learned.entry(key).or_insert(0) += inc;
+            for (&s, &k2) in &owner {
+                prop_assert_eq!(t.read(k2), Q16(learned[&k2]), "slot {}", s);
+            }
+        }
+        prop_assert_eq!(t.occupancy().refused, 0);
     }
 }
