@@ -4,7 +4,8 @@
 //! - **a few homes** (bit 2 clear): 16 or 32 slots (bit 0), 16- or 32-bit
 //!   tags (bit 1); then every 5 bytes are one operation on a key drawn from
 //!   a small pool whose keys share homes, so that probe runs meet, wrap the
-//!   end and fill the table;
+//!   end and fill the table; bit 3 set makes it a table that replaces
+//!   when full ([`WhenFull::Replace`]) instead of refusing;
 //! - **one home** (bit 2 set): a table of 2^1 … 2^17 slots (bits 3–7) with
 //!   16- or 32-bit tags (bit 1), a home from the next 4 bytes, then every 5
 //!   bytes one operation on a key of that home with random high bits (or
@@ -14,6 +15,10 @@
 //! Invariants, checked after every operation:
 //! - a read changes nothing, the occupancy included;
 //! - a refused claim changes no slot, and is counted;
+//! - a replacing table never refuses a single claim; it gives away a slot
+//!   that was held by another feature, within the probe bound of the new
+//!   one, changes no other slot, counts it, and the feature it took the
+//!   slot from reads its initial weight again;
 //! - a claim is refused only when no slot is free within the probe bound;
 //! - the claimed count is the number of tagged slots, never above the size;
 //! - the longest probe is the longest a claim took (a refusal's is
@@ -28,7 +33,7 @@
 
 use super::{ensure, Outcome, Target};
 use crate::gen::{below, bytes};
-use pada_core::claim_table::{tag_of, Claim, ClaimTable, InitialWeights, TagStore, Tags16, Tags32, MAX_PROBE};
+use pada_core::claim_table::{tag_of, Claim, ClaimTable, InitialWeights, TagStore, Tags16, Tags32, WhenFull, MAX_PROBE};
 use pada_core::fixed::Q16;
 use pada_core::weights::{entry_factor, WeightStore};
 use std::collections::HashMap;
@@ -68,12 +73,13 @@ impl Target for Claims {
         }
         let slots = if config & 1 == 0 { 16 } else { 32 };
         let init = InitialWeights { seed: config as u64 * 0x9E37_79B9, lo: -(1 << 16), span: 1 << 17 };
+        let when_full = if config & 8 == 0 { WhenFull::Refuse } else { WhenFull::Replace };
         if config & 2 == 0 {
-            let mut t = ClaimTable::new(vec![Q16::ZERO; slots], Tags16(vec![0u16; slots])).unwrap();
+            let mut t = ClaimTable::new(vec![Q16::ZERO; slots], Tags16(vec![0u16; slots])).unwrap().on_full(when_full);
             t.reset(init);
             run(&mut t, ops, false)
         } else {
-            let mut t = ClaimTable::new(vec![Q16::ZERO; slots], Tags32(vec![0u32; slots])).unwrap();
+            let mut t = ClaimTable::new(vec![Q16::ZERO; slots], Tags32(vec![0u32; slots])).unwrap().on_full(when_full);
             t.reset(init);
             run(&mut t, ops, true)
         }
@@ -90,6 +96,7 @@ fn run<T: TagStore>(t: &mut ClaimTable<Vec<Q16>, T>, ops: &[u8], exact: bool) ->
     // The model of a 32-bit-tag table: key identity is the tag.
     let mut model: HashMap<u32, i32> = HashMap::new();
     let mut refused = 0u32;
+    let mut replaced = 0u32;
     let mut longest = 0u32;
     let mut checksum = t.checksum();
     for op in ops.chunks_exact(5) {
@@ -107,6 +114,7 @@ fn run<T: TagStore>(t: &mut ClaimTable<Vec<Q16>, T>, ops: &[u8], exact: bool) ->
             }
             _ => {
                 let before = snapshot(t);
+                let raws: Vec<u32> = (0..slots).map(|i| t.raw(i)).collect();
                 match t.claim(k) {
                     Claim::Slot { slot, fresh } => {
                         let i = slot as usize;
@@ -125,9 +133,36 @@ fn run<T: TagStore>(t: &mut ClaimTable<Vec<Q16>, T>, ops: &[u8], exact: bool) ->
                             *w = w.saturating_add(inc);
                         }
                     }
+                    Claim::Replaced { slot, old_raw } => {
+                        let i = slot as usize;
+                        ensure!(WeightStore::when_full(t) == WhenFull::Replace, "a refusing table replaced");
+                        ensure!(i < slots, "slot {i} outside the table of {slots}");
+                        ensure!(slot.wrapping_sub(k) & (slots as u32 - 1) < MAX_PROBE, "slot {i} beyond the probe of {k:#x}");
+                        let (old_tag, _) = before[i];
+                        ensure!(old_tag != 0, "replaced the free slot {i}");
+                        ensure!(old_raw == raws[i], "old raw {old_raw:#x} is not the slot's {:#x}", raws[i]);
+                        let after = snapshot(t);
+                        ensure!(
+                            after.iter().zip(&before).enumerate().all(|(j, (a, b))| j == i || a == b),
+                            "a replacement changed another slot"
+                        );
+                        replaced += 1;
+                        longest = MAX_PROBE;
+                        checksum = checksum.wrapping_add(t.raw(i).wrapping_sub(old_raw).wrapping_mul(entry_factor(i)));
+                        let old = t.raw(i);
+                        t.add(i, Q16(inc), 0);
+                        checksum = checksum.wrapping_add(t.raw(i).wrapping_sub(old).wrapping_mul(entry_factor(i)));
+                        if exact {
+                            // 32-bit tags: a feature's stored tag is its model key.
+                            ensure!(model.remove(&old_tag).is_some(), "replaced a slot the model does not hold");
+                            ensure!(!model.contains_key(&tag_of(k, 32)), "key {k:#x} held a slot and replaced another");
+                            model.insert(tag_of(k, 32), init.of(k).0.saturating_add(inc));
+                        }
+                    }
                     Claim::Refused => {
                         refused += 1;
                         longest = MAX_PROBE;
+                        ensure!(WeightStore::when_full(t) == WhenFull::Refuse, "a replacing table refused a single claim");
                         ensure!(snapshot(t) == before, "a refused claim changed the table");
                         let free = before.iter().filter(|(tag, _)| *tag == 0).count();
                         // Every slot is within the bound of a table this small.
@@ -140,6 +175,7 @@ fn run<T: TagStore>(t: &mut ClaimTable<Vec<Q16>, T>, ops: &[u8], exact: bool) ->
         let tagged = snapshot(t).iter().filter(|(tag, _)| *tag != 0).count() as u32;
         ensure!(o.claimed == tagged && o.claimed as usize <= slots, "claimed {} but {tagged} slots tagged", o.claimed);
         ensure!(o.refused == refused, "refused {} counted, {refused} seen", o.refused);
+        ensure!(o.replaced == replaced, "replaced {} counted, {replaced} seen", o.replaced);
         ensure!(o.longest_probe == longest, "longest probe {} reported, {longest} taken by a claim", o.longest_probe);
         ensure!(checksum == t.checksum(), "running checksum {checksum:#x}, table {:#x}", t.checksum());
     }
@@ -222,6 +258,9 @@ fn run_one_home<T: TagStore>(t: &mut ClaimTable<Vec<Q16>, T>, home: u32, log2: u
                     let e = model.entry(k & kept).or_insert((want, slot));
                     e.0 = e.0.saturating_add(inc);
                     ensure!(t.read(k).0 == e.0, "key {k:#x} reads {} after a write, the model {}", t.read(k).0, e.0);
+                }
+                Claim::Replaced { slot, .. } => {
+                    return Outcome::Failed(format!("2^{log2} slots: a refusing table replaced slot {slot} for {k:#x}"));
                 }
                 Claim::Refused => {
                     refused += 1;

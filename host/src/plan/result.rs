@@ -415,7 +415,7 @@ mod tests {
             end_speed_m_s: None,
             saturations: 0,
             trace_drops: 0,
-            table: Some(pada_core::claim_table::Occupancy { claimed: 3, slots: 8, refused: 1, longest_probe: 2 }),
+            table: Some(pada_core::claim_table::Occupancy { claimed: 3, slots: 8, refused: 1, replaced: 0, longest_probe: 2 }),
             curve: (0..50)
                 .map(|i| TestPoint {
                     learning_time_s: i as f64 / 30.0,
