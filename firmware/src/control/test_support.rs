@@ -52,6 +52,13 @@ pub(super) fn leo_table_of(n: usize) -> LeoTable {
         .unwrap()
 }
 
+/// LEO's claim table in the F405's CCM alone (2^14 slots of 16-bit weight
+/// and tag, 64 KiB): a table whose checkpoint fits a 128 KiB flash sector.
+pub(super) fn ccm_leo_profile() -> LearnerProfile {
+    let p = profile(&leo::SPEC);
+    p.with_hashed_table(pada_core::tile_coding::Layout::Claimed, 14, p.format, 2)
+}
+
 /// The F405's LEO table.
 pub(super) fn leo_table() -> LeoTable {
     leo_table_of(profile(&leo::SPEC).weights().unwrap())

@@ -11,6 +11,8 @@
 //! board will learn; `pada sil` shows that the binary does the same, bit
 //! for bit.
 //!
+//! - [`demand`]: the slots a trial writes against the board's claim
+//!   table, known before flashing;
 //! - [`protocol`]: the run protocol and seeds, shared with `pada sil`;
 //! - [`trial`]: one trial, the controller and the rig in lock step;
 //! - [`fault_line`]: a fault's cause as one line for a person;
@@ -19,6 +21,7 @@
 //! - [`run_board`]: the trials of a run in parallel, with the same
 //!   [`TrialResult`]s (and so the same `summary.json`) as `pada run`.
 
+pub mod demand;
 pub mod fault_line;
 pub mod protocol;
 pub mod readable;

@@ -11,7 +11,8 @@ use crate::board::{robot_of_task, run_board};
 use crate::experiment::task::{Task, TaskSpec};
 use crate::experiment::tasks::{visit_task, TaskVisitor};
 use crate::summary::{board_files, BoardSummary};
-use pada_core::profile::{Board, TILINGS};
+use pada_core::claim_table::WhenFull;
+use pada_core::profile::{Board, LearnerProfile, TILINGS};
 use pada_core::tile_coding::Layout;
 use pada_core::weights::WeightFormat;
 use crate::experiment::{build_agent, run_trials, run_trials_observed, RunConfig, TrialResult};
@@ -122,6 +123,14 @@ pub struct RunArgs {
     /// pada_core::claim_table).
     #[arg(long, value_name = "BITS", requires = "board", value_parser = ["16", "32"])]
     pub tag_bits: Option<String>,
+    /// With --board: what the board's claim table does when a claim finds
+    /// it full (docs/board.md, "A full table"): refuse the claim (the
+    /// feature never learns), replace the least-learned feature of the
+    /// probe (the F405's default), or collide: a hashed table of 16-bit
+    /// weights in the same memory, twice the entries, where features share
+    /// them.
+    #[arg(long, value_name = "BEHAVIOUR", requires = "board")]
+    pub table_full: Option<TableFull>,
     /// Seed and threads.
     #[command(flatten)]
     pub trial: TrialOptions,
@@ -153,6 +162,40 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
         }
         None => visit_task(args.task, RunVisitor(args)),
     }
+}
+
+/// What a full board table does (`--table-full`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum TableFull {
+    /// Refuse the claim and count it.
+    Refuse,
+    /// Give the new feature the least-learned slot of its probe.
+    Replace,
+    /// No claims: a hashed table of 16-bit weights in the same bytes.
+    Collide,
+}
+
+/// `profile` with its full claim table doing `full`, or why it cannot.
+fn with_table_full(profile: LearnerProfile, full: TableFull) -> Result<LearnerProfile, CliError> {
+    if profile.layout != Layout::Claimed {
+        return Err(usage(format!(
+            "--table-full needs a claim table; {} has a {} one for {}",
+            profile.board.name(),
+            profile.layout.name(),
+            profile.robot.name
+        )));
+    }
+    Ok(match full {
+        TableFull::Refuse => profile.when_full(WhenFull::Refuse),
+        TableFull::Replace => profile.when_full(WhenFull::Replace),
+        TableFull::Collide => {
+            // The claim table's bytes, all of them 16-bit weights.
+            let bytes = profile.table_bytes().unwrap_or(0);
+            let format = WeightFormat::Half { shift: profile.robot.half_shift };
+            let entries = (bytes / format.bytes()).max(1);
+            profile.with_hashed_table(Layout::Hashed, entries.ilog2(), format, 0).when_full(WhenFull::Refuse)
+        }
+    })
 }
 
 /// `pada run --board`: the board's own learner ([`crate::board`]).
@@ -215,6 +258,9 @@ fn run_on_board(args: RunArgs, board: Board, sim: crate::robots::SimRobot) -> Re
         let layout = if profile.layout == Layout::Exact { Layout::Hashed } else { profile.layout };
         profile = profile.with_hashed_table(layout, log2, format, tag_bytes);
     }
+    if let Some(full) = args.table_full {
+        profile = with_table_full(profile, full)?;
+    }
     let policy = policy_of(&args)?;
     // The task as the runner describes it, with the board's table: the
     // summary's keys and parameters are `pada run`'s.
@@ -231,6 +277,26 @@ fn run_on_board(args: RunArgs, board: Board, sim: crate::robots::SimRobot) -> Re
         )));
     }
     let cfg = run_config(&args, &task_spec, policy)?;
+    // Before the board's run: the slots this robot's learning writes
+    // against the board's claim table, from a host trial (cached).
+    if profile.layout == Layout::Claimed && crate::board::demand::has_claim_table(&sim) {
+        let bar = steps_bar(
+            cfg.expected_steps(task_spec.control_period_s, task_spec.episode_steps, task_spec.test_interval),
+            &format!("{}: the table's demand (a host trial)", task_spec.name),
+        );
+        let demand = crate::board::demand::demand(&sim, policy, cfg.seconds, cfg.seed, &|n| bar.inc(n))
+            .map_err(|e| usage(format!("{e:#}")))?;
+        bar.finish_and_clear();
+        if let Some(f) = crate::board::demand::Forecast::of(&demand, &profile) {
+            for line in f.lines(&demand) {
+                if args.json {
+                    eprintln!("{line}");
+                } else {
+                    outln!("{line}")?;
+                }
+            }
+        }
+    }
     let out_path = args.out.clone().unwrap_or_else(|| {
         PathBuf::from(format!("pada-out/run-{}-{}-{}", task_spec.name, args.algo, board.name()))
     });
@@ -530,11 +596,12 @@ pub fn print_summary(s: &RunSummary, label: &str) -> Result<(), CliError> {
     let tables: Vec<_> = s.per_trial.iter().filter_map(|t| t.table).collect();
     if let Some(most) = tables.iter().max_by_key(|o| o.claimed) {
         outln!(
-            "  claim table          {} of {} slots claimed ({:.1} %, the fullest trial), {} claims refused in all, longest probe {}",
+            "  claim table          {} of {} slots claimed ({:.1} %, the fullest trial), {} claims refused and {} replaced in all, longest probe {}",
             most.claimed,
             most.slots,
             100.0 * most.fraction(),
             tables.iter().map(|o| o.refused as u64).sum::<u64>(),
+            tables.iter().map(|o| o.replaced as u64).sum::<u64>(),
             tables.iter().map(|o| o.longest_probe).max().unwrap_or(0)
         )?;
     }
