@@ -72,6 +72,7 @@ pub mod error;
 pub mod exploration;
 pub mod fatigue;
 pub mod fixed;
+pub mod framing;
 pub mod governor;
 pub mod limits;
 pub mod policy;
