@@ -71,6 +71,7 @@ pub mod episodes;
 pub mod error;
 pub mod exploration;
 pub mod fatigue;
+pub mod feetech;
 pub mod fixed;
 pub mod framing;
 pub mod governor;
