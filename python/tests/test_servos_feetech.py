@@ -14,18 +14,14 @@ timeout)` converts positions to radians about the middle (2048) and
 speeds with sign bit 15. The memory map: docs/reference/feetech.md.
 """
 
-import json
 import math
-import os
-import signal
-import subprocess
 import time
 
 import pytest
 import rustypot
 import scservo_sdk as scs
 
-from conftest import pada_binary
+from conftest import start_servos, stop_servos
 
 BAUD = 1_000_000
 IDS = list(range(1, 7))
@@ -40,19 +36,10 @@ class Chain:
 
     def __init__(self, tmp_path, *extra):
         self.link = str(tmp_path / "so101")
-        args = [pada_binary(), "servos", "--port", self.link, "--chain", "sts3215:1-6", "--baud", str(BAUD), "--json", *extra]
-        self.proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        deadline = time.time() + 30
-        while not os.path.exists(self.link):
-            if self.proc.poll() is not None or time.time() > deadline:
-                raise RuntimeError(f"pada servos did not start: {self.proc.stderr.read()}")
-            time.sleep(0.02)
+        self.proc = start_servos(self.link, "--chain", "sts3215:1-6", "--baud", str(BAUD), *extra)
 
     def close(self):
-        self.proc.send_signal(signal.SIGINT)
-        out, err = self.proc.communicate(timeout=30)
-        assert self.proc.returncode == 0, err
-        return json.loads(out)
+        return stop_servos(self.proc)
 
 
 @pytest.fixture

@@ -153,44 +153,26 @@ impl VirtualBus {
         // servos (the pendulum's and LEO's encoders, LEO's foot switches);
         // every robot's operator hears the controller's calls at its ID.
         let sensor_answers = robot.encoder.is_some();
-        let supply_v = rig.supply_v();
-        Ok(VirtualBus {
-            rig,
-            supply_v,
-            driven: vec![(false, 0.0); devices.len()],
-            devices,
-            sensor: Some(SensorDevice::new()),
-            sensor_answers,
-            dec1: dxl1::InstructionDecoder::new(),
-            dec2: dxl2::InstructionDecoder::new(),
-            clock,
-            period_us: robot.period_us as u64,
-            now_us: 0,
-            period_ended: false,
-            onsets: vec![false; faults.len()],
-            raised: vec![false; faults.len()],
-            faults,
-            stats: BusStats::default(),
-            events: Vec::new(),
-        })
+        Ok(Self::assemble(rig, devices, Some(SensorDevice::new()), sensor_answers, clock, robot.period_us as u64, faults))
     }
 
-    /// A bare chain of STS3215s at `ids` (no robot: [`super::chain`]),
-    /// at `bps`; lock step ends a period of `period_us` at each SYNC WRITE.
-    pub fn chain(ids: &[u8], bps: u32, clock: Clock, faults: Vec<FaultSpec>, period_us: u64) -> Result<Self, String> {
-        let table = &feetech::control_table::sts3215::STS3215;
-        let baud = baud_value(table, bps).ok_or_else(|| baud_error(table, bps))?;
-        let devices: Vec<Device> = ids.iter().map(|&id| Device::P1(P1Servo::of(&super::ft::STS3215_LAYOUT, id, baud, None))).collect();
-        if let Some(f) = faults.iter().find(|f| !ids.contains(&f.servo)) {
-            return Err(format!("--fault {f}: no servo {} on the chain (its servos: {ids:?})", f.servo));
-        }
-        Ok(VirtualBus {
-            rig: Box::new(super::chain::NoPlant::new(ids.to_vec())),
-            supply_v: super::ft::SUPPLY_DV as f64 / 10.0,
+    /// The bus of `devices` behind `rig`, at time 0.
+    fn assemble(
+        rig: Box<dyn Rig>,
+        devices: Vec<Device>,
+        sensor: Option<SensorDevice>,
+        sensor_answers: bool,
+        clock: Clock,
+        period_us: u64,
+        faults: Vec<FaultSpec>,
+    ) -> Self {
+        VirtualBus {
+            supply_v: rig.supply_v(),
+            rig,
             driven: vec![(false, 0.0); devices.len()],
             devices,
-            sensor: None,
-            sensor_answers: false,
+            sensor,
+            sensor_answers,
             dec1: dxl1::InstructionDecoder::new(),
             dec2: dxl2::InstructionDecoder::new(),
             clock,
@@ -202,7 +184,20 @@ impl VirtualBus {
             faults,
             stats: BusStats::default(),
             events: Vec::new(),
-        })
+        }
+    }
+
+    /// A bare chain of STS3215s at `ids` (no robot: [`super::chain`]),
+    /// at `bps`; lock step ends a period of `period_us` at each SYNC WRITE.
+    pub fn chain(ids: &[u8], bps: u32, clock: Clock, faults: Vec<FaultSpec>, period_us: u64) -> Result<Self, String> {
+        let table = &feetech::control_table::sts3215::STS3215;
+        let baud = baud_value(table, bps).ok_or_else(|| baud_error(table, bps))?;
+        let devices: Vec<Device> = ids.iter().map(|&id| Device::P1(P1Servo::of(&super::ft::STS3215_LAYOUT, id, baud, None))).collect();
+        if let Some(f) = faults.iter().find(|f| !ids.contains(&f.servo)) {
+            return Err(format!("--fault {f}: no servo {} on the chain (its servos: {ids:?})", f.servo));
+        }
+        let rig = Box::new(super::chain::NoPlant::new(ids.to_vec()));
+        Ok(Self::assemble(rig, devices, None, false, clock, period_us, faults))
     }
 
     /// Counters so far.
@@ -275,7 +270,7 @@ impl VirtualBus {
                     // An STS3215's Status has the bits at the same places.
                     Device::P1(s) if s.id() == f.servo && s.own_loop.is_some() => {
                         if let Some(out) = s.own_loop.as_mut() {
-                            out.injected = out.injected.union(feetech::ServoStatus(bits.bits()));
+                            out.injected = out.injected.union(bits);
                         }
                     }
                     _ => continue,
@@ -317,23 +312,21 @@ impl VirtualBus {
         let mut replies = Vec::new();
         for &b in bytes {
             self.stats.bytes_in += 1;
-            let mut next = self.dec1.push(b);
-            while let Some(r) = next {
+            // Each byte to both protocols' decoders: what it completes in
+            // each, in order.
+            for r in self.dec1.feed(&[b]).collect::<Vec<_>>() {
                 match r {
                     Ok(p) => self.packet1(p, line_bps, &mut replies),
                     Err(dxl1::DecodeError::BadChecksum { id, .. }) => self.damaged(id, ServoProtocol::V1, line_bps, &mut replies),
                     Err(_) => {}
                 }
-                next = self.dec1.poll();
             }
-            let mut next = self.dec2.push(b);
-            while let Some(r) = next {
+            for r in self.dec2.feed(&[b]).collect::<Vec<_>>() {
                 match r {
                     Ok(p) => self.packet2(p, line_bps, &mut replies),
                     Err(dxl2::DecodeError::BadCrc { id, .. }) => self.damaged(id, ServoProtocol::V2, line_bps, &mut replies),
                     Err(_) => {}
                 }
-                next = self.dec2.poll();
             }
         }
         self.stats.replies += replies.len() as u64;
@@ -476,6 +469,8 @@ impl VirtualBus {
             }
             let ins = if feetech(&self.devices[i]) { ft } else { dx };
             let Device::P1(s) = &mut self.devices[i] else { continue };
+            // It answers from the ID it was asked at (RESET changes it).
+            let id = s.id();
             let answer = match ins {
                 Err(_) => {
                     self.answer1(i, broadcast, Some(ErrorFlags::INSTRUCTION), replies);
@@ -490,7 +485,6 @@ impl VirtualBus {
                 s.own_loop = Some(out);
             }
             if let Some((error, data)) = answer {
-                let id = s.id();
                 let error = if s.own_loop.is_some() { super::ft::answer_error(s, error) } else { error };
                 let bytes = encode1(id, (error, data));
                 self.push_reply(i, bytes, replies);

@@ -36,7 +36,7 @@ use super::p1::{Layout, P1Servo};
 use pada_core::feetech::control_table::sts3215::{self as sts, STS3215};
 use pada_core::feetech::value::{from_sign_magnitude, to_sign_magnitude_saturating, POSITION_SIGN_BIT, VELOCITY_SIGN_BIT};
 use pada_core::dynamixel::ErrorFlags;
-use pada_core::feetech::ServoStatus;
+use pada_core::feetech::status::{self, ServoStatus};
 
 /// The time constant of the emulated position loop \[s\].
 pub const TAU_S: f64 = 0.05;
@@ -81,8 +81,8 @@ pub fn factory_table(id: u8, baud: u8) -> Vec<u8> {
     put(sts::MAX_INPUT_VOLTAGE, &[140]);
     put(sts::MIN_INPUT_VOLTAGE, &[40]);
     put(sts::MAX_TORQUE_LIMIT, &1000u16.to_le_bytes());
-    put(sts::UNLOADING_CONDITION, &[ServoStatus::HARDWARE.bits()]);
-    put(sts::LED_ALARM_CONDITION, &[ServoStatus::HARDWARE.bits() | ServoStatus::ANGLE.bits()]);
+    put(sts::UNLOADING_CONDITION, &[status::HARDWARE.bits()]);
+    put(sts::LED_ALARM_CONDITION, &[status::HARDWARE.bits() | status::ANGLE.bits()]);
     put(sts::P_COEFFICIENT, &[32]);
     put(sts::D_COEFFICIENT, &[32]);
     put(sts::CW_DEAD_ZONE, &[1]);
@@ -139,13 +139,13 @@ fn conditions(t: &[u8]) -> ServoStatus {
     let mut s = ServoStatus::NONE;
     let volts = t[sts::PRESENT_VOLTAGE as usize];
     if volts > t[sts::MAX_INPUT_VOLTAGE as usize] || volts < t[sts::MIN_INPUT_VOLTAGE as usize] {
-        s = s.union(ServoStatus::VOLTAGE);
+        s = s.union(status::VOLTAGE);
     }
     if t[sts::PRESENT_TEMPERATURE as usize] > t[sts::MAX_TEMPERATURE_LIMIT as usize] {
-        s = s.union(ServoStatus::OVERHEAT);
+        s = s.union(status::OVERHEAT);
     }
     if target(t).1 {
-        s = s.union(ServoStatus::ANGLE);
+        s = s.union(status::ANGLE);
     }
     s
 }
@@ -179,7 +179,7 @@ pub fn advance(servo: &mut P1Servo, out: &mut Output, now_us: u64) -> bool {
     t[sts::MOVING as usize] = u8::from(out.velocity.abs() > 1.0);
     let status = conditions(t).union(out.injected);
     t[sts::STATUS as usize] = status.bits();
-    let unload = status.intersects(ServoStatus(t[sts::UNLOADING_CONDITION as usize]));
+    let unload = status.intersects(ErrorFlags(t[sts::UNLOADING_CONDITION as usize]));
     let dropped = unload && t[sts::TORQUE_ENABLE as usize] != 0;
     if dropped {
         t[sts::TORQUE_ENABLE as usize] = 0;
@@ -275,17 +275,17 @@ mod tests {
         s.table[sts::MAX_POSITION_LIMIT as usize..][..2].copy_from_slice(&3000u16.to_le_bytes());
         s.table[sts::GOAL_POSITION as usize..][..2].copy_from_slice(&3500u16.to_le_bytes());
         assert!(!advance(&mut s, &mut out, 10_000));
-        assert_eq!(error_byte(&s), ServoStatus::ANGLE.bits());
+        assert_eq!(error_byte(&s), status::ANGLE.bits());
         // An injected overload: Status, and the torque drops.
-        out.injected = ServoStatus::OVERLOAD;
+        out.injected = status::OVERLOAD;
         assert!(advance(&mut s, &mut out, 20_000));
         assert!(!s.torque());
-        assert!(ServoStatus(error_byte(&s)).intersects(ServoStatus::OVERLOAD));
+        assert!(ErrorFlags(error_byte(&s)).intersects(status::OVERLOAD));
         // Overheating from the table.
         let (mut s, mut out) = servo();
         s.table[sts::MAX_TEMPERATURE_LIMIT as usize] = 30;
         advance(&mut s, &mut out, 1);
-        assert_eq!(error_byte(&s), ServoStatus::OVERHEAT.bits());
+        assert_eq!(error_byte(&s), status::OVERHEAT.bits());
     }
 
     #[test]

@@ -20,7 +20,7 @@
 //! and garbage must match ID, LENGTH and checksum to pass.
 
 use super::packet::{checksum, ErrorFlags, InstructionPacket, StatusPacket, BROADCAST_ID, DEFAULT_PACKET_LEN, HEADER, OVERHEAD};
-use crate::framing::{bump, Counters, Framed, Step};
+use crate::framing::{bump, Step};
 use heapless::Vec;
 
 /// Why bytes received did not form a packet. The decoder has already
@@ -134,15 +134,6 @@ pub type StatusDecoder<const N: usize = DEFAULT_PACKET_LEN> = Decoder<StatusPack
 /// The bus emulator's decoder of instruction packets.
 pub type InstructionDecoder<const N: usize = DEFAULT_PACKET_LEN> = Decoder<InstructionPacket<N>, N>;
 
-impl Counters for DecoderStats {
-    fn packets(&mut self) -> &mut u32 {
-        &mut self.packets
-    }
-    fn skipped_bytes(&mut self) -> &mut u32 {
-        &mut self.skipped_bytes
-    }
-}
-
 /// The counters of a new decoder.
 const NO_STATS: DecoderStats =
     DecoderStats { packets: 0, skipped_bytes: 0, bad_checksums: 0, bad_lengths: 0, unexpected_ids: 0 };
@@ -192,34 +183,9 @@ pub fn examine<P: FromRaw<N>, const N: usize>(buf: &[u8], expected: Option<Reply
     Step::Accept { len: total, packet: P::from_raw(id, packet[4], params) }
 }
 
-impl<const N: usize> Framed<N> for StatusPacket<N> {
-    const HEADER: &'static [u8] = &HEADER;
-    const MIN_PACKET: usize = OVERHEAD;
-    type Reply = Reply;
-    type Error = DecodeError;
-    type Stats = DecoderStats;
-    const NO_STATS: DecoderStats = NO_STATS;
-    fn count(stats: &mut DecoderStats, error: &DecodeError) {
-        count(stats, error)
-    }
-    fn examine(buf: &[u8], expected: Option<Reply>) -> Step<Self, DecodeError> {
-        examine(buf, expected)
-    }
-}
-
-impl<const N: usize> Framed<N> for InstructionPacket<N> {
-    const HEADER: &'static [u8] = &HEADER;
-    const MIN_PACKET: usize = OVERHEAD;
-    type Reply = Reply;
-    type Error = DecodeError;
-    type Stats = DecoderStats;
-    const NO_STATS: DecoderStats = NO_STATS;
-    fn count(stats: &mut DecoderStats, error: &DecodeError) {
-        count(stats, error)
-    }
-    fn examine(buf: &[u8], expected: Option<Reply>) -> Step<Self, DecodeError> {
-        examine(buf, expected)
-    }
+crate::framed! {
+    header: HEADER, min: OVERHEAD, reply: Reply, error: DecodeError, stats: DecoderStats = NO_STATS,
+    count: count, examine: examine, packets: [StatusPacket, InstructionPacket]
 }
 
 #[cfg(test)]

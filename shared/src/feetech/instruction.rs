@@ -22,46 +22,24 @@ use crate::dynamixel::{self, EncodeError, BROADCAST_ID};
 
 pub use crate::dynamixel::InstructionError;
 
-/// Feetech's instruction codes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[repr(u8)]
-pub enum InstructionCode {
-    /// Is a servo there.
-    Ping = 0x01,
-    /// Read from the memory table.
-    Read = 0x02,
-    /// Write to the memory table.
-    Write = 0x03,
-    /// Write, held until ACTION.
-    RegWrite = 0x04,
-    /// Execute the held REG WRITE.
-    Action = 0x05,
-    /// Reset the memory table to factory values.
-    Recovery = 0x06,
-    /// Read the same items of several servos, one reply each.
-    SyncRead = 0x82,
-    /// Write the same items of several servos.
-    SyncWrite = 0x83,
-}
-
-/// Every code of the table, in order.
-pub const INSTRUCTIONS: [InstructionCode; 8] = [
-    InstructionCode::Ping,
-    InstructionCode::Read,
-    InstructionCode::Write,
-    InstructionCode::RegWrite,
-    InstructionCode::Action,
-    InstructionCode::Recovery,
-    InstructionCode::SyncRead,
-    InstructionCode::SyncWrite,
+/// Feetech's instruction table: each code and its name.
+pub const INSTRUCTIONS: [(u8, &str); 8] = [
+    (0x01, "PING"),
+    (0x02, "READ"),
+    (0x03, "WRITE"),
+    (0x04, "REG WRITE"),
+    (0x05, "ACTION"),
+    (0x06, "RECOVERY"),
+    (SYNC_READ, "SYNC READ"),
+    (0x83, "SYNC WRITE"),
 ];
 
-impl InstructionCode {
-    /// The code for a byte, if Feetech's table has it.
-    pub fn from_u8(b: u8) -> Option<Self> {
-        INSTRUCTIONS.iter().copied().find(|c| *c as u8 == b)
-    }
+/// SYNC READ's code, the one row Protocol 1.0 lacks.
+pub const SYNC_READ: u8 = 0x82;
+
+/// The name of a code in Feetech's table, if it has it.
+pub fn name(code: u8) -> Option<&'static str> {
+    INSTRUCTIONS.iter().find(|(c, _)| *c == code).map(|(_, n)| *n)
 }
 
 /// A Feetech instruction, borrowing its parameters.
@@ -86,7 +64,7 @@ impl<'a> Instruction<'a> {
     pub fn code(&self) -> u8 {
         match self {
             Instruction::Shared(i) => i.code() as u8,
-            Instruction::SyncRead { .. } => InstructionCode::SyncRead as u8,
+            Instruction::SyncRead { .. } => SYNC_READ,
         }
     }
 
@@ -94,9 +72,9 @@ impl<'a> Instruction<'a> {
     /// READ needs at least one ID and a length of at least one byte.
     pub fn parse(code: u8, params: &'a [u8]) -> Result<Self, InstructionError> {
         let bad = InstructionError::BadParams { code, len: params.len() as u8 };
-        match InstructionCode::from_u8(code) {
+        match name(code) {
             None => Err(InstructionError::UnknownCode { code }),
-            Some(InstructionCode::SyncRead) => match params {
+            Some(_) if code == SYNC_READ => match params {
                 [addr, len, ids @ ..] if *len > 0 && !ids.is_empty() => {
                     Ok(Instruction::SyncRead { addr: *addr, len: *len, ids })
                 }
@@ -118,7 +96,7 @@ impl<'a> Instruction<'a> {
                 if len == 0 || ids.is_empty() {
                     return Err(EncodeError::SyncDataLength { entry: 0, expected: len, got: ids.len() });
                 }
-                write_packet(id, InstructionCode::SyncRead as u8, &[&[addr, len], ids], out)
+                write_packet(id, SYNC_READ, &[&[addr, len], ids], out)
             }
         }
     }
@@ -167,11 +145,9 @@ mod tests {
         assert_eq!(Instruction::parse(0x92, &[0, 2, 1, 36]), Err(InstructionError::UnknownCode { code: 0x92 }));
         let bulk = Instruction::Shared(dynamixel::Instruction::BulkRead { entries: &[2, 1, 36] });
         assert_eq!(bulk.encode(0xFE, &mut a), Err(EncodeError::Unsupported { code: 0x92 }));
-        assert_eq!(Instruction::parse(0x06, &[]).unwrap().code(), InstructionCode::Recovery as u8);
+        assert_eq!(name(Instruction::parse(0x06, &[]).unwrap().code()), Some("RECOVERY"));
         assert_eq!(Instruction::parse(0x0A, &[]), Err(InstructionError::UnknownCode { code: 0x0A }));
         assert_eq!(Instruction::parse(0x02, &[56, 8]).unwrap().reply_params(), 8);
-        for c in INSTRUCTIONS {
-            assert_eq!(InstructionCode::from_u8(c as u8), Some(c));
-        }
+        assert_eq!(INSTRUCTIONS.iter().filter(|(c, _)| name(*c).is_some()).count(), 8);
     }
 }

@@ -65,7 +65,7 @@ pub use crate::dynamixel::{
     ErrorFlags, Feed, InstructionDecoder, InstructionPacket, Reply, StatusDecoder, StatusPacket, BROADCAST_ID,
     DEFAULT_PACKET_LEN, HEADER, MAX_PARAMS, OVERHEAD,
 };
-pub use instruction::{sync_read, Instruction, InstructionCode, InstructionError};
+pub use instruction::{sync_read, Instruction, InstructionError};
 pub use status::ServoStatus;
 pub use value::ByteOrder;
 

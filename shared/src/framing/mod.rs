@@ -85,6 +85,42 @@ pub trait Framed<const N: usize>: Sized {
     fn examine(buf: &[u8], expected: Option<Self::Reply>) -> Step<Self, Self::Error>;
 }
 
+/// Implements [`Framed`] for each packet type named, all with one
+/// protocol's framing: its header, smallest packet, reply, error and
+/// counters (whose `packets` and `skipped_bytes` fields make
+/// [`Counters`]), and its `count` and `examine` functions.
+#[macro_export]
+#[doc(hidden)]
+macro_rules! framed {
+    (header: $header:expr, min: $min:expr, reply: $reply:ty, error: $error:ty, stats: $stats:ty = $none:expr,
+     count: $count:path, examine: $examine:path, packets: [$($packet:ident),*]) => {
+        impl $crate::framing::Counters for $stats {
+            fn packets(&mut self) -> &mut u32 {
+                &mut self.packets
+            }
+            fn skipped_bytes(&mut self) -> &mut u32 {
+                &mut self.skipped_bytes
+            }
+        }
+        $(
+            impl<const N: usize> $crate::framing::Framed<N> for $packet<N> {
+                const HEADER: &'static [u8] = &$header;
+                const MIN_PACKET: usize = $min;
+                type Reply = $reply;
+                type Error = $error;
+                type Stats = $stats;
+                const NO_STATS: $stats = $none;
+                fn count(stats: &mut $stats, error: &$error) {
+                    $count(stats, error)
+                }
+                fn examine(buf: &[u8], expected: Option<$reply>) -> $crate::framing::Step<Self, $error> {
+                    $examine(buf, expected)
+                }
+            }
+        )*
+    };
+}
+
 /// Adds one to a counter, saturating.
 pub fn bump(counter: &mut u32) {
     *counter = counter.saturating_add(1);

@@ -28,7 +28,7 @@ use super::crc::crc16;
 use super::packet::{is_stuffed, InstructionPacket, StatusPacket, BROADCAST_ID, DEFAULT_PACKET_LEN, HEADER, MAX_ID, PREFIX_LEN, STATUS, STATUS_OVERHEAD};
 use super::status::StatusError;
 use super::stuffing::{destuff, max_stuffed_len};
-use crate::framing::{bump, Counters, Framed, Step};
+use crate::framing::{bump, Step};
 use heapless::Vec;
 
 /// Why bytes received did not form an acceptable packet. The decoder has
@@ -189,15 +189,6 @@ pub type StatusDecoder<const N: usize = DEFAULT_PACKET_LEN> = Decoder<StatusPack
 /// A servo's (or the bus emulator's) decoder of instruction packets.
 pub type InstructionDecoder<const N: usize = DEFAULT_PACKET_LEN> = Decoder<InstructionPacket<N>, N>;
 
-impl Counters for DecoderStats {
-    fn packets(&mut self) -> &mut u32 {
-        &mut self.packets
-    }
-    fn skipped_bytes(&mut self) -> &mut u32 {
-        &mut self.skipped_bytes
-    }
-}
-
 /// The counters of a new decoder.
 const NO_STATS: DecoderStats = DecoderStats {
     packets: 0,
@@ -278,32 +269,7 @@ pub fn examine<P: FromFrame<N>, const N: usize>(buf: &[u8], expected: Option<Rep
     }
 }
 
-impl<const N: usize> Framed<N> for StatusPacket<N> {
-    const HEADER: &'static [u8] = &HEADER;
-    const MIN_PACKET: usize = STATUS_OVERHEAD;
-    type Reply = Reply;
-    type Error = DecodeError;
-    type Stats = DecoderStats;
-    const NO_STATS: DecoderStats = NO_STATS;
-    fn count(stats: &mut DecoderStats, error: &DecodeError) {
-        count(stats, error)
-    }
-    fn examine(buf: &[u8], expected: Option<Reply>) -> Step<Self, DecodeError> {
-        examine(buf, expected)
-    }
-}
-
-impl<const N: usize> Framed<N> for InstructionPacket<N> {
-    const HEADER: &'static [u8] = &HEADER;
-    const MIN_PACKET: usize = STATUS_OVERHEAD;
-    type Reply = Reply;
-    type Error = DecodeError;
-    type Stats = DecoderStats;
-    const NO_STATS: DecoderStats = NO_STATS;
-    fn count(stats: &mut DecoderStats, error: &DecodeError) {
-        count(stats, error)
-    }
-    fn examine(buf: &[u8], expected: Option<Reply>) -> Step<Self, DecodeError> {
-        examine(buf, expected)
-    }
+crate::framed! {
+    header: HEADER, min: STATUS_OVERHEAD, reply: Reply, error: DecodeError, stats: DecoderStats = NO_STATS,
+    count: count, examine: examine, packets: [StatusPacket, InstructionPacket]
 }
