@@ -1,8 +1,11 @@
 """Shared helpers: the `pada` command the results are compared with."""
 
+import json
 import os
 import shutil
+import signal
 import subprocess
+import time
 from pathlib import Path
 
 import pytest
@@ -36,3 +39,24 @@ def pada_bin():
 def run_pada(binary, *args):
     out = subprocess.run([binary, *args], check=True, capture_output=True, text=True, timeout=600)
     return out.stdout
+
+
+def start_servos(link, *args):
+    """Starts `pada servos --port LINK ARGS… --json` and waits for its
+    port's link; returns the process."""
+    proc = subprocess.Popen([pada_binary(), "servos", "--port", str(link), *args, "--json"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.time() + 30
+    while not os.path.exists(link):
+        if proc.poll() is not None or time.time() > deadline:
+            raise RuntimeError(f"pada servos did not start: {proc.stderr.read()}")
+        time.sleep(0.02)
+    return proc
+
+
+def stop_servos(proc):
+    """Interrupts `pada servos` as Ctrl-C does; returns its JSON summary."""
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=30)
+    assert proc.returncode == 0, err
+    return json.loads(out)

@@ -10,16 +10,11 @@ XM430-W350 at ID 1, an XL430-W250 at ID 2). Protocol 1.0: LEO's seven
 RX-28s (IDs 1-7) with the sensor device at ID 100.
 """
 
-import json
-import os
-import signal
-import subprocess
-import time
 
 import dynamixel_sdk as dxl
 import pytest
 
-from conftest import REPO, pada_binary
+from conftest import REPO, start_servos, stop_servos
 
 BAUD = 1_000_000
 ARM = str(REPO / "examples" / "robots" / "arm2" / "robot.toml")
@@ -41,13 +36,7 @@ class Servos:
     def __init__(self, tmp_path, protocol, *extra):
         self.link = str(tmp_path / f"dxl{protocol}")
         robot = ARM if protocol == 2 else "leo"
-        args = [pada_binary(), "servos", "--port", self.link, "--robot", robot, "--baud", str(BAUD), "--json", *extra]
-        self.proc = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        deadline = time.time() + 30
-        while not os.path.exists(self.link):
-            if self.proc.poll() is not None or time.time() > deadline:
-                raise RuntimeError(f"pada servos did not start: {self.proc.stderr.read()}")
-            time.sleep(0.02)
+        self.proc = start_servos(self.link, "--robot", robot, "--baud", str(BAUD), *extra)
         self.port = dxl.PortHandler(self.link)
         assert self.port.openPort()
         assert self.port.setBaudRate(BAUD)
@@ -55,10 +44,7 @@ class Servos:
 
     def close(self):
         self.port.closePort()
-        self.proc.send_signal(signal.SIGINT)
-        out, err = self.proc.communicate(timeout=30)
-        assert self.proc.returncode == 0, err
-        return json.loads(out)
+        return stop_servos(self.proc)
 
 
 @pytest.fixture

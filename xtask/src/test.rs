@@ -48,8 +48,10 @@ const COMPONENTS: [&str; 5] = ["firmware-toolchain", "qemu", "chromium", "slurm"
 /// python/tests/test_mcap.py reads and validates with (the `mcap` reader,
 /// JSON Schema validation, a WebSocket client), and the ROBOTIS SDK that
 /// python/tests/test_servos_sdk.py drives `pada servos` with (PyPI's
-/// `dynamixel-sdk`, the vendor's own, not written from pada).
-const PYTHON_PACKAGES: &[&str] = &["maturin", "numpy", "gymnasium", "pytest", "mcap", "jsonschema", "websockets", "dynamixel-sdk"];
+/// `dynamixel-sdk`, the vendor's own, not written from pada), and
+/// python/tests/test_servos_feetech.py with Feetech's SDK as LeRobot
+/// installs it (`feetech-servo-sdk`) and pollen-robotics' `rustypot`.
+const PYTHON_PACKAGES: &[&str] = &["maturin", "numpy", "gymnasium", "pytest", "mcap", "jsonschema", "websockets", "dynamixel-sdk", "feetech-servo-sdk", "rustypot"];
 
 struct Phase {
     name: &'static str,

@@ -47,7 +47,7 @@ const TO_HOST_VARIANTS: u8 = 16;
 const TO_CHIP_VARIANTS: u8 = 14;
 
 /// Every target: the host's and the chip's frame decoders, the status and
-/// instruction packet decoders of Protocol 1.0 and 2.0, checkpoint loading
+/// instruction packet decoders of Protocol 1.0, Feetech and 2.0, checkpoint loading
 /// and torn saves, a checkpoint streamed back to a board and damaged on the
 /// way, and the claim table's reads, claims and writes.
 pub fn all(corpus: &Corpus) -> Vec<Box<dyn Target>> {
@@ -66,7 +66,12 @@ pub fn all(corpus: &Corpus) -> Vec<Box<dyn Target>> {
             Vec::new(),
         )),
         Box::new(dynamixel::Status::<32>::new("dynamixel-status")),
-        Box::new(dynamixel::Instructions::<64>::new("dynamixel-instr")),
+        Box::new(dynamixel::Instructions::<64>::new("dynamixel-instr", dynamixel::Dialect::Dynamixel)),
+        // Feetech: Protocol 1.0's framing with its own instruction table;
+        // its status side is Protocol 1.0's decoder at the SO-101's
+        // buffer (a SYNC READ of six servos' present block).
+        Box::new(dynamixel::Status::<64>::new("feetech-status")),
+        Box::new(dynamixel::Instructions::<128>::new("feetech-instr", dynamixel::Dialect::Feetech)),
         // Protocol 2.0: the firmware's default buffer, and a small one so
         // that too-long packets are common.
         Box::new(dynamixel_v2::Status::<{ pada_core::dynamixel::v2::DEFAULT_PACKET_LEN }>::new("dxl2-status")),

@@ -3,6 +3,7 @@
 //!
 //! ```text
 //! pada servos --port /tmp/dxl --robot pendulum|PATH/robot.toml [--servo XM430-W350] [--baud 1000000] [--lockstep] [--fault SPEC]… [--seconds S] [--json]
+//! pada servos --port /tmp/so101 --chain sts3215:1-6 [--baud 1000000] [--lockstep] [--fault SPEC]… [--seconds S] [--json]
 //! pada servos --scan --port /dev/ttyUSB0 [--baud 57600,1000000] [--protocol 1|2] [--ids 0-252] [--timeout-ms 5] [--json]
 //! pada servos --reboot ID --port /dev/ttyUSB0 [--baud 1000000] [--timeout-ms 5] [--json]
 //! ```
@@ -32,6 +33,11 @@ pub struct ServosArgs {
     /// pendulum-20hz, leo) or the path of a robot's robot.toml.
     #[arg(long, value_name = "R", value_parser = RobotArg::parser())]
     pub robot: Option<RobotArg>,
+    /// A bare chain of servos instead of a robot's: MODEL:A-B or
+    /// MODEL:A,B,… (sts3215:1-6 is an SO-101's six Feetech STS3215), each
+    /// moving under its own position loop, no robot behind them.
+    #[arg(long, value_name = "MODEL:IDS", conflicts_with_all = ["robot", "servo"])]
+    pub chain: Option<String>,
     /// Every joint's servo of this model instead of the definition's (the
     /// pendulum on an X-series servo): RX-28, XM430-W350, XL430-W250,
     /// XL330-M288.
@@ -93,8 +99,11 @@ pub fn run(args: ServosArgs) -> Result<(), CliError> {
             return Err(usage(format!("{flag} goes with --scan")));
         }
     }
+    if let Some(chain) = &args.chain {
+        return run_chain(&args, chain);
+    }
     let Some(mut robot) = args.robot else {
-        return Err(usage("give --robot R (the robot whose servos to emulate; valid are pendulum, pendulum-20hz, leo, or the path of a robot.toml) or --scan"));
+        return Err(usage("give --robot R (the robot whose servos to emulate; valid are pendulum, pendulum-20hz, leo, or the path of a robot.toml), --chain MODEL:IDS or --scan"));
     };
     if let Some(name) = &args.servo {
         let model = pada_core::servo::servo(name).map_err(|e| usage(format!("--servo: {e}")))?;
@@ -163,6 +172,7 @@ fn one_rate(baud: Option<&str>) -> Result<u32, CliError> {
 fn refuse_virtual_flags(args: &ServosArgs, task: &str, why: &str) -> Result<(), CliError> {
     for (flag, given) in [
         ("--robot", args.robot.is_some()),
+        ("--chain", args.chain.is_some()),
         ("--servo", args.servo.is_some()),
         ("--lockstep", args.lockstep),
         ("--fault", !args.faults.is_empty()),
@@ -200,6 +210,41 @@ fn run_reboot(args: &ServosArgs, id: u8) -> Result<(), CliError> {
         return Err(CliError::Runtime(anyhow::anyhow!(
             "servo {id} raised its alert again after the reboot: the cause persists (let it cool, check the supply and the load)"
         )));
+    }
+    Ok(())
+}
+
+/// The control period a bare chain's lock step ends at each SYNC WRITE
+/// \[µs\] (a chain has no robot to give one).
+const CHAIN_PERIOD_US: u64 = 20_000;
+
+/// `pada servos --chain`: a bare chain of virtual servos.
+fn run_chain(args: &ServosArgs, chain: &str) -> Result<(), CliError> {
+    let spec = crate::servos::chain::parse(chain).map_err(usage)?;
+    let bps = one_rate(args.baud.as_deref())?;
+    if let Some(s) = args.seconds {
+        if !(s.is_finite() && s > 0.0) {
+            return Err(usage(format!("--seconds {s} is out of range: valid is > 0")));
+        }
+    }
+    let faults = args.faults.iter().map(|f| crate::sil::fault::parse(f).map_err(usage)).collect::<Result<Vec<_>, _>>()?;
+    let clock = if args.lockstep { Clock::LockStep } else { Clock::RealTime };
+    let mut bus = VirtualBus::chain(&spec.ids, bps, clock, faults, CHAIN_PERIOD_US).map_err(usage)?;
+    let pty = Pty::create(&args.port).map_err(|e| usage(format!("--port {}: cannot make the virtual port: {e}", args.port.display())))?;
+    let name = format!("{} chain", spec.model.to_ascii_uppercase());
+    errln!("servos: {name} (IDs {:?}) at {bps} bps on {} -> {}", spec.ids, args.port.display(), pty.device());
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
+    }
+    let summary = serve::serve(&mut bus, &pty, bps, &stop, args.seconds, &name, args.lockstep)
+        .map_err(|e| CliError::Runtime(anyhow::anyhow!("the virtual port failed: {e}")))?;
+    drop(pty);
+    if args.json {
+        outln!("{}", serde_json::to_string_pretty(&summary).map_err(|e| CliError::Runtime(e.into()))?)?;
+    } else {
+        errln!("servos: ended ({}): {} packets, {} answers", summary.ended, summary.stats.packets, summary.stats.replies);
     }
     Ok(())
 }

@@ -29,6 +29,7 @@ use crate::sil::fault::{FaultKind, FaultSpec};
 use pada_core::dynamixel::control_table::{self, rx28, x_series::HardwareError};
 use pada_core::dynamixel::v2::{self as dxl2, ErrorNumber, StatusError};
 use pada_core::dynamixel::{self as dxl1, ErrorFlags, BROADCAST_ID};
+use pada_core::feetech::{self, Instruction as ft_ins};
 use pada_core::robot::{JointSpec, RobotSpec};
 use pada_core::servo::{ServoModel, ServoProtocol};
 use pada_firmware::sensor_device::SENSOR_ID;
@@ -152,18 +153,30 @@ impl VirtualBus {
         // servos (the pendulum's and LEO's encoders, LEO's foot switches);
         // every robot's operator hears the controller's calls at its ID.
         let sensor_answers = robot.encoder.is_some();
-        let supply_v = rig.supply_v();
-        Ok(VirtualBus {
+        Ok(Self::assemble(rig, devices, Some(SensorDevice::new()), sensor_answers, clock, robot.period_us as u64, faults))
+    }
+
+    /// The bus of `devices` behind `rig`, at time 0.
+    fn assemble(
+        rig: Box<dyn Rig>,
+        devices: Vec<Device>,
+        sensor: Option<SensorDevice>,
+        sensor_answers: bool,
+        clock: Clock,
+        period_us: u64,
+        faults: Vec<FaultSpec>,
+    ) -> Self {
+        VirtualBus {
+            supply_v: rig.supply_v(),
             rig,
-            supply_v,
             driven: vec![(false, 0.0); devices.len()],
             devices,
-            sensor: Some(SensorDevice::new()),
+            sensor,
             sensor_answers,
             dec1: dxl1::InstructionDecoder::new(),
             dec2: dxl2::InstructionDecoder::new(),
             clock,
-            period_us: robot.period_us as u64,
+            period_us,
             now_us: 0,
             period_ended: false,
             onsets: vec![false; faults.len()],
@@ -171,7 +184,20 @@ impl VirtualBus {
             faults,
             stats: BusStats::default(),
             events: Vec::new(),
-        })
+        }
+    }
+
+    /// A bare chain of STS3215s at `ids` (no robot: [`super::chain`]),
+    /// at `bps`; lock step ends a period of `period_us` at each SYNC WRITE.
+    pub fn chain(ids: &[u8], bps: u32, clock: Clock, faults: Vec<FaultSpec>, period_us: u64) -> Result<Self, String> {
+        let table = &feetech::control_table::sts3215::STS3215;
+        let baud = baud_value(table, bps).ok_or_else(|| baud_error(table, bps))?;
+        let devices: Vec<Device> = ids.iter().map(|&id| Device::P1(P1Servo::of(&super::ft::STS3215_LAYOUT, id, baud, None))).collect();
+        if let Some(f) = faults.iter().find(|f| !ids.contains(&f.servo)) {
+            return Err(format!("--fault {f}: no servo {} on the chain (its servos: {ids:?})", f.servo));
+        }
+        let rig = Box::new(super::chain::NoPlant::new(ids.to_vec()));
+        Ok(Self::assemble(rig, devices, None, false, clock, period_us, faults))
     }
 
     /// Counters so far.
@@ -239,13 +265,18 @@ impl VirtualBus {
                 continue;
             }
             for d in &mut self.devices {
-                if let Device::P2(s) = d {
-                    if s.id() == f.servo {
-                        s.raise(hardware_error_of(bits));
-                        self.raised[k] = true;
-                        self.events.push(Event { at_us: now, id: f.servo, what: "alert" });
+                match d {
+                    Device::P2(s) if s.id() == f.servo => s.raise(hardware_error_of(bits)),
+                    // An STS3215's Status has the bits at the same places.
+                    Device::P1(s) if s.id() == f.servo && s.own_loop.is_some() => {
+                        if let Some(out) = s.own_loop.as_mut() {
+                            out.injected = out.injected.union(bits);
+                        }
                     }
+                    _ => continue,
                 }
+                self.raised[k] = true;
+                self.events.push(Event { at_us: now, id: f.servo, what: "alert" });
             }
         }
     }
@@ -281,23 +312,21 @@ impl VirtualBus {
         let mut replies = Vec::new();
         for &b in bytes {
             self.stats.bytes_in += 1;
-            let mut next = self.dec1.push(b);
-            while let Some(r) = next {
+            // Each byte to both protocols' decoders: what it completes in
+            // each, in order.
+            for r in self.dec1.feed(&[b]).collect::<Vec<_>>() {
                 match r {
                     Ok(p) => self.packet1(p, line_bps, &mut replies),
                     Err(dxl1::DecodeError::BadChecksum { id, .. }) => self.damaged(id, ServoProtocol::V1, line_bps, &mut replies),
                     Err(_) => {}
                 }
-                next = self.dec1.poll();
             }
-            let mut next = self.dec2.push(b);
-            while let Some(r) = next {
+            for r in self.dec2.feed(&[b]).collect::<Vec<_>>() {
                 match r {
                     Ok(p) => self.packet2(p, line_bps, &mut replies),
                     Err(dxl2::DecodeError::BadCrc { id, .. }) => self.damaged(id, ServoProtocol::V2, line_bps, &mut replies),
                     Err(_) => {}
                 }
-                next = self.dec2.poll();
             }
         }
         self.stats.replies += replies.len() as u64;
@@ -314,7 +343,7 @@ impl VirtualBus {
     /// Whether device `i` hears a line at `bps`.
     fn hears(&self, i: usize, bps: u32) -> bool {
         match &self.devices[i] {
-            Device::P1(s) => same_rate(rx28::RX28.baud_rate_bps(s.baud()).unwrap_or(0), bps),
+            Device::P1(s) => same_rate(s.baud_bps(), bps),
             Device::P2(s) => same_rate(s.table.baud_rate_bps(s.baud()).unwrap_or(0), bps),
         }
     }
@@ -328,7 +357,10 @@ impl VirtualBus {
             return;
         }
         let answer = match (&self.devices[i], protocol) {
-            (Device::P1(s), ServoProtocol::V1) => s.refuse(false, ErrorFlags::CHECKSUM).map(|a| encode1(id, a)),
+            (Device::P1(s), ServoProtocol::V1) => {
+                let error = if s.own_loop.is_some() { super::ft::answer_error(s, ErrorFlags::CHECKSUM) } else { ErrorFlags::CHECKSUM };
+                s.refuse(false, error).map(|a| encode1(id, a))
+            }
             (Device::P2(s), ServoProtocol::V2) => s.refuse(false, ErrorNumber::Crc).map(|a| encode2(id, a)),
             _ => None,
         };
@@ -352,6 +384,16 @@ impl VirtualBus {
     fn refresh(&mut self, i: usize) {
         let now = self.now_us;
         let supply = self.supply_v;
+        if let Device::P1(s) = &mut self.devices[i] {
+            if let Some(mut out) = s.own_loop.take() {
+                let dropped = super::ft::advance(s, &mut out, now);
+                s.own_loop = Some(out);
+                if dropped {
+                    self.events.push(Event { at_us: now, id: s.id(), what: "unloaded" });
+                }
+                return;
+            }
+        }
         let joint = match &self.devices[i] {
             Device::P1(s) => s.joint,
             Device::P2(s) => s.joint,
@@ -362,7 +404,7 @@ impl VirtualBus {
                 let p = self.rig.present(now, joint.id);
                 let p = self.plant(now, joint, p);
                 if let Device::P1(s) = &mut self.devices[i] {
-                    s.table = super::p1::with_present(s.table, &p);
+                    super::p1::with_present(&mut s.table, &p);
                 }
             }
             Device::P2(_) => {
@@ -383,6 +425,9 @@ impl VirtualBus {
         p
     }
 
+    /// A packet in Protocol 1.0's framing: a Dynamixel 1.0 instruction to
+    /// the RX-28s, a Feetech one to the STS3215s (the tables differ in
+    /// SYNC READ and BULK READ only).
     fn packet1(&mut self, p: dxl1::InstructionPacket<PACKET_LEN>, bps: u32, replies: &mut Vec<Reply>) {
         self.stats.packets += 1;
         let broadcast = p.id == BROADCAST_ID;
@@ -390,27 +435,31 @@ impl VirtualBus {
             self.sensor_packet(ServoProtocol::V1, &p.params, p.code, replies);
             return;
         }
-        let ins = match p.instruction() {
-            Ok(ins) => ins,
-            Err(_) => {
-                if let Some(i) = self.p1_at(p.id, bps) {
-                    if let Device::P1(s) = &self.devices[i] {
-                        if let Some(a) = s.refuse(broadcast, ErrorFlags::INSTRUCTION) {
-                            let bytes = encode1(p.id, a);
-                            self.push_reply(i, bytes, replies);
-                        }
-                    }
-                }
-                return;
+        let dx = p.instruction().map(ft_ins::Shared);
+        let ft = feetech::Instruction::parse(p.code, &p.params);
+        let feetech = |d: &Device| matches!(d, Device::P1(s) if s.own_loop.is_some());
+        if let (Err(_), Err(_)) = (&dx, &ft) {
+            if let Some(i) = self.p1_at(p.id, bps) {
+                self.answer1(i, broadcast, Some(ErrorFlags::INSTRUCTION), replies);
             }
-        };
-        let reads = matches!(ins, dxl1::Instruction::Read { .. } | dxl1::Instruction::BulkRead { .. });
+            return;
+        }
+        let reads = matches!(
+            (&dx, &ft),
+            (Ok(ft_ins::Shared(dxl1::Instruction::Read { .. } | dxl1::Instruction::BulkRead { .. })), _)
+                | (_, Ok(ft_ins::SyncRead { .. }))
+        );
         if reads {
             self.before_read();
         }
         // The servos it concerns, in the order they answer.
-        let order: Vec<usize> = match ins {
-            dxl1::Instruction::BulkRead { .. } => ins.bulk_read_entries().filter_map(|(id, _, _)| self.p1_at(id, bps)).collect(),
+        let order: Vec<usize> = match (&dx, &ft) {
+            (Ok(ft_ins::Shared(ins @ dxl1::Instruction::BulkRead { .. })), _) => {
+                ins.bulk_read_entries().filter_map(|(id, _, _)| self.p1_at(id, bps)).filter(|&i| !feetech(&self.devices[i])).collect()
+            }
+            (_, Ok(ft_ins::SyncRead { ids, .. })) => {
+                ids.iter().filter_map(|&id| self.p1_at(id, bps)).filter(|&i| feetech(&self.devices[i])).collect()
+            }
             _ if broadcast => (0..self.devices.len()).filter(|&i| matches!(self.devices[i], Device::P1(_)) && self.hears(i, bps)).collect(),
             _ => self.p1_at(p.id, bps).into_iter().collect(),
         };
@@ -418,19 +467,46 @@ impl VirtualBus {
             if reads {
                 self.refresh(i);
             }
+            let ins = if feetech(&self.devices[i]) { ft } else { dx };
             let Device::P1(s) = &mut self.devices[i] else { continue };
+            // It answers from the ID it was asked at (RESET changes it).
             let id = s.id();
-            let answer = s.execute(&ins, broadcast && !matches!(ins, dxl1::Instruction::BulkRead { .. }));
-            if let Some(a) = answer {
-                let bytes = encode1(id, a);
+            let answer = match ins {
+                Err(_) => {
+                    self.answer1(i, broadcast, Some(ErrorFlags::INSTRUCTION), replies);
+                    continue;
+                }
+                Ok(ft_ins::Shared(ins)) => s.execute(&ins, broadcast && !matches!(ins, dxl1::Instruction::BulkRead { .. })),
+                // Its turn in the chain.
+                Ok(ft_ins::SyncRead { addr, len, .. }) => Some(s.read(addr, len)),
+            };
+            if let Some(mut out) = s.own_loop.take() {
+                super::ft::calibrate_middle(s, &mut out);
+                s.own_loop = Some(out);
+            }
+            if let Some((error, data)) = answer {
+                let error = if s.own_loop.is_some() { super::ft::answer_error(s, error) } else { error };
+                let bytes = encode1(id, (error, data));
                 self.push_reply(i, bytes, replies);
             }
         }
-        if let dxl1::Instruction::SyncWrite { .. } = ins {
+        if let Ok(ft_ins::Shared(dxl1::Instruction::SyncWrite { .. })) = dx {
             self.stats.sync_writes += 1;
             self.period_ended = true;
         }
         self.drive_all();
+    }
+
+    /// Device `i`'s answer to an instruction it cannot execute, or a
+    /// damaged packet (`error`), as its level allows.
+    fn answer1(&mut self, i: usize, broadcast: bool, error: Option<ErrorFlags>, replies: &mut Vec<Reply>) {
+        let Device::P1(s) = &self.devices[i] else { return };
+        let error = error.unwrap_or(ErrorFlags::CHECKSUM);
+        let error = if s.own_loop.is_some() { super::ft::answer_error(s, error) } else { error };
+        if let Some(a) = s.refuse(broadcast, error) {
+            let bytes = encode1(s.id(), a);
+            self.push_reply(i, bytes, replies);
+        }
     }
 
     fn packet2(&mut self, p: dxl2::InstructionPacket<PACKET_LEN>, bps: u32, replies: &mut Vec<Reply>) {
@@ -648,7 +724,9 @@ fn device(model: &'static ServoModel, id: u8, bps: u32, joint: Option<JointSpec>
 fn baud_error(table: &control_table::ControlTable, bps: u32) -> String {
     let valid: Vec<String> = match table.protocol {
         pada_core::dynamixel::Protocol::V1 => vec!["9600".into(), "57600".into(), "115200".into(), "1000000".into(), "2000000/(n+1)".into()],
-        pada_core::dynamixel::Protocol::V2 => table.baud_rates.iter().map(u32::to_string).collect(),
+        pada_core::dynamixel::Protocol::V2 | pada_core::dynamixel::Protocol::Feetech => {
+            table.baud_rates.iter().map(u32::to_string).collect()
+        }
     };
     format!("--baud {bps}: the {} takes no such rate; valid are {}", table.model, valid.join(", "))
 }

@@ -1,7 +1,11 @@
-//! A virtual RX-28 on Protocol 1.0: its control table
-//! ([`pada_core::dynamixel::control_table::rx28::RX28`]) and what it does
-//! with every instruction of the e-Manual's Protocol 1.0 page
-//! (docs/reference/rx28.md, docs/servos.md).
+//! A virtual servo on Protocol 1.0's framing: an RX-28
+//! ([`pada_core::dynamixel::control_table::rx28::RX28`], the e-Manual's
+//! Protocol 1.0 page: docs/reference/rx28.md, docs/servos.md) or a Feetech
+//! STS3215 ([`pada_core::feetech::control_table::sts3215::STS3215`],
+//! docs/reference/feetech.md), which answer the instructions they share
+//! alike; [`Layout`] says where each keeps what the answers depend on.
+//! The STS3215's own parts (SYNC READ, its position loop, its alarms) are
+//! [`super::ft`].
 //!
 //! | instruction | answered (Status Return Level) | what it does |
 //! |---|---|---|
@@ -15,12 +19,15 @@
 //! | another code, bad parameters | 2 | Instruction Error |
 //! | a damaged packet to it | 2 | Checksum Error |
 //!
+//! (The levels are the RX-28's Status Return Level; the STS3215's
+//! Response Status Level 0 and 1 answer as the RX-28's 1 and 2.)
+//!
 //! A broadcast instruction is never answered. The present values
 //! (addresses 36–43) are the robot's at the instant of the read; Moving
 //! Speed and Torque Enable drive it (the bus does: [`super::bus`]).
 
 use pada_core::dynamixel::control_table::rx28::RX28;
-use pada_core::dynamixel::control_table::TableError;
+use pada_core::dynamixel::control_table::{ControlTable, TableError};
 use pada_core::dynamixel::table::{self, PresentState};
 use pada_core::dynamixel::{ErrorFlags, Instruction};
 use pada_core::robot::JointSpec;
@@ -56,20 +63,65 @@ pub fn factory_table(id: u8, baud: u8) -> [u8; table::TABLE_LEN] {
     t
 }
 
-/// `table` with the present values `p` (addresses 36–43).
-pub fn with_present(mut t: [u8; table::TABLE_LEN], p: &PresentState) -> [u8; table::TABLE_LEN] {
+/// An RX-28's `table` with the present values `p` (addresses 36–43).
+pub fn with_present(t: &mut [u8], p: &PresentState) {
     let at = table::PRESENT_BLOCK as usize;
-    t[at..at + table::PRESENT_BLOCK_LEN as usize].copy_from_slice(&p.to_bytes());
-    t
+    if let Some(block) = t.get_mut(at..at + table::PRESENT_BLOCK_LEN as usize) {
+        block.copy_from_slice(&p.to_bytes());
+    }
 }
 
-/// One virtual RX-28.
+/// Where a model on Protocol 1.0's framing keeps what its answers depend
+/// on, and its factory table.
+#[derive(Debug)]
+pub struct Layout {
+    /// Its control table.
+    pub table: &'static ControlTable,
+    /// The factory table at an ID and a Baud Rate value.
+    pub factory: fn(u8, u8) -> Vec<u8>,
+    /// ID's address.
+    pub id: u8,
+    /// Baud Rate's address.
+    pub baud: u8,
+    /// Return Delay Time's address (2 µs per unit on both models).
+    pub return_delay: u8,
+    /// The address of the level that says which instructions are
+    /// answered.
+    pub level: u8,
+    /// What that level's 0 stands for on the RX-28's scale (0 PING only, 1
+    /// READ too, 2 all): RX-28 0, STS3215 1 (its 0 answers READ and PING).
+    pub level_base: u8,
+    /// The address of the flag a held REG WRITE sets.
+    pub registered: u8,
+    /// Torque Enable's address.
+    pub torque: u8,
+}
+
+/// The RX-28's layout.
+pub static RX28_LAYOUT: Layout = Layout {
+    table: &RX28,
+    factory: |id, baud| factory_table(id, baud).to_vec(),
+    id: table::ID,
+    baud: table::BAUD_RATE,
+    return_delay: table::RETURN_DELAY_TIME,
+    level: table::STATUS_RETURN_LEVEL,
+    level_base: 0,
+    registered: table::REGISTERED,
+    torque: table::TORQUE_ENABLE,
+};
+
+/// One virtual servo on Protocol 1.0's framing.
 #[derive(Debug, Clone)]
 pub struct P1Servo {
-    /// Its control table.
-    pub table: [u8; table::TABLE_LEN],
+    /// Its model.
+    pub layout: &'static Layout,
+    /// Its control table (memory table), indexed by address.
+    pub table: Vec<u8>,
     /// The joint it drives (the robot's calibration), if any.
     pub joint: Option<JointSpec>,
+    /// An STS3215's output under its own position loop ([`super::ft`]);
+    /// `None` for an RX-28, whose output is the rig's.
+    pub own_loop: Option<super::ft::Output>,
     /// The Baud Rate value it came with (a RESET restores the factory's).
     registered: Option<(u8, Vec<u8>)>,
 }
@@ -78,24 +130,45 @@ pub struct P1Servo {
 pub type Answer = Option<(ErrorFlags, Vec<u8>)>;
 
 impl P1Servo {
-    /// A servo with the factory table at `id` and Baud Rate value `baud`.
+    /// An RX-28 with the factory table at `id` and Baud Rate value `baud`.
     pub fn new(id: u8, baud: u8, joint: Option<JointSpec>) -> Self {
-        P1Servo { table: factory_table(id, baud), joint, registered: None }
+        Self::of(&RX28_LAYOUT, id, baud, joint)
+    }
+
+    /// A servo of `layout`'s model with its factory table at `id` and Baud
+    /// Rate value `baud`.
+    pub fn of(layout: &'static Layout, id: u8, baud: u8, joint: Option<JointSpec>) -> Self {
+        let own_loop = (!core::ptr::eq(layout, &RX28_LAYOUT)).then(super::ft::Output::default);
+        P1Servo { layout, table: (layout.factory)(id, baud), joint, own_loop, registered: None }
+    }
+
+    fn at(&self, address: u8) -> u8 {
+        self.table.get(address as usize).copied().unwrap_or(0)
     }
 
     /// Its ID now.
     pub fn id(&self) -> u8 {
-        self.table[table::ID as usize]
+        self.at(self.layout.id)
     }
 
     /// Its Baud Rate value now.
     pub fn baud(&self) -> u8 {
-        self.table[table::BAUD_RATE as usize]
+        self.at(self.layout.baud)
+    }
+
+    /// Its bit rate now \[bps\].
+    pub fn baud_bps(&self) -> u32 {
+        self.layout.table.baud_rate_bps(self.baud()).unwrap_or(0)
     }
 
     /// Torque Enable.
     pub fn torque(&self) -> bool {
-        self.table[table::TORQUE_ENABLE as usize] != 0
+        self.at(self.layout.torque) != 0
+    }
+
+    /// Whether it is an RX-28 (whose Moving Speed drives the rig).
+    fn is_rx28(&self) -> bool {
+        core::ptr::eq(self.layout, &RX28_LAYOUT)
     }
 
     /// Moving Speed.
@@ -106,6 +179,10 @@ impl P1Servo {
     /// The voltage its Moving Speed applies in wheel mode on `supply` \[V\]
     /// (0 in joint mode, whose position control is not emulated).
     pub fn volts(&self, supply: f64) -> f64 {
+        if !self.is_rx28() {
+            // The STS3215 runs its own position loop (`super::ft`).
+            return 0.0;
+        }
         let wheel = self.table[table::CW_ANGLE_LIMIT as usize..table::CCW_ANGLE_LIMIT as usize + 2].iter().all(|&b| b == 0);
         if wheel {
             table::ratio_from_moving_speed(self.moving_speed()) as f64 * supply
@@ -116,11 +193,12 @@ impl P1Servo {
 
     /// Return Delay Time \[µs\].
     pub fn return_delay_us(&self) -> u64 {
-        self.table[table::RETURN_DELAY_TIME as usize] as u64 * 2
+        self.at(self.layout.return_delay) as u64 * 2
     }
 
+    /// Its answering level on the RX-28's scale.
     fn level(&self) -> u8 {
-        self.table[table::STATUS_RETURN_LEVEL as usize]
+        self.at(self.layout.level).saturating_add(self.layout.level_base)
     }
 
     /// Answers with `error` and `params` if its Status Return Level answers
@@ -131,7 +209,7 @@ impl P1Servo {
 
     /// Reads `len` bytes at `addr` (its answer's error and data).
     pub fn read(&self, addr: u8, len: u8) -> (ErrorFlags, Vec<u8>) {
-        match RX28.check_read(addr as u16, len as u16) {
+        match self.layout.table.check_read(addr as u16, len as u16) {
             Ok(()) => (ErrorFlags::NONE, self.table[addr as usize..addr as usize + len as usize].to_vec()),
             Err(_) => (ErrorFlags::RANGE, Vec::new()),
         }
@@ -140,7 +218,7 @@ impl P1Servo {
     /// Writes `data` at `addr` if the table takes it (whole writable items,
     /// values in range, EEPROM not locked).
     pub fn write(&mut self, addr: u8, data: &[u8]) -> Result<(), TableError> {
-        RX28.check_write(addr as u16, data, &self.table)?;
+        self.layout.table.check_write(addr as u16, data, &self.table)?;
         self.table[addr as usize..addr as usize + data.len()].copy_from_slice(data);
         Ok(())
     }
@@ -163,10 +241,10 @@ impl P1Servo {
                 (!broadcast && level >= 2).then_some((error, Vec::new()))
             }
             Instruction::RegWrite { addr, data } => {
-                let error = match RX28.check_write(addr as u16, data, &self.table) {
+                let error = match self.layout.table.check_write(addr as u16, data, &self.table) {
                     Ok(()) => {
                         self.registered = Some((addr, data.to_vec()));
-                        self.table[table::REGISTERED as usize] = 1;
+                        self.table[self.layout.registered as usize] = 1;
                         ErrorFlags::NONE
                     }
                     Err(_) => ErrorFlags::RANGE,
@@ -176,7 +254,7 @@ impl P1Servo {
             Instruction::Action => {
                 let error = match self.registered.take() {
                     Some((addr, data)) => {
-                        self.table[table::REGISTERED as usize] = 0;
+                        self.table[self.layout.registered as usize] = 0;
                         self.write(addr, &data).map_or(ErrorFlags::RANGE, |()| ErrorFlags::NONE)
                     }
                     None => ErrorFlags::INSTRUCTION,
@@ -185,7 +263,7 @@ impl P1Servo {
             }
             Instruction::Reset => {
                 let answer = self.answer(broadcast, 2, ErrorFlags::NONE, Vec::new());
-                self.table = factory_table(1, FACTORY_BAUD);
+                self.table = (self.layout.factory)(1, self.factory_baud());
                 self.registered = None;
                 answer
             }
@@ -204,6 +282,16 @@ impl P1Servo {
                 // Its turn in the chain, at level 1 or 2 (the bus orders).
                 (self.level() >= 1).then_some((error, data))
             }
+        }
+    }
+
+    /// The Baud Rate value a RESET (RECOVERY) restores: the RX-28's
+    /// factory 34, the STS3215's 0 (1 Mbps).
+    fn factory_baud(&self) -> u8 {
+        if self.is_rx28() {
+            FACTORY_BAUD
+        } else {
+            0
         }
     }
 

@@ -3,7 +3,10 @@
 //! question. At each rate: one Protocol 2.0 PING to the broadcast ID
 //! (every X-series servo answers in turn with its model and firmware),
 //! then a Protocol 1.0 PING to each ID (Protocol 1.0 has no broadcast
-//! PING) and a READ of the model number of each that answers.
+//! PING) and a READ of the model number of each that answers. Feetech's
+//! servos answer that PING too (their framing is Protocol 1.0's): a READ
+//! of addresses 0–4 tells them apart, as Dynamixel 1.0 keeps its model
+//! number at 0 and Feetech at 3 (the STS3215 reads 777 there).
 //!
 //! Time: a Protocol 1.0 PING waits `timeout` for its answer (the USB
 //! adapter's latency and the return delay, 250 × 2 µs out of the box);
@@ -11,6 +14,7 @@
 
 use pada_core::dynamixel::v2::{self as dxl2, PingReply};
 use pada_core::dynamixel::{self as dxl1, table};
+use pada_core::feetech::control_table::sts3215 as feetech_table;
 use serde::Serialize;
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -25,8 +29,10 @@ pub const RATES: [u32; 7] = [57_600, 1_000_000, 115_200, 2_000_000, 3_000_000, 4
 pub struct Found {
     /// The rate \[bps\].
     pub baud: u32,
-    /// 1 or 2.
+    /// 1 or 2 (a Feetech servo: 1, the framing it shares).
     pub protocol: u8,
+    /// Who makes it: "ROBOTIS" or "Feetech".
+    pub vendor: &'static str,
     /// Its ID.
     pub id: u8,
     /// Its Model Number (`None` if the READ of it failed).
@@ -106,6 +112,7 @@ fn scan2(port: &mut dyn serialport::SerialPort, baud: u32, timeout: Duration) ->
             found.push(Found {
                 baud,
                 protocol: 2,
+                vendor: "ROBOTIS",
                 id: packet.id,
                 model_number: Some(reply.model_number),
                 model: model_name(reply.model_number, 2),
@@ -131,22 +138,30 @@ fn scan1(port: &mut dyn serialport::SerialPort, baud: u32, cfg: &ScanConfig) -> 
         if !dec.feed(&bytes).any(|r| r.is_ok()) {
             continue;
         }
-        let Ok(read) = dxl1::read_data(id, table::MODEL_NUMBER, 2, &mut tx) else { continue };
+        let Ok(read) = dxl1::read_data(id, table::MODEL_NUMBER, 5, &mut tx) else { continue };
         send(port, read)?;
         let bytes = listen(port, cfg.timeout)?;
         let mut dec: dxl1::StatusDecoder<64> = dxl1::StatusDecoder::new();
-        dec.expect(Some(dxl1::Reply { id, params: 2 }));
-        let model_number = dec.feed(&bytes).flatten().find_map(|p| p.u16_at(0));
-        found.push(Found {
-            baud,
-            protocol: 1,
-            id,
-            model_number,
-            model: model_number.and_then(|m| model_name(m, 1)),
-            firmware: None,
+        dec.expect(Some(dxl1::Reply { id, params: 5 }));
+        let head = dec.feed(&bytes).flatten().next();
+        let feetech = head.as_ref().and_then(|p| p.u16_at(feetech_table::MODEL_NUMBER as usize)).filter(|&m| {
+            pada_core::feetech::control_table::by_model_number(m).is_some() && model_name(head_u16(&head), 1).is_none()
         });
+        let (vendor, model_number, model) = match feetech {
+            Some(m) => ("Feetech", Some(m), pada_core::feetech::control_table::by_model_number(m).map(|t| t.model)),
+            None => {
+                let m = head.as_ref().and_then(|p| p.u16_at(0));
+                ("ROBOTIS", m, m.and_then(|m| model_name(m, 1)))
+            }
+        };
+        found.push(Found { baud, protocol: 1, vendor, id, model_number, model, firmware: None });
     }
     Ok(found)
+}
+
+/// The little-endian value at address 0 of a READ of addresses 0–4.
+fn head_u16(head: &Option<dxl1::StatusPacket<64>>) -> u16 {
+    head.as_ref().and_then(|p| p.u16_at(0)).unwrap_or(0)
 }
 
 /// The name of the model with this number in `protocol`, if pada knows it

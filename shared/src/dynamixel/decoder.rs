@@ -19,8 +19,8 @@
 //! spurious header cannot hold back or swallow the real reply behind it,
 //! and garbage must match ID, LENGTH and checksum to pass.
 
-use super::packet::{checksum, ErrorFlags, InstructionPacket, StatusPacket, BROADCAST_ID, DEFAULT_PACKET_LEN, OVERHEAD};
-use core::marker::PhantomData;
+use super::packet::{checksum, ErrorFlags, InstructionPacket, StatusPacket, BROADCAST_ID, DEFAULT_PACKET_LEN, HEADER, OVERHEAD};
+use crate::framing::{bump, Step};
 use heapless::Vec;
 
 /// Why bytes received did not form a packet. The decoder has already
@@ -110,9 +110,12 @@ impl<const N: usize> FromRaw<N> for InstructionPacket<N> {
     }
 }
 
-/// Incremental decoder of packets `P` of up to `N` bytes (header to
-/// checksum). Feed it bytes with [`push`](Self::push) or
-/// [`feed`](Self::feed).
+pub use crate::framing::{Decoder, Feed};
+
+/// The firmware's decoder of status packets: the skeleton every protocol
+/// shares ([`crate::framing::Decoder`]) with Protocol 1.0's framing
+/// ([`examine`]). Feed it bytes with [`push`](Decoder::push) or
+/// [`feed`](Decoder::feed).
 ///
 /// `N` must hold the smallest packet, [`OVERHEAD`] = 6 bytes (header,
 /// ID, length, instruction or error, checksum): a smaller decoder could
@@ -127,184 +130,62 @@ impl<const N: usize> FromRaw<N> for InstructionPacket<N> {
 /// let d = pada_core::dynamixel::StatusDecoder::<6>::new();
 /// assert_eq!(d.buffered(), 0);
 /// ```
-#[derive(Debug, Clone)]
-pub struct Decoder<P, const N: usize> {
-    buf: [u8; N],
-    len: usize,
-    stats: DecoderStats,
-    expected: Option<Reply>,
-    _packet: PhantomData<fn() -> P>,
-}
-
-/// The firmware's decoder of status packets.
 pub type StatusDecoder<const N: usize = DEFAULT_PACKET_LEN> = Decoder<StatusPacket<N>, N>;
 /// The bus emulator's decoder of instruction packets.
 pub type InstructionDecoder<const N: usize = DEFAULT_PACKET_LEN> = Decoder<InstructionPacket<N>, N>;
 
-impl<P: FromRaw<N>, const N: usize> Default for Decoder<P, N> {
-    fn default() -> Self {
-        Self::new()
-    }
+/// The counters of a new decoder.
+const NO_STATS: DecoderStats =
+    DecoderStats { packets: 0, skipped_bytes: 0, bad_checksums: 0, bad_lengths: 0, unexpected_ids: 0 };
+
+/// Counts a refusal of Protocol 1.0's framing in its counter.
+fn count(stats: &mut DecoderStats, error: &DecodeError) {
+    bump(match error {
+        DecodeError::BadChecksum { .. } => &mut stats.bad_checksums,
+        DecodeError::BadLength { .. } => &mut stats.bad_lengths,
+        DecodeError::UnexpectedId { .. } | DecodeError::BroadcastStatus => &mut stats.unexpected_ids,
+    })
 }
 
-impl<P: FromRaw<N>, const N: usize> Decoder<P, N> {
-    /// A decoder that accepts any ID and length; `N` below [`OVERHEAD`]
-    /// is a compile-time error naming the valid range.
-    pub const fn new() -> Self {
-        const {
-            assert!(
-                N >= OVERHEAD,
-                "Decoder capacity N is too small: valid is N >= 6 (OVERHEAD: header, ID, length, instruction or error, checksum)"
-            )
-        };
-        Decoder {
-            buf: [0; N],
-            len: 0,
-            stats: DecoderStats { packets: 0, skipped_bytes: 0, bad_checksums: 0, bad_lengths: 0, unexpected_ids: 0 },
-            expected: None,
-            _packet: PhantomData,
+/// Protocol 1.0's framing (Feetech's too): what the bytes at the front of
+/// `buf`, which start with `FF FF`, make. A refusal before the checksum
+/// matched drops only the first header byte.
+pub fn examine<P: FromRaw<N>, const N: usize>(buf: &[u8], expected: Option<Reply>) -> Step<P, DecodeError> {
+    let refuse = |error| Step::Refuse { drop: 1, error };
+    let Some(&id) = buf.get(2) else { return Step::More };
+    if id == 0xFF {
+        // 0xFF 0xFF 0xFF: the header starts one byte later.
+        return Step::Resync;
+    }
+    if id == BROADCAST_ID && !P::FROM_BROADCAST {
+        return refuse(DecodeError::BroadcastStatus);
+    }
+    let Some(&length) = buf.get(3) else { return Step::More };
+    let total = length as usize + 4;
+    if let Some(reply) = expected {
+        if id != reply.id {
+            return refuse(DecodeError::UnexpectedId { expected: reply.id, got: id });
+        }
+        if length as u16 != reply.params as u16 + 2 {
+            return refuse(DecodeError::BadLength { id, length });
         }
     }
-
-    /// Accept only `reply` (`None`: any packet). A status decoder is told
-    /// before every request.
-    pub fn expect(&mut self, reply: Option<Reply>) {
-        self.expected = reply;
+    if length < 2 || total > N {
+        return refuse(DecodeError::BadLength { id, length });
     }
-
-    /// Drops any partial packet (e.g. after a timeout, before the next
-    /// request); the dropped bytes count as skipped.
-    pub fn reset(&mut self) {
-        self.skip(self.len);
+    let Some(packet) = buf.get(..total) else { return Step::More };
+    let expected = checksum(&packet[2..total - 1]);
+    let got = packet[total - 1];
+    if expected != got {
+        return refuse(DecodeError::BadChecksum { id, expected, got });
     }
-
-    /// Counters since creation.
-    pub fn stats(&self) -> DecoderStats {
-        self.stats
-    }
-
-    /// Bytes held for a packet not yet complete.
-    pub fn buffered(&self) -> usize {
-        self.len
-    }
-
-    fn skip(&mut self, n: usize) {
-        let n = n.min(self.len);
-        self.stats.skipped_bytes = self.stats.skipped_bytes.saturating_add(n as u32);
-        self.buf.copy_within(n..self.len, 0);
-        self.len -= n;
-    }
-
-    /// Takes one byte; returns a packet or an error if this byte completed
-    /// one. After `Some`, call [`poll`](Self::poll) until `None`: the bytes
-    /// kept after an error may already hold the next packet.
-    pub fn push(&mut self, byte: u8) -> Option<Result<P, DecodeError>> {
-        if self.len >= N {
-            // Cannot happen (a candidate longer than N is refused as soon
-            // as its LENGTH is seen), but never overrun.
-            self.skip(1);
-        }
-        if let Some(slot) = self.buf.get_mut(self.len) {
-            *slot = byte;
-            self.len += 1;
-        }
-        self.poll()
-    }
-
-    /// Looks for one complete packet or error in the buffered bytes.
-    pub fn poll(&mut self) -> Option<Result<P, DecodeError>> {
-        loop {
-            // Find `0xFF 0xFF` at the front.
-            let start = self.buf[..self.len].iter().position(|&b| b == 0xFF).unwrap_or(self.len);
-            self.skip(start);
-            if self.len < 2 {
-                return None;
-            }
-            if self.buf[1] != 0xFF {
-                self.skip(1);
-                continue;
-            }
-            if self.len < 3 {
-                return None;
-            }
-            if self.buf[2] == 0xFF {
-                // 0xFF 0xFF 0xFF: the header starts one byte later.
-                self.skip(1);
-                continue;
-            }
-            if self.buf[2] == BROADCAST_ID && !P::FROM_BROADCAST {
-                self.stats.unexpected_ids = self.stats.unexpected_ids.saturating_add(1);
-                self.skip(1);
-                return Some(Err(DecodeError::BroadcastStatus));
-            }
-            if self.len < 4 {
-                return None;
-            }
-            let (id, length) = (self.buf[2], self.buf[3]);
-            let total = length as usize + 4;
-            if let Some(reply) = self.expected {
-                if id != reply.id {
-                    self.stats.unexpected_ids = self.stats.unexpected_ids.saturating_add(1);
-                    self.skip(1);
-                    return Some(Err(DecodeError::UnexpectedId { expected: reply.id, got: id }));
-                }
-                if length as u16 != reply.params as u16 + 2 {
-                    self.stats.bad_lengths = self.stats.bad_lengths.saturating_add(1);
-                    self.skip(1);
-                    return Some(Err(DecodeError::BadLength { id, length }));
-                }
-            }
-            if length < 2 || total > N {
-                self.stats.bad_lengths = self.stats.bad_lengths.saturating_add(1);
-                self.skip(1);
-                return Some(Err(DecodeError::BadLength { id, length }));
-            }
-            if self.len < total {
-                return None;
-            }
-            let expected = checksum(&self.buf[2..total - 1]);
-            let got = self.buf[total - 1];
-            if expected != got {
-                self.stats.bad_checksums = self.stats.bad_checksums.saturating_add(1);
-                self.skip(1);
-                return Some(Err(DecodeError::BadChecksum { id, expected, got }));
-            }
-            let params = Vec::from_slice(&self.buf[5..total - 1]).unwrap_or_default();
-            let packet = P::from_raw(id, self.buf[4], params);
-            self.buf.copy_within(total..self.len, 0);
-            self.len -= total;
-            self.stats.packets = self.stats.packets.saturating_add(1);
-            return Some(Ok(packet));
-        }
-    }
-
-    /// Feeds a chunk and iterates over every packet and error in it.
-    pub fn feed<'s, 'b>(&'s mut self, bytes: &'b [u8]) -> Feed<'s, 'b, P, N> {
-        Feed { decoder: self, rest: bytes }
-    }
+    let params = Vec::from_slice(&packet[5..total - 1]).unwrap_or_default();
+    Step::Accept { len: total, packet: P::from_raw(id, packet[4], params) }
 }
 
-/// Iterator over the packets and errors of a chunk fed to a decoder. Bytes
-/// of an incomplete packet at the end stay in the decoder for the next chunk.
-pub struct Feed<'s, 'b, P, const N: usize> {
-    decoder: &'s mut Decoder<P, N>,
-    rest: &'b [u8],
-}
-
-impl<P: FromRaw<N>, const N: usize> Iterator for Feed<'_, '_, P, N> {
-    type Item = Result<P, DecodeError>;
-    fn next(&mut self) -> Option<Self::Item> {
-        if let Some(r) = self.decoder.poll() {
-            return Some(r);
-        }
-        while let Some((&b, rest)) = self.rest.split_first() {
-            self.rest = rest;
-            if let Some(r) = self.decoder.push(b) {
-                return Some(r);
-            }
-        }
-        None
-    }
+crate::framed! {
+    header: HEADER, min: OVERHEAD, reply: Reply, error: DecodeError, stats: DecoderStats = NO_STATS,
+    count: count, examine: examine, packets: [StatusPacket, InstructionPacket]
 }
 
 #[cfg(test)]

@@ -55,6 +55,9 @@ pub enum Protocol {
     V1,
     /// Protocol 2.0 (X series, MX(2.0), P series): [`v2`].
     V2,
+    /// Feetech's SCS/STS protocol: Protocol 1.0's framing with Feetech's
+    /// instruction table and byte orders ([`crate::feetech`]).
+    Feetech,
 }
 
 pub use decoder::{DecodeError, Decoder, DecoderStats, Feed, FromRaw, InstructionDecoder, Reply, StatusDecoder};

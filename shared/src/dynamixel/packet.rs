@@ -175,6 +175,11 @@ pub enum EncodeError {
         /// Bytes given for this entry.
         got: usize,
     },
+    /// An instruction the protocol does not have (Feetech's: BULK READ).
+    Unsupported {
+        /// The instruction code.
+        code: u8,
+    },
 }
 
 /// The checksum of Protocol 1.0 over `ID, LENGTH, INSTRUCTION/ERROR, params`.
@@ -182,8 +187,9 @@ pub fn checksum(bytes: &[u8]) -> u8 {
     !bytes.iter().fold(0u8, |s, &b| s.wrapping_add(b))
 }
 
-/// Writes one packet into `out`, returning the written prefix.
-fn write_packet<'b>(id: u8, code: u8, parts: &[&[u8]], out: &'b mut [u8]) -> Result<&'b [u8], EncodeError> {
+/// Writes one packet into `out`, returning the written prefix (Feetech's
+/// packets are framed so too: [`crate::feetech`]).
+pub(crate) fn write_packet<'b>(id: u8, code: u8, parts: &[&[u8]], out: &'b mut [u8]) -> Result<&'b [u8], EncodeError> {
     if id == 0xFF {
         return Err(EncodeError::InvalidId { id });
     }

@@ -28,7 +28,7 @@ use super::crc::crc16;
 use super::packet::{is_stuffed, InstructionPacket, StatusPacket, BROADCAST_ID, DEFAULT_PACKET_LEN, HEADER, MAX_ID, PREFIX_LEN, STATUS, STATUS_OVERHEAD};
 use super::status::StatusError;
 use super::stuffing::{destuff, max_stuffed_len};
-use core::marker::PhantomData;
+use crate::framing::{bump, Step};
 use heapless::Vec;
 
 /// Why bytes received did not form an acceptable packet. The decoder has
@@ -167,9 +167,12 @@ impl<const N: usize> FromFrame<N> for InstructionPacket<N> {
     }
 }
 
-/// Incremental decoder of packets `P` of up to `N` bytes (header to CRC,
-/// as received). Feed it bytes with [`push`](Self::push) or
-/// [`feed`](Self::feed).
+pub use crate::framing::{Decoder, Feed};
+
+/// The firmware's decoder of status packets: the skeleton every protocol
+/// shares ([`crate::framing::Decoder`]) with Protocol 2.0's framing
+/// ([`examine`]). Feed it bytes with [`push`](Decoder::push) or
+/// [`feed`](Decoder::feed).
 ///
 /// `N` must hold the smallest status packet, 11 bytes; a smaller decoder
 /// could never complete one. Such a decoder does not compile:
@@ -182,210 +185,91 @@ impl<const N: usize> FromFrame<N> for InstructionPacket<N> {
 /// let d = pada_core::dynamixel::v2::StatusDecoder::<11>::new();
 /// assert_eq!(d.buffered(), 0);
 /// ```
-#[derive(Debug, Clone)]
-pub struct Decoder<P, const N: usize> {
-    buf: [u8; N],
-    len: usize,
-    stats: DecoderStats,
-    expected: Option<Reply>,
-    _packet: PhantomData<fn() -> P>,
-}
-
-/// The firmware's decoder of status packets.
 pub type StatusDecoder<const N: usize = DEFAULT_PACKET_LEN> = Decoder<StatusPacket<N>, N>;
 /// A servo's (or the bus emulator's) decoder of instruction packets.
 pub type InstructionDecoder<const N: usize = DEFAULT_PACKET_LEN> = Decoder<InstructionPacket<N>, N>;
 
-impl<P: FromFrame<N>, const N: usize> Default for Decoder<P, N> {
-    fn default() -> Self {
-        Self::new()
+/// The counters of a new decoder.
+const NO_STATS: DecoderStats = DecoderStats {
+    packets: 0,
+    skipped_bytes: 0,
+    bad_crcs: 0,
+    bad_lengths: 0,
+    unexpected_ids: 0,
+    not_status: 0,
+    bad_stuffing: 0,
+};
+
+/// Counts a refusal of Protocol 2.0's framing in its counter.
+fn count(stats: &mut DecoderStats, error: &DecodeError) {
+    bump(match error {
+        DecodeError::BadCrc { .. } => &mut stats.bad_crcs,
+        DecodeError::BadLength { .. } => &mut stats.bad_lengths,
+        DecodeError::InvalidId { .. } | DecodeError::UnexpectedId { .. } => &mut stats.unexpected_ids,
+        DecodeError::NotStatus { .. } => &mut stats.not_status,
+        DecodeError::BadStuffing { .. } => &mut stats.bad_stuffing,
+    })
+}
+
+/// Protocol 2.0's framing: what the bytes at the front of `buf`, which
+/// start with `FF FF FD 00`, make (the e-Manual's order of reception: ID,
+/// LENGTH, INSTRUCTION, CRC, then the stuffing).
+pub fn examine<P: FromFrame<N>, const N: usize>(buf: &[u8], expected: Option<Reply>) -> Step<P, DecodeError> {
+    // Refused before the CRC matched: only the first header byte goes.
+    let early = |error| Step::Refuse { drop: 1, error };
+    let Some(&id) = buf.get(4) else { return Step::More };
+    if id > MAX_ID && id != BROADCAST_ID {
+        return early(DecodeError::InvalidId { id });
+    }
+    if let Some(r) = expected {
+        if id != r.id {
+            return early(DecodeError::UnexpectedId { expected: r.id, got: id });
+        }
+    }
+    let Some(&[l0, l1]) = buf.get(5..7) else { return Step::More };
+    let length = u16::from_le_bytes([l0, l1]);
+    let total = PREFIX_LEN + length as usize;
+    let in_window = expected.is_none_or(|r| {
+        let (min, max) = r.length_range(P::MIN_LENGTH, P::STATUS_ONLY);
+        (min..=max).contains(&(length as usize))
+    });
+    if length < P::MIN_LENGTH || total > N || !in_window {
+        return early(DecodeError::BadLength { id, length });
+    }
+    let Some(&instruction) = buf.get(PREFIX_LEN) else { return Step::More };
+    if P::STATUS_ONLY && instruction != STATUS {
+        return early(DecodeError::NotStatus { id, instruction });
+    }
+    if instruction == STATUS && length < 4 {
+        // A status packet without its ERROR byte.
+        return early(DecodeError::BadLength { id, length });
+    }
+    let Some(packet) = buf.get(..total) else { return Step::More };
+    let (body, crc) = packet.split_at(total - 2);
+    let expected_crc = crc16(body);
+    let got = u16::from_le_bytes([crc.first().copied().unwrap_or(0), crc.get(1).copied().unwrap_or(0)]);
+    if expected_crc != got {
+        return early(DecodeError::BadCrc { id, expected: expected_crc, got });
+    }
+    // From here on it is a packet: refusals drop all of it.
+    let payload = body.get(PREFIX_LEN..).unwrap_or_default();
+    let mut plain: Vec<u8, N> = Vec::new();
+    let ok = if is_stuffed(id, instruction) {
+        destuff(payload, &mut plain).is_ok()
+    } else {
+        plain.extend_from_slice(payload).is_ok()
+    };
+    // INSTRUCTION (and ERROR) precede the parameters.
+    let params_ok = expected.is_none_or(|r| plain.len() == r.params as usize + P::MIN_LENGTH as usize - 2);
+    let packet = if ok { plain.get(1..).and_then(|b| P::from_frame(id, instruction, b)) } else { None };
+    match packet {
+        None => Step::Refuse { drop: total, error: DecodeError::BadStuffing { id } },
+        Some(_) if !params_ok => Step::Refuse { drop: total, error: DecodeError::BadLength { id, length } },
+        Some(packet) => Step::Accept { len: total, packet },
     }
 }
 
-impl<P: FromFrame<N>, const N: usize> Decoder<P, N> {
-    /// A decoder that accepts any ID and length; `N` below 11 is a
-    /// compile-time error naming the valid range.
-    pub const fn new() -> Self {
-        const {
-            assert!(
-                N >= STATUS_OVERHEAD,
-                "Decoder capacity N is too small: valid is N >= 11 (STATUS_OVERHEAD: header, ID, LENGTH, 0x55, ERROR, CRC)"
-            )
-        };
-        Decoder { buf: [0; N], len: 0, stats: DecoderStats {
-            packets: 0, skipped_bytes: 0, bad_crcs: 0, bad_lengths: 0, unexpected_ids: 0, not_status: 0, bad_stuffing: 0,
-        }, expected: None, _packet: PhantomData }
-    }
-
-    /// Accept only `reply` (`None`: any packet). A status decoder is told
-    /// before every request that has one reply. For a sync or bulk read,
-    /// whose replies follow one another, drive it with
-    /// [`push`](Self::push) and set the next servo's reply after each
-    /// accepted packet, before [`poll`](Self::poll) looks at the bytes
-    /// already buffered (or expect `None` and check the IDs afterwards).
-    pub fn expect(&mut self, reply: Option<Reply>) {
-        self.expected = reply;
-    }
-
-    /// Drops any partial packet (e.g. after a timeout, before the next
-    /// request); the dropped bytes count as skipped.
-    pub fn reset(&mut self) {
-        self.skip(self.len);
-    }
-
-    /// Counters since creation.
-    pub fn stats(&self) -> DecoderStats {
-        self.stats
-    }
-
-    /// Bytes held for a packet not yet complete.
-    pub fn buffered(&self) -> usize {
-        self.len
-    }
-
-    fn skip(&mut self, n: usize) {
-        let n = n.min(self.len);
-        self.stats.skipped_bytes = self.stats.skipped_bytes.saturating_add(n as u32);
-        self.buf.copy_within(n..self.len, 0);
-        self.len -= n;
-    }
-
-    /// Counts a refusal (through `counter`), drops `drop` bytes and
-    /// returns the error.
-    fn refuse(
-        &mut self,
-        counter: fn(&mut DecoderStats) -> &mut u32,
-        drop: usize,
-        e: DecodeError,
-    ) -> Option<Result<P, DecodeError>> {
-        let c = counter(&mut self.stats);
-        *c = c.saturating_add(1);
-        self.skip(drop);
-        Some(Err(e))
-    }
-
-    /// Takes one byte; returns a packet or an error if this byte completed
-    /// one. After `Some`, call [`poll`](Self::poll) until `None`: the bytes
-    /// kept after an error may already hold the next packet.
-    pub fn push(&mut self, byte: u8) -> Option<Result<P, DecodeError>> {
-        if self.len >= N {
-            // Cannot happen (a candidate longer than N is refused as soon
-            // as its LENGTH is seen), but never overrun.
-            self.skip(1);
-        }
-        if let Some(slot) = self.buf.get_mut(self.len) {
-            *slot = byte;
-            self.len += 1;
-        }
-        self.poll()
-    }
-
-    /// Looks for one complete packet or error in the buffered bytes.
-    pub fn poll(&mut self) -> Option<Result<P, DecodeError>> {
-        'scan: loop {
-            // The first header byte at the front.
-            let start = self.buf[..self.len].iter().position(|&b| b == HEADER[0]).unwrap_or(self.len);
-            self.skip(start);
-            // The rest of the header, byte by byte as it arrives.
-            for (i, &h) in HEADER.iter().enumerate().skip(1) {
-                match self.buf[..self.len].get(i) {
-                    None => return None,
-                    Some(&b) if b != h => {
-                        self.skip(1);
-                        continue 'scan;
-                    }
-                    Some(_) => {}
-                }
-            }
-            let &id = self.buf[..self.len].get(4)?;
-            if id > MAX_ID && id != BROADCAST_ID {
-                return self.refuse(|s| &mut s.unexpected_ids, 1, DecodeError::InvalidId { id });
-            }
-            if let Some(r) = self.expected {
-                if id != r.id {
-                    let e = DecodeError::UnexpectedId { expected: r.id, got: id };
-                    return self.refuse(|s| &mut s.unexpected_ids, 1, e);
-                }
-            }
-            let (l0, l1) = match self.buf[..self.len].get(5..7) {
-                Some(&[l0, l1]) => (l0, l1),
-                _ => return None,
-            };
-            let length = u16::from_le_bytes([l0, l1]);
-            let total = PREFIX_LEN + length as usize;
-            let in_window = self.expected.is_none_or(|r| {
-                let (min, max) = r.length_range(P::MIN_LENGTH, P::STATUS_ONLY);
-                (min..=max).contains(&(length as usize))
-            });
-            if length < P::MIN_LENGTH || total > N || !in_window {
-                return self.refuse(|s| &mut s.bad_lengths, 1, DecodeError::BadLength { id, length });
-            }
-            let &instruction = self.buf[..self.len].get(PREFIX_LEN)?;
-            if P::STATUS_ONLY && instruction != STATUS {
-                return self.refuse(|s| &mut s.not_status, 1, DecodeError::NotStatus { id, instruction });
-            }
-            if instruction == STATUS && length < 4 {
-                // A status packet without its ERROR byte.
-                return self.refuse(|s| &mut s.bad_lengths, 1, DecodeError::BadLength { id, length });
-            }
-            let packet = self.buf.get(..total).filter(|_| self.len >= total)?;
-            let (body, crc) = packet.split_at(total - 2);
-            let expected = crc16(body);
-            let got = u16::from_le_bytes([crc.first().copied().unwrap_or(0), crc.get(1).copied().unwrap_or(0)]);
-            if expected != got {
-                return self.refuse(|s| &mut s.bad_crcs, 1, DecodeError::BadCrc { id, expected, got });
-            }
-            // From here on it is a packet: refusals drop all of it.
-            let payload = body.get(PREFIX_LEN..).unwrap_or_default();
-            let mut plain: Vec<u8, N> = Vec::new();
-            let ok = if is_stuffed(id, instruction) {
-                destuff(payload, &mut plain).is_ok()
-            } else {
-                plain.extend_from_slice(payload).is_ok()
-            };
-            // INSTRUCTION (and ERROR) precede the parameters.
-            let params_ok = self.expected.is_none_or(|r| plain.len() == r.params as usize + P::MIN_LENGTH as usize - 2);
-            let packet = if ok { plain.get(1..).and_then(|b| P::from_frame(id, instruction, b)) } else { None };
-            match packet {
-                None => return self.refuse(|s| &mut s.bad_stuffing, total, DecodeError::BadStuffing { id }),
-                Some(_) if !params_ok => {
-                    return self.refuse(|s| &mut s.bad_lengths, total, DecodeError::BadLength { id, length })
-                }
-                Some(p) => {
-                    self.buf.copy_within(total..self.len, 0);
-                    self.len -= total;
-                    self.stats.packets = self.stats.packets.saturating_add(1);
-                    return Some(Ok(p));
-                }
-            }
-        }
-    }
-
-    /// Feeds a chunk and iterates over every packet and error in it.
-    pub fn feed<'s, 'b>(&'s mut self, bytes: &'b [u8]) -> Feed<'s, 'b, P, N> {
-        Feed { decoder: self, rest: bytes }
-    }
-}
-
-/// Iterator over the packets and errors of a chunk fed to a decoder. Bytes
-/// of an incomplete packet at the end stay in the decoder for the next chunk.
-pub struct Feed<'s, 'b, P, const N: usize> {
-    decoder: &'s mut Decoder<P, N>,
-    rest: &'b [u8],
-}
-
-impl<P: FromFrame<N>, const N: usize> Iterator for Feed<'_, '_, P, N> {
-    type Item = Result<P, DecodeError>;
-    fn next(&mut self) -> Option<Self::Item> {
-        if let Some(r) = self.decoder.poll() {
-            return Some(r);
-        }
-        while let Some((&b, rest)) = self.rest.split_first() {
-            self.rest = rest;
-            if let Some(r) = self.decoder.push(b) {
-                return Some(r);
-            }
-        }
-        None
-    }
+crate::framed! {
+    header: HEADER, min: STATUS_OVERHEAD, reply: Reply, error: DecodeError, stats: DecoderStats = NO_STATS,
+    count: count, examine: examine, packets: [StatusPacket, InstructionPacket]
 }
