@@ -171,7 +171,7 @@ impl PositionLoop {
             * (s.gains.p as f32 * e as f32
                 + s.gains.d as f32 * de as f32
                 + s.gains.i as f32 * self.integral / ticks_per_s);
-        let u = if u != 0.0 && u.abs() < s.min_duty { s.min_duty.copysign(u) } else { u };
+        let u = if u != 0.0 && libm::fabsf(u) < s.min_duty { libm::copysignf(s.min_duty, u) } else { u };
         self.duty = u.clamp(-s.max_duty, s.max_duty);
         self.duty
     }
