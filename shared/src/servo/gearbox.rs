@@ -225,22 +225,62 @@ pub const XL330_M288_GEARBOX: Gearbox = Gearbox {
            Table I's backlash.",
 };
 
+/// The Feetech STS3215's last gear: an estimate (metal gears, the metal
+/// not steel by the one listing that names it).
+pub const STS3215_GEARBOX: Gearbox = Gearbox {
+    name: "STS3215",
+    params: GearboxParams {
+        // "≤ 0.5°" (Feetech's datasheet as quoted): 0.5·π/180 rad.
+        theta_bl_rad: 0.008726646259971648,
+        // LEO's coupling (Table I): the robot's, not the servo's.
+        k_nm_per_rad: 106.0,
+        // Metal gears: Table I's material assumed (see the note).
+        d: -0.262,
+        sigma_f_mpa: 4402.0,
+        // Table I's 4 mm, 0.4 mm, 18.5 mm × 24.7/35.6 (case width), 3 s.f.
+        b_mm: 2.78,
+        m_n_mm: 0.278,
+        d_w_mm: 12.8,
+        // Table I's: the same 45-tooth profile assumed.
+        y_fa: 2.15,
+        y_sa: 2.0,
+        y_epsilon: 1.22,
+        y_beta: 1.0,
+        teeth: 45,
+    },
+    sources: GearboxSources {
+        theta_bl: "Feetech datasheet as quoted (SO-ARM100 issue 134, Robonine): backlash <= 0.5 deg",
+        k: COUPLING,
+        fatigue: "estimate: Table I's (metal gear; the listing's copper and aluminium may be weaker than the RX-28's steel)",
+        geometry: SCALED,
+        y_factors: AS_TABLE_I,
+        teeth: AS_TABLE_I,
+    },
+    estimate: true,
+    note: "Metal gears, 1/345 (Feetech's listing: \"metal tooth\"; DFRobot's: copper and \
+           aluminium). No module, width or tooth count is published: Table I's gear scaled \
+           with the case width (24.7/35.6), Table I's fatigue curve (a copper alloy's would \
+           lie lower, so the MTBF is optimistic), the datasheet's 0.5 deg backlash.",
+};
+
 /// Every gearbox pada knows.
-pub static GEARBOXES: [Gearbox; 5] = [
+pub static GEARBOXES: [Gearbox; 6] = [
     RX28_GEARBOX,
     MX28_GEARBOX,
     XM430_W350_GEARBOX,
     XL430_W250_GEARBOX,
     XL330_M288_GEARBOX,
+    STS3215_GEARBOX,
 ];
 
 /// The names of [`GEARBOXES`], in order.
-pub static GEARBOX_NAMES: [&str; 5] = [
+pub static GEARBOX_NAMES: [&str; 6] = [
     RX28_GEARBOX.name,
     MX28_GEARBOX.name,
     XM430_W350_GEARBOX.name,
     XL430_W250_GEARBOX.name,
     XL330_M288_GEARBOX.name,
+    STS3215_GEARBOX.name,
 ];
 
 /// The gearbox called `name` (ASCII case-insensitive, surrounding spaces

@@ -12,6 +12,8 @@
 //! |---|---|
 //! | `mod.rs` | the servo models: datasheet figures, the DC motor, lookup by name |
 //! | `gearbox.rs` | the gearboxes: the last gear's Eqs. 3–7 parameters, each with its source, estimates marked |
+//! | `feetech.rs` | the Feetech STS3215: its figures and sources, kept apart until pada speaks its protocol |
+//! | `position_loop.rs` | a servo's own position loop (the STS3215's in Operating_Mode 0): goal error to motor voltage |
 //!
 //! # The DC motor from a datasheet
 //!
@@ -57,15 +59,21 @@
 //! RX-28 keeps GRL's 13.6 V).
 
 pub mod encoding;
+pub mod feetech;
 pub mod gearbox;
+pub mod position_loop;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod feetech_tests;
 
 use crate::rx28;
 use core::fmt;
 
 pub use encoding::{CommandKind, Drive, Encoding, PositionScale, Present};
+pub use feetech::{feetech_servo, FeetechModel, FEETECH_SERVOS, STS3215};
 pub use gearbox::{gearbox, Gearbox, GearboxSources, GEARBOXES};
+pub use position_loop::{ControlMode, LoopGains, PositionLoop, PositionLoopSpec};
 
 /// The Dynamixel protocol a servo model speaks (its firmware's default).
 ///

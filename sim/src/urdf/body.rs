@@ -12,10 +12,19 @@
 //! is left out (the X-series' is an estimate: docs/reference/servos.md),
 //! and so are contacts: the body has no floor and no colliders, a robot of
 //! files is an arm on a fixed base.
+//!
+//! A joint's servo takes its command in one of two modes
+//! ([`pada_core::servo::ControlMode`]): a voltage held over the period
+//! (the paper's actions), or a goal angle that the servo's own position
+//! loop follows ([`pada_core::servo::PositionLoop`], the STS3215's in
+//! Operating_Mode 0: docs/reference/feetech.md). In position mode the loop
+//! runs every sub-step at its own rate and its voltage drives the same
+//! motor model, so the gear torques are the ones the loop causes.
 
 use pada_core::limits::MAX_SERVOS;
 use pada_core::robot::PerServo;
 use pada_core::rx28::ReducedJoint;
+use pada_core::servo::{ControlMode, PositionLoop};
 use pada_robot_file::RobotFile;
 use rapier3d::prelude::*;
 use rapier3d_urdf::{UrdfLoaderOptions, UrdfMultibodyOptions, UrdfRobot};
@@ -42,6 +51,8 @@ struct ServoJoint {
     axis: Vector,
     /// The servo's motor.
     servo: ReducedJoint,
+    /// The servo's own position loop, when the joint is in position mode.
+    position: Option<PositionLoop>,
 }
 
 /// A robot's body, simulated.
@@ -54,6 +65,12 @@ pub struct UrdfBody {
     start: Vec<f32>,
     substeps: u32,
     volts: PerServo,
+    /// The goal angle of each joint in position mode \[rad\].
+    goals: PerServo,
+    /// The supply the position loops' duty cycles apply \[V\].
+    supply_v: f32,
+    /// The mean voltage each servo applied over the last period \[V\].
+    applied: PerServo,
     /// The mean gear torque of each servo over the last period \[N·m\].
     torques: PerServo,
 }
@@ -157,6 +174,7 @@ impl UrdfBody {
                 parent: h.link1,
                 axis: Vector::new((axis[0] / n) as f32, (axis[1] / n) as f32, (axis[2] / n) as f32),
                 servo: spec.servo.motor().to_rx28().reduced(),
+                position: None,
             });
         }
         let multibody = multibody.ok_or_else(|| anyhow::anyhow!("the robot has no servo joint"))?;
@@ -181,6 +199,9 @@ impl UrdfBody {
             start: start.clone(),
             substeps,
             volts: [0.0; MAX_SERVOS],
+            goals: [0.0; MAX_SERVOS],
+            supply_v: spec.supply_nominal_v,
+            applied: [0.0; MAX_SERVOS],
             torques: [0.0; MAX_SERVOS],
         };
         body.reset_to(&start)?;
@@ -202,7 +223,16 @@ impl UrdfBody {
     pub fn reset_to(&mut self, angles: &[f32]) -> anyhow::Result<()> {
         self.built.restore(&mut self.world);
         self.volts = [0.0; MAX_SERVOS];
+        self.applied = [0.0; MAX_SERVOS];
         self.torques = [0.0; MAX_SERVOS];
+        // A position-mode joint holds where it starts.
+        self.goals = [0.0; MAX_SERVOS];
+        for (k, (j, q)) in self.joints.iter_mut().zip(angles).enumerate() {
+            if let Some(l) = &mut j.position {
+                l.reset();
+                self.goals[k] = *q;
+            }
+        }
         let w = &mut self.world;
         let mb = w.multibody_joints.get_multibody_mut(self.multibody).ok_or_else(|| anyhow::anyhow!("no multibody"))?;
         for (j, q) in self.joints.iter().zip(angles) {
@@ -215,19 +245,62 @@ impl UrdfBody {
     }
 
     /// The voltage each servo applies from now on (held until the next
-    /// call, as a servo holds its command over the period).
+    /// call, as a servo holds its command over the period). A joint in
+    /// position mode ignores it.
     pub fn set_voltages(&mut self, volts: &PerServo) {
         self.volts = *volts;
+    }
+
+    /// How joint `joint`'s servo takes its command from now on; a joint
+    /// switched to position mode holds its present angle until
+    /// [`UrdfBody::set_goals`]. False when there is no such joint.
+    pub fn set_control_mode(&mut self, joint: usize, mode: ControlMode) -> bool {
+        let q = self.angles();
+        let Some(j) = self.joints.get_mut(joint) else { return false };
+        j.position = match mode {
+            ControlMode::Voltage => None,
+            ControlMode::Position(spec) => Some(PositionLoop::new(spec)),
+        };
+        self.goals[joint] = q[joint];
+        true
+    }
+
+    /// The supply the position loops apply their duty cycles to \[V\]
+    /// (the robot's `supply_v` until set).
+    pub fn set_supply(&mut self, supply_v: f32) {
+        self.supply_v = supply_v;
+    }
+
+    /// The goal angle of each joint in position mode from now on \[rad\]
+    /// (the others ignore theirs).
+    pub fn set_goals(&mut self, goals: &PerServo) {
+        self.goals = *goals;
     }
 
     /// One control period: the physics steps with the held voltages.
     pub fn step_period(&mut self) -> Result<(), BlowUp> {
         let mut sum = [0.0f32; MAX_SERVOS];
+        let mut applied = [0.0f32; MAX_SERVOS];
         let dt = self.world.integration_parameters.dt;
+        let looped = self.joints.iter().any(|j| j.position.is_some());
         for _ in 0..self.substeps {
             let before = self.rates();
+            // Each servo's voltage over this sub-step: the held command, or
+            // what its position loop makes of the goal and the angle now.
+            let mut volts = self.volts;
+            if looped {
+                let q = self.angles();
+                for (k, j) in self.joints.iter_mut().enumerate() {
+                    if let Some(l) = &mut j.position {
+                        volts[k] = l.step(self.goals[k], q[k], self.supply_v, dt);
+                    }
+                }
+            }
+            for k in 0..MAX_SERVOS {
+                applied[k] += volts[k];
+            }
             for (k, j) in self.joints.iter().enumerate() {
-                let tau = j.servo.voltage_torque(self.volts[k]);
+                let tau = j.servo.voltage_torque(volts[k]);
                 let axis = self.world.bodies[j.child].rotation() * j.axis;
                 self.world.bodies[j.child].reset_torques(false);
                 self.world.bodies[j.child].add_torque(axis * tau, false);
@@ -235,7 +308,7 @@ impl UrdfBody {
             // A parent may be another joint's child: its reaction torques
             // go on after every child's own torque is set.
             for (k, j) in self.joints.iter().enumerate() {
-                let tau = j.servo.voltage_torque(self.volts[k]);
+                let tau = j.servo.voltage_torque(volts[k]);
                 let axis = self.world.bodies[j.child].rotation() * j.axis;
                 if self.world.bodies[j.parent].is_dynamic() {
                     self.world.bodies[j.parent].add_torque(-axis * tau, false);
@@ -246,7 +319,7 @@ impl UrdfBody {
             for (k, j) in self.joints.iter().enumerate() {
                 // The torque the gears carry: the motor's, less its back-EMF
                 // and the rotor's inertia.
-                sum[k] += j.servo.joint_torque(self.volts[k], after[k], (after[k] - before[k]) / dt);
+                sum[k] += j.servo.joint_torque(volts[k], after[k], (after[k] - before[k]) / dt);
             }
             if !after.iter().all(|x| x.is_finite()) {
                 return Err(BlowUp);
@@ -254,8 +327,15 @@ impl UrdfBody {
         }
         for k in 0..MAX_SERVOS {
             self.torques[k] = sum[k] / self.substeps as f32;
+            self.applied[k] = applied[k] / self.substeps as f32;
         }
         Ok(())
+    }
+
+    /// The mean voltage each servo applied over the last period \[V\]:
+    /// the held command, or its position loop's output.
+    pub fn applied_voltages(&self) -> PerServo {
+        self.applied
     }
 
     /// The joint angles \[rad\], joint order (0 past the joints).

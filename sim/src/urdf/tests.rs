@@ -99,3 +99,65 @@ fn the_task_learns_on_the_rules_and_reports_the_servos_torques() {
     assert!(plant.gearbox_torques(&[2.0, -2.0])[..2].iter().all(|t| *t != 0.0));
     assert_eq!(plant.rules().spec().name, "reacher");
 }
+
+#[test]
+fn a_joint_in_position_mode_follows_its_goal_through_the_servos_loop() {
+    use pada_core::servo::{ControlMode, LoopGains, STS3215};
+    // The reacher's shoulder under the STS3215's loop (LeRobot's gains):
+    // the loop's voltage drives the shoulder's own motor model at the
+    // robot's 12 V supply; the elbow stays in voltage mode at 0 V.
+    let robot = reacher();
+    let model = UrdfModel::load(&robot).unwrap().with_steps(16, 4);
+    let mut body = UrdfBody::new(&model).unwrap();
+    let spec = STS3215.position_loop(LoopGains::LEROBOT);
+    assert!(body.set_control_mode(0, ControlMode::Position(spec)));
+    assert!(!body.set_control_mode(MAX_SERVOS, ControlMode::Voltage));
+    // Switched on, it holds where it is.
+    body.step_period().unwrap();
+    assert!(body.angles()[0].abs() * spec.counts_per_rad <= 1.5, "{}", body.angles()[0]);
+    let mut goals = [0.0; MAX_SERVOS];
+    goals[0] = 0.3;
+    body.set_goals(&goals);
+    body.step_period().unwrap();
+    assert!(body.gear_torques()[0] > 0.0 && body.applied_voltages()[0] > 0.0);
+    assert_eq!(body.applied_voltages()[1], 0.0, "the elbow is in voltage mode");
+    for _ in 0..40 {
+        body.step_period().unwrap();
+    }
+    let e = (body.angles()[0] - 0.3).abs();
+    assert!(e < 0.02, "{} rad off the goal", e);
+    assert!(body.rates()[0].abs() < 0.05, "{}", body.rates()[0]);
+    // The goal flips: the first period's gear torque flips with it.
+    goals[0] = -0.3;
+    body.set_goals(&goals);
+    body.step_period().unwrap();
+    assert!(body.gear_torques()[0] < 0.0 && body.applied_voltages()[0] < 0.0);
+    // A reset puts the loop back at rest, holding the start pose.
+    body.reset().unwrap();
+    body.step_period().unwrap();
+    assert!(body.angles()[0].abs() < 0.01, "{}", body.angles()[0]);
+}
+
+#[test]
+fn voltage_mode_is_what_it_was() {
+    // The same voltages give the same angles and torques, bit for bit,
+    // whether or not the body could run a position loop.
+    use pada_core::servo::ControlMode;
+    let robot = reacher();
+    let model = UrdfModel::load(&robot).unwrap();
+    let mut a = UrdfBody::new(&model).unwrap();
+    let mut b = UrdfBody::new(&model).unwrap();
+    assert!(b.set_control_mode(0, ControlMode::Voltage));
+    let mut volts = [0.0; MAX_SERVOS];
+    volts[0] = 3.0;
+    volts[1] = -1.5;
+    for body in [&mut a, &mut b] {
+        body.set_voltages(&volts);
+        for _ in 0..5 {
+            body.step_period().unwrap();
+        }
+    }
+    assert_eq!(a.angles().map(f32::to_bits), b.angles().map(f32::to_bits));
+    assert_eq!(a.gear_torques().map(f32::to_bits), b.gear_torques().map(f32::to_bits));
+    assert_eq!(a.applied_voltages(), volts);
+}
