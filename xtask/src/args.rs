@@ -24,7 +24,10 @@ tasks:
         build the firmware ELF of a board's learner profile for
         thumbv7em-none-eabihf (debug unless --release; board f405 unless
         --board; the 33 Hz pendulum unless --robot) and print its use of
-        flash, SRAM, CCM and SDRAM and where the weight table lies.
+        flash, SRAM, CCM and SDRAM and where the weight table lies; then,
+        for a claim table, whether the robot's learning fits it (`pada
+        claims --board B --robot R`: one host trial, cached, against the
+        board's slots, and a warning where it fills before learning ends).
         --robot takes a robot of pada's by name, or a robot of your own by
         the path of its robot.toml (a value ending in .toml or holding a
         /; relative to the current directory): its constants are

@@ -251,12 +251,38 @@ fn firmware(root: &Path, build: Build) -> Result<PathBuf, String> {
     );
     println!("xtask: firmware ELF: {}", elf_path.display());
     print!("{}", usage.report(&regions, &table));
+    table_demand(root, chip, &robot);
     println!(
         "xtask: flash with: probe-rs run --chip {} {}",
         chip.probe_rs_name(),
         elf_path.display()
     );
     Ok(elf_path)
+}
+
+/// Before flashing: whether the robot's learning fits the image's table.
+/// `pada claims --board B --robot R` (or `--task NAME`) measures the
+/// features one host trial writes over the robot's learning time (cached
+/// between runs) against the board's claim table, and warns where the
+/// table fills before learning ends; an exact table is said to fit (the
+/// build would have failed otherwise). A check that cannot run is said,
+/// and the build stands.
+fn table_demand(root: &Path, chip: Chip, robot: &Robot) {
+    let mut cmd = std::process::Command::new(env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
+    cmd.current_dir(root).args(["run", "--release", "--quiet", "-p", "pada", "--", "claims", "--board", chip.profile()]);
+    match robot {
+        Robot::File(p) => cmd.arg("--robot").arg(p),
+        // pada's own robots: their exact tables are fixed by the build;
+        // LEO's claim table is measured as a robot of files' is.
+        Robot::BuiltIn(b) if b.spec.table == pada_core::robot::TableNeed::Claimed => cmd.args(["--task", b.spec.name]),
+        Robot::BuiltIn(_) => return,
+    };
+    println!("xtask: will the robot's learning fit the table? (`pada claims`, one host trial, cached)");
+    match cmd.status() {
+        Ok(s) if s.success() => {}
+        Ok(s) => println!("xtask: the table's demand could not be measured ({s}): run `pada claims --board {} --robot …` to know before flashing", chip.profile()),
+        Err(e) => println!("xtask: the table's demand could not be measured (cannot start cargo: {e})"),
+    }
 }
 
 /// Builds the emulated board's image; returns the ELF's path.

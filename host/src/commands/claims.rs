@@ -1,4 +1,7 @@
-//! `pada claims`: what a trial writes. Reads the output directories of
+//! `pada claims`: what a trial writes. With `--robot FILE` or `--task
+//! leo` and `--board B`, before flashing: the slots one host trial of the
+//! robot writes against the board's claim table ([`super::claims_demand`]).
+//! Otherwise it reads the output directories of
 //! `pada run --task leo` (their `summary.json` and the `claimed_slots`
 //! column of each `trial-NNN.csv`, written for claim tables), prints the
 //! slots claimed at chosen learning times and when each board's claim
@@ -18,10 +21,33 @@ use std::path::{Path, PathBuf};
 /// `pada claims`.
 #[derive(Debug, Clone, Args)]
 pub struct ClaimsArgs {
-    /// Output directories of `pada run` on a claim table (LEO), one per
-    /// configuration.
-    #[arg(required = true, value_name = "RUN_DIR")]
+    /// Output directories of `pada run` on a claim table, one per
+    /// configuration (or none, with --robot or --task and --board).
+    #[arg(value_name = "RUN_DIR", required_unless_present_any = ["robot", "task"])]
     pub runs: Vec<PathBuf>,
+    /// Before flashing: a robot of your own (its robot.toml), whose demand
+    /// a host trial measures (cached), against --board's claim table.
+    #[arg(long, value_name = "robot.toml", conflicts_with_all = ["task", "runs"], requires = "board")]
+    pub robot: Option<PathBuf>,
+    /// Before flashing: one of pada's robots (leo) instead of --robot.
+    #[arg(long, value_enum, conflicts_with = "runs", requires = "board")]
+    pub task: Option<crate::experiment::tasks::TaskName>,
+    /// With --robot or --task: the board whose claim table to check.
+    #[arg(long, value_name = "NAME", value_parser = crate::robots::board_parser())]
+    pub board: Option<Board>,
+    /// With --robot or --task: the learner (default pada).
+    #[arg(long, value_parser = crate::experiment::algo::algo_parser())]
+    pub algo: Option<Algo>,
+    /// With --algo pada (or another that takes Δ): its Δ (the default otherwise).
+    #[arg(long)]
+    pub delta: Option<f32>,
+    /// With --robot or --task: the learning time [s] (the robot's default
+    /// otherwise).
+    #[arg(long, value_name = "S")]
+    pub seconds: Option<f64>,
+    /// With --robot or --task: the run's master seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
     /// Learning times to report the claimed slots at [s].
     #[arg(long, value_name = "S", value_delimiter = ',', default_values_t = [3600.0, 7333.0, 14666.0])]
     pub at: Vec<f64>,
@@ -107,6 +133,9 @@ fn at_time(curve: &[(f64, u32)], t: f64) -> Option<u32> {
 
 /// Runs `pada claims`.
 pub fn run(args: ClaimsArgs) -> Result<(), CliError> {
+    if args.robot.is_some() || args.task.is_some() {
+        return super::claims_demand::run(args);
+    }
     if let Some(t) = args.at.iter().find(|t| !(t.is_finite() && **t >= 0.0)) {
         return Err(usage(format!("--at {t} is out of range: valid is a learning time >= 0 s")));
     }

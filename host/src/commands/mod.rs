@@ -2,6 +2,7 @@
 
 pub mod capture;
 pub mod claims;
+pub mod claims_demand;
 pub mod demo;
 pub mod drive;
 pub mod leo;

@@ -277,6 +277,11 @@ fn run_on_board(args: RunArgs, board: Board, sim: crate::robots::SimRobot) -> Re
         )));
     }
     let cfg = run_config(&args, &task_spec, policy)?;
+    let out_path = args.out.clone().unwrap_or_else(|| {
+        PathBuf::from(format!("pada-out/run-{}-{}-{}", task_spec.name, args.algo, board.name()))
+    });
+    let out = OutDir::check(&out_path)?;
+    set_threads(args.trial.threads)?;
     // Before the board's run: the slots this robot's learning writes
     // against the board's claim table, from a host trial (cached).
     if profile.layout == Layout::Claimed && crate::board::demand::has_claim_table(&sim) {
@@ -297,11 +302,6 @@ fn run_on_board(args: RunArgs, board: Board, sim: crate::robots::SimRobot) -> Re
             }
         }
     }
-    let out_path = args.out.clone().unwrap_or_else(|| {
-        PathBuf::from(format!("pada-out/run-{}-{}-{}", task_spec.name, args.algo, board.name()))
-    });
-    let out = OutDir::check(&out_path)?;
-    set_threads(args.trial.threads)?;
     let total = cfg.trials as u64
         * cfg.expected_steps(task_spec.control_period_s, task_spec.episode_steps, task_spec.test_interval);
     let bar = steps_bar(total, &format!("{} {} on {}", task_spec.name, label(&policy), board.name()));
