@@ -9,7 +9,7 @@
 //!
 //! | board | memory for the table | pendulum | LEO |
 //! |---|---|---|---|
-//! | `f405` | 64 KB CCM + 64 KB of the 128 KB SRAM (STM32F405) | exact, 24 960 Q16 weights (CCM, then SRAM) | claim table, 2^15 slots of 16-bit weight (all 64 KiB of CCM) + 16-bit tag (64 KiB of SRAM), replacing when full |
+//! | `f405` | 64 KB CCM + 64 KB of the 128 KB SRAM (STM32F405) | exact, 24 960 Q16 weights (CCM, then SRAM) | hashed table, 2^16 16-bit weights (CCM, then SRAM) |
 //! | `f429-sdram` | 8 MB SDRAM on the FMC (STM32F429I-DISC1) | exact, in SRAM | claim table, 2^21 slots of 16-bit weight + 16-bit tag (8 MiB) |
 //! | `host` | the heap | exact, as large as the policy needs | claim table, 2^22 slots of Q16 weight + 32-bit tag (32 MiB) |
 //!
@@ -92,16 +92,20 @@ impl Board {
                 };
                 (Layout::Exact, TableSize::Weights(weights), WeightFormat::Q16, memory, 0)
             }
-            // A claim table over all the chip gives it: 2^15 slots, their
-            // 16-bit weights filling the 64 KB of CCM and their 16-bit
-            // tags 64 KB of SRAM (F405_SRAM_TABLE_BYTES), twice the slots
-            // of the CCM alone. (2^16 would need 256 KB.)
+            // A hashed table over all the memory the chip gives a table:
+            // 2^16 16-bit weights, the first half in the 64 KB of CCM, the
+            // rest in 64 KB of SRAM (F405_SRAM_TABLE_BYTES). Features whose
+            // hashes collide share a weight. Of the three things a full
+            // table can do in these 128 KB (a claim table of 2^15 slots
+            // that refuses, one that replaces, or twice the entries
+            // without tags that collide), this learned best on a
+            // three-joint arm and on LEO (docs/board.md, "A full table").
             (Board::F405, TableNeed::Claimed) => (
-                Layout::Claimed,
-                TableSize::Weights(F405_CLAIM_SLOTS),
+                Layout::Hashed,
+                TableSize::Weights(F405_HASHED_WEIGHTS),
                 WeightFormat::Half { shift: robot.half_shift },
-                Memory::CcmWeightsSramTags,
-                2,
+                Memory::CcmThenSram { ccm_weights: CCM_BYTES / 2 },
+                0,
             ),
             (Board::F429Sdram, TableNeed::Exact { weights }) => {
                 let bytes = weights * 4;
@@ -134,16 +138,11 @@ impl Board {
                 (Layout::Claimed, TableSize::Weights(1 << HOST_CLAIM_LOG2), WeightFormat::Q16, Memory::Heap, 4)
             }
         };
-        // A full claim table on the F405 gives the least-learned slot to a
-        // new feature instead of refusing it (docs/board.md, "A full
-        // table", measures the three behaviours). The F429's and the host's
-        // tables do not fill with the paper's robots: they refuse, as
-        // before, so their runs are bit for bit as they were.
-        let when_full = match (self, layout) {
-            (Board::F405, Layout::Claimed) => WhenFull::Replace,
-            _ => WhenFull::Refuse,
-        };
-        Ok(LearnerProfile { board: self, robot, layout, size, format, memory, tag_bytes, when_full })
+        // The F429's and the host's claim tables do not fill with the
+        // paper's robots: they refuse, as before, so their runs are bit
+        // for bit as they were (`pada run --board --table-full` tries the
+        // others).
+        Ok(LearnerProfile { board: self, robot, layout, size, format, memory, tag_bytes, when_full: WhenFull::Refuse })
     }
 }
 
@@ -190,9 +189,9 @@ pub const CCM_BYTES: usize = 64 * 1024;
 /// the firmware's statics (about 32 KB: the images' sizes in docs/board.md)
 /// and its stack.
 pub const F405_SRAM_TABLE_BYTES: usize = 64 * 1024;
-/// Slots of the F405's claim table: 16-bit weights in all of CCM, their
-/// 16-bit tags in [`F405_SRAM_TABLE_BYTES`] of SRAM.
-pub const F405_CLAIM_SLOTS: usize = CCM_BYTES / 2;
+/// Weights of the F405's hashed table: 16-bit weights in all of CCM and
+/// [`F405_SRAM_TABLE_BYTES`] of SRAM.
+pub const F405_HASHED_WEIGHTS: usize = (CCM_BYTES + F405_SRAM_TABLE_BYTES) / 2;
 /// Bytes of the F429's 192 KB SRAM an exact table may take.
 pub const F429_SRAM_TABLE_BYTES: usize = 128 * 1024;
 
@@ -429,7 +428,7 @@ mod tests {
             match p.memory {
                 Memory::Ccm => assert!(bytes <= CCM_BYTES, "{}", robot.name),
                 Memory::CcmThenSram { ccm_weights } => {
-                    assert!(ccm_weights * p.format.bytes() <= CCM_BYTES);
+                    assert!(ccm_weights * p.format.bytes() <= CCM_BYTES, "{}", robot.name);
                     // The rest must leave most of the 128 KB SRAM to the
                     // firmware's stack, buffers and executor.
                     assert!(bytes - ccm_weights * p.format.bytes() <= F405_SRAM_TABLE_BYTES, "{}", robot.name);
@@ -459,8 +458,8 @@ mod tests {
         assert_eq!((p.layout, p.weights(), p.format), (Layout::Exact, Some(24_960), WeightFormat::Q16));
         assert_eq!(p.memory, Memory::CcmThenSram { ccm_weights: 16_384 });
         let l = Board::F405.profile(&leo::SPEC).unwrap();
-        assert_eq!((l.layout, l.weights(), l.format, l.tag_bytes), (Layout::Claimed, Some(1 << 15), WeightFormat::Half { shift: 12 }, 2));
-        assert_eq!((l.memory, l.when_full), (Memory::CcmWeightsSramTags, WhenFull::Replace));
+        assert_eq!((l.layout, l.weights(), l.format, l.tag_bytes), (Layout::Hashed, Some(1 << 16), WeightFormat::Half { shift: 12 }, 0));
+        assert_eq!(l.memory, Memory::CcmThenSram { ccm_weights: 1 << 15 });
         let l = Board::F429Sdram.profile(&leo::SPEC).unwrap();
         assert_eq!((l.weights(), l.memory, l.tag_bytes), (Some(1 << 21), Memory::Sdram, 2));
         let h = Board::Host.profile(&leo::SPEC).unwrap();

@@ -64,7 +64,7 @@ fn every_policy_every_robot_and_every_board_is_checked() {
 fn table_of(profile: LearnerProfile, weights: usize) -> HostTable {
     match profile.layout {
         Layout::Claimed => HostTable::claimed(weights, profile.format, profile.tag_bytes).unwrap().on_full(profile.when_full),
-        Layout::Exact | Layout::Hashed => HostTable::plain(weights),
+        Layout::Exact | Layout::Hashed => HostTable::plain_of(weights, profile.format).unwrap(),
     }
 }
 

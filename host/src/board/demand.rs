@@ -144,7 +144,7 @@ pub struct Forecast {
     pub board: String,
     /// Its claim table's slots.
     pub slots: u32,
-    /// What it does when full (`refuse`, `replace`).
+    /// What it does when full (`refuse`, `replace`, `collide`).
     pub when_full: String,
     /// Features the trial wrote by the end of its learning time.
     pub demand_at_end: u32,
@@ -155,17 +155,20 @@ pub struct Forecast {
 }
 
 impl Forecast {
-    /// The forecast of `profile`'s table against `demand`; `None` for a
-    /// profile without a claim table.
+    /// The forecast of `profile`'s table against `demand`; `None` for an
+    /// exact table (its size is the robot's).
     pub fn of(demand: &Demand, profile: &LearnerProfile) -> Option<Forecast> {
-        if profile.layout != Layout::Claimed {
-            return None;
-        }
+        let when_full = match profile.layout {
+            Layout::Exact => return None,
+            // Past its entries, a hashed table's features share them.
+            Layout::Hashed => "collide".to_string(),
+            Layout::Claimed => profile.when_full.name().to_string(),
+        };
         let slots = profile.weights()? as u32;
         Some(Forecast {
             board: profile.board.name().to_string(),
             slots,
-            when_full: profile.when_full.name().to_string(),
+            when_full,
             demand_at_end: demand.at_end(),
             learning_s: demand.learning_s,
             nine_tenths_at_s: demand.time_of(0.9 * slots as f64),
@@ -183,18 +186,29 @@ impl Forecast {
     pub fn lines(&self, demand: &Demand) -> Vec<String> {
         let pct = 100.0 * self.demand_at_end as f64 / self.slots as f64;
         let mut lines = vec![format!(
-            "table demand: a host trial of {} ({}, seed {}) writes {} features in {:.0} s of learning; {}'s claim table has {} slots ({pct:.0} % of them)",
-            demand.robot, demand.policy, demand.seed, self.demand_at_end, self.learning_s, self.board, self.slots
+            "table demand: a host trial of {} ({}, seed {}) writes {} features in {:.0} s of learning; {}'s table has {} {} ({pct:.0} % of them)",
+            demand.robot,
+            demand.policy,
+            demand.seed,
+            self.demand_at_end,
+            self.learning_s,
+            self.board,
+            self.slots,
+            if self.when_full == "collide" { "hashed entries" } else { "claim slots" }
         )];
         match self.nine_tenths_at_s {
             Some(t) => {
                 lines.push(format!("  nine tenths full at {t:.0} s of learning"));
                 lines.push(format!(
-                    "warning: {}'s table fills at {t:.0} s, before learning ends at {:.0} s; then it {}s (docs/board.md, \"A full table\"). \
+                    "warning: {}'s table fills at {t:.0} s, before learning ends at {:.0} s; then {} (docs/board.md, \"A full table\"). \
                      To fit: coarser tiles, fewer observed signals, fewer levels, or the f429-sdram",
                     self.board,
                     self.learning_s,
-                    self.when_full
+                    match self.when_full.as_str() {
+                        "collide" => "new features share weights with others",
+                        "replace" => "new features replace the least-learned",
+                        _ => "new features are refused and do not learn",
+                    }
                 ));
             }
             None => lines.push(format!("  never nine tenths full: at most {pct:.0} % by the end")),
@@ -224,7 +238,11 @@ mod tests {
 
     #[test]
     fn a_table_that_fills_warns_in_one_line_with_the_fixes_and_one_that_does_not_says_so() {
-        let profile = Board::F405.profile(&pada_core::robot::leo::SPEC).unwrap();
+        let hashed = Board::F405.profile(&pada_core::robot::leo::SPEC).unwrap();
+        let f = Forecast::of(&demand(vec![(600.0, 40_000), (1200.0, 80_000)]), &hashed).unwrap();
+        assert_eq!((f.slots, f.when_full.as_str()), (1 << 16, "collide"));
+        assert!(f.lines(&demand(vec![]))[0].contains("65536 hashed entries"));
+        let profile = hashed.with_hashed_table(Layout::Claimed, 15, hashed.format, 2);
         let fills = Forecast::of(&demand(vec![(600.0, 20_000), (1200.0, 40_000)]), &profile).unwrap();
         assert!(fills.fills());
         let lines = fills.lines(&demand(vec![]));
@@ -233,7 +251,7 @@ mod tests {
         for fix in ["coarser tiles", "fewer observed signals", "fewer levels", "f429-sdram"] {
             assert!(warnings[0].contains(fix), "{fix}: {}", warnings[0]);
         }
-        assert!(lines[0].contains("32768 slots"), "{}", lines[0]);
+        assert!(lines[0].contains("32768 claim slots"), "{}", lines[0]);
         let fits = Forecast::of(&demand(vec![(600.0, 2_000), (1200.0, 4_000)]), &profile).unwrap();
         assert!(!fits.fills());
         assert!(fits.lines(&demand(vec![])).iter().all(|l| !l.starts_with("warning")));

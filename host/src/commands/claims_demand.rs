@@ -43,7 +43,7 @@ pub fn run(args: ClaimsArgs) -> Result<(), CliError> {
     };
     let profile = board.profile(sim.robot).map_err(|e| usage(e.to_string()))?;
     let name = sim.robot.name.to_string();
-    if profile.layout != pada_core::tile_coding::Layout::Claimed || !has_claim_table(&sim) {
+    if profile.layout == pada_core::tile_coding::Layout::Exact || !has_claim_table(&sim) {
         let line = format!(
             "{name} on {}: an exact table of {} weights ({} bytes), fixed by its tiles: it fits, or the build fails",
             board.name(),

@@ -123,12 +123,12 @@ pub struct RunArgs {
     /// pada_core::claim_table).
     #[arg(long, value_name = "BITS", requires = "board", value_parser = ["16", "32"])]
     pub tag_bits: Option<String>,
-    /// With --board: what the board's claim table does when a claim finds
-    /// it full (docs/board.md, "A full table"): refuse the claim (the
-    /// feature never learns), replace the least-learned feature of the
-    /// probe (the F405's default), or collide: a hashed table of 16-bit
-    /// weights in the same memory, twice the entries, where features share
-    /// them.
+    /// With --board: what the board's table memory does when it is full
+    /// (docs/board.md, "A full table"): a claim table of 16-bit weights and
+    /// tags that refuses a new feature (it never learns) or replaces the
+    /// least-learned feature of its probe, or collide: a hashed table of
+    /// 16-bit weights in the same bytes, twice the entries, where features
+    /// share them (the F405's own for robots with many features).
     #[arg(long, value_name = "BEHAVIOUR", requires = "board")]
     pub table_full: Option<TableFull>,
     /// Seed and threads.
@@ -175,24 +175,29 @@ pub enum TableFull {
     Collide,
 }
 
-/// `profile` with its full claim table doing `full`, or why it cannot.
+/// `profile`'s table memory holding `full`'s table, or why it cannot: a
+/// claim table of 16-bit weights and 16-bit tags that refuses or
+/// replaces when full, or a hashed table of 16-bit weights (twice the
+/// entries) whose features collide.
 fn with_table_full(profile: LearnerProfile, full: TableFull) -> Result<LearnerProfile, CliError> {
-    if profile.layout != Layout::Claimed {
+    if profile.layout == Layout::Exact {
         return Err(usage(format!(
-            "--table-full needs a claim table; {} has a {} one for {}",
+            "--table-full needs a robot whose table is hashed or claimed; {} has an exact one for {}",
             profile.board.name(),
-            profile.layout.name(),
             profile.robot.name
         )));
     }
+    let bytes = profile.table_bytes().unwrap_or(0);
+    let format = WeightFormat::Half { shift: profile.robot.half_shift };
+    let claim = |when_full| {
+        let slots = (bytes / (format.bytes() + 2)).max(2);
+        profile.with_hashed_table(Layout::Claimed, slots.ilog2(), format, 2).when_full(when_full)
+    };
     Ok(match full {
-        TableFull::Refuse => profile.when_full(WhenFull::Refuse),
-        TableFull::Replace => profile.when_full(WhenFull::Replace),
+        TableFull::Refuse => claim(WhenFull::Refuse),
+        TableFull::Replace => claim(WhenFull::Replace),
         TableFull::Collide => {
-            // The claim table's bytes, all of them 16-bit weights.
-            let bytes = profile.table_bytes().unwrap_or(0);
-            let format = WeightFormat::Half { shift: profile.robot.half_shift };
-            let entries = (bytes / format.bytes()).max(1);
+            let entries = (bytes / format.bytes()).max(2);
             profile.with_hashed_table(Layout::Hashed, entries.ilog2(), format, 0).when_full(WhenFull::Refuse)
         }
     })
@@ -284,7 +289,7 @@ fn run_on_board(args: RunArgs, board: Board, sim: crate::robots::SimRobot) -> Re
     set_threads(args.trial.threads)?;
     // Before the board's run: the slots this robot's learning writes
     // against the board's claim table, from a host trial (cached).
-    if profile.layout == Layout::Claimed && crate::board::demand::has_claim_table(&sim) {
+    if profile.layout != Layout::Exact && crate::board::demand::has_claim_table(&sim) {
         let bar = steps_bar(
             cfg.expected_steps(task_spec.control_period_s, task_spec.episode_steps, task_spec.test_interval),
             &format!("{}: the table's demand (a host trial)", task_spec.name),

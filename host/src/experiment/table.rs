@@ -31,12 +31,28 @@ pub enum HostTable {
     Claimed(HostClaimTable),
     /// The chips' LEO claim table.
     Chip(ChipClaimTable),
+    /// One 16-bit weight per index: the F405's hashed table (its two
+    /// memories are one slice here, as `Split` addresses them).
+    Half(Half<Box<[i16]>, LEO_SHIFT>),
 }
 
 impl HostTable {
     /// A plain table of `n` zero weights.
     pub fn plain(n: usize) -> HostTable {
         HostTable::Plain(vec![Q16::ZERO; n].into_boxed_slice())
+    }
+
+    /// A plain table of `n` zero weights in `format`: Q16, or the chips'
+    /// 16-bit weights shifted by LEO's shift (no other is built on the
+    /// host).
+    pub fn plain_of(n: usize, format: WeightFormat) -> anyhow::Result<HostTable> {
+        match format {
+            WeightFormat::Q16 => Ok(HostTable::plain(n)),
+            WeightFormat::Half { shift } if shift as u32 == LEO_SHIFT => {
+                Ok(HostTable::Half(Half::new(vec![0i16; n].into_boxed_slice())))
+            }
+            _ => anyhow::bail!("no host table of {format:?} weights (Q16, or 16-bit weights shifted by {LEO_SHIFT})"),
+        }
     }
 
     /// A claim table of `n` free slots (`n` a power of two): Q16 weights
@@ -72,6 +88,7 @@ impl HostTable {
             HostTable::Plain(t) => HostTable::Plain(t),
             HostTable::Claimed(t) => HostTable::Claimed(t.on_full(when_full)),
             HostTable::Chip(t) => HostTable::Chip(t.on_full(when_full)),
+            HostTable::Half(t) => HostTable::Half(t),
         }
     }
 }
@@ -82,6 +99,7 @@ macro_rules! each {
             HostTable::Plain($t) => $e,
             HostTable::Claimed($t) => $e,
             HostTable::Chip($t) => $e,
+            HostTable::Half($t) => $e,
         }
     };
 }
@@ -130,7 +148,7 @@ impl WeightStore for HostTable {
 
     #[inline]
     fn claims(&self) -> bool {
-        !matches!(self, HostTable::Plain(_))
+        !matches!(self, HostTable::Plain(_) | HostTable::Half(_))
     }
 
     fn tag_bytes(&self) -> usize {

@@ -85,7 +85,13 @@ pub fn replay(profile: &LearnerProfile, policy: PolicyKind, seed: u64, records: 
                 return report;
             }
         },
-        Layout::Exact | Layout::Hashed => HostTable::plain(weights),
+        Layout::Exact | Layout::Hashed => match HostTable::plain_of(weights, profile.format) {
+            Ok(t) => t,
+            Err(e) => {
+                report.error = Some(format!("cannot build the table: {e}"));
+                return report;
+            }
+        },
     };
     let agent = profile.robot.agent::<_, TILINGS, TRACE>(policy, profile.layout, table);
     let mut agent = match agent {
