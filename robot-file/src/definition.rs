@@ -19,6 +19,7 @@ use pada_core::robot::vocabulary::{
 };
 use pada_core::robot::{MotorLevels, RobotSpec, TableNeed, TorqueLaw};
 use pada_core::safety::SoftLimit;
+use pada_core::servo::PositionScale;
 use pada_core::tile_coding::StateDim;
 use pada_core::trace::TraceKind;
 use std::path::{Path, PathBuf};
@@ -75,7 +76,11 @@ pub fn load(path: &Path) -> Result<RobotFile, RobotFileError> {
     let at = Locator::new(path, &text);
     let toml: RobotToml = toml::from_str(&text).map_err(|e| {
         let span = e.span().unwrap_or(0..0);
-        at.at(&span, "", e.message().trim().replace('\n', "; "))
+        let message = e.message().trim().replace('\n', "; ");
+        match crate::type_error::reworded(&text, &span, &message) {
+            Some((field, reworded)) => at.at(&span, field, reworded),
+            None => at.at(&span, "", message),
+        }
     })?;
     build(path, &at, toml)
 }
@@ -175,7 +180,7 @@ fn build(path: &Path, at: &Locator, t: RobotToml) -> Result<RobotFile, RobotFile
         learned: leak(motor.learned.clone()),
         held: leak(motor.held),
         voltage_limit_v: robot.voltage_limit_v as f32,
-        start: leak(t.joints.iter().map(|j| j.get_ref().start_rad as f32).collect()),
+        start: leak(t.joints.iter().map(|j| *j.get_ref().start_rad.get_ref() as f32).collect()),
         reset,
         points: leak(points),
         rewards: leak(rewards),
@@ -300,19 +305,51 @@ fn joints(at: &Locator, t: &RobotToml, urdf: &Urdf, urdf_path: &Path) -> Result<
         if sign != 1 && sign != -1 {
             return Err(at.at(&j.sign.span(), f("sign"), format!("{sign} is not valid: 1 or -1")));
         }
+        let zero = *j.zero_count.get_ref();
+        let last = match servo.encoding.position {
+            PositionScale::Span { max, .. } => max as u32,
+            PositionScale::Turns { per_turn } => per_turn.saturating_sub(1),
+        };
+        if zero as u32 > last {
+            return Err(at.at(
+                &j.zero_count.span(),
+                f("zero_count"),
+                format!("{zero} is not valid: a position count of the {}'s encoder, 0 to {last}", servo.name),
+            ));
+        }
         let soft_limit = match &j.soft_limit_rad {
             None => None,
             Some(l) => {
                 let [min, max] = range(at, l, &f("soft_limit_rad"))?;
+                // A revolute joint stops at its URDF limits (rapier holds
+                // it there): a soft limit past them is never reached.
+                let stop = &u.limit;
+                let revolute = matches!(u.joint_type, urdf_rs::JointType::Revolute) && stop.lower < stop.upper;
+                if revolute && (min < stop.lower || max > stop.upper) {
+                    return Err(at.at(
+                        &l.span(),
+                        f("soft_limit_rad"),
+                        format!(
+                            "[{min}, {max}] is not valid: within the URDF joint {:?}'s limits [{}, {}] rad (the joint cannot go further)",
+                            u.name, stop.lower, stop.upper
+                        ),
+                    ));
+                }
                 Some(SoftLimit { min: min as f32, max: max as f32 })
             }
         };
+        let start = *j.start_rad.get_ref();
+        let inside = soft_limit.map_or(start.is_finite(), |l| l.fault(i as u8, start as f32).is_none());
+        if !inside {
+            let valid = soft_limit.map_or("a finite angle in radians".to_string(), |l| format!("within the joint's soft_limit_rad [{}, {}]", l.min, l.max));
+            return Err(at.at(&j.start_rad.span(), f("start_rad"), format!("{start} is not valid: {valid} (the robot would fault at its first reading)")));
+        }
         names.push(u.name.clone());
         joints.push(JointSpec {
             name: Box::leak(u.name.clone().into_boxed_str()),
             servo,
             id,
-            zero: *j.zero_count.get_ref(),
+            zero,
             sign,
             soft_limit,
         });
@@ -426,7 +463,7 @@ fn motor(at: &Locator, t: &RobotToml, voltage_limit_v: f64) -> Result<Motor, Rob
         match (&j.hold_gain_v_per_rad, j.learned) {
             (Some(g), false) => {
                 let gain = positive(at, g, &format!("joint[{i}].hold_gain_v_per_rad"), "volts per radian")?;
-                held.push(Hold { joint: i as u8, target: j.hold_target_rad.unwrap_or(j.start_rad) as f32, gain_v_per_rad: gain as f32 });
+                held.push(Hold { joint: i as u8, target: j.hold_target_rad.unwrap_or(*j.start_rad.get_ref()) as f32, gain_v_per_rad: gain as f32 });
             }
             (Some(g), true) => return Err(at.at(&g.span(), format!("joint[{i}].hold_gain_v_per_rad"), "a learned joint is not held: set learned = false to hold it")),
             (None, false) => return Err(at.at(&j.urdf.span(), format!("joint[{i}]"), "a joint the learner does not drive needs hold_gain_v_per_rad (its P law)")),

@@ -91,17 +91,19 @@ pub struct JointSection {
     pub servo: Spanned<String>,
     /// The servo's bus ID, 0–252.
     pub id: Spanned<u8>,
-    /// The servo's position count at joint angle 0.
+    /// The servo's position count at joint angle 0, within its encoder's
+    /// counts.
     pub zero_count: Spanned<u16>,
     /// +1 if the joint angle grows with the servo's counts, −1 if not.
     #[serde(default = "default_sign")]
     pub sign: Spanned<i8>,
-    /// Past these angles the robot faults, torque off \[rad\].
+    /// Past these angles the robot faults, torque off \[rad\]; within
+    /// the URDF joint's limits.
     #[serde(default)]
     pub soft_limit_rad: Option<Spanned<[f64; 2]>>,
-    /// The angle of the start pose \[rad\].
-    #[serde(default)]
-    pub start_rad: f64,
+    /// The angle of the start pose \[rad\], inside the soft limits.
+    #[serde(default = "default_start")]
+    pub start_rad: Spanned<f64>,
     /// Whether the learner drives it (a motor dimension); else it is held.
     #[serde(default = "default_true")]
     pub learned: bool,
@@ -119,6 +121,10 @@ pub struct JointSection {
 
 fn default_sign() -> Spanned<i8> {
     Spanned::new(0..0, 1)
+}
+
+fn default_start() -> Spanned<f64> {
+    Spanned::new(0..0, 0.0)
 }
 
 fn default_true() -> bool {
