@@ -14,6 +14,7 @@
 //! | [`pendulum`] | the physical inverted pendulum of Section VII (33 or 20 Hz) |
 //! | [`leo`] | the biped LEO walking on its boom (Section VIII) |
 //! | [`filter`] | GRL's rate filter, used by LEO |
+//! | `soft_limits.rs` | the soft-limit check of every reading, on the board and the host |
 //!
 //! A robot is identified by its name and the hash of its definition
 //! ([`RobotSpec::definition_hash`]), never by a number from a closed list:
@@ -31,6 +32,7 @@ pub mod leo;
 pub mod pendulum;
 pub mod registry;
 pub mod rules;
+mod soft_limits;
 pub mod vocabulary;
 
 pub use hardware::{EncoderSpec, JointRange, JointSpec};
