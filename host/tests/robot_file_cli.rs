@@ -178,3 +178,49 @@ fn a_soft_limit_stops_the_host_as_it_stops_the_board() {
     assert!((host.position - board.position).abs() <= 2.0 * count, "{host:?} against {board:?}");
     assert!(host.position > 0.5, "{host:?}");
 }
+
+/// `pada run --help` says that `--board` runs a robot of files too.
+#[test]
+fn run_help_names_robots_of_files_for_a_board() {
+    let help = String::from_utf8_lossy(&pada(&["run", "--help"]).stdout).into_owned();
+    let board = help.split("--board <NAME>").nth(1).expect("--board in the help");
+    let board = board.split("\n  -").next().unwrap().split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(board.contains("a robot of files (--robot robot.toml"), "{board}");
+}
+
+/// A squared-distance term and quadratic terms on a point's coordinates
+/// are drawn and judged by `pada render` as a distance term is; a joint
+/// with levels of its own learns on the host and on a board.
+#[test]
+fn every_target_on_a_point_is_drawn_and_judged_and_joints_may_have_their_own_levels() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = PathBuf::from(reacher());
+    std::fs::copy(src.with_file_name("reacher.urdf"), dir.path().join("reacher.urdf")).unwrap();
+    let text = std::fs::read_to_string(&src).unwrap();
+    let edited = text
+        .replace("term = \"distance\"", "term = \"distance_squared\"")
+        .replace("weight = -10.0", "weight = -50.0")
+        .replace("id = 2\nzero_count = 2048\nstart_rad = 0.0", "id = 2\nzero_count = 2048\nstart_rad = 0.0\nlevels_v = [-1.0, 0.0, 1.0, 2.0]")
+        + "\n[[reward]]\nterm = \"quadratic\"\nsignal = \"tip.x\"\ntarget = 0.1\nweight = 0.0\n\n[[reward]]\nterm = \"quadratic\"\nsignal = \"tip.z\"\ntarget = 0.2\nweight = 0.0\n";
+    assert_eq!(edited.matches("levels_v = [-1.0, 0.0, 1.0, 2.0]").count(), 1, "the reacher's robot.toml moved");
+    let toml = dir.path().join("robot.toml");
+    std::fs::write(&toml, edited).unwrap();
+    let toml = toml.display().to_string();
+    let w = dir.path().join("w.wts").display().to_string();
+    let out = |name: &str| dir.path().join(name).display().to_string();
+    ok(&pada(&["run", "--robot", &toml, "--algo", "pada", "--trials", "1", "--seconds", "30", "--out", &out("host"), "--save-weights", &w]));
+    ok(&pada(&["run", "--robot", &toml, "--board", "f405", "--algo", "pada", "--trials", "1", "--seconds", "10", "--out", &out("board")]));
+    let rendered = ok(&pada(&["render", "--robot", &toml, "--policy", &w, "--out", &out("render")]));
+    // The squared distance's goal, and the two coordinates' together.
+    assert!(rendered.lines().any(|l| l.starts_with("tip: over the last half")), "{rendered}");
+    assert!(rendered.lines().any(|l| l.starts_with("tip_xz: over the last half")), "{rendered}");
+    let csv = std::fs::read_to_string(dir.path().join("render/motion.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    assert!(header.ends_with("tip_distance_m,tip_xz_distance_m"), "{header}");
+    // Both targets are the same point: (0.1, 0, 0.2) and (0.1, ·, 0.2) on
+    // an arm that moves in the x–z plane.
+    for row in csv.lines().skip(1) {
+        let v: Vec<f64> = row.rsplit(',').take(2).map(|x| x.parse().unwrap()).collect();
+        assert!((v[0] - v[1]).abs() < 1e-5, "{row}");
+    }
+}

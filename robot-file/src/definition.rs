@@ -451,7 +451,7 @@ fn motor(at: &Locator, t: &RobotToml, voltage_limit_v: f64) -> Result<Motor, Rob
     if learned.is_empty() || learned.len() > MAX_ACTION_DIMS {
         return Err(at.field("joint", format!("{} learned joints: valid are 1 to {MAX_ACTION_DIMS}", learned.len())));
     }
-    let levels = motor_levels(at, &t.action, voltage_limit_v)?;
+    let levels = levels_of(at, t, &learned, voltage_limit_v)?;
     let action_tiles = match t.action.get_ref().tile_v {
         None => None,
         Some(w) if w.is_finite() && w > 0.0 => Some(leak(vec![w as f32; learned.len()])),
@@ -584,7 +584,9 @@ impl Leaked for RobotSpec {
 fn reward_finite(term: Option<&RewardTerm>) -> bool {
     match term {
         Some(RewardTerm::Quadratic { target, weight, .. }) => target.is_finite() && weight.is_finite(),
-        Some(RewardTerm::Distance { target, weight, .. }) => target.iter().all(|v| v.is_finite()) && weight.is_finite(),
+        Some(RewardTerm::Distance { target, weight, .. }) | Some(RewardTerm::DistanceSquared { target, weight, .. }) => {
+            target.iter().all(|v| v.is_finite()) && weight.is_finite()
+        }
         Some(RewardTerm::Progress { weight, .. }) | Some(RewardTerm::Action { weight }) | Some(RewardTerm::ActionChange { weight }) => weight.is_finite(),
         Some(RewardTerm::Constant { value }) => value.is_finite(),
         None => true,
@@ -597,15 +599,7 @@ fn motor_levels(at: &Locator, a: &Spanned<ActionSection>, limit: f64) -> Result<
     let s = a.span();
     let in_limit = |v: f64| v.is_finite() && v.abs() <= limit + 1e-9;
     match (&a.get_ref().levels_v, &a.get_ref().uniform_v) {
-        (Some(levels), None) => {
-            let ok = (2..=MAX_LEVELS).contains(&levels.len())
-                && levels.windows(2).all(|w| w[0] < w[1])
-                && levels.iter().all(|v| in_limit(*v));
-            if !ok {
-                return Err(at.at(&s, "action.levels_v", format!("{levels:?} is not valid: 2 to {MAX_LEVELS} increasing voltages within ±voltage_limit_v ({limit} V)")));
-            }
-            Ok(MotorLevels::Listed(leak(levels.iter().map(|v| *v as f32).collect())))
-        }
+        (Some(levels), None) => Ok(MotorLevels::Listed(leak(listed_levels(at, &s, "action.levels_v", levels, limit)?))),
         (None, Some(u)) => {
             if !((2..=MAX_LEVELS as u8).contains(&u.count) && u.min < u.max && in_limit(u.min) && in_limit(u.max)) {
                 return Err(at.at(&s, "action.uniform_v", format!("min {} max {} count {} is not valid: min < max within ±{limit} V, 2 to {MAX_LEVELS} levels", u.min, u.max, u.count)));
@@ -614,6 +608,47 @@ fn motor_levels(at: &Locator, a: &Spanned<ActionSection>, limit: f64) -> Result<
         }
         _ => Err(at.at(&s, "action", "give either levels_v = [...] or uniform_v = { min, max, count }")),
     }
+}
+
+/// A list of levels: 2 to 16 increasing voltages within the limit.
+fn listed_levels(at: &Locator, span: &Range<usize>, field: &str, levels: &[f64], limit: f64) -> Result<Vec<f32>, RobotFileError> {
+    let in_limit = |v: f64| v.is_finite() && v.abs() <= limit + 1e-9;
+    let ok = (2..=MAX_LEVELS).contains(&levels.len()) && levels.windows(2).all(|w| w[0] < w[1]) && levels.iter().all(|v| in_limit(*v));
+    if !ok {
+        return Err(at.at(span, field, format!("{levels:?} is not valid: 2 to {MAX_LEVELS} increasing voltages within ±voltage_limit_v ({limit} V)")));
+    }
+    Ok(levels.iter().map(|v| *v as f32).collect())
+}
+
+/// The levels of the learned joints: `[action]`'s for all, or, where a
+/// learned joint gives its own `levels_v`, a list per motor dimension
+/// (`[action]`'s for the joints that give none).
+fn levels_of(at: &Locator, t: &RobotToml, learned: &[u8], limit: f64) -> Result<MotorLevels, RobotFileError> {
+    for (i, js) in t.joints.iter().enumerate() {
+        let j = js.get_ref();
+        if let (Some(l), false) = (&j.levels_v, j.learned) {
+            return Err(at.at(&l.span(), format!("joint[{i}].levels_v"), "a held joint has no levels of its own: set learned = true, or leave levels_v out"));
+        }
+    }
+    if learned.iter().all(|&k| t.joints[k as usize].get_ref().levels_v.is_none()) {
+        return motor_levels(at, &t.action, limit);
+    }
+    let mut each = Vec::new();
+    for &k in learned {
+        let values = match &t.joints[k as usize].get_ref().levels_v {
+            Some(l) => listed_levels(at, &l.span(), &format!("joint[{k}].levels_v"), l.get_ref(), limit)?,
+            None => match motor_levels(at, &t.action, limit)? {
+                MotorLevels::Listed(l) => l.to_vec(),
+                MotorLevels::Uniform { min, max, count } => pada_core::action_space::ActionDim::uniform(min, max, count as usize)
+                    .map_err(|e| at.at(&t.action.span(), "action.uniform_v", e.to_string()))?
+                    .values()
+                    .to_vec(),
+                MotorLevels::PerMotor(_) => unreachable!("[action] gives one list"),
+            },
+        };
+        each.push(leak(values));
+    }
+    Ok(MotorLevels::PerMotor(leak(each)))
 }
 
 /// One `[[reward]]`: its `term` and exactly the fields that term takes.
@@ -633,12 +668,12 @@ fn reward_term(at: &Locator, names: &Names, r: &RewardSection, i: usize) -> Resu
     ];
     let takes: &[&str] = match term {
         "quadratic" => &["signal", "target", "wrap", "weight"],
-        "distance" => &["point", "target_m", "weight"],
+        "distance" | "distance_squared" => &["point", "target_m", "weight"],
         "progress" => &["point", "axis", "weight"],
         "action" | "action_change" => &["weight"],
         "constant" => &["value"],
         other => {
-            return Err(at.at(&span, f("term"), format!("{other:?} is not valid: quadratic, distance, progress, action, action_change or constant")))
+            return Err(at.at(&span, f("term"), format!("{other:?} is not valid: quadratic, distance, distance_squared, progress, action, action_change or constant")))
         }
     };
     if let Some((extra, _)) = given.iter().find(|(name, set)| *set && !takes.contains(name)) {
@@ -658,6 +693,11 @@ fn reward_term(at: &Locator, names: &Names, r: &RewardSection, i: usize) -> Resu
         "distance" => RewardTerm::Distance {
             point: names.point(at, &need_name("point", &r.point)?, &f("point"))?,
             target: r.target_m.ok_or_else(|| at.at(&span, f("target_m"), "a distance term needs target_m = [x, y, z]"))?.map(|v| v as f32),
+            weight: need("weight", r.weight)? as f32,
+        },
+        "distance_squared" => RewardTerm::DistanceSquared {
+            point: names.point(at, &need_name("point", &r.point)?, &f("point"))?,
+            target: r.target_m.ok_or_else(|| at.at(&span, f("target_m"), "a distance_squared term needs target_m = [x, y, z]"))?.map(|v| v as f32),
             weight: need("weight", r.weight)? as f32,
         },
         "progress" => {

@@ -107,6 +107,10 @@ pub struct JointSection {
     /// Whether the learner drives it (a motor dimension); else it is held.
     #[serde(default = "default_true")]
     pub learned: bool,
+    /// A learned joint's own voltage levels \[V\], increasing (default:
+    /// `[action]`'s).
+    #[serde(default)]
+    pub levels_v: Option<Spanned<Vec<f64>>>,
     /// A held joint's P gain \[V/rad\].
     #[serde(default)]
     pub hold_gain_v_per_rad: Option<Spanned<f64>>,
@@ -247,6 +251,7 @@ fn d_init() -> Spanned<[f64; 2]> {
 /// |---|---|---|
 /// | `quadratic` | `signal`, `target` (0), `weight`, `wrap` (false) | `weight · (signal − target)²` |
 /// | `distance` | `point`, `target_m`, `weight` | `weight · ‖point − target_m‖` |
+/// | `distance_squared` | `point`, `target_m`, `weight` | `weight · ‖point − target_m‖²` |
 /// | `progress` | `point`, `axis`, `weight` | `weight · Δ(point's coordinate)` per step |
 /// | `action` | `weight` | `weight · Σ u²` over the learned joints |
 /// | `action_change` | `weight` | `weight · Σ (u − u_prev)²` |
@@ -268,10 +273,10 @@ pub struct RewardSection {
     /// The difference is an angle's, taken in (−π, π] (`quadratic`).
     #[serde(default)]
     pub wrap: Option<bool>,
-    /// The point (`distance`, `progress`).
+    /// The point (`distance`, `distance_squared`, `progress`).
     #[serde(default)]
     pub point: Option<Spanned<String>>,
-    /// The target point \[m\] (`distance`).
+    /// The target point \[m\] (`distance`, `distance_squared`).
     #[serde(default)]
     pub target_m: Option<[f64; 3]>,
     /// `x`, `y` or `z` (`progress`).

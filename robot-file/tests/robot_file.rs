@@ -205,3 +205,31 @@ fn loaded(edit: impl Fn(String) -> String) -> pada_robot_file::RobotFile {
     std::fs::copy(src.with_file_name("reacher.urdf"), dir.path().join("reacher.urdf")).unwrap();
     load(&dir.path().join("robot.toml")).unwrap_or_else(|e| panic!("{e}"))
 }
+
+#[test]
+fn a_squared_distance_term_reads_and_is_written_for_the_chip() {
+    let r = loaded(|t| t.replace("term = \"distance\"", "term = \"distance_squared\""));
+    assert!(matches!(r.vocabulary().rewards[0], RewardTerm::DistanceSquared { point: 0, target, weight } if target == [0.1, 0.0, 0.2] && weight == -10.0));
+    let source = pada_robot_file::rust_source(r.spec, "robot.toml").unwrap();
+    assert!(source.contains("RewardTerm::DistanceSquared { point: 0,"), "{source}");
+    let e = refused(|t| t.replace("term = \"distance\"", "term = \"distance_cubed\""), |u| u);
+    assert!(e.contains("reward[0].term") && e.contains("distance_squared"), "{e}");
+}
+
+#[test]
+fn a_learned_joint_may_have_levels_of_its_own() {
+    // As written: one list for both joints.
+    assert!(matches!(load(&reacher()).unwrap().spec.levels, pada_core::robot::MotorLevels::Listed(_)));
+    let r = loaded(|t| in_elbow(t, |j| format!("{j}\nlevels_v = [-1.0, 0.0, 0.5, 1.0]")));
+    let motor = r.spec.motor().unwrap();
+    assert_eq!((motor.dim(0).values(), motor.dim(1).values()), (&[-2.0f32, 0.0, 2.0][..], &[-1.0f32, 0.0, 0.5, 1.0][..]));
+    assert_eq!(motor.joint_count(), 12);
+    let source = pada_robot_file::rust_source(r.spec, "robot.toml").unwrap();
+    assert!(source.contains("static LEVELS_1: [f32; 4]") && source.contains("MotorLevels::PerMotor(&LEVELS)"), "{source}");
+    assert_ne!(r.spec.definition_hash(), load(&reacher()).unwrap().spec.definition_hash());
+    // Checked as [action]'s are, and refused on a joint nobody learns.
+    let e = refused(|t| in_elbow(t, |j| format!("{j}\nlevels_v = [1.0, 0.0]")), |u| u);
+    assert!(e.contains("joint[1].levels_v") && e.contains("increasing"), "{e}");
+    let e = refused(|t| in_elbow(t, |j| format!("{j}\nlearned = false\nhold_gain_v_per_rad = 5.0\nlevels_v = [-1.0, 1.0]")), |u| u);
+    assert!(e.contains("joint[1].levels_v") && e.contains("held joint"), "{e}");
+}
