@@ -557,16 +557,17 @@ fn simulation(at: &Locator, s: &SimulationSection) -> Result<(u32, u32), RobotFi
 /// The table: exact where it fits an F405 (or where asked for), else a
 /// claim table.
 fn table(at: &Locator, r: &RobotSection, spec: &RobotSpec) -> Result<TableNeed, RobotFileError> {
-    let exact = spec.exact_table_len::<TILINGS>(PolicyKind::Sarsa).map_err(|e| at.field("observe", format!("the observation's tiles: {e}")))?;
-    let fits_f405 = Board::F405.profile(&RobotSpec { table: TableNeed::Exact { weights: exact }, ..*spec }.leaked()).is_ok();
-    match r.table.as_ref().map(|s| s.get_ref().as_str()) {
-        None if fits_f405 => Ok(TableNeed::Exact { weights: exact }),
-        None => Ok(TableNeed::Claimed),
-        Some("exact") => Ok(TableNeed::Exact { weights: exact }),
-        Some("claim") => Ok(TableNeed::Claimed),
-        Some(other) => {
-            Err(at.at(&r.table.as_ref().map(|s| s.span()).unwrap_or(0..0), "robot.table", format!("{other:?} is not valid: exact or claim")))
-        }
+    // An observation with more features than an exact table can index
+    // (past 2^32 weights) still learns in a claim table.
+    let exact = spec.exact_table_len::<TILINGS>(PolicyKind::Sarsa);
+    let fits_f405 = exact.as_ref().is_ok_and(|&weights| Board::F405.profile(&RobotSpec { table: TableNeed::Exact { weights }, ..*spec }.leaked()).is_ok());
+    let span = r.table.as_ref().map(|s| s.span()).unwrap_or(0..0);
+    match (r.table.as_ref().map(|s| s.get_ref().as_str()), exact) {
+        (None, Ok(weights)) if fits_f405 => Ok(TableNeed::Exact { weights }),
+        (None, _) | (Some("claim"), _) => Ok(TableNeed::Claimed),
+        (Some("exact"), Ok(weights)) => Ok(TableNeed::Exact { weights }),
+        (Some("exact"), Err(e)) => Err(at.at(&span, "robot.table", format!("\"exact\" is not valid for this observation ({e}): claim, or coarser tiles"))),
+        (Some(other), _) => Err(at.at(&span, "robot.table", format!("{other:?} is not valid: exact or claim"))),
     }
 }
 

@@ -233,3 +233,22 @@ fn a_learned_joint_may_have_levels_of_its_own() {
     let e = refused(|t| in_elbow(t, |j| format!("{j}\nlearned = false\nhold_gain_v_per_rad = 5.0\nlevels_v = [-1.0, 1.0]")), |u| u);
     assert!(e.contains("joint[1].levels_v") && e.contains("held joint"), "{e}");
 }
+
+/// Six observed signals at fine tiles: more features than an exact table
+/// can index. The file reads, with a claim table; asking for an exact
+/// table is refused with the reason.
+#[test]
+fn an_observation_too_fine_for_an_exact_table_takes_a_claim_table() {
+    let fine = |t: String| {
+        let mut more = String::new();
+        for (s, lo, hi, tile) in [("shoulder.rate", -6.0, 6.0, 2.0), ("elbow.rate", -6.0, 6.0, 2.0), ("tip.x", -0.25, 0.25, 0.01), ("tip.z", -0.2, 0.3, 0.01)] {
+            more += &format!("[[observe]]\nsignal = \"{s}\"\nrange = [{lo}, {hi}]\ntile = {tile}\n\n");
+        }
+        t.replace("tile = 0.35", "tile = 0.2").replacen("[[observe]]", &format!("{more}[[observe]]"), 1)
+    };
+    let r = loaded(fine);
+    assert_eq!((r.spec.state.len(), r.spec.table), (6, TableNeed::Claimed));
+    assert!(r.profile(Board::F405).is_ok() && r.profile(Board::Host).is_ok());
+    let e = refused(|t| fine(t).replace("[robot]\n", "[robot]\ntable = \"exact\"\n"), |u| u);
+    assert!(e.contains("robot.table") && e.contains("exact") && e.contains("claim"), "{e}");
+}
