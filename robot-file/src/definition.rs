@@ -560,7 +560,7 @@ fn table(at: &Locator, r: &RobotSection, spec: &RobotSpec) -> Result<TableNeed, 
     // An observation with more features than an exact table can index
     // (past 2^32 weights) still learns in a claim table.
     let exact = spec.exact_table_len::<TILINGS>(PolicyKind::Sarsa);
-    let fits_f405 = exact.as_ref().is_ok_and(|&weights| Board::F405.profile(&RobotSpec { table: TableNeed::Exact { weights }, ..*spec }.leaked()).is_ok());
+    let fits_f405 = exact.as_ref().is_ok_and(|&weights| Board::F405.profile(RobotSpec { table: TableNeed::Exact { weights }, ..*spec }.leaked()).is_ok());
     let span = r.table.as_ref().map(|s| s.span()).unwrap_or(0..0);
     match (r.table.as_ref().map(|s| s.get_ref().as_str()), exact) {
         (None, Ok(weights)) if fits_f405 => Ok(TableNeed::Exact { weights }),
