@@ -1,7 +1,8 @@
 //! The learned motion of a robot of files: the greedy policy of saved
 //! weights run for one episode on a fresh body, every control step's pose
-//! kept as the chain of each named point, every distance reward's point
-//! measured against its target, and whether it holds there. Drawn as the
+//! kept as the chain of each named point, the point of every reward term
+//! with a target measured against it (a distance or squared distance, or
+//! quadratic terms on a point's coordinates), and whether it holds there. Drawn as the
 //! poses overlaid in the plane the robot moves in beside the distance over
 //! time (SVG, PNG), and written as CSV. Used by `pada render --robot`.
 
@@ -9,21 +10,42 @@ use crate::experiment::task::{Plant, Task};
 use crate::experiment::HostAgent;
 use crate::plot::{plot_err, svg_to_png, FONT};
 use pada_core::agent::{EpisodeEnd, Mode};
-use pada_core::robot::vocabulary::{ChainJoint, Point, RewardTerm};
+use pada_core::robot::vocabulary::{ChainJoint, Point, RewardTerm, Signal};
 use pada_robot_file::RobotFile;
 use pada_sim::urdf::UrdfTask;
 use plotters::prelude::*;
 use rand_core::SeedableRng;
 
-/// A point that a distance reward pulls towards a target.
+/// A point that the reward pulls towards a target: a `distance` or
+/// `distance_squared` term's (every axis), or the `quadratic` terms on one
+/// point's coordinates together (the axes they name).
 #[derive(Debug, Clone)]
 pub struct Goal {
     /// The point's name in robot.toml.
     pub point: &'static str,
     /// Its index in the vocabulary's points.
     pub index: usize,
-    /// The target in the base frame \[m\].
+    /// The target in the base frame \[m\] (0 on an axis not pinned).
     pub target: [f32; 3],
+    /// The axes the target pins (x, y, z); the distance is over these.
+    pub axes: [bool; 3],
+}
+
+impl Goal {
+    /// Its name in reports: the point's, with the pinned axes when not all
+    /// three are (`tip`, `tip_xz`).
+    pub fn label(&self) -> String {
+        if self.axes == [true; 3] {
+            self.point.to_string()
+        } else {
+            format!("{}_{}", self.point, axes_named(self).replace(", ", ""))
+        }
+    }
+
+    /// The distance of `p` to the target over the pinned axes \[m\].
+    pub fn distance(&self, p: [f32; 3]) -> f32 {
+        (0..3).filter(|a| self.axes[*a]).map(|a| (p[a] - self.target[a]).powi(2)).sum::<f32>().sqrt()
+    }
 }
 
 /// One control step of the greedy episode.
@@ -51,6 +73,9 @@ pub struct Motion {
     pub frames: Vec<MotionFrame>,
     /// Whether an end of the robot's rules stopped the episode early.
     pub ended: bool,
+    /// A joint past its soft limit that stopped it, as the board would
+    /// have stopped (the fault's line).
+    pub fault: Option<String>,
 }
 
 /// How well a goal was held over the last half of the episode.
@@ -62,20 +87,38 @@ pub struct HoldReport {
     pub mean_m: f32,
 }
 
-/// The goals of `file`'s reward: one per distance term.
+/// The goals of `file`'s reward: one per `distance` or `distance_squared`
+/// term, in the order of the terms, then one per point whose coordinates
+/// `quadratic` terms pull towards a target. (A `progress` term pulls along
+/// an axis without a target: no goal.)
 pub fn goals(file: &RobotFile) -> Vec<Goal> {
     let voc = file.vocabulary();
-    voc.rewards
+    let mut goals: Vec<Goal> = voc
+        .rewards
         .iter()
         .filter_map(|r| match *r {
-            RewardTerm::Distance { point, target, .. } => voc.points.get(point as usize).map(|p| Goal {
-                point: p.name,
-                index: point as usize,
-                target,
-            }),
+            RewardTerm::Distance { point, target, .. } | RewardTerm::DistanceSquared { point, target, .. } => {
+                voc.points.get(point as usize).map(|p| Goal { point: p.name, index: point as usize, target, axes: [true; 3] })
+            }
             _ => None,
         })
-        .collect()
+        .collect();
+    let mut coordinates: Vec<Goal> = Vec::new();
+    for r in voc.rewards {
+        let RewardTerm::Quadratic { signal: Signal::Position { point, axis }, target, .. } = *r else { continue };
+        let (Some(p), Some(a)) = (voc.points.get(point as usize), [0usize, 1, 2].get(axis as usize).copied()) else { continue };
+        let at = match coordinates.iter().position(|g| g.index == point as usize) {
+            Some(k) => k,
+            None => {
+                coordinates.push(Goal { point: p.name, index: point as usize, target: [0.0; 3], axes: [false; 3] });
+                coordinates.len() - 1
+            }
+        };
+        coordinates[at].target[a] = target;
+        coordinates[at].axes[a] = true;
+    }
+    goals.extend(coordinates);
+    goals
 }
 
 /// The base, every joint origin on the way to `point` and the point, for
@@ -90,10 +133,6 @@ fn chain_of(point: &Point, angles: &[f32]) -> Vec<[f32; 3]> {
     }
     out.push(point.position(angles));
     out
-}
-
-fn distance(a: [f32; 3], b: [f32; 3]) -> f32 {
-    a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f32>().sqrt()
 }
 
 /// Runs `agent` greedily on a fresh body of `task` for `seconds` (or until
@@ -117,16 +156,21 @@ pub fn record(file: &RobotFile, task: &UrdfTask, agent: &mut HostAgent, seconds:
         let chains = voc.points.iter().map(|p| chain_of(p, &angles)).collect();
         let distances = goals
             .iter()
-            .map(|g| distance(voc.points[g.index].position(&angles), g.target))
+            .map(|g| g.distance(voc.points[g.index].position(&angles)))
             .collect();
         MotionFrame { time: k as f64 * period, angles, chains, distances }
     };
     let mut frames = vec![frame(&plant, 0)];
     let steps = ((seconds / period).round() as u32).max(1);
     let mut ended = false;
+    let mut fault = None;
     for k in 1..=steps {
         let s = plant.step(&decision.output[..dims], &mut obs);
         frames.push(frame(&plant, k));
+        if let Some(cause) = plant.fault() {
+            fault = Some(crate::board::fault_line::fault_line(&cause, file.spec));
+            break;
+        }
         if s.terminal {
             ended = true;
             agent.end_episode(s.reward, EpisodeEnd::Absorbing, &mut rng).map_err(err)?;
@@ -134,7 +178,12 @@ pub fn record(file: &RobotFile, task: &UrdfTask, agent: &mut HostAgent, seconds:
         }
         decision = agent.step(s.reward, &obs, &mut rng).map_err(err)?;
     }
-    Ok(Motion { robot: file.spec.name, goals, frames, ended })
+    Ok(Motion { robot: file.spec.name, goals, frames, ended, fault })
+}
+
+/// The axes a goal pins, `x, z`.
+fn axes_named(g: &Goal) -> String {
+    ["x", "y", "z"].iter().zip(g.axes).filter(|(_, on)| *on).map(|(a, _)| *a).collect::<Vec<_>>().join(", ")
 }
 
 impl Motion {
@@ -156,7 +205,7 @@ impl Motion {
                 let h = self.hold(g);
                 format!(
                     "{}: over the last half of {:.2} s, at most {:.2} cm from its target (mean {:.2} cm): {} {:.1} cm",
-                    self.goals[g].point,
+                    self.goals[g].label(),
                     self.frames.last().map_or(0.0, |f| f.time),
                     h.max_m * 100.0,
                     h.mean_m * 100.0,
@@ -176,7 +225,7 @@ impl Motion {
         for p in voc.points {
             head.extend(["x", "y", "z"].iter().map(|a| format!("{}_{a}_m", p.name)));
         }
-        head.extend(self.goals.iter().map(|g| format!("{}_distance_m", g.point)));
+        head.extend(self.goals.iter().map(|g| format!("{}_distance_m", g.label())));
         let mut out = head.join(",") + "\n";
         for f in &self.frames {
             let mut row = vec![format!("{}", f.time)];
@@ -201,7 +250,7 @@ impl Motion {
             spread[a] = hi - lo;
         }
         for g in &self.goals {
-            for (a, s) in spread.iter_mut().enumerate() {
+            for (a, s) in spread.iter_mut().enumerate().filter(|(a, _)| g.axes[*a]) {
                 *s = s.max(g.target[a].abs());
             }
         }
@@ -218,7 +267,14 @@ impl Motion {
         const AXIS: [&str; 3] = ["x", "y", "z"];
         let (ha, va) = self.plane();
         let all = self.frames.iter().flat_map(|f| f.chains.iter().flatten().copied());
-        let pts: Vec<[f32; 3]> = all.chain(self.goals.iter().map(|g| g.target)).collect();
+        // A goal's free axes take the point's last position (where the
+        // target is drawn along them).
+        let last = |g: &Goal| self.frames.last().and_then(|f| f.chains.get(g.index)).and_then(|c| c.last().copied()).unwrap_or([0.0; 3]);
+        let shown_target = |g: &Goal| {
+            let p = last(g);
+            [0, 1, 2].map(|a| if g.axes[a] { g.target[a] } else { p[a] })
+        };
+        let pts: Vec<[f32; 3]> = all.chain(self.goals.iter().map(shown_target)).collect();
         let bound = |a: usize| {
             let (lo, hi) = pts.iter().fold((f32::MAX, f32::MIN), |(l, h), p| (l.min(p[a]), h.max(p[a])));
             (lo, hi)
@@ -265,7 +321,24 @@ impl Motion {
                 }
             }
             for g in &self.goals {
-                let (x, y) = (g.target[ha], g.target[va]);
+                let t = shown_target(g);
+                let (x, y) = (t[ha], t[va]);
+                if !(g.axes[ha] && g.axes[va]) {
+                    // Pinned on one axis of the view: the target is a line
+                    // across the other (and a band of the tolerance).
+                    let (h0, h1, v0, v1) = (hc - side / 2.0, hc + side / 2.0, vc - side / 2.0, vc + side / 2.0);
+                    let line = match (g.axes[ha], g.axes[va]) {
+                        (true, false) => vec![(x, v0), (x, v1)],
+                        (false, true) => vec![(h0, y), (h1, y)],
+                        _ => continue,
+                    };
+                    poses
+                        .draw_series(std::iter::once(PathElement::new(line, RED.stroke_width(2))))
+                        .map_err(plot_err)?
+                        .label(format!("{} target, ±{:.0} cm", g.label(), tolerance_m * 100.0))
+                        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
+                    continue;
+                }
                 let ring: Vec<(f32, f32)> = (0..=48)
                     .map(|i| {
                         let a = i as f32 / 48.0 * std::f32::consts::TAU;
@@ -333,7 +406,7 @@ impl Motion {
                     colour.stroke_width(2),
                 ))
                 .map_err(plot_err)?
-                .label(goal.point.to_string())
+                .label(goal.label())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2)));
             }
             dist.configure_series_labels()

@@ -103,3 +103,124 @@ fn a_robot_that_faults_on_the_board_is_told_why() {
     assert!(stderr.contains("[[end]]"), "no way out named: {stderr}");
     assert!(!stderr.contains("no end after"), "{stderr}");
 }
+
+/// Where a run stopped at a soft limit, as its error line tells it: the
+/// episode, the step within it, the joint and its angle.
+#[derive(Debug, PartialEq)]
+struct SoftLimitEvent {
+    episode: String,
+    step: u32,
+    joint: String,
+    position: f64,
+}
+
+fn soft_limit_event(stderr: &str) -> SoftLimitEvent {
+    let after = |key: &str| {
+        let i = stderr.find(key).unwrap_or_else(|| panic!("no {key:?} in: {stderr}"));
+        stderr[i + key.len()..].to_string()
+    };
+    // "… at step 7 of test episode 0 (soft-limit): joint 1 (elbow) at 0.102 rad, …"
+    let at_step = after(" at step ");
+    let (step, rest) = at_step.split_once(" of ").unwrap();
+    let episode = rest.split_once(" (").unwrap().0.to_string();
+    let joint_at = after("(soft-limit): joint ");
+    let (joint, rest) = joint_at.split_once(" at ").unwrap();
+    let position = rest.split_once(" rad").unwrap().0.parse().unwrap();
+    SoftLimitEvent { episode, step: step.parse().unwrap(), joint: joint.to_string(), position }
+}
+
+/// The host's simulation stops at a soft limit as the board does: the same
+/// joint at the same step of the same episode, and the trial ends there
+/// with the cause, on the host as on the board.
+///
+/// The two learners draw their random tie-breaks from different generators
+/// (the runner's PCG64, the board's PCG32), so here nothing they choose
+/// moves the arm: the elbow is held by its P law towards 1 rad, past its
+/// soft limit of 0.5 rad, and the learned shoulder's two levels lie below
+/// one step of its servo's Goal PWM (0 V on the board, a tenth of a
+/// millivolt apart on the host). Both runs follow the same trajectory up to
+/// the servos' counts and the board's PWM steps.
+#[test]
+fn a_soft_limit_stops_the_host_as_it_stops_the_board() {
+    let dir = tempfile::tempdir().unwrap();
+    let arm2 = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/robots/arm2");
+    std::fs::copy(arm2.join("arm2.urdf"), dir.path().join("arm2.urdf")).unwrap();
+    let text = std::fs::read_to_string(arm2.join("robot.toml")).unwrap();
+    let narrowed = text
+        .replace(
+            "id = 2\nzero_count = 2048\nstart_rad = 0.0",
+            "id = 2\nzero_count = 2048\nsoft_limit_rad = [-0.1, 0.5]\nstart_rad = 0.0\nlearned = false\nhold_gain_v_per_rad = 1.5\nhold_target_rad = 1.0",
+        )
+        .replace("(arm straight up)\nstart_rad = 0.0", "(arm straight up)\nsoft_limit_rad = [-2.0, 2.0]\nstart_rad = 0.0")
+        .replace("levels_v = [-2.0, -1.0, 0.0, 1.0, 2.0]", "levels_v = [0.0, 0.0001]");
+    let edits = ["[-0.1, 0.5]", "[-2.0, 2.0]", "[0.0, 0.0001]"].map(|e| narrowed.matches(e).count());
+    assert_eq!(edits, [1, 1, 1], "arm2's robot.toml moved");
+    let toml = dir.path().join("robot.toml");
+    std::fs::write(&toml, narrowed).unwrap();
+    let toml = toml.display().to_string();
+    let run = |board: &[&str], out: &str| {
+        let out_dir = dir.path().join(out).display().to_string();
+        let mut args = vec!["run", "--robot", &toml, "--algo", "sarsa", "--trials", "1", "--seconds", "30", "--out", &out_dir];
+        args.extend_from_slice(board);
+        let out = pada(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+        assert_eq!(out.status.code(), Some(1), "the trial ends at the soft limit: {stderr}");
+        assert!(stderr.contains("[[end]]"), "no way out named: {stderr}");
+        soft_limit_event(&stderr)
+    };
+    let host = run(&[], "host");
+    let board = run(&["--board", "f405"], "board");
+    assert_eq!((host.joint.as_str(), host.episode.as_str()), ("1 (elbow)", "test episode 0"), "{host:?}");
+    assert!(host.step > 10, "the arm moved for a while first: {host:?}");
+    assert_eq!((&host.episode, host.step, &host.joint), (&board.episode, board.step, &board.joint), "{host:?} against {board:?}");
+    // The board reads the angle in its servo's counts (4096 a turn).
+    let count = std::f64::consts::TAU / 4096.0;
+    assert!((host.position - board.position).abs() <= 2.0 * count, "{host:?} against {board:?}");
+    assert!(host.position > 0.5, "{host:?}");
+}
+
+/// `pada run --help` says that `--board` runs a robot of files too.
+#[test]
+fn run_help_names_robots_of_files_for_a_board() {
+    let help = String::from_utf8_lossy(&pada(&["run", "--help"]).stdout).into_owned();
+    let board = help.split("--board <NAME>").nth(1).expect("--board in the help");
+    let board = board.split("\n  -").next().unwrap().split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(board.contains("a robot of files (--robot robot.toml"), "{board}");
+}
+
+/// A squared-distance term and quadratic terms on a point's coordinates
+/// are drawn and judged by `pada render` as a distance term is; a joint
+/// with levels of its own learns on the host and on a board.
+#[test]
+fn every_target_on_a_point_is_drawn_and_judged_and_joints_may_have_their_own_levels() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = PathBuf::from(reacher());
+    std::fs::copy(src.with_file_name("reacher.urdf"), dir.path().join("reacher.urdf")).unwrap();
+    let text = std::fs::read_to_string(&src).unwrap();
+    let edited = text
+        .replace("term = \"distance\"", "term = \"distance_squared\"")
+        .replace("weight = -10.0", "weight = -50.0")
+        .replace("id = 2\nzero_count = 2048\nstart_rad = 0.0", "id = 2\nzero_count = 2048\nstart_rad = 0.0\nlevels_v = [-1.0, 0.0, 1.0, 2.0]")
+        + "\n[[reward]]\nterm = \"quadratic\"\nsignal = \"tip.x\"\ntarget = 0.1\nweight = 0.0\n\n[[reward]]\nterm = \"quadratic\"\nsignal = \"tip.z\"\ntarget = 0.2\nweight = 0.0\n";
+    assert_eq!(edited.matches("levels_v = [-1.0, 0.0, 1.0, 2.0]").count(), 1, "the reacher's robot.toml moved");
+    let toml = dir.path().join("robot.toml");
+    std::fs::write(&toml, edited).unwrap();
+    let toml = toml.display().to_string();
+    let w = dir.path().join("w.wts").display().to_string();
+    let out = |name: &str| dir.path().join(name).display().to_string();
+    ok(&pada(&["run", "--robot", &toml, "--algo", "pada", "--trials", "1", "--seconds", "30", "--out", &out("host"), "--save-weights", &w]));
+    ok(&pada(&["run", "--robot", &toml, "--board", "f405", "--algo", "pada", "--trials", "1", "--seconds", "10", "--out", &out("board")]));
+    let rendered = ok(&pada(&["render", "--robot", &toml, "--policy", &w, "--out", &out("render")]));
+    // The squared distance's goal, and the two coordinates' together.
+    assert!(rendered.lines().any(|l| l.starts_with("tip: over the last half")), "{rendered}");
+    assert!(rendered.lines().any(|l| l.starts_with("tip_xz: over the last half")), "{rendered}");
+    let csv = std::fs::read_to_string(dir.path().join("render/motion.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    assert!(header.ends_with("tip_distance_m,tip_xz_distance_m"), "{header}");
+    // Both targets are the same point: (0.1, 0, 0.2) and (0.1, ·, 0.2) on
+    // an arm that moves in the x–z plane.
+    for row in csv.lines().skip(1) {
+        let v: Vec<f64> = row.rsplit(',').take(2).map(|x| x.parse().unwrap()).collect();
+        assert!((v[0] - v[1]).abs() < 1e-5, "{row}");
+    }
+}

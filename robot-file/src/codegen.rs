@@ -62,6 +62,9 @@ fn reward(r: &RewardTerm) -> String {
         RewardTerm::Distance { point, target, weight } => {
             format!("RewardTerm::Distance {{ point: {point}, target: {}, weight: {} }}", f3(target), f(weight))
         }
+        RewardTerm::DistanceSquared { point, target, weight } => {
+            format!("RewardTerm::DistanceSquared {{ point: {point}, target: {}, weight: {} }}", f3(target), f(weight))
+        }
         RewardTerm::Progress { point, axis, weight } => {
             format!("RewardTerm::Progress {{ point: {point}, axis: {axis}, weight: {} }}", f(weight))
         }
@@ -125,6 +128,14 @@ pub fn rust_source(spec: &RobotSpec, origin: &str) -> Result<String, String> {
         }
         MotorLevels::Uniform { min, max, count } => {
             format!("MotorLevels::Uniform {{ min: {}, max: {}, count: {count} }}", f(min), f(max))
+        }
+        MotorLevels::PerMotor(dims) => {
+            for (k, l) in dims.iter().enumerate() {
+                let _ = writeln!(w, "static LEVELS_{k}: [f32; {}] = [{}];", l.len(), l.iter().map(|x| f(*x)).collect::<Vec<_>>().join(", "));
+            }
+            let each: Vec<String> = (0..dims.len()).map(|k| format!("&LEVELS_{k}")).collect();
+            let _ = writeln!(w, "static LEVELS: [&[f32]; N_MOTORS] = [{}];", each.join(", "));
+            "MotorLevels::PerMotor(&LEVELS)".to_string()
         }
     };
     let tiles = match spec.action_tiles {
@@ -191,6 +202,7 @@ fn capacities(w: &mut String, spec: &RobotSpec, v: &Vocabulary) {
     let levels = match spec.levels {
         MotorLevels::Listed(l) => l.len(),
         MotorLevels::Uniform { count, .. } => count as usize,
+        MotorLevels::PerMotor(dims) => dims.iter().map(|l| l.len()).max().unwrap_or(0),
     };
     let gearboxes = spec.counted.end.saturating_sub(spec.counted.start) as usize;
     let _ = writeln!(w, "// Capacities: each length, and pada-core's room for it.");

@@ -6,7 +6,7 @@
 //! firmware's are constants.
 
 use crate::error::{Locator, RobotFileError};
-use crate::schema::{ActionSection, RewardSection, RobotToml};
+use crate::schema::{ActionSection, LearningSection, ResetSection, RewardSection, RobotSection, RobotToml, SimulationSection};
 use std::ops::Range;
 use crate::urdf::{servo_joint_type, Urdf};
 use pada_core::agent::{SarsaParams, WeightInit};
@@ -19,6 +19,7 @@ use pada_core::robot::vocabulary::{
 };
 use pada_core::robot::{MotorLevels, RobotSpec, TableNeed, TorqueLaw};
 use pada_core::safety::SoftLimit;
+use pada_core::servo::PositionScale;
 use pada_core::tile_coding::StateDim;
 use pada_core::trace::TraceKind;
 use std::path::{Path, PathBuf};
@@ -75,7 +76,11 @@ pub fn load(path: &Path) -> Result<RobotFile, RobotFileError> {
     let at = Locator::new(path, &text);
     let toml: RobotToml = toml::from_str(&text).map_err(|e| {
         let span = e.span().unwrap_or(0..0);
-        at.at(&span, "", e.message().trim().replace('\n', "; "))
+        let message = e.message().trim().replace('\n', "; ");
+        match crate::type_error::reworded(&text, &span, &message) {
+            Some((field, reworded)) => at.at(&span, field, reworded),
+            None => at.at(&span, "", message),
+        }
     })?;
     build(path, &at, toml)
 }
@@ -151,9 +156,82 @@ impl Names<'_> {
     }
 }
 
-/// The checks and the conversion.
+/// The checks and the conversion, section by section in the order the
+/// errors are found: `[robot]`, `[[joint]]`, `[point.*]`, `[[observe]]`,
+/// `[action]` with the held joints, `[learning]`, `[[reward]]`, `[[end]]`,
+/// `[reset]`, `[simulation]`, and the table.
 fn build(path: &Path, at: &Locator, t: RobotToml) -> Result<RobotFile, RobotFileError> {
+    let robot = robot_section(path, at, &t.robot)?;
+    let urdf = robot.urdf;
+    let (joints, names) = joints(at, &t, &urdf, &urdf.path)?;
+    let counted = counted(at, &t)?;
+    let (points, point_names) = points(at, &t, &urdf, &names)?;
+    let signals = Names { joints: &names, points: &point_names };
+    let (observation, state) = observation(at, &t, &signals)?;
+    let motor = motor(at, &t, robot.voltage_limit_v)?;
+    let params = learning(at, &t.learning)?;
+    let rewards = rewards(at, &t, &signals)?;
+    let ends = ends(at, &t, &signals)?;
+    let reset = reset(at, &t.reset)?;
+    let (substeps, solver_iterations) = simulation(at, &t.simulation)?;
+
+    let vocabulary: &'static Vocabulary = Box::leak(Box::new(Vocabulary {
+        observation: leak(observation),
+        learned: leak(motor.learned.clone()),
+        held: leak(motor.held),
+        voltage_limit_v: robot.voltage_limit_v as f32,
+        start: leak(t.joints.iter().map(|j| *j.get_ref().start_rad.get_ref() as f32).collect()),
+        reset,
+        points: leak(points),
+        rewards: leak(rewards),
+        ends: leak(ends),
+    }));
     let r = &t.robot;
+    let half_shift = *r.half_shift.get_ref();
+    if !(8..=15).contains(&half_shift) {
+        return Err(at.at(&r.half_shift.span(), "robot.half_shift", format!("{half_shift} is not valid: 8 to 15 (16-bit weights hold ±2^(shift−1))")));
+    }
+    let mut spec = RobotSpec {
+        name: Box::leak(robot.name.into_boxed_str()),
+        period_us: robot.period_us,
+        episode_steps: robot.episode_steps,
+        test_interval: robot.test_interval,
+        state: leak(state),
+        motor_dims: motor.learned.len() as u8,
+        levels: motor.levels,
+        action_tiles: motor.action_tiles,
+        params,
+        joints: leak(joints),
+        counted,
+        encoder: None,
+        supply_nominal_v: robot.supply_v as f32,
+        paper_torque: TorqueLaw::ServoStall,
+        footstep_remap: None,
+        half_shift,
+        table: TableNeed::Claimed,
+        vocabulary: Some(vocabulary),
+    };
+    spec.table = table(at, r, &spec)?;
+    let spec: &'static RobotSpec = Box::leak(Box::new(spec));
+    Vocab::check(spec, vocabulary).map_err(|e| at.field(e.param, e.to_string()))?;
+    spec.params.validate().map_err(|e| at.field(format!("learning.{}", e.param), e.to_string()))?;
+    spec.motor().map_err(|e| at.field("action", e.to_string()))?;
+    Ok(RobotFile { path: path.to_path_buf(), urdf, spec, substeps, solver_iterations })
+}
+
+/// `[robot]`, checked.
+struct RobotPart {
+    name: String,
+    urdf: Urdf,
+    period_us: u32,
+    episode_steps: u32,
+    test_interval: u32,
+    supply_v: f64,
+    voltage_limit_v: f64,
+}
+
+/// `[robot]`: the name, the URDF (read), the timing and the supply.
+fn robot_section(path: &Path, at: &Locator, r: &RobotSection) -> Result<RobotPart, RobotFileError> {
     // The name.
     let name = r.name.get_ref();
     if name.is_empty()
@@ -193,8 +271,12 @@ fn build(path: &Path, at: &Locator, t: RobotToml) -> Result<RobotFile, RobotFile
     }
     let supply_v = positive(at, &r.supply_v, "robot.supply_v", "volts")?;
     let voltage_limit_v = positive(at, &r.voltage_limit_v, "robot.voltage_limit_v", "volts")?;
+    Ok(RobotPart { name: name.clone(), urdf, period_us, episode_steps: episode_steps as u32, test_interval, supply_v, voltage_limit_v })
+}
 
-    // Joints.
+/// `[[joint]]`: each joint's URDF joint, servo, ID, calibration and soft
+/// limit; the joints' URDF names, in joint order.
+fn joints(at: &Locator, t: &RobotToml, urdf: &Urdf, urdf_path: &Path) -> Result<(Vec<JointSpec>, Vec<String>), RobotFileError> {
     if t.joints.is_empty() || t.joints.len() > MAX_SERVOS {
         return Err(at.field("joint", format!("{} joints: valid are 1 to {MAX_SERVOS} [[joint]] tables", t.joints.len())));
     }
@@ -223,19 +305,51 @@ fn build(path: &Path, at: &Locator, t: RobotToml) -> Result<RobotFile, RobotFile
         if sign != 1 && sign != -1 {
             return Err(at.at(&j.sign.span(), f("sign"), format!("{sign} is not valid: 1 or -1")));
         }
+        let zero = *j.zero_count.get_ref();
+        let last = match servo.encoding.position {
+            PositionScale::Span { max, .. } => max as u32,
+            PositionScale::Turns { per_turn } => per_turn.saturating_sub(1),
+        };
+        if zero as u32 > last {
+            return Err(at.at(
+                &j.zero_count.span(),
+                f("zero_count"),
+                format!("{zero} is not valid: a position count of the {}'s encoder, 0 to {last}", servo.name),
+            ));
+        }
         let soft_limit = match &j.soft_limit_rad {
             None => None,
             Some(l) => {
                 let [min, max] = range(at, l, &f("soft_limit_rad"))?;
+                // A revolute joint stops at its URDF limits (rapier holds
+                // it there): a soft limit past them is never reached.
+                let stop = &u.limit;
+                let revolute = matches!(u.joint_type, urdf_rs::JointType::Revolute) && stop.lower < stop.upper;
+                if revolute && (min < stop.lower || max > stop.upper) {
+                    return Err(at.at(
+                        &l.span(),
+                        f("soft_limit_rad"),
+                        format!(
+                            "[{min}, {max}] is not valid: within the URDF joint {:?}'s limits [{}, {}] rad (the joint cannot go further)",
+                            u.name, stop.lower, stop.upper
+                        ),
+                    ));
+                }
                 Some(SoftLimit { min: min as f32, max: max as f32 })
             }
         };
+        let start = *j.start_rad.get_ref();
+        let inside = soft_limit.map_or(start.is_finite(), |l| l.fault(i as u8, start as f32).is_none());
+        if !inside {
+            let valid = soft_limit.map_or("a finite angle in radians".to_string(), |l| format!("within the joint's soft_limit_rad [{}, {}]", l.min, l.max));
+            return Err(at.at(&j.start_rad.span(), f("start_rad"), format!("{start} is not valid: {valid} (the robot would fault at its first reading)")));
+        }
         names.push(u.name.clone());
         joints.push(JointSpec {
             name: Box::leak(u.name.clone().into_boxed_str()),
             servo,
             id,
-            zero: *j.zero_count.get_ref(),
+            zero,
             sign,
             soft_limit,
         });
@@ -254,23 +368,27 @@ fn build(path: &Path, at: &Locator, t: RobotToml) -> Result<RobotFile, RobotFile
             ));
         }
     }
-    // Counted gearboxes: a run of joints.
+    Ok((joints, names))
+}
+
+/// The counted gearboxes: a run of joints.
+fn counted(at: &Locator, t: &RobotToml) -> Result<JointRange, RobotFileError> {
     let counted: Vec<usize> =
         t.joints.iter().enumerate().filter(|(_, j)| j.get_ref().counted.unwrap_or(j.get_ref().learned)).map(|(i, _)| i).collect();
-    let counted = match (counted.first(), counted.last()) {
+    match (counted.first(), counted.last()) {
         (Some(&a), Some(&b)) if b - a + 1 == counted.len() && counted.len() <= pada_core::limits::MAX_GEARBOXES => {
-            JointRange { start: a as u8, end: b as u8 + 1 }
+            Ok(JointRange { start: a as u8, end: b as u8 + 1 })
         }
-        (None, _) => return Err(at.field("joint", "no joint is counted: set counted = true on the joints whose gearbox wear counts")),
-        _ => {
-            return Err(at.field(
-                "joint",
-                format!("the counted joints {counted:?} must follow each other in joint order, at most {} of them", pada_core::limits::MAX_GEARBOXES),
-            ))
-        }
-    };
+        (None, _) => Err(at.field("joint", "no joint is counted: set counted = true on the joints whose gearbox wear counts")),
+        _ => Err(at.field(
+            "joint",
+            format!("the counted joints {counted:?} must follow each other in joint order, at most {} of them", pada_core::limits::MAX_GEARBOXES),
+        )),
+    }
+}
 
-    // Points.
+/// `[point.NAME]`: each point's kinematic chain; the points' names.
+fn points(at: &Locator, t: &RobotToml, urdf: &Urdf, names: &[String]) -> Result<(Vec<Point>, Vec<String>), RobotFileError> {
     if t.points.len() > MAX_POINTS {
         return Err(at.field("point", format!("{} points: at most {MAX_POINTS}", t.points.len())));
     }
@@ -293,9 +411,11 @@ fn build(path: &Path, at: &Locator, t: RobotToml) -> Result<RobotFile, RobotFile
             offset: p.get_ref().offset_m.map(|v| v as f32),
         });
     }
-    let signals = Names { joints: &names, points: &point_names };
+    Ok((points, point_names))
+}
 
-    // The observation.
+/// `[[observe]]`: the signals and the tile coder's dimensions.
+fn observation(at: &Locator, t: &RobotToml, signals: &Names) -> Result<(Vec<Signal>, Vec<StateDim>), RobotFileError> {
     if t.observe.is_empty() || t.observe.len() > MAX_STATE_DIMS - MAX_ACTION_DIMS {
         return Err(at.field(
             "observe",
@@ -313,13 +433,25 @@ fn build(path: &Path, at: &Locator, t: RobotToml) -> Result<RobotFile, RobotFile
         dim.validate().map_err(|e| at.at(&o.tile.span(), format!("observe[{i}]"), e.to_string()))?;
         state.push(dim);
     }
+    Ok((observation, state))
+}
 
-    // The motor.
+/// The motor: the learned joints, their levels and action tiles, and the
+/// held joints' P laws.
+struct Motor {
+    learned: Vec<u8>,
+    levels: MotorLevels,
+    action_tiles: Option<&'static [f32]>,
+    held: Vec<Hold>,
+}
+
+/// `[action]` and the joints' `learned` and `hold_*` fields.
+fn motor(at: &Locator, t: &RobotToml, voltage_limit_v: f64) -> Result<Motor, RobotFileError> {
     let learned: Vec<u8> = t.joints.iter().enumerate().filter(|(_, j)| j.get_ref().learned).map(|(i, _)| i as u8).collect();
     if learned.is_empty() || learned.len() > MAX_ACTION_DIMS {
         return Err(at.field("joint", format!("{} learned joints: valid are 1 to {MAX_ACTION_DIMS}", learned.len())));
     }
-    let levels = motor_levels(at, &t.action, voltage_limit_v)?;
+    let levels = levels_of(at, t, &learned, voltage_limit_v)?;
     let action_tiles = match t.action.get_ref().tile_v {
         None => None,
         Some(w) if w.is_finite() && w > 0.0 => Some(leak(vec![w as f32; learned.len()])),
@@ -331,16 +463,18 @@ fn build(path: &Path, at: &Locator, t: RobotToml) -> Result<RobotFile, RobotFile
         match (&j.hold_gain_v_per_rad, j.learned) {
             (Some(g), false) => {
                 let gain = positive(at, g, &format!("joint[{i}].hold_gain_v_per_rad"), "volts per radian")?;
-                held.push(Hold { joint: i as u8, target: j.hold_target_rad.unwrap_or(j.start_rad) as f32, gain_v_per_rad: gain as f32 });
+                held.push(Hold { joint: i as u8, target: j.hold_target_rad.unwrap_or(*j.start_rad.get_ref()) as f32, gain_v_per_rad: gain as f32 });
             }
             (Some(g), true) => return Err(at.at(&g.span(), format!("joint[{i}].hold_gain_v_per_rad"), "a learned joint is not held: set learned = false to hold it")),
             (None, false) => return Err(at.at(&j.urdf.span(), format!("joint[{i}]"), "a joint the learner does not drive needs hold_gain_v_per_rad (its P law)")),
             (None, true) => {}
         }
     }
+    Ok(Motor { learned, levels, action_tiles, held })
+}
 
-    // Learning.
-    let l = &t.learning;
+/// `[learning]`: SARSA(λ)'s parameters, each error at its line.
+fn learning(at: &Locator, l: &LearningSection) -> Result<SarsaParams, RobotFileError> {
     let [w0, w1] = *l.initial_weights.get_ref();
     let params = SarsaParams {
         alpha: *l.alpha.get_ref() as f32,
@@ -362,11 +496,14 @@ fn build(path: &Path, at: &Locator, t: RobotToml) -> Result<RobotFile, RobotFile
         };
         return Err(at.at(&span, format!("learning.{}", e.param), e.to_string()));
     }
+    Ok(params)
+}
 
-    // Rewards and ends.
+/// `[[reward]]`: at least one term, every number finite.
+fn rewards(at: &Locator, t: &RobotToml, signals: &Names) -> Result<Vec<RewardTerm>, RobotFileError> {
     let mut rewards = Vec::new();
     for (i, rs) in t.rewards.iter().enumerate() {
-        let term = reward_term(at, &signals, rs.get_ref(), i)?;
+        let term = reward_term(at, signals, rs.get_ref(), i)?;
         if !reward_finite(Some(&term)) {
             return Err(at.at(&rs.span(), format!("reward[{i}]"), "its numbers must be finite"));
         }
@@ -375,13 +512,22 @@ fn build(path: &Path, at: &Locator, t: RobotToml) -> Result<RobotFile, RobotFile
     if rewards.is_empty() {
         return Err(at.field("reward", "no [[reward]]: the learner needs at least one term to learn from"));
     }
+    Ok(rewards)
+}
+
+/// `[[end]]`: the limits that end an episode.
+fn ends(at: &Locator, t: &RobotToml, signals: &Names) -> Result<Vec<End>, RobotFileError> {
     let mut ends = Vec::new();
     for (i, e) in t.ends.iter().enumerate() {
         let e = e.get_ref();
         let [min, max] = range(at, &e.range, &format!("end[{i}].range"))?;
         ends.push(End { signal: signals.signal(at, &e.signal, &format!("end[{i}].signal"))?, min: min as f32, max: max as f32, reward: e.reward as f32 });
     }
-    let rs = &t.reset;
+    Ok(ends)
+}
+
+/// `[reset]`: every value positive.
+fn reset(at: &Locator, rs: &ResetSection) -> Result<Reset, RobotFileError> {
     let reset = Reset {
         gain_v_per_rad: rs.gain_v_per_rad as f32,
         tolerance_rad: rs.tolerance_rad as f32,
@@ -392,68 +538,37 @@ fn build(path: &Path, at: &Locator, t: RobotToml) -> Result<RobotFile, RobotFile
     if [rs.gain_v_per_rad, rs.tolerance_rad, rs.still_rad_s, rs.settle_s, rs.timeout_s].iter().any(|v| !(v.is_finite() && *v > 0.0)) {
         return Err(at.field("reset", "gain_v_per_rad, tolerance_rad, still_rad_s, settle_s and timeout_s must be positive"));
     }
-    let substeps = *t.simulation.substeps.get_ref();
-    if !(1..=1000).contains(&substeps) {
-        return Err(at.at(&t.simulation.substeps.span(), "simulation.substeps", format!("{substeps} is not valid: 1 to 1000 physics steps per control period")));
-    }
-    let solver_iterations = *t.simulation.solver_iterations.get_ref();
-    if !(1..=64).contains(&solver_iterations) {
-        return Err(at.at(&t.simulation.solver_iterations.span(), "simulation.solver_iterations", format!("{solver_iterations} is not valid: 1 to 64")));
-    }
+    Ok(reset)
+}
 
-    let vocabulary: &'static Vocabulary = Box::leak(Box::new(Vocabulary {
-        observation: leak(observation),
-        learned: leak(learned.clone()),
-        held: leak(held),
-        voltage_limit_v: voltage_limit_v as f32,
-        start: leak(t.joints.iter().map(|j| j.get_ref().start_rad as f32).collect()),
-        reset,
-        points: leak(points),
-        rewards: leak(rewards),
-        ends: leak(ends),
-    }));
-    let half_shift = *r.half_shift.get_ref();
-    if !(8..=15).contains(&half_shift) {
-        return Err(at.at(&r.half_shift.span(), "robot.half_shift", format!("{half_shift} is not valid: 8 to 15 (16-bit weights hold ±2^(shift−1))")));
+/// `[simulation]`: physics steps per control period and solver iterations.
+fn simulation(at: &Locator, s: &SimulationSection) -> Result<(u32, u32), RobotFileError> {
+    let substeps = *s.substeps.get_ref();
+    if !(1..=1000).contains(&substeps) {
+        return Err(at.at(&s.substeps.span(), "simulation.substeps", format!("{substeps} is not valid: 1 to 1000 physics steps per control period")));
     }
-    let mut spec = RobotSpec {
-        name: Box::leak(name.clone().into_boxed_str()),
-        period_us,
-        episode_steps: episode_steps as u32,
-        test_interval,
-        state: leak(state),
-        motor_dims: learned.len() as u8,
-        levels,
-        action_tiles,
-        params,
-        joints: leak(joints),
-        counted,
-        encoder: None,
-        supply_nominal_v: supply_v as f32,
-        paper_torque: TorqueLaw::ServoStall,
-        footstep_remap: None,
-        half_shift,
-        table: TableNeed::Claimed,
-        vocabulary: Some(vocabulary),
-    };
-    // The table: exact where it fits an F405 (or where asked for), else a
-    // claim table.
-    let exact = spec.exact_table_len::<TILINGS>(PolicyKind::Sarsa).map_err(|e| at.field("observe", format!("the observation's tiles: {e}")))?;
-    let fits_f405 = Board::F405.profile(&RobotSpec { table: TableNeed::Exact { weights: exact }, ..spec }.leaked()).is_ok();
-    spec.table = match r.table.as_ref().map(|s| s.get_ref().as_str()) {
-        None if fits_f405 => TableNeed::Exact { weights: exact },
-        None => TableNeed::Claimed,
-        Some("exact") => TableNeed::Exact { weights: exact },
-        Some("claim") => TableNeed::Claimed,
-        Some(other) => {
-            return Err(at.at(&r.table.as_ref().map(|s| s.span()).unwrap_or(0..0), "robot.table", format!("{other:?} is not valid: exact or claim")))
-        }
-    };
-    let spec: &'static RobotSpec = Box::leak(Box::new(spec));
-    Vocab::check(spec, vocabulary).map_err(|e| at.field(e.param, e.to_string()))?;
-    spec.params.validate().map_err(|e| at.field(format!("learning.{}", e.param), e.to_string()))?;
-    spec.motor().map_err(|e| at.field("action", e.to_string()))?;
-    Ok(RobotFile { path: path.to_path_buf(), urdf, spec, substeps, solver_iterations })
+    let solver_iterations = *s.solver_iterations.get_ref();
+    if !(1..=64).contains(&solver_iterations) {
+        return Err(at.at(&s.solver_iterations.span(), "simulation.solver_iterations", format!("{solver_iterations} is not valid: 1 to 64")));
+    }
+    Ok((substeps, solver_iterations))
+}
+
+/// The table: exact where it fits an F405 (or where asked for), else a
+/// claim table.
+fn table(at: &Locator, r: &RobotSection, spec: &RobotSpec) -> Result<TableNeed, RobotFileError> {
+    // An observation with more features than an exact table can index
+    // (past 2^32 weights) still learns in a claim table.
+    let exact = spec.exact_table_len::<TILINGS>(PolicyKind::Sarsa);
+    let fits_f405 = exact.as_ref().is_ok_and(|&weights| Board::F405.profile(RobotSpec { table: TableNeed::Exact { weights }, ..*spec }.leaked()).is_ok());
+    let span = r.table.as_ref().map(|s| s.span()).unwrap_or(0..0);
+    match (r.table.as_ref().map(|s| s.get_ref().as_str()), exact) {
+        (None, Ok(weights)) if fits_f405 => Ok(TableNeed::Exact { weights }),
+        (None, _) | (Some("claim"), _) => Ok(TableNeed::Claimed),
+        (Some("exact"), Ok(weights)) => Ok(TableNeed::Exact { weights }),
+        (Some("exact"), Err(e)) => Err(at.at(&span, "robot.table", format!("\"exact\" is not valid for this observation ({e}): claim, or coarser tiles"))),
+        (Some(other), _) => Err(at.at(&span, "robot.table", format!("{other:?} is not valid: exact or claim"))),
+    }
 }
 
 trait Leaked {
@@ -470,7 +585,9 @@ impl Leaked for RobotSpec {
 fn reward_finite(term: Option<&RewardTerm>) -> bool {
     match term {
         Some(RewardTerm::Quadratic { target, weight, .. }) => target.is_finite() && weight.is_finite(),
-        Some(RewardTerm::Distance { target, weight, .. }) => target.iter().all(|v| v.is_finite()) && weight.is_finite(),
+        Some(RewardTerm::Distance { target, weight, .. }) | Some(RewardTerm::DistanceSquared { target, weight, .. }) => {
+            target.iter().all(|v| v.is_finite()) && weight.is_finite()
+        }
         Some(RewardTerm::Progress { weight, .. }) | Some(RewardTerm::Action { weight }) | Some(RewardTerm::ActionChange { weight }) => weight.is_finite(),
         Some(RewardTerm::Constant { value }) => value.is_finite(),
         None => true,
@@ -483,15 +600,7 @@ fn motor_levels(at: &Locator, a: &Spanned<ActionSection>, limit: f64) -> Result<
     let s = a.span();
     let in_limit = |v: f64| v.is_finite() && v.abs() <= limit + 1e-9;
     match (&a.get_ref().levels_v, &a.get_ref().uniform_v) {
-        (Some(levels), None) => {
-            let ok = (2..=MAX_LEVELS).contains(&levels.len())
-                && levels.windows(2).all(|w| w[0] < w[1])
-                && levels.iter().all(|v| in_limit(*v));
-            if !ok {
-                return Err(at.at(&s, "action.levels_v", format!("{levels:?} is not valid: 2 to {MAX_LEVELS} increasing voltages within ±voltage_limit_v ({limit} V)")));
-            }
-            Ok(MotorLevels::Listed(leak(levels.iter().map(|v| *v as f32).collect())))
-        }
+        (Some(levels), None) => Ok(MotorLevels::Listed(leak(listed_levels(at, &s, "action.levels_v", levels, limit)?))),
         (None, Some(u)) => {
             if !((2..=MAX_LEVELS as u8).contains(&u.count) && u.min < u.max && in_limit(u.min) && in_limit(u.max)) {
                 return Err(at.at(&s, "action.uniform_v", format!("min {} max {} count {} is not valid: min < max within ±{limit} V, 2 to {MAX_LEVELS} levels", u.min, u.max, u.count)));
@@ -500,6 +609,47 @@ fn motor_levels(at: &Locator, a: &Spanned<ActionSection>, limit: f64) -> Result<
         }
         _ => Err(at.at(&s, "action", "give either levels_v = [...] or uniform_v = { min, max, count }")),
     }
+}
+
+/// A list of levels: 2 to 16 increasing voltages within the limit.
+fn listed_levels(at: &Locator, span: &Range<usize>, field: &str, levels: &[f64], limit: f64) -> Result<Vec<f32>, RobotFileError> {
+    let in_limit = |v: f64| v.is_finite() && v.abs() <= limit + 1e-9;
+    let ok = (2..=MAX_LEVELS).contains(&levels.len()) && levels.windows(2).all(|w| w[0] < w[1]) && levels.iter().all(|v| in_limit(*v));
+    if !ok {
+        return Err(at.at(span, field, format!("{levels:?} is not valid: 2 to {MAX_LEVELS} increasing voltages within ±voltage_limit_v ({limit} V)")));
+    }
+    Ok(levels.iter().map(|v| *v as f32).collect())
+}
+
+/// The levels of the learned joints: `[action]`'s for all, or, where a
+/// learned joint gives its own `levels_v`, a list per motor dimension
+/// (`[action]`'s for the joints that give none).
+fn levels_of(at: &Locator, t: &RobotToml, learned: &[u8], limit: f64) -> Result<MotorLevels, RobotFileError> {
+    for (i, js) in t.joints.iter().enumerate() {
+        let j = js.get_ref();
+        if let (Some(l), false) = (&j.levels_v, j.learned) {
+            return Err(at.at(&l.span(), format!("joint[{i}].levels_v"), "a held joint has no levels of its own: set learned = true, or leave levels_v out"));
+        }
+    }
+    if learned.iter().all(|&k| t.joints[k as usize].get_ref().levels_v.is_none()) {
+        return motor_levels(at, &t.action, limit);
+    }
+    let mut each = Vec::new();
+    for &k in learned {
+        let values = match &t.joints[k as usize].get_ref().levels_v {
+            Some(l) => listed_levels(at, &l.span(), &format!("joint[{k}].levels_v"), l.get_ref(), limit)?,
+            None => match motor_levels(at, &t.action, limit)? {
+                MotorLevels::Listed(l) => l.to_vec(),
+                MotorLevels::Uniform { min, max, count } => pada_core::action_space::ActionDim::uniform(min, max, count as usize)
+                    .map_err(|e| at.at(&t.action.span(), "action.uniform_v", e.to_string()))?
+                    .values()
+                    .to_vec(),
+                MotorLevels::PerMotor(_) => unreachable!("[action] gives one list"),
+            },
+        };
+        each.push(leak(values));
+    }
+    Ok(MotorLevels::PerMotor(leak(each)))
 }
 
 /// One `[[reward]]`: its `term` and exactly the fields that term takes.
@@ -519,12 +669,12 @@ fn reward_term(at: &Locator, names: &Names, r: &RewardSection, i: usize) -> Resu
     ];
     let takes: &[&str] = match term {
         "quadratic" => &["signal", "target", "wrap", "weight"],
-        "distance" => &["point", "target_m", "weight"],
+        "distance" | "distance_squared" => &["point", "target_m", "weight"],
         "progress" => &["point", "axis", "weight"],
         "action" | "action_change" => &["weight"],
         "constant" => &["value"],
         other => {
-            return Err(at.at(&span, f("term"), format!("{other:?} is not valid: quadratic, distance, progress, action, action_change or constant")))
+            return Err(at.at(&span, f("term"), format!("{other:?} is not valid: quadratic, distance, distance_squared, progress, action, action_change or constant")))
         }
     };
     if let Some((extra, _)) = given.iter().find(|(name, set)| *set && !takes.contains(name)) {
@@ -544,6 +694,11 @@ fn reward_term(at: &Locator, names: &Names, r: &RewardSection, i: usize) -> Resu
         "distance" => RewardTerm::Distance {
             point: names.point(at, &need_name("point", &r.point)?, &f("point"))?,
             target: r.target_m.ok_or_else(|| at.at(&span, f("target_m"), "a distance term needs target_m = [x, y, z]"))?.map(|v| v as f32),
+            weight: need("weight", r.weight)? as f32,
+        },
+        "distance_squared" => RewardTerm::DistanceSquared {
+            point: names.point(at, &need_name("point", &r.point)?, &f("point"))?,
+            target: r.target_m.ok_or_else(|| at.at(&span, f("target_m"), "a distance_squared term needs target_m = [x, y, z]"))?.map(|v| v as f32),
             weight: need("weight", r.weight)? as f32,
         },
         "progress" => {

@@ -17,6 +17,7 @@
 //! | `codegen.rs` | the definition as Rust source for the firmware |
 //! | `template.rs` | a new robot's files, commented field by field (`pada new-robot`) |
 //! | `error.rs` | one error in one line, pointing at the line of the file |
+//! | `type_error.rs` | toml's type and length errors, reworded with the field and the valid values |
 //!
 //! [`RobotSpec`]: pada_core::robot::RobotSpec
 
@@ -25,6 +26,7 @@ mod definition;
 mod error;
 pub mod schema;
 pub mod template;
+mod type_error;
 pub mod urdf;
 
 pub use codegen::rust_source;

@@ -91,20 +91,26 @@ pub struct JointSection {
     pub servo: Spanned<String>,
     /// The servo's bus ID, 0–252.
     pub id: Spanned<u8>,
-    /// The servo's position count at joint angle 0.
+    /// The servo's position count at joint angle 0, within its encoder's
+    /// counts.
     pub zero_count: Spanned<u16>,
     /// +1 if the joint angle grows with the servo's counts, −1 if not.
     #[serde(default = "default_sign")]
     pub sign: Spanned<i8>,
-    /// Past these angles the robot faults, torque off \[rad\].
+    /// Past these angles the robot faults, torque off \[rad\]; within
+    /// the URDF joint's limits.
     #[serde(default)]
     pub soft_limit_rad: Option<Spanned<[f64; 2]>>,
-    /// The angle of the start pose \[rad\].
-    #[serde(default)]
-    pub start_rad: f64,
+    /// The angle of the start pose \[rad\], inside the soft limits.
+    #[serde(default = "default_start")]
+    pub start_rad: Spanned<f64>,
     /// Whether the learner drives it (a motor dimension); else it is held.
     #[serde(default = "default_true")]
     pub learned: bool,
+    /// A learned joint's own voltage levels \[V\], increasing (default:
+    /// `[action]`'s).
+    #[serde(default)]
+    pub levels_v: Option<Spanned<Vec<f64>>>,
     /// A held joint's P gain \[V/rad\].
     #[serde(default)]
     pub hold_gain_v_per_rad: Option<Spanned<f64>>,
@@ -119,6 +125,10 @@ pub struct JointSection {
 
 fn default_sign() -> Spanned<i8> {
     Spanned::new(0..0, 1)
+}
+
+fn default_start() -> Spanned<f64> {
+    Spanned::new(0..0, 0.0)
 }
 
 fn default_true() -> bool {
@@ -241,6 +251,7 @@ fn d_init() -> Spanned<[f64; 2]> {
 /// |---|---|---|
 /// | `quadratic` | `signal`, `target` (0), `weight`, `wrap` (false) | `weight · (signal − target)²` |
 /// | `distance` | `point`, `target_m`, `weight` | `weight · ‖point − target_m‖` |
+/// | `distance_squared` | `point`, `target_m`, `weight` | `weight · ‖point − target_m‖²` |
 /// | `progress` | `point`, `axis`, `weight` | `weight · Δ(point's coordinate)` per step |
 /// | `action` | `weight` | `weight · Σ u²` over the learned joints |
 /// | `action_change` | `weight` | `weight · Σ (u − u_prev)²` |
@@ -262,10 +273,10 @@ pub struct RewardSection {
     /// The difference is an angle's, taken in (−π, π] (`quadratic`).
     #[serde(default)]
     pub wrap: Option<bool>,
-    /// The point (`distance`, `progress`).
+    /// The point (`distance`, `distance_squared`, `progress`).
     #[serde(default)]
     pub point: Option<Spanned<String>>,
-    /// The target point \[m\] (`distance`).
+    /// The target point \[m\] (`distance`, `distance_squared`).
     #[serde(default)]
     pub target_m: Option<[f64; 3]>,
     /// `x`, `y` or `z` (`progress`).

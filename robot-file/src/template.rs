@@ -114,13 +114,15 @@ pub fn urdf(name: &str) -> String {
   <!-- The fixed base (the URDF's root link). -->
   <link name="base"/>
 
-  <!-- The servo's horn, 46 mm above the base; the arm turns about y. -->
+  <!-- The servo's horn, 46 mm above the base; the arm turns about y. Its
+       limits are the mechanical stops: robot.toml's soft limits lie within
+       them. -->
   <joint name="shoulder" type="revolute">
     <parent link="base"/>
     <child link="arm"/>
     <origin xyz="0 0 0.046" rpy="0 0 0"/>
     <axis xyz="0 1 0"/>
-    <limit lower="-2.0" upper="2.0" effort="4.1" velocity="4.8"/>
+    <limit lower="-2.6" upper="2.6" effort="4.1" velocity="4.8"/>
   </joint>
 
   <!-- A 12 cm arm of 40 g, its centre of mass 6 cm out. -->

@@ -67,3 +67,24 @@ fn every_field_of_robot_toml_is_described_once_in_docs_your_robot() {
     assert!(missing.is_empty(), "fields without a row in docs/your-robot.md: {missing:?}");
     assert!(unknown.is_empty(), "rows of docs/your-robot.md for no field: {unknown:?}");
 }
+
+/// The `reward.term` row names every term the reader takes, as its error
+/// for an unknown term lists them (a term added to the vocabulary without
+/// a word in the table fails here).
+#[test]
+fn every_reward_term_is_named_in_the_table() {
+    let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/reacher");
+    let dir = tempfile::tempdir().unwrap();
+    let toml = std::fs::read_to_string(src.join("robot.toml")).unwrap().replace("term = \"distance\"", "term = \"nonsense\"");
+    std::fs::write(dir.path().join("robot.toml"), toml).unwrap();
+    std::fs::copy(src.join("reacher.urdf"), dir.path().join("reacher.urdf")).unwrap();
+    let e = pada_robot_file::load(&dir.path().join("robot.toml")).unwrap_err().to_string();
+    let valid = e.split("is not valid: ").nth(1).unwrap_or_else(|| panic!("{e}"));
+    let terms: Vec<&str> = valid.split([',', ' ']).filter(|w| !w.is_empty() && *w != "or").collect();
+    assert!(terms.len() >= 7 && terms.contains(&"distance_squared"), "{terms:?}");
+    let doc = include_str!("../../docs/your-robot.md");
+    let row = doc.lines().find(|l| l.starts_with("| `reward.term`")).expect("a reward.term row");
+    for t in terms {
+        assert!(row.contains(&format!("`{t}`")), "the reward.term row lacks {t}: {row}");
+    }
+}

@@ -68,7 +68,7 @@ fn a_new_robots_template_reads_as_it_is() {
 #[test]
 fn an_unknown_servo_model_names_the_valid_ones() {
     let e = refused(|t| t.replace("\"XL330-M288\"", "\"XL999\""), |u| u);
-    assert!(e.contains(":25:9:") && e.contains("joint[1].servo"), "{e}");
+    assert!(e.contains(":29:9:") && e.contains("joint[1].servo"), "{e}");
     assert!(e.contains("XL999") && e.contains("XM430-W350, XL430-W250, XL330-M288"), "{e}");
 }
 
@@ -90,8 +90,8 @@ fn a_floating_or_planar_joint_is_no_servos() {
 fn a_range_with_min_not_below_max_is_refused() {
     let e = refused(|t| t.replace("range = [-1.6, 1.6]", "range = [1.6, -1.6]"), |u| u);
     assert!(e.contains("observe[0].range") && e.contains("min < max"), "{e}");
-    let e = refused(|t| t.replace("soft_limit_rad = [-2.5, 2.5]", "soft_limit_rad = [2.5, 2.5]"), |u| u);
-    assert!(e.contains("joint[1].soft_limit_rad"), "{e}");
+    let e = refused(|t| in_shoulder(t, |j| format!("{j}\nsoft_limit_rad = [1.5, 1.5]")), |u| u);
+    assert!(e.contains("joint[0].soft_limit_rad") && e.contains("min < max"), "{e}");
 }
 
 #[test]
@@ -132,4 +132,123 @@ fn an_unknown_field_a_missing_servo_and_a_bad_signal_are_refused_where_they_are(
     assert!(e.contains("reward[0].point") && e.contains("\"hand\" is no point"), "{e}");
     let e = refused(|t| t.replace("name = \"reacher\"", "name = \"leo\""), |u| u);
     assert!(e.contains("robot.name") && e.contains("pada's own"), "{e}");
+}
+
+/// The arm's `robot.toml` with `edit` applied to the `[[joint]]` table of
+/// URDF joint `name` alone.
+fn in_joint(name: &str, t: String, edit: impl Fn(&str) -> String) -> String {
+    let start = t.find(&format!("[[joint]]\nurdf = \"{name}\"")).unwrap();
+    let end = start + t[start..].find("\n\n").unwrap();
+    format!("{}{}{}", &t[..start], edit(&t[start..end]), &t[end..])
+}
+
+fn in_elbow(t: String, edit: impl Fn(&str) -> String) -> String {
+    in_joint("elbow", t, edit)
+}
+
+fn in_shoulder(t: String, edit: impl Fn(&str) -> String) -> String {
+    in_joint("shoulder", t, edit)
+}
+
+#[test]
+fn a_start_pose_outside_the_soft_limits_is_refused() {
+    let e = refused(|t| in_shoulder(t, |j| j.replace("start_rad = 0.0", "soft_limit_rad = [-1.5, 1.5]\nstart_rad = 1.8")), |u| u);
+    assert!(e.contains(":26:13:") && e.contains("joint[0].start_rad") && e.contains("1.8 is not valid"), "{e}");
+    assert!(e.contains("[-1.5, 1.5]"), "names the valid range: {e}");
+}
+
+#[test]
+fn a_zero_count_past_the_encoder_is_refused() {
+    let e = refused(|t| in_elbow(t, |j| j.replace("zero_count = 2048", "zero_count = 5000")), |u| u);
+    assert!(e.contains(":31:14:") && e.contains("joint[1].zero_count") && e.contains("5000 is not valid"), "{e}");
+    assert!(e.contains("XL330-M288") && e.contains("0 to 4095"), "names the valid range: {e}");
+}
+
+#[test]
+fn a_soft_limit_past_the_urdfs_limits_is_refused() {
+    let e = refused(|t| in_shoulder(t, |j| format!("{j}\nsoft_limit_rad = [-1.9, 2.1]")), |u| u);
+    assert!(e.contains(":26:18:") && e.contains("joint[0].soft_limit_rad") && e.contains("[-1.9, 2.1] is not valid"), "{e}");
+    assert!(e.contains("\"shoulder\"") && e.contains("[-2, 2]"), "names the URDF's limits: {e}");
+    // Within them, and the joints with limits first: read.
+    loaded(|t| in_shoulder(t, |j| format!("{j}\nsoft_limit_rad = [-2.0, 2.0]")));
+}
+
+#[test]
+fn a_string_for_a_bus_id_names_the_field_and_the_ids() {
+    let e = refused(|t| in_elbow(t, |j| j.replace("id = 2", "id = \"2\"")), |u| u);
+    assert!(e.contains(":30:6:") && e.contains("joint[1].id: \"2\" is not valid") && e.contains("0 to 252"), "{e}");
+}
+
+#[test]
+fn a_bus_id_past_a_byte_names_the_field_and_the_ids() {
+    let e = refused(|t| in_elbow(t, |j| j.replace("id = 2", "id = 300")), |u| u);
+    assert!(e.contains(":30:6:") && e.contains("joint[1].id: 300 is not valid") && e.contains("0 to 252"), "{e}");
+}
+
+#[test]
+fn a_soft_limit_of_one_number_names_the_field_and_its_shape() {
+    let e = refused(|t| in_shoulder(t, |j| format!("{j}\nsoft_limit_rad = 2.5")), |u| u);
+    assert!(e.contains(":26:18:") && e.contains("joint[0].soft_limit_rad: 2.5 is not valid") && e.contains("[min, max] in radians"), "{e}");
+}
+
+#[test]
+fn a_target_of_two_numbers_names_the_field_and_its_shape() {
+    let e = refused(|t| t.replace("target_m = [0.1, 0.0, 0.2]", "target_m = [0.1, 0.2]"), |u| u);
+    assert!(e.contains("reward[0].target_m: [0.1, 0.2] is not valid") && e.contains("[x, y, z] in metres"), "{e}");
+}
+
+/// The arm's files with `edit` applied to its `robot.toml`, loaded.
+fn loaded(edit: impl Fn(String) -> String) -> pada_robot_file::RobotFile {
+    let dir = tempfile::tempdir().unwrap();
+    let src = reacher();
+    std::fs::write(dir.path().join("robot.toml"), edit(std::fs::read_to_string(&src).unwrap())).unwrap();
+    std::fs::copy(src.with_file_name("reacher.urdf"), dir.path().join("reacher.urdf")).unwrap();
+    load(&dir.path().join("robot.toml")).unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn a_squared_distance_term_reads_and_is_written_for_the_chip() {
+    let r = loaded(|t| t.replace("term = \"distance\"", "term = \"distance_squared\""));
+    assert!(matches!(r.vocabulary().rewards[0], RewardTerm::DistanceSquared { point: 0, target, weight } if target == [0.1, 0.0, 0.2] && weight == -10.0));
+    let source = pada_robot_file::rust_source(r.spec, "robot.toml").unwrap();
+    assert!(source.contains("RewardTerm::DistanceSquared { point: 0,"), "{source}");
+    let e = refused(|t| t.replace("term = \"distance\"", "term = \"distance_cubed\""), |u| u);
+    assert!(e.contains("reward[0].term") && e.contains("distance_squared"), "{e}");
+}
+
+#[test]
+fn a_learned_joint_may_have_levels_of_its_own() {
+    // As written: one list for both joints.
+    assert!(matches!(load(&reacher()).unwrap().spec.levels, pada_core::robot::MotorLevels::Listed(_)));
+    let r = loaded(|t| in_elbow(t, |j| format!("{j}\nlevels_v = [-1.0, 0.0, 0.5, 1.0]")));
+    let motor = r.spec.motor().unwrap();
+    assert_eq!((motor.dim(0).values(), motor.dim(1).values()), (&[-2.0f32, 0.0, 2.0][..], &[-1.0f32, 0.0, 0.5, 1.0][..]));
+    assert_eq!(motor.joint_count(), 12);
+    let source = pada_robot_file::rust_source(r.spec, "robot.toml").unwrap();
+    assert!(source.contains("static LEVELS_1: [f32; 4]") && source.contains("MotorLevels::PerMotor(&LEVELS)"), "{source}");
+    assert_ne!(r.spec.definition_hash(), load(&reacher()).unwrap().spec.definition_hash());
+    // Checked as [action]'s are, and refused on a joint nobody learns.
+    let e = refused(|t| in_elbow(t, |j| format!("{j}\nlevels_v = [1.0, 0.0]")), |u| u);
+    assert!(e.contains("joint[1].levels_v") && e.contains("increasing"), "{e}");
+    let e = refused(|t| in_elbow(t, |j| format!("{j}\nlearned = false\nhold_gain_v_per_rad = 5.0\nlevels_v = [-1.0, 1.0]")), |u| u);
+    assert!(e.contains("joint[1].levels_v") && e.contains("held joint"), "{e}");
+}
+
+/// Six observed signals at fine tiles: more features than an exact table
+/// can index. The file reads, with a claim table; asking for an exact
+/// table is refused with the reason.
+#[test]
+fn an_observation_too_fine_for_an_exact_table_takes_a_claim_table() {
+    let fine = |t: String| {
+        let mut more = String::new();
+        for (s, lo, hi, tile) in [("shoulder.rate", -6.0, 6.0, 2.0), ("elbow.rate", -6.0, 6.0, 2.0), ("tip.x", -0.25, 0.25, 0.01), ("tip.z", -0.2, 0.3, 0.01)] {
+            more += &format!("[[observe]]\nsignal = \"{s}\"\nrange = [{lo}, {hi}]\ntile = {tile}\n\n");
+        }
+        t.replace("tile = 0.35", "tile = 0.2").replacen("[[observe]]", &format!("{more}[[observe]]"), 1)
+    };
+    let r = loaded(fine);
+    assert_eq!((r.spec.state.len(), r.spec.table), (6, TableNeed::Claimed));
+    assert!(r.profile(Board::F405).is_ok() && r.profile(Board::Host).is_ok());
+    let e = refused(|t| fine(t).replace("[robot]\n", "[robot]\ntable = \"exact\"\n"), |u| u);
+    assert!(e.contains("robot.table") && e.contains("exact") && e.contains("claim"), "{e}");
 }

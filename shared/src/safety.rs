@@ -336,6 +336,19 @@ pub struct SoftLimit {
     pub max: f32,
 }
 
+impl SoftLimit {
+    /// The fault of joint `joint` at `position` \[rad\]: past this limit,
+    /// or not finite (a broken reading). The one check of a soft limit:
+    /// the board's safety machine makes it of every reading
+    /// ([`Event::JointPosition`]), and the host's simulation of every
+    /// simulated reading (`RobotSpec::soft_limit_fault`), so both stop at
+    /// the same reading.
+    pub fn fault(&self, joint: u8, position: f32) -> Option<FaultCause> {
+        let inside = position >= self.min && position <= self.max;
+        (!inside).then_some(FaultCause::SoftLimit { joint, position })
+    }
+}
+
 /// Thresholds of the fault detection. [`Default`]: retry budget 2,
 /// 5 checksum errors within 1 s, voltage/overheating/overload bits, 3
 /// overruns in a row, no soft limits.
@@ -535,11 +548,7 @@ impl Safety {
                 }
                 None
             }
-            Event::JointPosition { joint, position } => {
-                let limit = self.config.soft_limits.get(joint as usize)?;
-                let inside = position >= limit.min && position <= limit.max;
-                (!inside).then_some(FaultCause::SoftLimit { joint, position })
-            }
+            Event::JointPosition { joint, position } => self.config.soft_limits.get(joint as usize)?.fault(joint, position),
             Event::LoopTiming { overrun } => {
                 if !overrun {
                     self.overruns = 0;

@@ -52,6 +52,16 @@ pub trait Plant: Send {
         self.gearbox_torques(command)
     }
 
+    /// The fault the robot's safety machine raises at the plant's last
+    /// reading (after [`Plant::reset`] or [`Plant::step`]): a joint past
+    /// its soft limit ([`pada_core::robot::RobotSpec::soft_limit_fault`]).
+    /// On the board torque goes off there until an operator clears it;
+    /// the runner ends the trial there as well. `None` for a plant without
+    /// soft limits.
+    fn fault(&self) -> Option<pada_core::safety::FaultCause> {
+        None
+    }
+
     /// Distance walked in the current episode \[m\], for walking tasks
     /// (LEO); `None` for the others.
     fn walked_distance_m(&self) -> Option<f64> {

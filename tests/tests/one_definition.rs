@@ -36,6 +36,12 @@ mod arm2 {
     include!(concat!(env!("OUT_DIR"), "/arm2_robot.rs"));
 }
 
+/// The same arm with a squared-distance term and an elbow with levels of
+/// its own (tests/build.rs).
+mod words {
+    include!(concat!(env!("OUT_DIR"), "/words_robot.rs"));
+}
+
 /// Every policy of `--algo`, each with its default parameters (and PADA
 /// with LEO's Δ = 1/6 besides).
 fn policies() -> Vec<PolicyKind> {
@@ -217,4 +223,19 @@ fn the_firmware_constants_of_a_robot_of_files_learn_as_the_host_reads_the_files(
         }
     }
     assert!(compared >= 2 * (policies().len() - 2), "{compared} learners compared");
+}
+
+#[test]
+fn the_firmware_constants_of_every_word_are_the_files() {
+    let path = std::path::Path::new(env!("OUT_DIR")).join("words/robot.toml");
+    let file = pada_robot_file::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(words::ROBOT, file.spec);
+    assert_eq!(words::ROBOT.definition_hash(), file.spec.definition_hash());
+    assert!(matches!(words::ROBOT.levels, pada_core::robot::MotorLevels::PerMotor(l) if l.len() == 2 && l[1] == [-1.0, 0.0, 1.0]));
+    let rewards = words::ROBOT.vocabulary.unwrap().rewards;
+    assert!(matches!(rewards[0], pada_core::robot::vocabulary::RewardTerm::DistanceSquared { .. }), "{rewards:?}");
+    let chip = Board::F405.profile(words::ROBOT).unwrap();
+    let firmware = Controller::new(words::this_robot(), chip, PolicyKind::Sarsa, table_of(chip, chip.weights().unwrap()), 1).unwrap();
+    let host = build_agent(&pada::robots::from_file(&file).unwrap().task_spec(file.profile(Board::F405).unwrap()).unwrap(), PolicyKind::Sarsa).unwrap();
+    assert_eq!(config_hash(&file.profile(Board::F405).unwrap(), &host), firmware.config_hash());
 }

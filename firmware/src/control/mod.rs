@@ -293,6 +293,11 @@ where
         self.safety.state()
     }
 
+    /// The episode in progress, if any (what a fault report names).
+    pub fn episode(&self) -> Option<pada_core::episodes::EpisodeAt> {
+        self.episodes.position()
+    }
+
     /// Whether torque may be on now.
     pub fn torque_enabled(&self) -> bool {
         self.safety.torque_enabled()

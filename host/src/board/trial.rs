@@ -30,6 +30,7 @@
 //! held joints and resets, and the switch back to SARSA(λ) at the first
 //! period at or after `--switch-at` rather than at the exact step.
 
+use super::fault_line::{fault_explained, Faulted};
 use super::protocol::{EpisodeOutcome, RunProtocol};
 use crate::experiment::governed::GovernorStats;
 use crate::experiment::metrics::{end_performance, rise_time};
@@ -45,8 +46,7 @@ use pada_core::episodes::is_learning_action;
 use crate::robots::{DynRules, SimRobot};
 use pada_core::claim_table::{ClaimTable, Tags16, Tags32};
 use pada_core::profile::{LearnerProfile, TILINGS};
-use pada_core::robot::{RobotRules, RobotSpec};
-use pada_core::safety::FaultCause;
+use pada_core::robot::RobotRules;
 use pada_core::servo::ServoProtocol;
 use pada_core::tile_coding::Layout;
 use pada_core::weights::{Half, WeightFormat, WeightStore};
@@ -204,21 +204,6 @@ pub fn run_board_trial_on(
     with_table(&profile, n, Visit { profile, rules, rig, cfg, trial, seed, progress })
 }
 
-/// What a fault at `t_us` means for a run of the board on the host, and
-/// what to change.
-fn fault_explained(spec: &RobotSpec, cause: FaultCause, t_us: u64) -> String {
-    let line = super::fault_line::fault_line(&cause, spec);
-    let at = format!("the board faulted {:.2} s into the run ({}): {line}", t_us as f64 * 1e-6, cause.name());
-    let waits = "torque went off, and a board waits there for its operator to clear the fault";
-    match cause {
-        FaultCause::SoftLimit { .. } => format!(
-            "{at}; {waits}. End an episode before a joint reaches its soft limits \
-             (an [[end]] on its angle in robot.toml, inside the limits), or widen the limits if the joint can go further"
-        ),
-        _ => format!("{at}; {waits}"),
-    }
-}
-
 /// Carries out a host command, as the board would; a refusal is an error.
 pub fn command<W: WeightStore, R: RobotRules>(ctl: &mut Controller<W, R>, cmd: ToChip) -> anyhow::Result<()> {
     ctl.command(&cmd).0.map_err(|e| anyhow!("{cmd:?} refused: {e:?}"))
@@ -297,7 +282,7 @@ fn run<R: RobotRules, W: WeightStore>(
         // A fault switches torque off until an operator clears it, and
         // nobody does here: the trial ends with the cause.
         if let Some(cause) = out.transitions.iter().find_map(|tr| tr.entered_fault()) {
-            bail!("trial {trial}: {}", fault_explained(spec, cause, t));
+            bail!("trial {trial}: {}", fault_explained(spec, cause, t, ctl.episode(), Faulted::Board));
         }
         // 3. Drive, and tell the operator.
         let supply = rig.supply_v();

@@ -83,12 +83,21 @@ fn render_robot(args: &RenderArgs, path: &std::path::Path) -> Result<(), CliErro
         "{}: greedy policy of {source}, {:.2} s{}",
         motion.robot,
         motion.frames.last().map_or(0.0, |f| f.time),
-        if motion.ended { ", ended by its rules" } else { "" }
+        if motion.fault.is_some() {
+            ", stopped at a soft limit"
+        } else if motion.ended {
+            ", ended by its rules"
+        } else {
+            ""
+        }
     );
     out.write_all(&motion.files(&file, tolerance, &title)?)?;
     outln!("{title}")?;
+    if let Some(line) = &motion.fault {
+        outln!("the robot faulted: {line} (on the board torque goes off there)")?;
+    }
     if lines.is_empty() {
-        outln!("(its reward has no distance term: nothing to hold)")?;
+        outln!("(its reward has no term with a target on a point: nothing to hold)")?;
     }
     for l in lines {
         outln!("{l}")?;

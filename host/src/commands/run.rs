@@ -102,8 +102,10 @@ pub struct RunArgs {
     /// controller built for the host, with the board's learner profile
     /// (table layout, size, weight format), its sensors (servo counts,
     /// differenced rates, the encoder) and its episode logic, against the
-    /// task's plant (physical-pendulum or leo). What it learns is what the
-    /// board will learn.
+    /// simulated robot: the task's plant (physical-pendulum or leo) or a
+    /// robot of files (--robot robot.toml, its URDF's body in rapier3d).
+    /// What it learns is what the board will learn; a soft limit faults it
+    /// and ends the trial, as it does without --board.
     #[arg(long, value_name = "NAME", value_parser = crate::robots::board_parser())]
     pub board: Option<pada_core::profile::Board>,
     /// With --board: a table of 2^N entries instead of the board's, in the

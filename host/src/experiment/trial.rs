@@ -24,6 +24,7 @@ use super::agent_setup::{build_agent, HostAgent};
 use super::governed::{GovernorTrial, TrialGovernor};
 use super::metrics::{end_performance, rise_time};
 use super::config::RunConfig;
+use crate::board::fault_line::{fault_explained, Faulted};
 use crate::experiment::task::{Plant, Task, TaskSpec};
 use crate::seed::{trial_rng, trial_seed};
 use anyhow::anyhow;
@@ -193,6 +194,7 @@ pub fn run_trial_observed<T: Task>(
     };
     let mut t = Trial {
         spec,
+        trial,
         agent,
         plant: task.plant(),
         rng,
@@ -282,6 +284,8 @@ pub fn run_trial_observed<T: Task>(
 /// The state of a running trial.
 struct Trial<'a, 'o, 'p, P: Plant> {
     spec: &'a TaskSpec,
+    /// The trial's index within the run.
+    trial: u32,
     agent: HostAgent,
     plant: P,
     rng: Pcg64,
@@ -359,6 +363,20 @@ impl<P: Plant> Trial<'_, '_, '_, P> {
         }));
     }
 
+    /// Ends the trial at a fault of the plant's last reading (a joint past
+    /// its soft limit), as the board's trial ends there: the same reading
+    /// faults on both, told in the same words.
+    fn stop_at_fault(&self) -> anyhow::Result<()> {
+        let Some(cause) = self.plant.fault() else { return Ok(()) };
+        let at = self.cycle.position();
+        let readings = self.learning_steps + self.test_steps + at.map_or(0, |e| e.steps as u64 + 1);
+        let t_us = (readings as f64 * self.spec.control_period_s * 1e6).round() as u64;
+        let Some(robot) = self.spec.profile.map(|p| p.robot) else {
+            anyhow::bail!("trial {}: {} faulted ({}) {:.2} s into the run", self.trial, self.spec.name, cause.name(), t_us as f64 * 1e-6);
+        };
+        anyhow::bail!("trial {}: {}", self.trial, fault_explained(robot, cause, t_us, at, Faulted::Simulation))
+    }
+
     /// One episode to the time limit or an absorbing state, in the mode the
     /// cycle gives `requested`; returns that mode. A learning episode
     /// counts its steps, falls and applied torques; a test run goes on the
@@ -373,12 +391,14 @@ impl<P: Plant> Trial<'_, '_, '_, P> {
             self.maybe_switch()?;
         }
         self.plant.reset(&mut self.rng, &mut self.obs[..n]);
+        self.stop_at_fault()?;
         let mut t = self.cycle.begin(&mut self.agent, requested, &self.obs[..n], &mut self.rng).map_err(bad)?;
         self.report_step(&t);
         let report = loop {
             let Some(d) = t.decision else { unreachable!("a decision until the episode ends") };
             let command = &d.output[..motors];
             let step = self.plant.step(command, &mut self.obs[..n]);
+            self.stop_at_fault()?;
             if learning {
                 let before = damage_raws(&self.fatigue);
                 self.fatigue

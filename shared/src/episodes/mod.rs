@@ -101,6 +101,19 @@ pub fn is_learning_action(mode: RunMode, kind: StepKind) -> bool {
     mode == RunMode::Learning && matches!(kind, StepKind::Start | StepKind::Step)
 }
 
+/// Where the episode in progress is ([`Episodes::position`]): what a fault
+/// report names, on the board and on the host alike.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EpisodeAt {
+    /// The episode's index (episodes started before it).
+    pub index: u32,
+    /// Its mode.
+    pub mode: RunMode,
+    /// Transitions taken so far: the next reading is the one after action
+    /// `steps + 1` of the episode.
+    pub steps: u32,
+}
+
 /// The episode cycle's state: the test cadence, the episode counter and
 /// the episode in progress.
 #[derive(Debug, Clone, PartialEq)]
@@ -143,6 +156,11 @@ impl Episodes {
     /// Whether an episode is in progress.
     pub fn running(&self) -> bool {
         self.current.is_some()
+    }
+
+    /// The episode in progress, if any.
+    pub fn position(&self) -> Option<EpisodeAt> {
+        self.current.map(|c| EpisodeAt { index: self.started.wrapping_sub(1), mode: c.mode, steps: c.steps })
     }
 
     /// The mode the next episode will have when `requested` is the run's

@@ -162,3 +162,19 @@ fn the_governors_feed_is_the_damage_since_before_and_never_wraps() {
     // Joints past the counter's are left out.
     assert_eq!(increments(&before, &f, 1..9)[1..], [0; crate::governor::GOVERNED_JOINTS - 1][..]);
 }
+
+#[test]
+fn the_position_names_the_episode_in_progress_and_its_transitions() {
+    let (mut agent, mut rng) = (pendulum_agent(PolicyKind::Sarsa), Pcg32::seed_from_u64(3));
+    let mut e = Episodes::new(rules(5, 10));
+    assert_eq!(e.position(), None);
+    run_episode(&mut e, &mut agent, RunMode::Testing, None, &mut rng);
+    assert_eq!(e.position(), None, "no episode between episodes");
+    e.begin(&mut agent, RunMode::Learning, &[0.1, 0.0], &mut rng).unwrap();
+    assert_eq!(e.position(), Some(EpisodeAt { index: 1, mode: RunMode::Learning, steps: 0 }));
+    e.advance(&mut agent, &[0.1, 0.0], -1.0, false, false, &mut rng).unwrap();
+    e.advance(&mut agent, &[0.1, 0.0], -1.0, false, false, &mut rng).unwrap();
+    assert_eq!(e.position(), Some(EpisodeAt { index: 1, mode: RunMode::Learning, steps: 2 }));
+    e.abandon();
+    assert_eq!(e.position(), None);
+}

@@ -14,6 +14,7 @@
 //! | [`pendulum`] | the physical inverted pendulum of Section VII (33 or 20 Hz) |
 //! | [`leo`] | the biped LEO walking on its boom (Section VIII) |
 //! | [`filter`] | GRL's rate filter, used by LEO |
+//! | `soft_limits.rs` | the soft-limit check of every reading, on the board and the host |
 //!
 //! A robot is identified by its name and the hash of its definition
 //! ([`RobotSpec::definition_hash`]), never by a number from a closed list:
@@ -31,6 +32,7 @@ pub mod leo;
 pub mod pendulum;
 pub mod registry;
 pub mod rules;
+mod soft_limits;
 pub mod vocabulary;
 
 pub use hardware::{EncoderSpec, JointRange, JointSpec};
@@ -78,7 +80,8 @@ pub enum TableNeed {
     Claimed,
 }
 
-/// The levels of each learned motor (every motor dimension has the same).
+/// The levels of each learned motor: the same for every motor dimension,
+/// or each its own.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum MotorLevels {
     /// These values, in increasing order.
@@ -93,6 +96,9 @@ pub enum MotorLevels {
         /// How many.
         count: u8,
     },
+    /// Each motor dimension's own values (in motor order), each list in
+    /// increasing order: a strong shoulder and a weak wrist.
+    PerMotor(&'static [&'static [f32]]),
 }
 
 /// Everything that defines one robot: its learning task and its hardware.
@@ -209,6 +215,15 @@ impl RobotSpec {
             MotorLevels::Uniform { min, max, count } => {
                 h.write_u32(2).write_f32(min).write_f32(max).write_u32(count as u32);
             }
+            MotorLevels::PerMotor(dims) => {
+                h.write_u32(3).write_u32(dims.len() as u32);
+                for values in dims {
+                    h.write_u32(values.len() as u32);
+                    for v in *values {
+                        h.write_f32(*v);
+                    }
+                }
+            }
         }
         match self.action_tiles {
             None => h.write_u32(0),
@@ -291,6 +306,17 @@ impl RobotSpec {
         let dim = match self.levels {
             MotorLevels::Listed(values) => ActionDim::from_levels(values)?,
             MotorLevels::Uniform { min, max, count } => ActionDim::uniform(min, max, count as usize)?,
+            MotorLevels::PerMotor(dims) => {
+                if dims.len() != self.motor_dims as usize {
+                    return Err(ConfigError::new("levels", dims.len() as f32, "one list of levels per motor dimension"));
+                }
+                let mut each: heapless::Vec<ActionDim, MAX_ACTION_DIMS> = heapless::Vec::new();
+                for values in dims {
+                    each.push(ActionDim::from_levels(values)?)
+                        .map_err(|_| ConfigError::new("levels", dims.len() as f32, "at most 4 motor dimensions"))?;
+                }
+                return ActionSpace::new(&each);
+            }
         };
         ActionSpace::repeated(dim, self.motor_dims as usize)
     }

@@ -4,7 +4,9 @@
 //! [`RulesPlant`] is generic over the rules ([`RobotRules`]): the same
 //! code that the firmware runs on the chip turns the simulated joint angles
 //! into observations, rewards and ends, and the learner's output into
-//! every servo's voltage. The body only moves.
+//! every servo's voltage. The body only moves. Every reading is checked
+//! against the joints' soft limits as the board's safety machine checks
+//! it ([`Plant::fault`]).
 
 use super::body::{UrdfBody, UrdfModel};
 use crate::task::{Plant, Step, Task, TaskSpec};
@@ -12,6 +14,7 @@ use pada_core::action_space::Output;
 use pada_core::limits::{MAX_ACTION_DIMS, MAX_SERVOS, MAX_STATE_DIMS};
 use pada_core::profile::{Board, LearnerProfile};
 use pada_core::robot::{PerServo, RobotRules, Sensed, Vocab};
+use pada_core::safety::FaultCause;
 use pada_robot_file::RobotFile;
 use rand_core::RngCore;
 
@@ -21,12 +24,14 @@ pub struct RulesPlant<R> {
     rules: R,
     /// The voltages the last step applied.
     volts: PerServo,
+    /// The soft-limit fault of the last reading, if any.
+    fault: Option<FaultCause>,
 }
 
 impl<R: RobotRules> RulesPlant<R> {
     /// `rules` driving `body`.
     pub fn new(body: UrdfBody, rules: R) -> Self {
-        RulesPlant { body, rules, volts: [0.0; MAX_SERVOS] }
+        RulesPlant { body, rules, volts: [0.0; MAX_SERVOS], fault: None }
     }
 
     /// The rules (for inspection).
@@ -46,6 +51,8 @@ impl<R: RobotRules> RulesPlant<R> {
         for k in 0..n {
             angles[k] = Some(q[k]);
         }
+        // The board's safety machine sees every reading first.
+        self.fault = self.rules.spec().soft_limit_fault(&angles[..n]);
         self.rules.sense(&Sensed { angles, encoder_angle: None, contacts: 0, applied: self.volts });
     }
 
@@ -74,6 +81,11 @@ impl<R: RobotRules + Send> Plant for RulesPlant<R> {
         let blew_up = self.body.step_period().is_err();
         self.volts = volts;
         self.sense();
+        if blew_up {
+            // The simulation's failure, not the robot's: the board's rig
+            // puts such a body back, and its servos never read NaN.
+            self.fault = None;
+        }
         self.observe(obs);
         Step {
             reward: self.rules.reward(&self.volts),
@@ -81,6 +93,11 @@ impl<R: RobotRules + Send> Plant for RulesPlant<R> {
             // (an end's signal leaves its range) and are counted as such.
             terminal: self.rules.absorbing() || blew_up,
         }
+    }
+
+    /// A joint past its soft limit at the last reading.
+    fn fault(&self) -> Option<FaultCause> {
+        self.fault
     }
 
     /// The simulation's torque on each counted gearbox over the step.

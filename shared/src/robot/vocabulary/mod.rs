@@ -2,7 +2,8 @@
 //! of the user's own needs a `robot.toml` and a URDF and no code: the
 //! signals it observes (joint angles and rates, the coordinates of named
 //! points and their rates), the reward as a sum of terms (a quadratic cost
-//! about a target, a point's distance to a target point, a point's
+//! about a target, a point's distance or squared distance to a target
+//! point, a point's
 //! progress along an axis, an action and an action-change cost, a constant
 //! per step), the limits that end an episode, the P laws of the joints the
 //! learner does not drive, and the start pose a robot is brought back to
@@ -79,6 +80,17 @@ pub enum RewardTerm {
         /// Where it should be, in the base frame \[m\].
         target: [f32; 3],
         /// The weight (negative: a cost).
+        weight: f32,
+    },
+    /// `weight · ‖point − target‖²` \[m²\]: the squared distance, a cost
+    /// that grows gently near the target and steeply far from it (a
+    /// [`RewardTerm::Distance`] pulls as hard at 1 mm as at 1 m).
+    DistanceSquared {
+        /// The point ([`Vocabulary::points`]).
+        point: u8,
+        /// Where it should be, in the base frame \[m\].
+        target: [f32; 3],
+        /// The weight per m² (negative: a cost).
         weight: f32,
     },
     /// `weight · Δ` of the point's coordinate `axis` over the step \[m\]:
@@ -249,6 +261,13 @@ impl Vocabulary {
                 }
                 RewardTerm::Constant { value } => {
                     h.write_u32(6).write_f32(value);
+                }
+                RewardTerm::DistanceSquared { point, target, weight } => {
+                    h.write_u32(7).write_u32(point as u32);
+                    for x in target {
+                        h.write_f32(x);
+                    }
+                    h.write_f32(weight);
                 }
             }
         }

@@ -111,7 +111,9 @@ impl Vocab {
         for term in words.rewards {
             let ok = match *term {
                 RewardTerm::Quadratic { signal, .. } => signal_ok(&signal),
-                RewardTerm::Distance { point, .. } => (point as usize) < words.points.len(),
+                RewardTerm::Distance { point, .. } | RewardTerm::DistanceSquared { point, .. } => {
+                    (point as usize) < words.points.len()
+                }
                 RewardTerm::Progress { point, axis, .. } => (point as usize) < words.points.len() && axis < 3,
                 RewardTerm::Action { .. } | RewardTerm::ActionChange { .. } | RewardTerm::Constant { .. } => true,
             };
@@ -142,6 +144,13 @@ impl Vocab {
     /// The position of point `point` now \[m\].
     pub fn point(&self, point: usize) -> Option<[f32; 3]> {
         (point < self.words.points.len()).then(|| self.points[point])
+    }
+
+    /// The squared distance of point `point` to `target` now \[m²\].
+    fn squared_distance(&self, point: u8, target: [f32; 3]) -> f32 {
+        let p = self.points.get(point as usize).copied().unwrap_or([0.0; 3]);
+        let (dx, dy, dz) = (p[0] - target[0], p[1] - target[1], p[2] - target[2]);
+        dx * dx + dy * dy + dz * dz
     }
 
     /// The end that is violated now, if any.
@@ -233,11 +242,8 @@ impl RobotRules for Vocab {
                     let d = if w { wrap(d) } else { d };
                     weight * d * d
                 }
-                RewardTerm::Distance { point, target, weight } => {
-                    let p = self.points.get(point as usize).copied().unwrap_or([0.0; 3]);
-                    let (dx, dy, dz) = (p[0] - target[0], p[1] - target[1], p[2] - target[2]);
-                    weight * libm::sqrtf(dx * dx + dy * dy + dz * dz)
-                }
+                RewardTerm::Distance { point, target, weight } => weight * libm::sqrtf(self.squared_distance(point, target)),
+                RewardTerm::DistanceSquared { point, target, weight } => weight * self.squared_distance(point, target),
                 RewardTerm::Progress { point, axis, weight } => {
                     let v = self.signal(super::Signal::Velocity { point, axis });
                     weight * v * self.period_s

@@ -227,3 +227,31 @@ fn the_pendulums_reward_is_said_in_the_vocabulary() {
     );
     assert!((v.reward(&u) as f64 - want).abs() < 1e-3 * want.abs(), "{} vs {want}", v.reward(&u));
 }
+
+#[test]
+fn a_squared_distance_term_is_the_distance_squared_and_hashes_apart() {
+    const SQUARED: [RewardTerm; 1] = [RewardTerm::DistanceSquared { point: 0, target: [0.2, 0.0, 0.3], weight: -4.0 }];
+    static WORDS_SQ: Vocabulary = Vocabulary { rewards: &SQUARED, ..WORDS };
+    static ARM_SQ: RobotSpec = RobotSpec { vocabulary: Some(&WORDS_SQ), ..ARM };
+    const PLAIN: [RewardTerm; 1] = [RewardTerm::Distance { point: 0, target: [0.2, 0.0, 0.3], weight: -4.0 }];
+    static WORDS_D: Vocabulary = Vocabulary { rewards: &PLAIN, ..WORDS };
+    static ARM_D: RobotSpec = RobotSpec { vocabulary: Some(&WORDS_D), ..ARM };
+    let (mut sq, mut d) = (Vocab::new(&ARM_SQ).unwrap(), Vocab::new(&ARM_D).unwrap());
+    let applied = per_servo([0.0; 3]);
+    for q in [[0.0, 0.0, 0.3], [0.4, -0.7, 0.3], [-1.2, 2.0, 0.3]] {
+        sense(&mut sq, q, [0.0; 3]);
+        sense(&mut d, q, [0.0; 3]);
+        let metres = d.reward(&applied) / -4.0;
+        let want = -4.0 * metres * metres;
+        assert!((sq.reward(&applied) - want).abs() <= 1e-6 * want.abs().max(1.0), "{q:?}: {} vs {want}", sq.reward(&applied));
+    }
+    // At the tip straight up: 0.25 m from the target, 0.0625 m².
+    sense(&mut sq, [0.0, 0.0, 0.3], [0.0; 3]);
+    assert!((sq.reward(&applied) + 4.0 * 0.0625).abs() < 1e-6);
+    assert_ne!(ARM_SQ.definition_hash(), ARM_D.definition_hash());
+    // A point the robot lacks is refused.
+    const NOWHERE: [RewardTerm; 1] = [RewardTerm::DistanceSquared { point: 3, target: [0.0; 3], weight: -1.0 }];
+    static WORDS_BAD: Vocabulary = Vocabulary { rewards: &NOWHERE, ..WORDS };
+    static ARM_BAD: RobotSpec = RobotSpec { vocabulary: Some(&WORDS_BAD), ..ARM };
+    assert!(Vocab::new(&ARM_BAD).is_err());
+}
