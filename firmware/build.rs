@@ -38,7 +38,7 @@ fn main() {
         println!("cargo:rerun-if-changed=build.rs");
         return;
     }
-    println!("cargo::rustc-check-cfg=cfg(pada_table, values(\"exact_ccm\", \"exact_ccm_sram\", \"exact_sram\", \"claimed_ccm\", \"hashed_ccm_sram\", \"claimed_sdram\"))");
+    println!("cargo::rustc-check-cfg=cfg(pada_table, values(\"exact_ccm\", \"exact_ccm_sram\", \"exact_sram\", \"claimed_ccm\", \"hashed_ccm\", \"claimed_sdram\"))");
     if chips.len() != 1 {
         panic!(
             "pada-firmware: enable exactly one board feature (stm32f405, stm32f407, stm32f429, qemu, mps2); \
@@ -110,7 +110,7 @@ fn robot(out: &Path, f429: bool) {
         (Layout::Exact, Memory::CcmThenSram { .. }) => "exact_ccm_sram",
         (Layout::Exact, Memory::Sram) => "exact_sram",
         (Layout::Claimed, Memory::Ccm) => "claimed_ccm",
-        (Layout::Hashed, Memory::CcmThenSram { .. }) => "hashed_ccm_sram",
+        (Layout::Hashed, Memory::Ccm) => "hashed_ccm",
         (Layout::Claimed, Memory::Sdram) => "claimed_sdram",
         (layout, memory) => fail(&format!("no table layout for {layout:?} in {memory:?}")),
     };

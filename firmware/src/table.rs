@@ -9,7 +9,7 @@
 //! | `exact_ccm_sram` | an exact table: all 64 KiB of CCM, then SRAM (`Split`) | the pendulum on F405/F407 and QEMU's netduinoplus2 (`stm32f405`, `stm32f407`, `qemu`) |
 //! | `exact_sram` | an exact table in SRAM | the pendulum on the F429I-DISC1 and QEMU's mps2-an386 (`stm32f429`, `mps2`) |
 //! | `claimed_ccm` | a claim table of 2^14 slots (16-bit weights and 16-bit tags) in CCM | — |
-//! | `hashed_ccm_sram` | a hashed table of 2^16 16-bit weights: all 64 KiB of CCM, then 64 KiB of SRAM (`Split`) | LEO and robots of files with a claim table elsewhere, on the F405 |
+//! | `hashed_ccm` | a hashed table of 2^15 16-bit weights in all 64 KiB of CCM | LEO and robots of files with a claim table elsewhere, on the F405 |
 //! | `claimed_sdram` | a claim table of 2^21 slots, all 8 MiB of the SDRAM (on mps2-an386: its PSRAM, `.sdram` in `memory-mps2.x`) | LEO on the F429 |
 //!
 //! The statics are NOLOAD (CCM, SDRAM) or `.uninit` (SRAM): the startup
@@ -180,18 +180,14 @@ mod layout {
     claim_table!(Memory::Ccm, ".ccmram", "PADA_TABLE_CCM", ".ccmram", "PADA_TABLE_TAGS_CCM");
 }
 
-// A hashed table of 16-bit weights over all of CCM, then SRAM (LEO and
-// robots of files whose features outgrow an exact table, on an F405).
-#[cfg(pada_table = "hashed_ccm_sram")]
+// A hashed table of 16-bit weights in all of CCM (LEO and robots of files
+// whose features outgrow an exact table, on an F405).
+#[cfg(pada_table = "hashed_ccm")]
 mod layout {
     use super::*;
-    use pada_core::weights::{Half, Split};
+    use pada_core::weights::Half;
 
-    const CCM: usize = match PROFILE.memory {
-        Memory::CcmThenSram { ccm_weights } => ccm_weights,
-        _ => panic!("build.rs chose a table split over CCM and SRAM"),
-    };
-    const REST: usize = WEIGHTS - CCM;
+    const _: () = assert!(matches!(PROFILE.memory, Memory::Ccm), "the profile puts the table elsewhere");
     const SHIFT: u32 = match PROFILE.format {
         pada_core::weights::WeightFormat::Half { shift } => shift as u32,
         pada_core::weights::WeightFormat::Q16 => panic!("the F405's hashed table has 16-bit weights"),
@@ -199,24 +195,16 @@ mod layout {
 
     #[link_section = ".ccmram"]
     #[export_name = "PADA_TABLE_CCM"]
-    static mut IN_CCM: MaybeUninit<[i16; CCM]> = MaybeUninit::uninit();
-    #[link_section = ".uninit.pada_table"]
-    #[export_name = "PADA_TABLE_SRAM"]
-    static mut IN_SRAM: MaybeUninit<[i16; REST]> = MaybeUninit::uninit();
+    static mut IN_CCM: MaybeUninit<[i16; WEIGHTS]> = MaybeUninit::uninit();
 
     /// The table.
-    pub type Table = Split<Half<&'static mut [i16; CCM], SHIFT>, Half<&'static mut [i16; REST], SHIFT>>;
+    pub type Table = Half<&'static mut [i16; WEIGHTS], SHIFT>;
 
     pub fn take() -> Table {
         TAKEN.init(());
-        // SAFETY: reached once (TAKEN), and nothing else names the statics;
+        // SAFETY: reached once (TAKEN), and nothing else names the static;
         // all-zero bits are valid i16.
-        unsafe {
-            Split {
-                first: Half::new(zeroed(core::ptr::addr_of_mut!(IN_CCM))),
-                second: Half::new(zeroed(core::ptr::addr_of_mut!(IN_SRAM))),
-            }
-        }
+        Half::new(unsafe { zeroed(core::ptr::addr_of_mut!(IN_CCM)) })
     }
 }
 

@@ -9,7 +9,7 @@
 //!
 //! | board | memory for the table | pendulum | LEO |
 //! |---|---|---|---|
-//! | `f405` | 64 KB CCM + 64 KB of the 128 KB SRAM (STM32F405) | exact, 24 960 Q16 weights (CCM, then SRAM) | hashed table, 2^16 16-bit weights (CCM, then SRAM) |
+//! | `f405` | 64 KB CCM + 48 KB of the 128 KB SRAM (STM32F405) | exact, 24 960 Q16 weights (CCM, then SRAM) | hashed table, 2^15 16-bit weights (all 64 KiB of CCM) |
 //! | `f429-sdram` | 8 MB SDRAM on the FMC (STM32F429I-DISC1) | exact, in SRAM | claim table, 2^21 slots of 16-bit weight + 16-bit tag (8 MiB) |
 //! | `host` | the heap | exact, as large as the policy needs | claim table, 2^22 slots of Q16 weight + 32-bit tag (32 MiB) |
 //!
@@ -92,19 +92,20 @@ impl Board {
                 };
                 (Layout::Exact, TableSize::Weights(weights), WeightFormat::Q16, memory, 0)
             }
-            // A hashed table over all the memory the chip gives a table:
-            // 2^16 16-bit weights, the first half in the 64 KB of CCM, the
-            // rest in 64 KB of SRAM (F405_SRAM_TABLE_BYTES). Features whose
-            // hashes collide share a weight. Of the three things a full
-            // table can do in these 128 KB (a claim table of 2^15 slots
-            // that refuses, one that replaces, or twice the entries
-            // without tags that collide), this learned best on a
+            // A hashed table of 2^15 16-bit weights in all 64 KB of CCM.
+            // Features whose hashes collide share a weight. Of the three
+            // things a full table can do in these bytes (a claim table of
+            // 2^14 slots that refuses, one that replaces, or twice the
+            // entries without tags that collide), this learned best on a
             // three-joint arm and on LEO (docs/board.md, "A full table").
+            // (2^16 over CCM and 64 KB of SRAM learned better still, but
+            // left the emulated image's stack 21 KB, and it overflowed at
+            // boot: docs/board.md.)
             (Board::F405, TableNeed::Claimed) => (
                 Layout::Hashed,
                 TableSize::Weights(F405_HASHED_WEIGHTS),
                 WeightFormat::Half { shift: robot.half_shift },
-                Memory::CcmThenSram { ccm_weights: CCM_BYTES / 2 },
+                Memory::Ccm,
                 0,
             ),
             (Board::F429Sdram, TableNeed::Exact { weights }) => {
@@ -184,14 +185,12 @@ pub const HOST_CLAIM_LOG2: u32 = 22;
 
 /// Bytes of the F405's core-coupled RAM.
 pub const CCM_BYTES: usize = 64 * 1024;
-/// Bytes of the F405's 128 KB SRAM a table may take besides all of CCM
-/// (an exact table's rest, or a claim table's tags): the other 64 KB are
-/// the firmware's statics (about 32 KB: the images' sizes in docs/board.md)
-/// and its stack.
-pub const F405_SRAM_TABLE_BYTES: usize = 64 * 1024;
-/// Weights of the F405's hashed table: 16-bit weights in all of CCM and
-/// [`F405_SRAM_TABLE_BYTES`] of SRAM.
-pub const F405_HASHED_WEIGHTS: usize = (CCM_BYTES + F405_SRAM_TABLE_BYTES) / 2;
+/// Bytes of the F405's 128 KB SRAM an exact table may take after all of
+/// CCM: the rest is the firmware's statics (about 32 KB on the chip, 43 KB
+/// in the emulated image) and its stack, which at 21 KB overflowed at boot.
+pub const F405_SRAM_TABLE_BYTES: usize = 48 * 1024;
+/// Weights of the F405's hashed table: 16-bit weights in all of CCM.
+pub const F405_HASHED_WEIGHTS: usize = CCM_BYTES / 2;
 /// Bytes of the F429's 192 KB SRAM an exact table may take.
 pub const F429_SRAM_TABLE_BYTES: usize = 128 * 1024;
 
@@ -458,8 +457,8 @@ mod tests {
         assert_eq!((p.layout, p.weights(), p.format), (Layout::Exact, Some(24_960), WeightFormat::Q16));
         assert_eq!(p.memory, Memory::CcmThenSram { ccm_weights: 16_384 });
         let l = Board::F405.profile(&leo::SPEC).unwrap();
-        assert_eq!((l.layout, l.weights(), l.format, l.tag_bytes), (Layout::Hashed, Some(1 << 16), WeightFormat::Half { shift: 12 }, 0));
-        assert_eq!(l.memory, Memory::CcmThenSram { ccm_weights: 1 << 15 });
+        assert_eq!((l.layout, l.weights(), l.format, l.tag_bytes), (Layout::Hashed, Some(1 << 15), WeightFormat::Half { shift: 12 }, 0));
+        assert_eq!(l.memory, Memory::Ccm);
         let l = Board::F429Sdram.profile(&leo::SPEC).unwrap();
         assert_eq!((l.weights(), l.memory, l.tag_bytes), (Some(1 << 21), Memory::Sdram, 2));
         let h = Board::Host.profile(&leo::SPEC).unwrap();
@@ -471,7 +470,7 @@ mod tests {
     fn an_exact_table_too_large_for_a_board_is_refused_with_its_sizes() {
         static HUGE: RobotSpec = RobotSpec { table: TableNeed::Exact { weights: 40_000 }, ..pendulum::SPEC_33HZ };
         let e = Board::F405.profile(&HUGE).unwrap_err();
-        assert_eq!((e.weights, e.bytes, e.room), (40_000, 160_000, 128 * 1024));
+        assert_eq!((e.weights, e.bytes, e.room), (40_000, 160_000, 112 * 1024));
         let text = alloc_free_text(&e);
         assert!(text.contains("40000 weights") && text.contains("f405"), "{text}");
         assert!(Board::F429Sdram.profile(&HUGE).is_err());

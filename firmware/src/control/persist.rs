@@ -621,20 +621,15 @@ mod tests {
     }
 
     #[test]
-    fn an_f405_checkpoint_fits_a_flash_sector_or_the_host_keeps_it() {
-        // The pendulum's exact table (97.5 KiB) fits a 128 KiB sector; a
-        // table over all of the chip's table memory (LEO's: 2^16 hashed
-        // 16-bit weights, 128 KiB) with its header does not, and the host
-        // keeps it, as it keeps the F429's LEO table.
+    fn every_f405_checkpoint_fits_a_flash_sector() {
+        // Every F405 table fits a 128 KiB sector: the pendulum's exact
+        // table (97.5 KiB), LEO's hashed one (2^15 16-bit weights, 64 KiB).
         for robot in pada_core::robot::registry::specs() {
             let p = profile(robot);
             let bytes = checkpoint::slot_len(p.weights().unwrap(), p.entry_bytes());
-            match p.layout {
-                pada_core::tile_coding::Layout::Exact => assert!(bytes <= FLASH_SLOT, "{}: {bytes}", robot.name),
-                _ => assert!(bytes > FLASH_SLOT, "{}: {bytes}: a hashed table's checkpoint fits flash now", robot.name),
-            }
+            assert!(bytes <= FLASH_SLOT, "{}: {bytes}", robot.name);
         }
         let leo = Controller::new(Leo::new(), profile(&leo::SPEC), PolicyKind::Sarsa, leo_table(), 1).unwrap();
-        assert!(leo.host_keeps_checkpoint(FLASH_SLOT), "{} bytes", leo.checkpoint_bytes());
+        assert!(!leo.host_keeps_checkpoint(FLASH_SLOT), "{} bytes", leo.checkpoint_bytes());
     }
 }

@@ -59,8 +59,8 @@ pub(super) fn ccm_leo_profile() -> LearnerProfile {
     p.with_hashed_table(pada_core::tile_coding::Layout::Claimed, 14, p.format, 2)
 }
 
-/// The F405's LEO table: 2^16 hashed 16-bit weights (as `crate::table`
-/// splits them over CCM and SRAM).
+/// The F405's LEO table: 2^15 hashed 16-bit weights (as `crate::table`
+/// lays them out in CCM).
 pub(super) fn leo_table() -> pada_core::weights::Half<Box<[i16]>, { pada_core::robot::leo::HALF_SHIFT as u32 }> {
     pada_core::weights::Half::new(vec![0i16; profile(&leo::SPEC).weights().unwrap()].into_boxed_slice())
 }
