@@ -104,9 +104,10 @@ pub const LEO_MAX_VOLTAGE: f32 = thermal_voltage_limit(
     GEAR_RATIO,
 );
 
-/// A non-finite input is read as 0 (see the module documentation).
+/// A non-finite input is read as 0 (see the module documentation); the
+/// servo models of [`crate::servo`] read theirs so too.
 #[inline]
-fn finite_or_zero(x: f32) -> f32 {
+pub(crate) fn finite_or_zero(x: f32) -> f32 {
     if x.is_finite() {
         x
     } else {

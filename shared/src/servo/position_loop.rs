@@ -106,14 +106,7 @@ impl PositionLoopSpec {
     }
 }
 
-#[inline]
-fn finite_or_zero(x: f32) -> f32 {
-    if x.is_finite() {
-        x
-    } else {
-        0.0
-    }
-}
+use crate::rx28::finite_or_zero;
 
 /// One servo's position loop in motion: the error of the last tick, the
 /// integral, the time to the next tick and the duty cycle held until then.
