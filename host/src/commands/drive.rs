@@ -100,6 +100,20 @@ pub struct DriveArgs {
     /// Print drive.json on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Run the periods at the ordinary priority: no SCHED_FIFO, no locked
+    /// memory (by default, in real time, both are asked for, and what was
+    /// granted is in the summary).
+    #[arg(long)]
+    pub no_realtime: bool,
+}
+
+/// `summary.json` of a drive: `pada run --board`'s, and what the operating
+/// system granted the control thread.
+#[derive(serde::Serialize)]
+struct DriveSummary<'a> {
+    #[serde(flatten)]
+    board: &'a BoardSummary,
+    realtime: &'a crate::drive::realtime::RealtimeReport,
 }
 
 /// Runs `pada drive`.
@@ -172,6 +186,7 @@ pub fn run(args: DriveArgs) -> Result<(), CliError> {
         checkpoint: Some(checkpoint),
         stop,
         latency: lat,
+        realtime: !args.no_realtime,
     };
     errln!(
         "drive: {} on {} at {} bps, {} on the {} learner, {} s of learning{}",
@@ -202,12 +217,17 @@ pub fn run(args: DriveArgs) -> Result<(), CliError> {
     for line in &outcome.checkpoint {
         errln!("drive: checkpoint {line}");
     }
+    for line in outcome.realtime.lines() {
+        errln!("drive: real time: {line}");
+    }
 
     // The files: the learning curve as `pada run --board` writes it, and
     // the run's own report.
     let task = pada_sim::task::TaskSpec::of_robot(profile, "the robot on the serial port", "the robot definition's torque law");
     let summary = BoardSummary::new(&task, &cfg, &profile, std::slice::from_ref(&outcome.trial), wall);
     let mut files = board_files(&summary).map_err(CliError::Runtime)?;
+    let drive_summary = DriveSummary { board: &summary, realtime: &outcome.realtime };
+    files[0].1 = (serde_json::to_string_pretty(&drive_summary).map_err(|e| CliError::Runtime(e.into()))? + "\n").into_bytes();
     let report = serde_json::to_string_pretty(&outcome).map_err(|e| CliError::Runtime(e.into()))?;
     files.push(("drive.json".to_string(), (report.clone() + "\n").into_bytes()));
     out.write_all(&files).map_err(CliError::Runtime)?;
@@ -236,6 +256,7 @@ pub fn run(args: DriveArgs) -> Result<(), CliError> {
             c.overruns,
             c.skipped_ticks
         )?;
+        outln!("  real time: {} (drive.json says why)", outcome.realtime.summary())?;
         outln!(
             "  bus: {:.0} bytes a period, {} timeouts, {} damaged answers; telemetry: {} frames, {} lost, {} dropped",
             outcome.bus.bytes_per_period,

@@ -63,6 +63,11 @@ pub struct ServosArgs {
     /// Print the summary (with every servo event) as JSON on stdout.
     #[arg(long)]
     pub json: bool,
+    /// In real time, serve at the ordinary priority: no SCHED_FIFO, no
+    /// locked memory (by default both are asked for; the summary says what
+    /// was granted).
+    #[arg(long)]
+    pub no_realtime: bool,
     /// Scan the port instead: which IDs and models answer, at which rate
     /// and protocol.
     #[arg(long)]
@@ -138,7 +143,8 @@ pub fn run(args: ServosArgs) -> Result<(), CliError> {
         let stop = stop.clone();
         let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
     }
-    let summary = serve::serve(&mut bus, &pty, bps, &stop, args.seconds, robot.spec.name, args.lockstep)
+    let opts = serve::ServeOptions { bps, seconds: args.seconds, name: robot.spec.name, lock_step: args.lockstep, realtime: !args.no_realtime };
+    let summary = serve::serve(&mut bus, &pty, &stop, &opts)
         .map_err(|e| CliError::Runtime(anyhow::anyhow!("the virtual port failed: {e}")))?;
     drop(pty);
     if args.json {
@@ -153,6 +159,7 @@ pub fn run(args: ServosArgs) -> Result<(), CliError> {
             summary.bus_s,
             summary.wall_s
         );
+        errln!("servos: real time: {}", summary.realtime.summary());
     }
     Ok(())
 }
@@ -177,6 +184,7 @@ fn refuse_virtual_flags(args: &ServosArgs, task: &str, why: &str) -> Result<(), 
         ("--lockstep", args.lockstep),
         ("--fault", !args.faults.is_empty()),
         ("--seconds", args.seconds.is_some()),
+        ("--no-realtime", args.no_realtime),
     ] {
         if given {
             return Err(usage(format!("{flag} does not go with {task} ({why})")));
@@ -238,7 +246,8 @@ fn run_chain(args: &ServosArgs, chain: &str) -> Result<(), CliError> {
         let stop = stop.clone();
         let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
     }
-    let summary = serve::serve(&mut bus, &pty, bps, &stop, args.seconds, &name, args.lockstep)
+    let opts = serve::ServeOptions { bps, seconds: args.seconds, name: &name, lock_step: args.lockstep, realtime: !args.no_realtime };
+    let summary = serve::serve(&mut bus, &pty, &stop, &opts)
         .map_err(|e| CliError::Runtime(anyhow::anyhow!("the virtual port failed: {e}")))?;
     drop(pty);
     if args.json {

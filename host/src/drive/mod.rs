@@ -9,6 +9,7 @@
 //! | `port.rs` | the serial port as the firmware's bus port; the permission check |
 //! | `latency.rs` | the USB adapter's latency timer, and how to set it |
 //! | `clock.rs` | the period clock: ticks, jitter, overruns |
+//! | `realtime.rs` | the control thread under SCHED_FIFO with locked memory; what was granted |
 //! | `store.rs` | checkpoints in a file, in the board's two slots |
 //! | `telemetry.rs` | the telemetry a board sends, framed and recorded on a thread |
 //! | `session.rs` | one run: boot, periods, the ways out |
@@ -16,6 +17,7 @@
 pub mod clock;
 pub mod latency;
 pub mod port;
+pub mod realtime;
 pub mod session;
 pub mod store;
 pub mod telemetry;

@@ -28,6 +28,7 @@
 use super::clock::{ClockReport, PeriodClock};
 use super::latency::Latency;
 use super::port::{block_on, SerialBusPort};
+use super::realtime::{Linux, Realtime, RealtimeReport};
 use super::store::FileStore;
 use super::telemetry::TelemetryPipe;
 use crate::board::protocol::{EpisodeOutcome, RunProtocol};
@@ -78,6 +79,9 @@ pub struct DriveSetup {
     pub stop: Arc<AtomicBool>,
     /// The adapter's latency timer.
     pub latency: Latency,
+    /// Ask for a real-time control thread (`SCHED_FIFO`, locked memory)
+    /// for the periods in real time ([`super::realtime`]).
+    pub realtime: bool,
 }
 
 /// Why a run ended.
@@ -104,6 +108,8 @@ pub struct DriveOutcome {
     pub trial: BoardTrial,
     /// The period clock's measurements.
     pub clock: ClockReport,
+    /// What the operating system granted the control thread.
+    pub realtime: RealtimeReport,
     /// The bus's counters.
     pub bus: BusReport,
     /// The set-up of every servo, one line each.
@@ -307,6 +313,11 @@ fn run<W: WeightStore>(setup: &DriveSetup, table: W, mut tm: TelemetryPipe) -> a
 
     let period_us = spec.period_us;
     let period_s = spec.period_s();
+    // The periods' thread real time (the telemetry thread, started before,
+    // stays ordinary); in lock step no clock is kept, and a FIFO thread
+    // running flat out would starve the machine.
+    let why_not = if setup.lock_step { "lock step: the periods wait for no clock" } else { "--no-realtime" };
+    let mut rt = Realtime::enter(Linux, setup.realtime && !setup.lock_step, why_not);
     let mut clock = PeriodClock::new(period_us, !setup.lock_step);
     let mut protocol = RunProtocol::new(cfg.seconds, period_us);
     let counted = spec.counted.range();
@@ -448,6 +459,9 @@ fn run<W: WeightStore>(setup: &DriveSetup, table: W, mut tm: TelemetryPipe) -> a
     if !matches!(ended, Ended::PortGone(_)) {
         block_on(bus.stop_all());
     }
+    // Torque is off: the checkpoint and the files are written at the
+    // ordinary priority.
+    rt.leave();
     let (_, t) = ctl.command(&ToChip::Stop);
     if let Some(t) = t.filter(|t| t.changed()) {
         report_transition(&mut tm, &t, &ctl, readings.time_ms);
@@ -526,7 +540,16 @@ fn run<W: WeightStore>(setup: &DriveSetup, table: W, mut tm: TelemetryPipe) -> a
         episodes,
     };
     let telemetry = tm.finish()?;
-    Ok(DriveOutcome { ended, trial, clock: clock.report(), bus: bus_report, servos, checkpoint: checkpoint_lines, telemetry })
+    Ok(DriveOutcome {
+        ended,
+        trial,
+        clock: clock.report(),
+        realtime: rt.report().clone(),
+        bus: bus_report,
+        servos,
+        checkpoint: checkpoint_lines,
+        telemetry,
+    })
 }
 
 /// The zero command of a servo's kind.

@@ -3,9 +3,15 @@
 //! physics kept up with the wall clock (real time), until Ctrl-C or
 //! `--seconds`. Each servo event is a line on stderr as it happens; the
 //! summary says what the bus carried and what every servo did.
+//!
+//! In real time the loop's thread asks for `pada drive`'s real-time
+//! treatment (`SCHED_FIFO`, locked memory: [`crate::drive::realtime`]):
+//! the virtual servos stand in for hardware that a busy PC cannot slow
+//! down. The summary says what was granted.
 
 use super::bus::{BusStats, Event, Reply, VirtualBus};
 use super::pty::Pty;
+use crate::drive::realtime::{Linux, Realtime, RealtimeReport};
 use serde::Serialize;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -27,6 +33,8 @@ pub struct ServeSummary {
     pub baud: u32,
     /// `real-time` or `lock-step`.
     pub clock: &'static str,
+    /// What the operating system granted the loop's thread.
+    pub realtime: RealtimeReport,
     /// Why it ended.
     pub ended: String,
     /// Wall time \[s\].
@@ -44,8 +52,29 @@ pub struct ServeSummary {
     pub events: Vec<Event>,
 }
 
-/// Serves `bus` on `pty` until `stop` or `seconds`; `name` is the robot's.
-pub fn serve(bus: &mut VirtualBus, pty: &Pty, bps: u32, stop: &AtomicBool, seconds: Option<f64>, name: &str, lock_step: bool) -> std::io::Result<ServeSummary> {
+/// How to serve.
+pub struct ServeOptions<'a> {
+    /// The servos' rate \[bps\].
+    pub bps: u32,
+    /// Stop after this many wall-clock seconds.
+    pub seconds: Option<f64>,
+    /// The robot's name.
+    pub name: &'a str,
+    /// Lock step (the physics advance at each SYNC WRITE).
+    pub lock_step: bool,
+    /// In real time, ask for a real-time thread.
+    pub realtime: bool,
+}
+
+/// Serves `bus` on `pty` until `stop` or `opts.seconds`.
+pub fn serve(bus: &mut VirtualBus, pty: &Pty, stop: &AtomicBool, opts: &ServeOptions) -> std::io::Result<ServeSummary> {
+    let ServeOptions { bps, seconds, name, lock_step, .. } = *opts;
+    // In lock step the loop only waits for the client: nothing to hold.
+    let why_not = if lock_step { "lock step: the servos wait for the client" } else { "--no-realtime" };
+    let mut rt = Realtime::enter(Linux, opts.realtime && !lock_step, why_not);
+    for line in rt.report().lines() {
+        crate::console::errln!("servos: real time: {line}");
+    }
     let started = Instant::now();
     let mut pending: Vec<Reply> = Vec::new();
     let mut out: Vec<u8> = Vec::new();
@@ -94,12 +123,14 @@ pub fn serve(bus: &mut VirtualBus, pty: &Pty, bps: u32, stop: &AtomicBool, secon
         let now = started.elapsed().as_micros() as u64;
         pending.extend(bus.receive(&buf[..n], now, line));
     };
+    rt.leave();
     Ok(ServeSummary {
         robot: name.to_string(),
         port: pty.link().display().to_string(),
         device: pty.device().to_string(),
         baud: bps,
         clock: if lock_step { "lock-step" } else { "real-time" },
+        realtime: rt.report().clone(),
         ended,
         wall_s: started.elapsed().as_secs_f64(),
         bus_s: bus.now_us() as f64 * 1e-6,
