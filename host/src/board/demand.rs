@@ -240,9 +240,10 @@ mod tests {
     fn a_table_that_fills_warns_in_one_line_with_the_fixes_and_one_that_does_not_says_so() {
         let hashed = Board::F405.profile(&pada_core::robot::leo::SPEC).unwrap();
         let f = Forecast::of(&demand(vec![(600.0, 40_000), (1200.0, 80_000)]), &hashed).unwrap();
-        assert_eq!((f.slots, f.when_full.as_str()), (1 << 16, "collide"));
-        assert!(f.lines(&demand(vec![]))[0].contains("65536 hashed entries"));
+        assert_eq!((f.slots, f.when_full.as_str()), (1 << 15, "collide"));
+        assert!(f.lines(&demand(vec![]))[0].contains("32768 hashed entries"));
         let profile = hashed.with_hashed_table(Layout::Claimed, 15, hashed.format, 2);
+        assert_eq!(profile.weights(), Some(1 << 15));
         let fills = Forecast::of(&demand(vec![(600.0, 20_000), (1200.0, 40_000)]), &profile).unwrap();
         assert!(fills.fills());
         let lines = fills.lines(&demand(vec![]));

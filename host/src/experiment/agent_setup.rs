@@ -10,6 +10,7 @@ use crate::experiment::task::{TaskSpec, WeightTable};
 use pada_core::agent::Agent;
 use pada_core::policy::PolicyKind;
 use pada_core::tile_coding::Layout;
+use pada_core::weights::WeightFormat;
 
 pub use pada_core::profile::{TILINGS, TRACE};
 
@@ -34,7 +35,9 @@ pub fn build_agent(spec: &TaskSpec, policy: PolicyKind) -> anyhow::Result<HostAg
     };
     let weights = match spec.table {
         WeightTable::Claimed { format, tag_bytes, when_full, .. } => HostTable::claimed(size, format, tag_bytes)?.on_full(when_full),
-        _ => HostTable::plain(size),
+        // A board's hashed table keeps its weights in the board's format
+        // (the F405's: 16 bits); the host's own tables are Q16.
+        _ => HostTable::plain_of(size, spec.profile.map_or(WeightFormat::Q16, |p| p.format))?,
     };
     let mut agent = Agent::new(
         &spec.state,
