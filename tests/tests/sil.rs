@@ -337,7 +337,7 @@ fn leo_runs_on_the_f405_board_too() {
     let dir = tempfile::tempdir().unwrap();
     let s = Run::leo(Board::F405, 10.0).go(dir.path());
     assert!(s.passed, "{:#?}", check_failures(&s));
-    assert_eq!((s.board, s.machine, s.weights), ("f405", "netduinoplus2", 1 << 14));
+    assert_eq!((s.board, s.machine, s.weights), ("f405", "netduinoplus2", 1 << 15));
     assert!(s.replay.identical && s.replay.checksums_compared >= 3, "{:?}", s.replay);
 }
 
