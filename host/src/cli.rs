@@ -146,6 +146,8 @@ where
         Command::Demo(a) => commands::demo::run(a),
         Command::Paper(a) => commands::paper::run(a),
         Command::Mtbf(a) => commands::mtbf::run(a),
+        // Before flashing (a robot and a board) or after runs (their directories).
+        Command::Claims(a) if a.robot.is_some() || a.task.is_some() => commands::claims_demand::run(a),
         Command::Claims(a) => commands::claims::run(a),
         Command::Sil(a) => commands::sil::run(a),
         Command::Drive(a) => commands::drive::run(a),

@@ -1,6 +1,7 @@
 //! `pada claims`: what a trial writes. With `--robot FILE` or `--task
 //! leo` and `--board B`, before flashing: the slots one host trial of the
-//! robot writes against the board's claim table ([`super::claims_demand`]).
+//! robot writes against the board's claim table (`claims_demand`, which
+//! the command line dispatches to).
 //! Otherwise it reads the output directories of
 //! `pada run --task leo` (their `summary.json` and the `claimed_slots`
 //! column of each `trial-NNN.csv`, written for claim tables), prints the
@@ -133,9 +134,6 @@ fn at_time(curve: &[(f64, u32)], t: f64) -> Option<u32> {
 
 /// Runs `pada claims`.
 pub fn run(args: ClaimsArgs) -> Result<(), CliError> {
-    if args.robot.is_some() || args.task.is_some() {
-        return super::claims_demand::run(args);
-    }
     if let Some(t) = args.at.iter().find(|t| !(t.is_finite() && **t >= 0.0)) {
         return Err(usage(format!("--at {t} is out of range: valid is a learning time >= 0 s")));
     }

@@ -101,24 +101,7 @@ pub fn factory_table(id: u8, baud: u8) -> Vec<u8> {
     t
 }
 
-/// The state of an STS3215's output, for its position loop.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Output {
-    /// Position \[steps\].
-    pub position: f64,
-    /// Velocity \[steps/s\].
-    pub velocity: f64,
-    /// Bus time of the state \[µs\].
-    pub at_us: u64,
-    /// Conditions injected by faults (kept until the next RECOVERY).
-    pub injected: ServoStatus,
-}
-
-impl Default for Output {
-    fn default() -> Self {
-        Output { position: 2048.0, velocity: 0.0, at_us: 0, injected: ServoStatus::NONE }
-    }
-}
+pub use super::ft_output::Output;
 
 fn u16_at(t: &[u8], address: u8) -> u16 {
     u16::from_le_bytes([t[address as usize], t[address as usize + 1]])

@@ -20,6 +20,7 @@
 pub mod bus;
 pub mod chain;
 pub mod ft;
+pub mod ft_output;
 pub mod p1;
 pub mod p2;
 pub mod pty;

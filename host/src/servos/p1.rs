@@ -121,7 +121,7 @@ pub struct P1Servo {
     pub joint: Option<JointSpec>,
     /// An STS3215's output under its own position loop ([`super::ft`]);
     /// `None` for an RX-28, whose output is the rig's.
-    pub own_loop: Option<super::ft::Output>,
+    pub own_loop: Option<super::ft_output::Output>,
     /// The Baud Rate value it came with (a RESET restores the factory's).
     registered: Option<(u8, Vec<u8>)>,
 }
@@ -138,7 +138,7 @@ impl P1Servo {
     /// A servo of `layout`'s model with its factory table at `id` and Baud
     /// Rate value `baud`.
     pub fn of(layout: &'static Layout, id: u8, baud: u8, joint: Option<JointSpec>) -> Self {
-        let own_loop = (!core::ptr::eq(layout, &RX28_LAYOUT)).then(super::ft::Output::default);
+        let own_loop = (!core::ptr::eq(layout, &RX28_LAYOUT)).then(super::ft_output::Output::default);
         P1Servo { layout, table: (layout.factory)(id, baud), joint, own_loop, registered: None }
     }
 
