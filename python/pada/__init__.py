@@ -8,8 +8,9 @@ a learner takes, and PADA to make them last.
   MTBF in ``info``), ``PadaWrapper`` (Eq. 9, optionally driven by the wear
   governor with ``mtbf_budget=``) and ``LowPassWrapper`` (Eq. 8).
 - :mod:`pada.envs` — pada's simulated robots as Gymnasium environments:
-  ``pada/Pendulum-v0``, ``pada/PhysicalPendulum-v0``, ``pada/Leo-v0``, and
-  ``LeoVector(n)``.
+  ``pada/Pendulum-v0``, ``pada/PhysicalPendulum-v0``, ``pada/Leo-v0``,
+  ``LeoVector(n)``, and ``pada/Robot-v0`` (a robot of your own, from its
+  ``robot.toml`` and URDF).
 - :func:`read_telemetry` — a recorded telemetry stream as numpy arrays.
 """
 

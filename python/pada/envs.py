@@ -8,7 +8,11 @@ and time limit):
   (voltages, 33 Hz);
 - ``pada/Leo-v0`` — the rapier3d LEO of Section VIII: 7 voltage levels in
   [−10.7, 10.7] V on the three learned joints (``MultiDiscrete([7, 7, 7])``),
-  or continuous voltages with ``continuous=True``; 30 Hz, 25 s episodes.
+  or continuous voltages with ``continuous=True``; 30 Hz, 25 s episodes;
+- ``pada/Robot-v0`` — a robot of your own, from its ``robot.toml`` and URDF:
+  ``gym.make("pada/Robot-v0", robot="path/robot.toml")``. Its observation,
+  voltage levels, reward, ends, period, episode length and gearboxes are the
+  file's, stepped by the same Rust as ``pada run --robot`` (docs/python.md).
 
 Every environment takes level indices (``Discrete``/``MultiDiscrete``), or
 with ``continuous=True`` the motor's commands (``Box`` over its range).
@@ -27,7 +31,7 @@ from gymnasium import spaces
 
 from . import _pada
 
-__all__ = ["PendulumEnv", "PhysicalPendulumEnv", "LeoEnv", "LeoVector"]
+__all__ = ["PendulumEnv", "PhysicalPendulumEnv", "LeoEnv", "RobotEnv", "LeoVector"]
 
 
 class _PadaEnv(gym.Env):
@@ -36,11 +40,14 @@ class _PadaEnv(gym.Env):
     _pada_env = True
 
     def __init__(self, continuous=False, render_mode=None):
+        self._init(self._robot, continuous, render_mode)
+
+    def _init(self, robot, continuous, render_mode):
         if render_mode is not None:
             raise ValueError(f"render_mode = {render_mode!r}: valid is None (pada's environments do not render; use `pada render`)")
         if not isinstance(continuous, bool):
             raise ValueError(f"continuous = {continuous!r}: valid is True or False")
-        self._core = _pada.PlantEnv(self._robot, continuous)
+        self._core = _pada.PlantEnv(robot, continuous)
         spec = self._core.spec()
         self.spec_dict = spec
         self.continuous = continuous
@@ -88,6 +95,9 @@ class _PadaEnv(gym.Env):
         walked = self._core.walked_distance_m()
         if walked is not None:
             info["walked_distance_m"] = walked
+        fault = self._core.fault()
+        if fault is not None:
+            info["fault"] = fault
         return np.array(obs, dtype=np.float32), reward, terminated, truncated, info
 
 
@@ -115,6 +125,31 @@ class LeoEnv(_PadaEnv):
     750-step (25 s) episodes at 30 Hz."""
 
     _robot = "leo"
+
+
+class RobotEnv(_PadaEnv):
+    """A robot of files (``pada run --robot PATH``): ``RobotEnv(robot,
+    continuous=False)`` with ``robot`` the path of its ``robot.toml`` (its
+    URDF beside it, as the file names it). The observation is the file's
+    ``[[observe]]`` signals in order; the actions are one level index per
+    joint of ``[action]`` (``continuous=True``: voltages within the levels'
+    range); the reward and the episode's ends are the file's rules; a joint
+    past its soft limit ends the episode (``terminated``) and names itself in
+    ``info["fault"]``, where ``pada run --robot`` ends its trial. A file that
+    does not load raises ``ValueError`` with pada's message (the file, the
+    line, the field and its valid values)."""
+
+    def __init__(self, robot, continuous=False, render_mode=None):
+        import os
+
+        if not isinstance(robot, (str, os.PathLike)):
+            raise ValueError(f"robot = {robot!r}: valid is the path of a robot.toml")
+        path = os.fspath(robot)
+        # A path the Rust side tells from a built-in robot's name.
+        if not (path.endswith(".toml") or "/" in path):
+            path = os.path.join(".", path)
+        self._robot = path
+        self._init(path, continuous, render_mode)
 
 
 class LeoVector(gym.vector.VectorEnv):
@@ -175,7 +210,12 @@ class LeoVector(gym.vector.VectorEnv):
 
 
 def _register():
-    for name, cls in (("Pendulum-v0", "PendulumEnv"), ("PhysicalPendulum-v0", "PhysicalPendulumEnv"), ("Leo-v0", "LeoEnv")):
+    for name, cls in (
+        ("Pendulum-v0", "PendulumEnv"),
+        ("PhysicalPendulum-v0", "PhysicalPendulumEnv"),
+        ("Leo-v0", "LeoEnv"),
+        ("Robot-v0", "RobotEnv"),
+    ):
         env_id = f"pada/{name}"
         if env_id not in gym.registry:
             gym.register(id=env_id, entry_point=f"pada.envs:{cls}", disable_env_checker=False)

@@ -1,11 +1,14 @@
 //! `pada._pada.PlantEnv`: one of pada's simulated robots stepped as
 //! `pada run` steps it — the plant of the task (`pada_sim::task`),
 //! the motor's levels (or continuous commands), the task's time limit —
-//! for the Gymnasium environments of `pada.envs`.
+//! for the Gymnasium environments of `pada.envs`. A robot of files (a
+//! `robot.toml` and its URDF) is stepped as `pada run --robot` steps it.
 
 use crate::check;
 use pada_sim::task::{Plant, Task, TaskSpec};
 use pada_sim::leo::rl::{LeoPlant, LeoTask};
+use pada_sim::urdf::{RulesPlant, UrdfTask};
+use pada_core::robot::{RobotSpec, Vocab};
 use pada_sim::pendulum::{
     PhysicalPendulum, PhysicalPendulumTask, SimulatedPendulum, SimulatedPendulumTask,
 };
@@ -16,8 +19,9 @@ use pyo3::types::{PyDict, PyTuple};
 use rand_core::SeedableRng;
 use rand_pcg::Pcg64;
 
-/// The robots, by the names `pada run --task` uses.
-pub const KINDS: &str = "\"pendulum\", \"physical-pendulum\" or \"leo\"";
+/// The robots, by the names `pada run --task` uses, or a robot of files.
+pub const KINDS: &str =
+    "\"pendulum\", \"physical-pendulum\", \"leo\", or the path of a robot.toml (as `pada run --robot` takes it)";
 
 /// One of the three plants (concrete types, so the environment is `Sync`).
 pub enum AnyPlant {
@@ -27,6 +31,8 @@ pub enum AnyPlant {
     Physical(PhysicalPendulum),
     /// The rapier3d LEO of Section VIII.
     Leo(Box<LeoPlant>),
+    /// A robot of files: its URDF in rapier3d, its robot.toml's rules.
+    Urdf(Box<RulesPlant<Vocab>>, &'static RobotSpec),
 }
 
 impl AnyPlant {
@@ -36,6 +42,7 @@ impl AnyPlant {
             AnyPlant::Pendulum(p) => p,
             AnyPlant::Physical(p) => p,
             AnyPlant::Leo(p) => p.as_mut(),
+            AnyPlant::Urdf(p, _) => p.as_mut(),
         }
     }
     /// The plant, shared.
@@ -44,12 +51,32 @@ impl AnyPlant {
             AnyPlant::Pendulum(p) => p,
             AnyPlant::Physical(p) => p,
             AnyPlant::Leo(p) => p.as_ref(),
+            AnyPlant::Urdf(p, _) => p.as_ref(),
         }
     }
 }
 
-/// The task's description and a new plant, as `pada run --task kind`.
+/// Whether `robot` names a file rather than a built-in robot: as `pada run
+/// --robot` tells them apart (a path has a `/` or ends in `.toml`).
+fn is_path(robot: &str) -> bool {
+    robot.ends_with(".toml") || robot.contains('/')
+}
+
+/// A robot of files read, checked and built as `pada run --robot` does it
+/// (the host's learner profile: the state, levels and ends are the file's).
+fn from_file(path: &str) -> PyResult<(TaskSpec, AnyPlant)> {
+    let file = pada_robot_file::load(std::path::Path::new(path))
+        .map_err(|e| PyValueError::new_err(format!("robot = {path:?}: {e}")))?;
+    let task = UrdfTask::new(&file).map_err(|e| PyValueError::new_err(format!("robot = {path:?}: {e}")))?;
+    Ok((task.spec().clone(), AnyPlant::Urdf(Box::new(task.plant()), file.spec)))
+}
+
+/// The task's description and a new plant, as `pada run --task kind` (or
+/// `pada run --robot PATH`).
 pub fn make(kind: &str) -> PyResult<(TaskSpec, AnyPlant)> {
+    if is_path(kind) {
+        return from_file(kind);
+    }
     Ok(match kind {
         "pendulum" => {
             let t = SimulatedPendulumTask::default();
@@ -130,10 +157,13 @@ impl Core {
         self.command[..m].copy_from_slice(&command[..m]);
         let s = self.plant.get().step(&command[..m], &mut self.obs[..n]);
         self.steps += 1;
+        // A fault (a joint past its soft limit) ends the episode, as `pada
+        // run --robot` ends its trial there; `PlantEnv.fault` names it.
+        let terminal = s.terminal || self.plant.get_ref().fault().is_some();
         StepOut {
             reward: s.reward,
-            terminal: s.terminal,
-            truncated: !s.terminal && self.steps >= self.spec.episode_steps,
+            terminal,
+            truncated: !terminal && self.steps >= self.spec.episode_steps,
         }
     }
 
@@ -352,6 +382,21 @@ impl PlantEnv {
     /// (`pada run`'s `physical_mtbf_s`).
     fn gearbox_torques(&self) -> Vec<f64> {
         self.core.gearbox_torques()
+    }
+
+    /// The fault of the last step (a joint past its soft limit), as
+    /// `"soft-limit: joint shoulder (servo id 1)"`, else `None`.
+    fn fault(&self) -> Option<String> {
+        let joints = match &self.core.plant {
+            AnyPlant::Urdf(_, robot) => robot.joints,
+            _ => &[],
+        };
+        self.core.plant.get_ref().fault().map(|f| {
+            match f.joint().and_then(|j| joints.get(j as usize)) {
+                Some(j) => format!("{}: joint {} (servo id {})", f.name(), j.name, j.id),
+                None => f.name().to_string(),
+            }
+        })
     }
 
     /// Walked distance in the episode \[m\] (LEO), else `None`.
