@@ -9,7 +9,9 @@
 #![warn(missing_docs)]
 
 pub mod board;
-pub mod capture;
+/// Telemetry decoding and its CSV: the crate `pada_telemetry`, here under
+/// the module name the commands use.
+pub use pada_telemetry::capture;
 pub mod checkpoint_keeper;
 pub mod cli;
 pub mod commands;
@@ -19,7 +21,6 @@ pub mod error;
 pub mod experiment;
 pub mod foxglove;
 pub mod gait;
-pub mod gearbox_spec;
 pub mod mcap;
 pub mod motion;
 pub mod output;

@@ -5,7 +5,7 @@
 //! the fields as a dict.
 
 use crate::check;
-use pada::gearbox_spec::{self, ChosenGearbox, GearboxFile};
+use pada_robot_file::gearbox_file::{self, ChosenGearbox, GearboxFile};
 use pada_core::fatigue::{FatigueReport, JointFatigue, PAPER_WINDOW_STEPS};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -158,7 +158,7 @@ impl Fatigue {
 fn one_gearbox(obj: &Bound<'_, PyAny>) -> PyResult<ChosenGearbox> {
     if let Ok(s) = obj.cast::<PyString>() {
         let spec = s.to_cow()?;
-        return gearbox_spec::resolve(&spec).map_err(|e| PyValueError::new_err(format!("gearbox: {e}")));
+        return gearbox_file::resolve(&spec).map_err(|e| PyValueError::new_err(format!("gearbox: {e}")));
     }
     if obj.cast::<PyDict>().is_ok() {
         let json: String = obj

@@ -1,9 +1,9 @@
 //! `pada.read_telemetry`: a recorded telemetry stream (`pada run
 //! --telemetry FILE`, a board's raw serial output) decoded by the host's
-//! capture decoder (`pada::capture::Recorder`, the one `pada capture`
+//! capture decoder (`pada_telemetry::capture::Recorder`, the one `pada capture`
 //! uses), so its frame and loss counts are `pada capture --json`'s.
 
-use pada::capture::{mode_name, step_kind_name, Recorder};
+use pada_telemetry::capture::{mode_name, step_kind_name, Recorder};
 use pada_core::wire::ToHost;
 use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;

@@ -93,7 +93,7 @@ pub fn rust_source(spec: &RobotSpec, origin: &str) -> Result<String, String> {
     let _ = writeln!(w, "use pada_core::tile_coding::StateDim;");
     let _ = writeln!(w, "use pada_core::agent::{{SarsaParams, WeightInit}};");
     let _ = writeln!(w, "use pada_core::trace::TraceKind;");
-    let _ = writeln!(w, "use pada_core::safety::SoftLimit;\n");
+    let _ = writeln!(w, "#[allow(unused_imports)] // a robot without soft limits names none\nuse pada_core::safety::SoftLimit;\n");
     capacities(w, spec, v);
 
     // Joints.

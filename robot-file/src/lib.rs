@@ -24,6 +24,8 @@
 mod codegen;
 mod definition;
 mod error;
+/// Gearbox files: the Table I fields of a gearbox by name or from TOML.
+pub mod gearbox_file;
 pub mod schema;
 pub mod template;
 mod type_error;

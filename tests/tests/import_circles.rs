@@ -422,10 +422,18 @@ fn crate_graph(c: &Crate) -> BTreeMap<Module, BTreeSet<Module>> {
     g
 }
 
-/// The import graph of every module of the three crates.
+/// The import graph of every module of pada's crates.
 fn graph(root: &Path) -> BTreeMap<Module, BTreeSet<Module>> {
     let mut g = BTreeMap::new();
-    for (name, dir) in [("shared", "shared/src"), ("host", "host/src"), ("firmware", "firmware/src")] {
+    for (name, dir) in [
+        ("shared", "shared/src"),
+        ("robot-file", "robot-file/src"),
+        ("sim", "sim/src"),
+        ("telemetry", "telemetry/src"),
+        ("host", "host/src"),
+        ("firmware", "firmware/src"),
+        ("python", "python/src"),
+    ] {
         g.extend(crate_graph(&load(name, &root.join(dir))));
     }
     g

@@ -8,7 +8,7 @@
 use crate::console::outln;
 use crate::error::{usage, CliError};
 use crate::torque_log;
-use crate::gearbox_spec::{self, ChosenGearbox};
+use pada_robot_file::gearbox_file::{self, ChosenGearbox};
 use pada_core::fatigue::{FatigueReport, JointFatigue};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -73,7 +73,7 @@ pub fn run(args: MtbfArgs) -> Result<(), CliError> {
     }
     let log = torque_log::read(&args.torques)?;
     let gearboxes = match &args.gearbox {
-        Some(spec) => gearbox_spec::resolve_list(spec, log.joints.len()).map_err(usage)?,
+        Some(spec) => gearbox_file::resolve_list(spec, log.joints.len()).map_err(usage)?,
         None => vec![ChosenGearbox::table_i(); log.joints.len()],
     };
     let period = 1.0 / args.rate;

@@ -151,7 +151,7 @@ pub struct Latest {
 }
 
 /// What a [`Recorder`] hands every frame to besides its own counters
-/// (`crate::mcap::Tap`: MCAP and the Foxglove server). A trait here, so
+/// (`pada::mcap`: MCAP and the Foxglove server). A trait here, so
 /// that the capture path need not import what it feeds.
 pub trait FrameTap {
     /// A decoded frame, with the link's counters after it.
