@@ -18,8 +18,9 @@ fn read(rel: &str) -> String {
 }
 
 /// The documents whose shell blocks a user copies.
-const GUIDES: [&str; 6] = [
+const GUIDES: [&str; 7] = [
     "README.md",
+    "docs/commands.md",
     "docs/your-robot.md",
     "docs/board.md",
     "docs/sil.md",
