@@ -107,7 +107,7 @@ pub fn run(args: ServosArgs) -> Result<(), CliError> {
     if let Some(chain) = &args.chain {
         return run_chain(&args, chain);
     }
-    let Some(mut robot) = args.robot else {
+    let Some(mut robot) = args.robot.clone() else {
         return Err(usage("give --robot R (the robot whose servos to emulate; valid are pendulum, pendulum-20hz, leo, or the path of a robot.toml), --chain MODEL:IDS or --scan"));
     };
     if let Some(name) = &args.servo {
@@ -138,18 +138,8 @@ pub fn run(args: ServosArgs) -> Result<(), CliError> {
     if robot.spec.encoder.is_some() {
         errln!("servos: the robot's encoder is the sensor device, ID {}", pada_firmware::sensor_device::SENSOR_ID);
     }
-    let stop = Arc::new(AtomicBool::new(false));
-    {
-        let stop = stop.clone();
-        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
-    }
-    let opts = serve::ServeOptions { bps, seconds: args.seconds, name: robot.spec.name, lock_step: args.lockstep, realtime: !args.no_realtime };
-    let summary = serve::serve(&mut bus, &pty, &stop, &opts)
-        .map_err(|e| CliError::Runtime(anyhow::anyhow!("the virtual port failed: {e}")))?;
-    drop(pty);
-    if args.json {
-        outln!("{}", serde_json::to_string_pretty(&summary).map_err(|e| CliError::Runtime(e.into()))?)?;
-    } else {
+    let summary = serve_until_stopped(&mut bus, pty, &args, bps, robot.spec.name)?;
+    if !args.json {
         errln!(
             "servos: ended ({}): {} packets, {} answers, {} periods (sync writes), {:.3} s of bus time in {:.1} s",
             summary.ended,
@@ -162,6 +152,24 @@ pub fn run(args: ServosArgs) -> Result<(), CliError> {
         errln!("servos: real time: {}", summary.realtime.summary());
     }
     Ok(())
+}
+
+/// Serves `bus` on `pty` until Ctrl-C, `--seconds` or a closed port; with
+/// `--json`, prints the summary on stdout (the caller reports it otherwise).
+fn serve_until_stopped(bus: &mut VirtualBus, pty: Pty, args: &ServosArgs, bps: u32, name: &str) -> Result<serve::ServeSummary, CliError> {
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
+    }
+    let opts = serve::ServeOptions { bps, seconds: args.seconds, name, lock_step: args.lockstep, realtime: !args.no_realtime };
+    let summary = serve::serve(bus, &pty, &stop, &opts)
+        .map_err(|e| CliError::Runtime(anyhow::anyhow!("the virtual port failed: {e}")))?;
+    drop(pty);
+    if args.json {
+        outln!("{}", serde_json::to_string_pretty(&summary).map_err(|e| CliError::Runtime(e.into()))?)?;
+    }
+    Ok(summary)
 }
 
 /// The servos' one rate (`--baud`, default 1 000 000 bps).
@@ -241,18 +249,8 @@ fn run_chain(args: &ServosArgs, chain: &str) -> Result<(), CliError> {
     let pty = Pty::create(&args.port).map_err(|e| usage(format!("--port {}: cannot make the virtual port: {e}", args.port.display())))?;
     let name = format!("{} chain", spec.model.to_ascii_uppercase());
     errln!("servos: {name} (IDs {:?}) at {bps} bps on {} -> {}", spec.ids, args.port.display(), pty.device());
-    let stop = Arc::new(AtomicBool::new(false));
-    {
-        let stop = stop.clone();
-        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
-    }
-    let opts = serve::ServeOptions { bps, seconds: args.seconds, name: &name, lock_step: args.lockstep, realtime: !args.no_realtime };
-    let summary = serve::serve(&mut bus, &pty, &stop, &opts)
-        .map_err(|e| CliError::Runtime(anyhow::anyhow!("the virtual port failed: {e}")))?;
-    drop(pty);
-    if args.json {
-        outln!("{}", serde_json::to_string_pretty(&summary).map_err(|e| CliError::Runtime(e.into()))?)?;
-    } else {
+    let summary = serve_until_stopped(&mut bus, pty, &args, bps, &name)?;
+    if !args.json {
         errln!("servos: ended ({}): {} packets, {} answers", summary.ended, summary.stats.packets, summary.stats.replies);
     }
     Ok(())
