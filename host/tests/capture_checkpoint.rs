@@ -232,6 +232,22 @@ impl Stderr {
 
 /// The file at `path` is the checkpoint `kept` (or, with none kept yet,
 /// absent), whole.
+/// `pada ARGS LINK --checkpoint PATH`, once it says it keeps the checkpoint.
+fn keep_checkpoint(args: &[&str], link: &Path, path: &Path) -> (Child, Stderr) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_pada"))
+        .args(args)
+        .arg(link)
+        .arg("--checkpoint")
+        .arg(path)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut err = Stderr::follow(&mut child);
+    err.wait_for("keeping the board's checkpoint at");
+    (child, err)
+}
+
 fn assert_kept(path: &Path, kept: Option<&Save>, when: &str) {
     match kept {
         None => assert!(!path.exists(), "{when}: a file before the first complete save"),
@@ -259,17 +275,7 @@ fn capture_keeps_the_checkpoint_through_ten_unplugs_mid_save_and_sends_it_back_a
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("leo.ckpt");
     let mut board = Board::plugged_at(dir.path().join("ttyUSB-leo"));
-    let mut child = Command::new(env!("CARGO_BIN_EXE_pada"))
-        .args(["capture", "--port"])
-        .arg(&board.link)
-        .arg("--checkpoint")
-        .arg(&path)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut err = Stderr::follow(&mut child);
-    err.wait_for("keeping the board's checkpoint at");
+    let (child, mut err) = keep_checkpoint(&["capture", "--port"], &board.link, &path);
 
     let mut kept: Option<Save> = None;
     // The generation the board saves next; a save cut off is made again
@@ -400,17 +406,7 @@ fn watch_keeps_the_checkpoint_and_sends_it_back_on_its_port() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("leo.ckpt");
     let mut board = Board::plugged_at(dir.path().join("ttyACM-leo"));
-    let mut child = Command::new(env!("CARGO_BIN_EXE_pada"))
-        .args(["watch", "--serve", "127.0.0.1:0", "--port"])
-        .arg(&board.link)
-        .arg("--checkpoint")
-        .arg(&path)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut err = Stderr::follow(&mut child);
-    err.wait_for("keeping the board's checkpoint at");
+    let (child, mut err) = keep_checkpoint(&["watch", "--serve", "127.0.0.1:0", "--port"], &board.link, &path);
     assert_eq!(board.restore(), Err(RestoreDenied::NoCheckpoint));
     let s = save(3, 3);
     for c in &s.chunks {

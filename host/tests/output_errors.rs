@@ -47,32 +47,14 @@ fn commands(dir: &Path) -> Vec<Vec<String>> {
     let file = recording().display().to_string();
     let log = torque_log(dir).display().to_string();
     let out = dir.join("run").display().to_string();
+    // Each line's words, with `@` standing for the one path (which may hold
+    // spaces).
+    let line = |text: &str, path: &str| text.split(' ').map(|w| if w == "@" { path.to_string() } else { w.to_string() }).collect();
     vec![
-        vec![
-            "capture".into(),
-            "--file".into(),
-            file.clone(),
-            "--json".into(),
-        ],
-        vec!["mtbf".into(), "--torques".into(), log.clone()],
-        vec!["mtbf".into(), "--torques".into(), log, "--json".into()],
-        [
-            "run",
-            "--task",
-            "pendulum",
-            "--algo",
-            "sarsa",
-            "--trials",
-            "1",
-            "--seconds",
-            "30",
-            "--threads",
-            "1",
-            "--out",
-            &out,
-        ]
-        .map(String::from)
-        .to_vec(),
+        line("capture --file @ --json", &file),
+        line("mtbf --torques @", &log),
+        line("mtbf --torques @ --json", &log),
+        line("run --task pendulum --algo sarsa --trials 1 --seconds 30 --threads 1 --out @", &out),
     ]
 }
 
