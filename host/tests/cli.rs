@@ -417,18 +417,9 @@ fn run_json_prints_the_summary_and_writes_the_files() {
 fn paper_pendulum_writes_the_report_and_the_figures() {
     let dir = tempfile::tempdir().unwrap();
     let out_dir = dir.path().join("paper");
-    let out = pada(&[
-        "paper",
-        "pendulum",
-        "--trials",
-        "2",
-        "--seconds",
-        "30",
-        "--physical-seconds",
-        "30",
-        "--out",
-        out_dir.to_str().unwrap(),
-    ]);
+    let mut args: Vec<&str> = "paper pendulum --trials 2 --seconds 30 --physical-seconds 30 --out".split(' ').collect();
+    args.push(out_dir.to_str().unwrap());
+    let out = pada(&args);
     assert_eq!(
         out.status.code(),
         Some(0),

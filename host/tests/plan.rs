@@ -74,19 +74,8 @@ fn a_merged_paper_pendulum_equals_the_local_run_byte_for_byte() {
         root.path().join("plan"),
         root.path().join("merged"),
     );
-    let opts = [
-        "--trials",
-        "2",
-        "--seconds",
-        "30",
-        "--physical-seconds",
-        "30",
-        "--seed",
-        "3",
-    ];
     let with = |extra: &[&str]| {
-        let mut v = vec!["paper", "pendulum"];
-        v.extend(opts);
+        let mut v: Vec<&str> = "paper pendulum --trials 2 --seconds 30 --physical-seconds 30 --seed 3".split(' ').collect();
         v.extend(extra);
         v.iter().map(|s| s.to_string()).collect::<Vec<_>>()
     };
