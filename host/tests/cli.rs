@@ -36,81 +36,34 @@ fn sil_faults_that_cannot_apply_are_refused() {
     assert_bad_input(&["sil", "--fault", "wobble"], &["wobble", "past-limit"]);
 }
 
+/// Each value out of its range: the command line, and what the one line of
+/// stderr must name.
+const OUT_OF_RANGE: &[(&str, &[&str])] = &[
+    ("run --algo lowpass --alpha 1.5", &["--alpha 1.5", "0 < alpha <= 1"]),
+    ("run --algo lowpass --alpha -0.2", &["0 < alpha <= 1"]),
+    ("run --algo pada --delta 0", &["--delta 0", "0 < delta <= 1"]),
+    ("run --algo integrator --delta NaN", &["0 < delta <= 1"]),
+    ("run --algo sarsa --delta 0.5", &["--delta applies only"]),
+    ("run --algo pada --alpha 0.5", &["--alpha applies only"]),
+    ("run --algo sarsa --trials 0", &["--trials", "1..=10000"]),
+    ("run --algo sarsa --trials many", &["--trials", "many"]),
+    ("run --algo sarsa --seconds -5", &["--seconds -5", "0 < seconds"]),
+    ("run --algo sarsa --seconds inf", &["0 < seconds"]),
+    ("run --algo sarsa --switch-at 10", &["--switch-at applies only"]),
+    ("run --algo pada --seconds 100 --switch-at 200", &["0 <= switch-at <= seconds"]),
+    ("run --algo sarsa --threads 0", &["--threads"]),
+    ("demo --seconds 0", &["0 < seconds"]),
+    ("paper pendulum --physical-seconds -1", &["--physical-seconds"]),
+    ("mtbf --torques x.csv --rate 0", &["--rate 0", "0 < rate"]),
+    ("mtbf --torques x.csv --window 0", &["--window"]),
+];
+
 #[test]
 fn parameters_out_of_range_name_the_range() {
-    assert_bad_input(
-        &["run", "--algo", "lowpass", "--alpha", "1.5"],
-        &["--alpha 1.5", "0 < alpha <= 1"],
-    );
-    assert_bad_input(
-        &["run", "--algo", "lowpass", "--alpha", "-0.2"],
-        &["0 < alpha <= 1"],
-    );
-    assert_bad_input(
-        &["run", "--algo", "pada", "--delta", "0"],
-        &["--delta 0", "0 < delta <= 1"],
-    );
-    assert_bad_input(
-        &["run", "--algo", "integrator", "--delta", "NaN"],
-        &["0 < delta <= 1"],
-    );
-    assert_bad_input(
-        &["run", "--algo", "sarsa", "--delta", "0.5"],
-        &["--delta applies only"],
-    );
-    assert_bad_input(
-        &["run", "--algo", "pada", "--alpha", "0.5"],
-        &["--alpha applies only"],
-    );
-    assert_bad_input(
-        &["run", "--algo", "sarsa", "--trials", "0"],
-        &["--trials", "1..=10000"],
-    );
-    assert_bad_input(
-        &["run", "--algo", "sarsa", "--trials", "many"],
-        &["--trials", "many"],
-    );
-    assert_bad_input(
-        &["run", "--algo", "sarsa", "--seconds", "-5"],
-        &["--seconds -5", "0 < seconds"],
-    );
-    assert_bad_input(
-        &["run", "--algo", "sarsa", "--seconds", "inf"],
-        &["0 < seconds"],
-    );
-    assert_bad_input(
-        &["run", "--algo", "sarsa", "--switch-at", "10"],
-        &["--switch-at applies only"],
-    );
-    assert_bad_input(
-        &[
-            "run",
-            "--algo",
-            "pada",
-            "--seconds",
-            "100",
-            "--switch-at",
-            "200",
-        ],
-        &["0 <= switch-at <= seconds"],
-    );
-    assert_bad_input(
-        &["run", "--algo", "sarsa", "--threads", "0"],
-        &["--threads"],
-    );
-    assert_bad_input(&["demo", "--seconds", "0"], &["0 < seconds"]);
-    assert_bad_input(
-        &["paper", "pendulum", "--physical-seconds", "-1"],
-        &["--physical-seconds"],
-    );
-    assert_bad_input(
-        &["mtbf", "--torques", "x.csv", "--rate", "0"],
-        &["--rate 0", "0 < rate"],
-    );
-    assert_bad_input(
-        &["mtbf", "--torques", "x.csv", "--window", "0"],
-        &["--window"],
-    );
+    for (line, needles) in OUT_OF_RANGE {
+        let args: Vec<&str> = line.split(' ').collect();
+        assert_bad_input(&args, needles);
+    }
 }
 
 #[test]
