@@ -188,16 +188,7 @@ fn firmware(root: &Path, build: Build) -> Result<PathBuf, String> {
     let target_dir = root.join("target").join("firmware");
     let profile = if release { "release" } else { "debug" };
 
-    let mut cmd = toolchain.cargo_build(&firmware_dir);
-    cmd.arg("--manifest-path")
-        .arg(firmware_dir.join("Cargo.toml"))
-        .arg("--target")
-        .arg(TARGET)
-        .arg("--target-dir")
-        .arg(&target_dir);
-    if release {
-        cmd.arg("--release");
-    }
+    let mut cmd = toolchain.cargo_build_firmware(&firmware_dir, &target_dir, release);
     let mut features: Vec<&str> = Vec::new();
     if chip != Chip::F405 {
         cmd.arg("--no-default-features");
@@ -306,18 +297,8 @@ fn qemu_image(root: &Path, build: Build) -> Result<PathBuf, String> {
     let profile = if build.release { "release" } else { "debug" };
     let (machine_feature, machine, memory_x) = build.chip.emulated();
     let features = [machine_feature];
-    let mut cmd = toolchain.cargo_build(&firmware_dir);
-    cmd.arg("--manifest-path")
-        .arg(firmware_dir.join("Cargo.toml"))
-        .arg("--target")
-        .arg(TARGET)
-        .arg("--target-dir")
-        .arg(&target_dir)
-        .args(["--no-default-features", "--features", &features.join(",")])
-        .env("PADA_ROBOT", build.robot.env());
-    if build.release {
-        cmd.arg("--release");
-    }
+    let mut cmd = toolchain.cargo_build_firmware(&firmware_dir, &target_dir, build.release);
+    cmd.args(["--no-default-features", "--features", &features.join(",")]).env("PADA_ROBOT", build.robot.env());
     println!(
         "xtask: building pada-firmware ({profile}, board profile {} emulated on QEMU's {machine}, robot {}) for {TARGET}",
         build.chip.profile(),

@@ -110,6 +110,23 @@ impl Toolchain {
         }
         cmd
     }
+
+    /// `cargo build` of the firmware crate in `firmware_dir` for [`TARGET`]
+    /// into `target_dir`, in release when `release`: what every firmware
+    /// image's build starts from (features and the robot come after).
+    pub fn cargo_build_firmware(&self, firmware_dir: &Path, target_dir: &Path, release: bool) -> Command {
+        let mut cmd = self.cargo_build(firmware_dir);
+        cmd.arg("--manifest-path")
+            .arg(firmware_dir.join("Cargo.toml"))
+            .arg("--target")
+            .arg(TARGET)
+            .arg("--target-dir")
+            .arg(target_dir);
+        if release {
+            cmd.arg("--release");
+        }
+        cmd
+    }
 }
 
 /// Finds a toolchain that can build for [`TARGET`], preferring the native one.
