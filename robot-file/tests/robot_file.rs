@@ -56,6 +56,17 @@ fn the_arm_reads_as_its_files_say() {
 }
 
 #[test]
+fn a_robots_directory_reads_as_its_robot_toml() {
+    let dir = reacher().parent().unwrap().to_path_buf();
+    let r = load(&dir).unwrap();
+    assert_eq!(r.spec.definition_hash(), load(&reacher()).unwrap().spec.definition_hash());
+    // A directory without one names the file it looked for.
+    let empty = tempfile::tempdir().unwrap();
+    let e = load(empty.path()).unwrap_err().to_string();
+    assert!(e.contains("robot.toml") && e.contains("cannot read it"), "{e}");
+}
+
+#[test]
 fn a_new_robots_template_reads_as_it_is() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("robot.toml"), template::robot_toml("my-arm")).unwrap();
