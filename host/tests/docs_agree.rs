@@ -18,13 +18,14 @@ fn read(rel: &str) -> String {
 }
 
 /// The documents whose shell blocks a user copies.
-const GUIDES: [&str; 6] = [
+const GUIDES: [&str; 7] = [
     "README.md",
     "docs/your-robot.md",
     "docs/board.md",
     "docs/sil.md",
     "docs/cluster.md",
     "examples/robots/arm2/README.md",
+    "examples/robots/so101/README.md",
 ];
 
 /// Every command line of the ```sh blocks of `doc`, comments cut, split at

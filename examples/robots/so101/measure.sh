@@ -10,24 +10,26 @@
 set -euo pipefail
 cd "$(dirname "$0")/../../.."
 out=${1:-pada-out/so101}
-robot=examples/robots/so101
 cargo build --release -q -p pada
-pada=target/release/pada
-mkdir -p "$out"
 
-for algo in sarsa pada; do
-    "$pada" run --robot "$robot" --algo "$algo" --trials 20 --seconds 1200 --threads 1 --out "$out/run-$algo"
-done
+# learn ALGO SECONDS DIR [pada run's other flags…]: one `pada run` of the arm.
+learn() {
+    local algo=$1 secs=$2 dir=$3
+    shift 3
+    mkdir -p "$dir"
+    target/release/pada run --robot examples/robots/so101 --algo "$algo" --seconds "$secs" --threads 1 --out "$dir/run" "$@"
+}
+
+learn sarsa 1200 "$out/sarsa" --trials 20
+learn pada 1200 "$out/pada" --trials 20
 
 for algo in pada sarsa; do
     for secs in 600 1200; do
         held=0
-        for seed in 1 2 3 4 5 6 7 8 9 10; do
+        for seed in $(seq 1 10); do
             dir="$out/hold-$algo-$secs/seed-$seed"
-            mkdir -p "$dir"
-            "$pada" run --robot "$robot" --algo "$algo" --trials 1 --seed "$seed" --seconds "$secs" --threads 1 \
-                --out "$dir/run" --save-weights "$dir/weights.wts" > /dev/null
-            line=$("$pada" render --robot "$robot" --policy "$dir/weights.wts" --out "$dir/render" | grep '^grip:')
+            learn "$algo" "$secs" "$dir" --trials 1 --seed "$seed" --save-weights "$dir/weights.wts" > /dev/null
+            line=$(target/release/pada render --robot examples/robots/so101 --policy "$dir/weights.wts" --out "$dir/render" | grep '^grip:')
             echo "$algo, $secs s, seed $seed: $line"
             [[ $line == *"not held"* ]] || held=$((held + 1))
         done
@@ -35,4 +37,4 @@ for algo in pada sarsa; do
     done
 done
 
-"$pada" run --robot "$robot" --board f405 --algo pada --trials 1 --seconds 1200 --threads 1 --out "$out/board-f405"
+learn pada 1200 "$out/board-f405" --trials 1 --board f405
