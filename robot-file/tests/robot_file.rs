@@ -288,3 +288,23 @@ fn an_observation_too_fine_for_an_exact_table_takes_a_claim_table() {
     let e = refused(|t| fine(t).replace("[robot]\n", "[robot]\ntable = \"exact\"\n"), |u| u);
     assert!(e.contains("robot.table") && e.contains("exact") && e.contains("claim"), "{e}");
 }
+
+#[test]
+fn the_so101_example_is_six_sts3215_two_learned() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/robots/so101");
+    let r = load(&dir).unwrap();
+    let s = r.spec;
+    assert_eq!(s.name, "so101");
+    // LeRobot's joint names and IDs, every servo the follower's STS3215-C001.
+    let names = ["shoulder_pan", "shoulder_lift", "elbow_flex", "wrist_flex", "wrist_roll", "gripper"];
+    assert_eq!(s.joints.iter().map(|j| (j.name, j.id)).collect::<Vec<_>>(), names.iter().copied().zip(1..=6).collect::<Vec<_>>());
+    for j in s.joints {
+        assert_eq!((j.servo.name, j.servo.protocol, j.zero), ("STS3215", pada_core::servo::ServoProtocol::Feetech, 2048));
+    }
+    // The shoulder lift and the elbow learned and counted, the rest held.
+    assert_eq!((s.counted.start, s.counted.end, s.motor_dims), (1, 3, 2));
+    // The kit's 5 V supply, and an exact table that fits the F405.
+    assert_eq!(s.supply_nominal_v, 5.0);
+    assert_eq!(s.table, TableNeed::Exact { weights: 25_600 });
+    assert!(r.profile(Board::F405).is_ok());
+}
