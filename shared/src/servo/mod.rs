@@ -4,7 +4,11 @@
 //! Eqs. 3–7, Table I).
 //!
 //! A robot's joint names its servo model ([`servo`], case-insensitive); the
-//! model names its gearbox ([`ServoModel::gearbox`], [`gearbox::gearbox`]).
+//! model names its gearbox ([`ServoModel::gearbox`], [`gearbox::gearbox`])
+//! and its bus protocol ([`ServoProtocol`]: Dynamixel 1.0, 2.0 or Feetech).
+//! The ROBOTIS models' figures are their e-Manual pages'; the Feetech
+//! STS3215's are its listings', its leader variants' estimates
+//! ([`feetech`], [`ServoModel::figure_notes`]).
 //! Every figure names where it comes from; `docs/reference/servos.md` shows
 //! both tables and a test keeps that page and this data equal.
 //!
