@@ -26,6 +26,7 @@ const GUIDES: [&str; 7] = [
     "docs/sil.md",
     "docs/cluster.md",
     "examples/robots/arm2/README.md",
+    "examples/robots/so101/README.md",
 ];
 
 /// Every command line of the ```sh blocks of `doc`, comments cut, split at

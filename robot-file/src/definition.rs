@@ -65,8 +65,16 @@ impl RobotFile {
     }
 }
 
-/// Reads, checks and builds the robot of `path` (a `robot.toml`).
+/// Reads, checks and builds the robot of `path` (a `robot.toml`, or the
+/// directory that holds it).
 pub fn load(path: &Path) -> Result<RobotFile, RobotFileError> {
+    let joined;
+    let path = if path.is_dir() {
+        joined = path.join("robot.toml");
+        joined.as_path()
+    } else {
+        path
+    };
     let text = std::fs::read_to_string(path).map_err(|e| RobotFileError {
         file: path.to_path_buf(),
         at: None,

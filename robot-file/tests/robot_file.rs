@@ -56,6 +56,17 @@ fn the_arm_reads_as_its_files_say() {
 }
 
 #[test]
+fn a_robots_directory_reads_as_its_robot_toml() {
+    let dir = reacher().parent().unwrap().to_path_buf();
+    let r = load(&dir).unwrap();
+    assert_eq!(r.spec.definition_hash(), load(&reacher()).unwrap().spec.definition_hash());
+    // A directory without one names the file it looked for.
+    let empty = tempfile::tempdir().unwrap();
+    let e = load(empty.path()).unwrap_err().to_string();
+    assert!(e.contains("robot.toml") && e.contains("cannot read it"), "{e}");
+}
+
+#[test]
 fn a_new_robots_template_reads_as_it_is() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("robot.toml"), template::robot_toml("my-arm")).unwrap();
@@ -165,6 +176,31 @@ fn a_zero_count_past_the_encoder_is_refused() {
 }
 
 #[test]
+fn a_feetech_sts3215_joint_reads_with_its_4096_counts_a_turn() {
+    // The elbow on an STS3215 leader variant: Feetech's protocol, its own
+    // encoding and gears.
+    let dir = tempfile::tempdir().unwrap();
+    let src = reacher();
+    let toml = std::fs::read_to_string(&src).unwrap().replace("\"XL330-M288\"", "\"sts3215-c046\"");
+    std::fs::write(dir.path().join("robot.toml"), toml).unwrap();
+    std::fs::copy(src.with_file_name("reacher.urdf"), dir.path().join("reacher.urdf")).unwrap();
+    let r = load(&dir.path().join("robot.toml")).unwrap();
+    let elbow = r.spec.joints[1];
+    assert_eq!(elbow.servo.name, "STS3215-C046");
+    assert_eq!(elbow.servo.protocol, pada_core::servo::ServoProtocol::Feetech);
+    assert_eq!(elbow.servo.datasheet.gear_ratio, 147.0);
+    // A quarter turn is 1024 of its 4096 counts; the encoder ends at 4095.
+    assert_eq!(elbow.counts_of(std::f64::consts::FRAC_PI_2), 2048 + 1024);
+    assert_eq!(elbow.counts_of(10.0), 4095);
+    assert!((elbow.angle_of(3072) - std::f32::consts::FRAC_PI_2).abs() < 1e-6);
+    // Its voltage command is Goal_Time in 0.1 % of the supply.
+    assert_eq!(elbow.drive(3.7, Some(7.4), 7.4), pada_core::servo::Drive::GoalTime { time: 500, full: 1000 });
+    // The same file with the C001 and a count past its encoder is refused.
+    let e = refused(|t| in_elbow(t, |j| j.replace("\"XL330-M288\"", "\"STS3215\"").replace("zero_count = 2048", "zero_count = 4096")), |u| u);
+    assert!(e.contains("joint[1].zero_count") && e.contains("4096 is not valid") && e.contains("STS3215's encoder, 0 to 4095"), "{e}");
+}
+
+#[test]
 fn a_soft_limit_past_the_urdfs_limits_is_refused() {
     let e = refused(|t| in_shoulder(t, |j| format!("{j}\nsoft_limit_rad = [-1.9, 2.1]")), |u| u);
     assert!(e.contains(":26:18:") && e.contains("joint[0].soft_limit_rad") && e.contains("[-1.9, 2.1] is not valid"), "{e}");
@@ -251,4 +287,24 @@ fn an_observation_too_fine_for_an_exact_table_takes_a_claim_table() {
     assert!(r.profile(Board::F405).is_ok() && r.profile(Board::Host).is_ok());
     let e = refused(|t| fine(t).replace("[robot]\n", "[robot]\ntable = \"exact\"\n"), |u| u);
     assert!(e.contains("robot.table") && e.contains("exact") && e.contains("claim"), "{e}");
+}
+
+#[test]
+fn the_so101_example_is_six_sts3215_two_learned() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/robots/so101");
+    let r = load(&dir).unwrap();
+    let s = r.spec;
+    assert_eq!(s.name, "so101");
+    // LeRobot's joint names and IDs, every servo the follower's STS3215-C001.
+    let names = ["shoulder_pan", "shoulder_lift", "elbow_flex", "wrist_flex", "wrist_roll", "gripper"];
+    assert_eq!(s.joints.iter().map(|j| (j.name, j.id)).collect::<Vec<_>>(), names.iter().copied().zip(1..=6).collect::<Vec<_>>());
+    for j in s.joints {
+        assert_eq!((j.servo.name, j.servo.protocol, j.zero), ("STS3215", pada_core::servo::ServoProtocol::Feetech, 2048));
+    }
+    // The shoulder lift and the elbow learned and counted, the rest held.
+    assert_eq!((s.counted.start, s.counted.end, s.motor_dims), (1, 3, 2));
+    // The kit's 5 V supply, and an exact table that fits the F405.
+    assert_eq!(s.supply_nominal_v, 5.0);
+    assert_eq!(s.table, TableNeed::Exact { weights: 25_600 });
+    assert!(r.profile(Board::F405).is_ok());
 }

@@ -146,6 +146,10 @@ impl<P: BusPort> RobotBus<P> {
                     }
                     r
                 }
+                // This bus does not speak Feetech's instructions: such a
+                // servo is refused (read as silent, so the safety machine
+                // faults on it) rather than driven blind.
+                ServoProtocol::Feetech => Err(SetupError::NoAnswer { id: joint.id }),
             };
             if let Some(r) = self.refused.get_mut(i) {
                 *r = result.is_err();
@@ -184,6 +188,8 @@ impl<P: BusPort> RobotBus<P> {
                     let _ = ids2.push(joint.id);
                     let _ = at2.push(i);
                 }
+                // Refused at set-up (see `setup`).
+                ServoProtocol::Feetech => *read = ServoRead { timeouts: attempts, ..ServoRead::default() },
             }
         }
         if ids2.is_empty() {
@@ -275,7 +281,8 @@ impl<P: BusPort> RobotBus<P> {
     /// protocol of the robot's servos; `None` if it did not answer.
     pub async fn sensors(&mut self) -> Option<(u16, u8)> {
         match self.sensor_protocol() {
-            ServoProtocol::V1 => {
+            // A Feetech READ or WRITE is Protocol 1.0's packet to the byte.
+            ServoProtocol::V1 | ServoProtocol::Feetech => {
                 let e = self.bus.read(SENSOR_ID, sensor_table::ENCODER_COUNT, sensor_table::READ_LEN).await;
                 e.status.as_ref().and_then(|s| parse_sensor_read(&s.params))
             }
@@ -291,7 +298,8 @@ impl<P: BusPort> RobotBus<P> {
     pub async fn call_operator(&mut self, call: OperatorCall) {
         let data = [call as u8];
         match self.sensor_protocol() {
-            ServoProtocol::V1 => {
+            // A Feetech READ or WRITE is Protocol 1.0's packet to the byte.
+            ServoProtocol::V1 | ServoProtocol::Feetech => {
                 self.bus.write_no_reply(SENSOR_ID, sensor_table::OPERATOR, &data).await.ok();
             }
             ServoProtocol::V2 => {

@@ -78,7 +78,8 @@ impl PeriodTraffic {
         if sensor {
             let first = robot.joints.first().map_or(ServoProtocol::V1, |j| j.servo.protocol);
             let (request, reply) = match first {
-                ServoProtocol::V1 => (len(dynamixel::read_data(100, 36, 3, &mut buf)), dynamixel::OVERHEAD + 3),
+                // A Feetech READ is Protocol 1.0's packet to the byte.
+                ServoProtocol::V1 | ServoProtocol::Feetech => (len(dynamixel::read_data(100, 36, 3, &mut buf)), dynamixel::OVERHEAD + 3),
                 ServoProtocol::V2 => (len(encoders::read(100, 36, 3, &mut buf)), status_len(3)),
             };
             out(&mut t, request);

@@ -554,10 +554,7 @@ fn run<W: WeightStore>(setup: &DriveSetup, table: W, mut tm: TelemetryPipe) -> a
 
 /// The zero command of a servo's kind.
 fn zero(d: Drive) -> Drive {
-    match d {
-        Drive::MovingSpeed(_) => Drive::MovingSpeed(0),
-        Drive::GoalPwm { full, .. } => Drive::GoalPwm { pwm: 0, full },
-    }
+    d.zeroed()
 }
 
 /// The policy as the command line names it.
