@@ -18,7 +18,7 @@ fn read(rel: &str) -> String {
 }
 
 /// The documents whose shell blocks a user copies.
-const GUIDES: [&str; 7] = [
+const GUIDES: [&str; 8] = [
     "README.md",
     "docs/commands.md",
     "docs/your-robot.md",
