@@ -27,6 +27,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 use crate::commands::options::TrialOptions;
 use crate::experiment::tasks::TaskName;
+use crate::start_weights::StartWeights;
 use clap::Args;
 
 /// `pada run`.
@@ -98,6 +99,16 @@ pub struct RunArgs {
     /// a checksum; read by `pada render`).
     #[arg(long, value_name = "FILE")]
     pub save_weights: Option<PathBuf>,
+    /// Continue from weights saved by `pada run --save-weights`: every
+    /// trial starts from them instead of the task's initial weights, and
+    /// learns on as a run from nothing would (the same seeds). The file
+    /// must be for the same task, table and learner (sarsa, pada, lowpass
+    /// and the gentle explorations share one); one that is not is refused
+    /// with the first difference. With --board: the weights are exported
+    /// into the board's table first (docs/board.md, "Weights from the
+    /// host"), and what that changed is printed.
+    #[arg(long, value_name = "FILE")]
+    pub weights: Option<PathBuf>,
     /// Run a board's own learner instead of the host's: the firmware's
     /// controller built for the host, with the board's learner profile
     /// (table layout, size, weight format), its sensors (servo counts,
@@ -402,11 +413,17 @@ impl TaskVisitor for RunVisitor {
             .unwrap_or_else(|| PathBuf::from(format!("pada-out/run-{}-{}", spec.name, args.algo)));
         let out = OutDir::check(&out_path)?;
         let mode = args.cluster.mode(out.path())?;
-        if mode != Mode::Local && (args.telemetry.is_some() || args.mcap.is_some() || args.save_weights.is_some()) {
+        if mode != Mode::Local
+            && (args.telemetry.is_some() || args.mcap.is_some() || args.save_weights.is_some() || args.weights.is_some())
+        {
             return Err(usage(
-                "--telemetry, --mcap and --save-weights need the trials in this process: they do not combine with --plan, --merge or --slurm",
+                "--telemetry, --mcap, --save-weights and --weights need the trials in this process: they do not combine with --plan, --merge or --slurm",
             ));
         }
+        let start = match &args.weights {
+            Some(p) => Some(StartWeights::load(p, spec, policy).map_err(|e| usage(format!("--weights {e}")))?),
+            None => None,
+        };
         let mut telemetry = match &args.telemetry {
             Some(t) => Some(TelemetrySink::open(&parse_target(t)?)?),
             None => None,
@@ -430,7 +447,7 @@ impl TaskVisitor for RunVisitor {
                     spec.test_interval,
                 );
             let bar = steps_bar(total, &format!("{} {}", spec.name, label(&policy)));
-            let results = if telemetry.is_none() && mcap.is_none() && args.save_weights.is_none() {
+            let results = if telemetry.is_none() && mcap.is_none() && args.save_weights.is_none() && start.is_none() {
                 run_trials(task, &cfg, &|n| bar.inc(n))?
             } else {
                 let weight_count = pada_core::weights::WeightStore::len(build_agent(spec, policy)?.weights()) as u32;
@@ -468,6 +485,7 @@ impl TaskVisitor for RunVisitor {
                     observer
                         .as_mut()
                         .map(|o| o as &mut (dyn FnMut(ToHost) + Send)),
+                    start.as_ref(),
                 )?;
                 if let Some(path) = &args.save_weights {
                     crate::weights::save(path, spec, cfg.policy, switched, &agent)?;
@@ -511,6 +529,14 @@ impl TaskVisitor for RunVisitor {
             outln!("{}", summary.to_json())?;
         } else {
             print_summary(&summary, &run_label(&policy, cfg.mtbf_budget_s))?;
+            if let Some(s) = &start {
+                outln!(
+                    "  started from         {} ({} weights learned by {})",
+                    s.path.display(),
+                    s.header.weights,
+                    crate::experiment::algo::label(&s.header.policy)
+                )?;
+            }
             outln!("wrote {}", out.path().display())?;
         }
         Ok(())

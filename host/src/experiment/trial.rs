@@ -27,6 +27,7 @@ use super::config::RunConfig;
 use crate::board::fault_line::{fault_explained, Faulted};
 use crate::experiment::task::{Plant, Task, TaskSpec};
 use crate::seed::{trial_rng, trial_seed};
+use crate::start_weights::StartWeights;
 use anyhow::anyhow;
 use pada_core::action_space::MAX_ACTION_DIMS;
 use pada_core::agent::Mode;
@@ -146,7 +147,7 @@ pub fn run_trial<T: Task>(
     trial: u32,
     progress: &(dyn Fn(u64) + Sync),
 ) -> anyhow::Result<TrialResult> {
-    run_trial_observed(task, cfg, trial, progress, None).map(|(r, _, _)| r)
+    run_trial_observed(task, cfg, trial, progress, None, None).map(|(r, _, _)| r)
 }
 
 /// [`run_trial`], also returning the agent as learned at the end (for
@@ -157,16 +158,18 @@ pub fn run_trial_keep<T: Task>(
     trial: u32,
     progress: &(dyn Fn(u64) + Sync),
 ) -> anyhow::Result<(TrialResult, HostAgent, bool)> {
-    run_trial_observed(task, cfg, trial, progress, None)
+    run_trial_observed(task, cfg, trial, progress, None, None)
 }
 
-/// [`run_trial_keep`], telling `observer` every agent call and episode.
+/// [`run_trial_keep`], telling `observer` every agent call and episode,
+/// and starting from `start`'s weights if given ([`StartWeights`]).
 pub fn run_trial_observed<T: Task>(
     task: &T,
     cfg: &RunConfig,
     trial: u32,
     progress: &(dyn Fn(u64) + Sync),
     observer: Option<TrialObserver<'_>>,
+    start: Option<&StartWeights>,
 ) -> anyhow::Result<(TrialResult, HostAgent, bool)> {
     let spec = task.spec();
     anyhow::ensure!(
@@ -176,7 +179,12 @@ pub fn run_trial_observed<T: Task>(
     );
     let mut rng = trial_rng(cfg.seed, trial);
     let mut agent = build_agent(spec, cfg.policy)?;
+    // Drawn even when `start` replaces them: the trial's random numbers
+    // afterwards are those of the trial from nothing.
     agent.reset_weights(&mut rng);
+    if let Some(start) = start {
+        start.apply(&mut agent)?;
+    }
     let fatigue = FatigueCounter::with_gearboxes(
         |c| spec.gearbox(c),
         spec.control_period_s,
