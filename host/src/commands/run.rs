@@ -7,7 +7,8 @@ use crate::display::{fmt_estimate, fmt_mtbf};
 use crate::error::{usage, CliError};
 use crate::experiment::algo::{label, parameter_of, policy_kind_of, Algo, PolicyFlags};
 use crate::board::trial::table_len;
-use crate::board::{robot_of_task, run_board};
+use crate::board::export::{export, ExportReport};
+use crate::board::{robot_of_task, run_board_from, BoardStart};
 use crate::experiment::task::{Task, TaskSpec};
 use crate::experiment::tasks::{visit_task, TaskVisitor};
 use crate::summary::{board_files, BoardSummary};
@@ -320,11 +321,26 @@ fn run_on_board(args: RunArgs, board: Board, sim: crate::robots::SimRobot) -> Re
             }
         }
     }
+    let entries = match &args.weights {
+        Some(path) => {
+            let (entries, report) = exported_weights(path, &sim, &task_spec, &profile, policy, weights)?;
+            for line in report.lines(board.name()) {
+                if args.json {
+                    eprintln!("{line}");
+                } else {
+                    outln!("{line}")?;
+                }
+            }
+            Some(entries)
+        }
+        None => None,
+    };
+    let start_from = entries.as_deref().map_or(BoardStart::Fresh, BoardStart::Entries);
     let total = cfg.trials as u64
         * cfg.expected_steps(task_spec.control_period_s, task_spec.episode_steps, task_spec.test_interval);
     let bar = steps_bar(total, &format!("{} {} on {}", task_spec.name, label(&policy), board.name()));
     let start = Instant::now();
-    let trials = run_board(profile, &sim, &cfg, &|n| bar.inc(n))?;
+    let trials = run_board_from(profile, &sim, &cfg, start_from, &|n| bar.inc(n))?;
     let wall = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
     let summary = BoardSummary::new(&task_spec, &cfg, &profile, &trials, wall);
@@ -347,6 +363,36 @@ fn run_on_board(args: RunArgs, board: Board, sim: crate::robots::SimRobot) -> Re
         outln!("wrote {}", out.path().display())?;
     }
     Ok(())
+}
+
+/// The host's weights in `path` (saved by `pada run` for `sim`'s robot,
+/// with the host's table), exported into `profile`'s table of `n`
+/// entries for a board run of `board_spec` with `policy`: the entries'
+/// bytes and what the export changed. A file for another robot, table or
+/// learner is refused with one line.
+pub fn exported_weights(
+    path: &std::path::Path,
+    sim: &crate::robots::SimRobot,
+    board_spec: &TaskSpec,
+    profile: &LearnerProfile,
+    policy: pada_core::policy::PolicyKind,
+    n: usize,
+) -> Result<(Vec<u8>, ExportReport), CliError> {
+    let host_profile = Board::Host.profile(sim.robot).map_err(|e| usage(e.to_string()))?;
+    let host_spec = sim.task_spec(host_profile).map_err(|e| usage(e.to_string()))?;
+    let w = StartWeights::load(path, &host_spec, policy).map_err(|e| usage(format!("--weights {e}")))?;
+    // The board's learner is the host's but for its table.
+    let mut host = crate::weights::WeightsHeader::new(&host_spec, policy, false, 0);
+    let on_board = crate::weights::WeightsHeader::new(board_spec, policy, false, 0);
+    (host.table, host.entry_bytes) = (on_board.table.clone(), on_board.entry_bytes);
+    if let Some((name, h, b)) = host.mismatch(&on_board) {
+        return Err(usage(format!(
+            "--weights {}: board {}'s learner differs from the host's in more than its table: {name} is {b} on the board but {h} on the host",
+            path.display(),
+            profile.board.name()
+        )));
+    }
+    export(&w, &host_spec, profile, n).map_err(|e| usage(format!("--weights {e}")))
 }
 
 /// The run's label: the policy, or the governed policy and its budget.
