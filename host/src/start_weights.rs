@@ -67,6 +67,12 @@ impl StartWeights {
         agent.restore_state(&state).map_err(|e| anyhow::anyhow!("{}: {e}", self.path.display()))
     }
 
+    /// Weights of `header` with `entries`, as if read from `path` (for
+    /// tests of what reads them).
+    pub fn from_parts(path: &Path, header: WeightsHeader, entries: Vec<u8>) -> StartWeights {
+        StartWeights { path: path.to_path_buf(), header, entries }
+    }
+
     /// The file's entries (`header.entry_bytes` each), for an export into
     /// a board's table.
     pub fn entries(&self) -> &[u8] {

@@ -145,12 +145,14 @@ fn source(w: &StartWeights, spec: &TaskSpec) -> anyhow::Result<Source> {
                 if tag == 0 {
                     continue;
                 }
-                let key = tag.wrapping_mul(back);
-                // A key's slot lies within its probe from its home; one
-                // that does not is the single pair of keys whose tag is 1.
-                if (i as u32).wrapping_sub(key & mask) & mask >= MAX_PROBE {
-                    continue;
-                }
+                // A key's slot lies within its probe from its home: that
+                // tells the two keys whose tag is 1 (0 and 1/TAG_MIX) apart.
+                let fits = |key: u32| (i as u32).wrapping_sub(key & mask) & mask < MAX_PROBE;
+                let key = match tag.wrapping_mul(back) {
+                    k if fits(k) => k,
+                    _ if tag == 1 && fits(0) => 0,
+                    _ => anyhow::bail!("{}: entry {i}'s tag {tag:#010x} belongs to no key near it (a damaged table)", w.path.display()),
+                };
                 let v = raw(e);
                 features.push(((v as i64 - init.of(key).0 as i64).unsigned_abs(), key, v));
             }
@@ -308,6 +310,75 @@ pub fn export(w: &StartWeights, host: &TaskSpec, profile: &LearnerProfile, n: us
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::experiment::table::HostTable;
+    use crate::weights::WeightsHeader;
+    use pada_core::profile::Board;
+    use pada_core::robot::leo;
+
+    /// A host claim table holding `keys` with `values`, exported into
+    /// `board`'s table: the board reads each key's weight, rounded to its
+    /// 16 bits, and the report counts them.
+    fn exported_reads_back(board: Board) {
+        let sim = crate::robots::sim_robot(&leo::SPEC).unwrap();
+        let spec = sim.task_spec(Board::Host.profile(&leo::SPEC).unwrap()).unwrap();
+        let WeightTable::Claimed { log2_size, .. } = spec.table else { panic!("LEO's host table is a claim table") };
+        let n = 1usize << log2_size;
+        let mut host = HostTable::claimed(n, WeightFormat::Q16, 4).unwrap();
+        // Keys with distinct low 15 bits (no collision in the F405's
+        // 2^15), their high bits varied; weights of both signs, one beyond
+        // the 16-bit range of ±2048.
+        let keys: Vec<u32> = (0..200u32).map(|i| (i * 97) | (i.wrapping_mul(0x9e37_79b9) & 0xffff_8000)).collect();
+        let values: Vec<f32> = (0..200).map(|i| (i as f32 - 100.0) * 0.37 + 0.01).collect();
+        let mut values = values;
+        values[7] = 3000.0;
+        for (k, v) in keys.iter().zip(&values) {
+            let Claim::Slot { slot, .. } = host.claim(*k) else { panic!("claimed") };
+            host.set(slot as usize, Q16::from_f32(*v));
+        }
+        let mut entries = vec![0u8; n * 8];
+        for (i, d) in entries.chunks_exact_mut(8).enumerate() {
+            host.stored_le(i, d);
+        }
+        let policy = pada_core::policy::PolicyKind::Pada { delta: 0.5 };
+        let header = WeightsHeader::new(&spec, policy, false, n);
+        let w = StartWeights::from_parts(std::path::Path::new("w.wts"), header, entries);
+        let profile = board.profile(&leo::SPEC).unwrap();
+        let m = profile.weights().unwrap();
+        let (bytes, report) = export(&w, &spec, &profile, m).unwrap();
+        assert_eq!((report.learned, report.kept, report.dropped, report.collisions), (200, 200, 0, 0), "{report:?}");
+        assert_eq!(report.clipped, 1, "{report:?}");
+        // Read back through the board's own table.
+        struct Read<'a>(&'a [u8], &'a [u32]);
+        impl TableVisitor for Read<'_> {
+            type Output = Vec<f32>;
+            fn visit<W: WeightStore>(self, mut t: W) -> anyhow::Result<Vec<f32>> {
+                let eb = t.entry_bytes();
+                for (i, s) in self.0.chunks_exact(eb).enumerate() {
+                    t.load_le(i, s);
+                }
+                t.restore_claims(InitialWeights { seed: 0, lo: 0, span: 1 }, 0);
+                // A plain table's feature is the key masked to its size (the
+                // tile coder's); a claim table's the whole key.
+                let mask = if t.claims() { u32::MAX } else { t.len() as u32 - 1 };
+                Ok(self.1.iter().map(|k| t.read(*k & mask).to_f32()).collect())
+            }
+        }
+        let read = with_table(&profile, m, Read(&bytes, &keys)).unwrap();
+        for (i, (r, v)) in read.iter().zip(&values).enumerate() {
+            let want = if i == 7 { 2048.0 - 1.0 / 16.0 } else { (v * 16.0).round() / 16.0 };
+            assert!((r - want).abs() <= 1.0 / 16.0, "{}: key {:#x}: {r} read, {v} exported", board.name(), keys[i]);
+        }
+    }
+
+    #[test]
+    fn the_f405s_hashed_table_reads_each_exported_feature() {
+        exported_reads_back(Board::F405);
+    }
+
+    #[test]
+    fn the_f429s_claim_table_reads_each_exported_feature() {
+        exported_reads_back(Board::F429Sdram);
+    }
 
     #[test]
     fn the_tag_multiplier_has_its_inverse() {
