@@ -118,3 +118,17 @@ fn board_runs_refuse_weights_of_another_robot_board_or_learner_with_one_line() {
     let o = ok(&pada(&board(&["--weights", &pp], &out("f")).iter().map(String::as_str).collect::<Vec<_>>()));
     assert!(o.contains("weights: ") && o.contains("0 dropped"), "{o}");
 }
+
+/// `pada sil --weights` on a board whose checkpoint lives in flash is
+/// refused with one line, before any emulation.
+#[test]
+fn sil_refuses_weights_on_a_board_whose_checkpoint_lives_in_flash() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sil").display().to_string();
+    // Any existing file as the image: the refusal comes first.
+    let elf = concat!(env!("CARGO_MANIFEST_DIR"), "/Cargo.toml");
+    assert_bad_input(
+        &["sil", "--task", "leo", "--board", "f405", "--algo", "pada", "--seconds", "5", "--elf", elf, "--out", &out, "--weights", "w.wts"],
+        &["--weights on board f405", "checkpoint lives in flash", "f429-sdram"],
+    );
+}
