@@ -13,6 +13,7 @@
 //!
 //! - [`export`]: weights learned on the host in the board's table;
 //! - [`exported`]: a board's checkpoint image of exported weights;
+//! - [`image_store`]: checkpoint images in memory, and loading one;
 //! - [`demand`]: the slots a trial writes against the board's claim
 //!   table, known before flashing;
 //! - [`protocol`]: the run protocol and seeds, shared with `pada sil`;
@@ -26,6 +27,7 @@
 pub mod demand;
 pub mod export;
 pub mod exported;
+pub mod image_store;
 pub mod fault_line;
 pub mod protocol;
 pub mod readable;

@@ -273,7 +273,7 @@ fn run<R: RobotRules, W: WeightStore>(
     if let BoardStart::Checkpoint(image) = start {
         // As the firmware's boot with a kept checkpoint: its learner, then
         // the run's Start.
-        super::exported::load_image(&mut ctl, image)?;
+        super::image_store::load_image(&mut ctl, image)?;
         command(&mut ctl, ToChip::Start(pada_core::wire::RunMode::Testing))?;
     }
     let protocol_start = if matches!(start, BoardStart::Checkpoint(_)) { None } else { Some(RunProtocol::start(cfg.policy)) };

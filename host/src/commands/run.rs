@@ -16,7 +16,7 @@ use pada_core::claim_table::WhenFull;
 use pada_core::profile::{Board, LearnerProfile, TILINGS};
 use pada_core::tile_coding::Layout;
 use pada_core::weights::WeightFormat;
-use crate::experiment::{build_agent, run_trials, run_trials_observed, RunConfig, TrialResult};
+use crate::experiment::{build_agent, run_trials, run_trials_observed, RunConfig, StartWith, TrialResult};
 use crate::output::OutDir;
 use crate::plan::mode::{obtain, Mode, Trials};
 use crate::plan::{Experiment, ExperimentKind};
@@ -472,6 +472,7 @@ impl TaskVisitor for RunVisitor {
             Some(p) => Some(StartWeights::load(p, spec, policy).map_err(|e| usage(format!("--weights {e}")))?),
             None => None,
         };
+        let apply = start.as_ref().map(|s| move |a: &mut crate::experiment::HostAgent| s.apply(a));
         let mut telemetry = match &args.telemetry {
             Some(t) => Some(TelemetrySink::open(&parse_target(t)?)?),
             None => None,
@@ -533,7 +534,7 @@ impl TaskVisitor for RunVisitor {
                     observer
                         .as_mut()
                         .map(|o| o as &mut (dyn FnMut(ToHost) + Send)),
-                    start.as_ref(),
+                    apply.as_ref().map(|f| f as StartWith<'_>),
                 )?;
                 if let Some(path) = &args.save_weights {
                     crate::weights::save(path, spec, cfg.policy, switched, &agent)?;

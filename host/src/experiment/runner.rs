@@ -5,8 +5,7 @@
 use super::agent_setup::HostAgent;
 /// The run configuration, where the runner's users have found it.
 pub use super::config::RunConfig;
-use super::trial::{run_trial_keep, run_trial_observed, TrialObserver, TrialResult};
-use crate::start_weights::StartWeights;
+use super::trial::{run_trial_keep, run_trial_observed, StartWith, TrialObserver, TrialResult};
 use crate::experiment::task::Task;
 use rayon::prelude::*;
 
@@ -22,13 +21,13 @@ pub fn run_trials<T: Task>(
 /// [`run_trials`], with trial 0 told to `observer` (telemetry) if given,
 /// and trial 0's learned agent returned with whether it had switched back
 /// to SARSA(λ) (for saving its weights). The other trials run in parallel
-/// with it. Every trial starts from `start`'s weights if given.
+/// with it. Every trial starts from the weights `start` puts in, if given.
 pub fn run_trials_observed<T: Task>(
     task: &T,
     cfg: &RunConfig,
     progress: &(dyn Fn(u64) + Sync),
     observer: Option<TrialObserver<'_>>,
-    start: Option<&StartWeights>,
+    start: Option<StartWith<'_>>,
 ) -> anyhow::Result<(Vec<TrialResult>, HostAgent, bool)> {
     let (first, rest) = rayon::join(
         || run_trial_observed(task, cfg, 0, progress, observer, start),

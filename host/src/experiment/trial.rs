@@ -27,7 +27,6 @@ use super::config::RunConfig;
 use crate::board::fault_line::{fault_explained, Faulted};
 use crate::experiment::task::{Plant, Task, TaskSpec};
 use crate::seed::{trial_rng, trial_seed};
-use crate::start_weights::StartWeights;
 use anyhow::anyhow;
 use pada_core::action_space::MAX_ACTION_DIMS;
 use pada_core::agent::Mode;
@@ -161,15 +160,19 @@ pub fn run_trial_keep<T: Task>(
     run_trial_observed(task, cfg, trial, progress, None, None)
 }
 
+/// What replaces a trial's initial weights (`pada run --weights`:
+/// `crate::start_weights`), after they were drawn from the trial's seed.
+pub type StartWith<'s> = &'s (dyn Fn(&mut HostAgent) -> anyhow::Result<()> + Sync);
+
 /// [`run_trial_keep`], telling `observer` every agent call and episode,
-/// and starting from `start`'s weights if given ([`StartWeights`]).
+/// and starting from the weights `start` puts in, if given.
 pub fn run_trial_observed<T: Task>(
     task: &T,
     cfg: &RunConfig,
     trial: u32,
     progress: &(dyn Fn(u64) + Sync),
     observer: Option<TrialObserver<'_>>,
-    start: Option<&StartWeights>,
+    start: Option<StartWith<'_>>,
 ) -> anyhow::Result<(TrialResult, HostAgent, bool)> {
     let spec = task.spec();
     anyhow::ensure!(
@@ -183,7 +186,7 @@ pub fn run_trial_observed<T: Task>(
     // afterwards are those of the trial from nothing.
     agent.reset_weights(&mut rng);
     if let Some(start) = start {
-        start.apply(&mut agent)?;
+        start(&mut agent)?;
     }
     let fatigue = FatigueCounter::with_gearboxes(
         |c| spec.gearbox(c),
