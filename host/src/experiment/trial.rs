@@ -146,7 +146,7 @@ pub fn run_trial<T: Task>(
     trial: u32,
     progress: &(dyn Fn(u64) + Sync),
 ) -> anyhow::Result<TrialResult> {
-    run_trial_observed(task, cfg, trial, progress, None).map(|(r, _, _)| r)
+    run_trial_observed(task, cfg, trial, progress, None, None).map(|(r, _, _)| r)
 }
 
 /// [`run_trial`], also returning the agent as learned at the end (for
@@ -157,16 +157,22 @@ pub fn run_trial_keep<T: Task>(
     trial: u32,
     progress: &(dyn Fn(u64) + Sync),
 ) -> anyhow::Result<(TrialResult, HostAgent, bool)> {
-    run_trial_observed(task, cfg, trial, progress, None)
+    run_trial_observed(task, cfg, trial, progress, None, None)
 }
 
-/// [`run_trial_keep`], telling `observer` every agent call and episode.
+/// What replaces a trial's initial weights (`pada run --weights`:
+/// `crate::start_weights`), after they were drawn from the trial's seed.
+pub type StartWith<'s> = &'s (dyn Fn(&mut HostAgent) -> anyhow::Result<()> + Sync);
+
+/// [`run_trial_keep`], telling `observer` every agent call and episode,
+/// and starting from the weights `start` puts in, if given.
 pub fn run_trial_observed<T: Task>(
     task: &T,
     cfg: &RunConfig,
     trial: u32,
     progress: &(dyn Fn(u64) + Sync),
     observer: Option<TrialObserver<'_>>,
+    start: Option<StartWith<'_>>,
 ) -> anyhow::Result<(TrialResult, HostAgent, bool)> {
     let spec = task.spec();
     anyhow::ensure!(
@@ -176,7 +182,12 @@ pub fn run_trial_observed<T: Task>(
     );
     let mut rng = trial_rng(cfg.seed, trial);
     let mut agent = build_agent(spec, cfg.policy)?;
+    // Drawn even when `start` replaces them: the trial's random numbers
+    // afterwards are those of the trial from nothing.
     agent.reset_weights(&mut rng);
+    if let Some(start) = start {
+        start(&mut agent)?;
+    }
     let fatigue = FatigueCounter::with_gearboxes(
         |c| spec.gearbox(c),
         spec.control_period_s,
