@@ -217,4 +217,4 @@ impl<P: BusPort> ServoBus<P> {
 
 #[cfg(test)]
 #[path = "ft_tests.rs"]
-mod tests;
+pub(crate) mod tests;

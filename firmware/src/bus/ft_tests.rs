@@ -17,6 +17,8 @@ pub struct FtFake {
     pub inbox: VecDeque<u8>,
     pub sent: std::vec::Vec<std::vec::Vec<u8>>,
     pub now: u64,
+    /// Bytes handed to the bus's receiver.
+    pub received: u64,
     /// Servos whose answers are dropped, and answers to corrupt.
     pub silent: std::vec::Vec<u8>,
     pub corrupt_next: u32,
@@ -49,6 +51,7 @@ impl FtFake {
             inbox: VecDeque::new(),
             sent: std::vec::Vec::new(),
             now: 0,
+            received: 0,
             silent: std::vec::Vec::new(),
             corrupt_next: 0,
             decoder: InstructionDecoder::new(),
@@ -134,7 +137,9 @@ impl BusPort for FtFake {
 
     async fn receive(&mut self, buf: &mut [u8], deadline_us: u64) -> Result<usize, PortError> {
         // Chunks that cut packets, and hold several.
-        Ok(crate::bus::fake_receive(&mut self.inbox, &mut self.now, buf, deadline_us, 23))
+        let n = crate::bus::fake_receive(&mut self.inbox, &mut self.now, buf, deadline_us, 23);
+        self.received += n as u64;
+        Ok(n)
     }
 
     fn now_us(&self) -> u64 {
