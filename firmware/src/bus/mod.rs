@@ -15,6 +15,7 @@
 //! | `v1.rs` | Protocol 1.0 (RX-28, MX-28): READ, PING, WRITE, SYNC_WRITE of Moving Speed, wheel-mode set-up |
 //! | `v2.rs` | Protocol 2.0 (X series): PING, READ, WRITE, SYNC_WRITE of Goal PWM, (fast) sync read of the present block, PWM-mode set-up, the Bus Watchdog |
 //! | `ft.rs` | Feetech (STS series) on Protocol 1.0's framing and transactions: SYNC READ of the present block, SYNC WRITE of torque and command, the set-up |
+//! | `parts.rs` | the interface of one protocol's part of a robot's bus (stop, set up, read, write), and its implementations |
 //! | `robot.rs` | one robot's period on the bus: every joint read and commanded in its servo's protocol, the sensor device, the boot |
 //! | `timing.rs` | the bytes each period's transactions put on the wire, and their time at a baud rate |
 //!
@@ -22,6 +23,7 @@
 //! drive`, a USB serial adapter), whose port blocks instead of awaiting.
 
 pub mod ft;
+pub mod parts;
 mod v1;
 pub mod robot;
 pub mod timing;
