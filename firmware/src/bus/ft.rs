@@ -43,6 +43,20 @@ const IDENTITY_LEN: u8 = sts::MODEL_NUMBER + 2;
 /// Operating Mode (33) … Acceleration (41): the set-up's second READ.
 const MODE_BLOCK_LEN: u8 = sts::ACCELERATION - sts::OPERATING_MODE + 1;
 
+/// Protocol 1.0's error bits for a Feetech ERROR byte, so that one safety
+/// machine counts both: Feetech's bits 0, 1, 2 and 5 mean what
+/// Dynamixel's do (voltage, angle, overheating, overload); its bit 3 is
+/// over-current where Dynamixel has its Range Error, and counts as an
+/// overload, a hardware condition that faults
+/// (docs/reference/feetech.md § "Status").
+pub fn flags_of_ft(error: ErrorFlags) -> ErrorFlags {
+    if error.intersects(status::OVERCURRENT) {
+        ErrorFlags(error.bits() & !status::OVERCURRENT.bits()) | ErrorFlags::OVERLOAD
+    } else {
+        error
+    }
+}
+
 /// A servo's set-up, and what the period's SYNC WRITE must keep.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct FtSetup {
@@ -102,7 +116,7 @@ impl<P: BusPort> ServoBus<P> {
             r.timeouts = r.timeouts.saturating_add(exchange.timeouts);
             r.checksum_errors = r.checksum_errors.saturating_add(exchange.checksum_errors);
             if let Some(s) = exchange.status {
-                r.error = s.error;
+                r.error = flags_of_ft(s.error);
                 r.state = present(&s.params, order);
             }
         }
@@ -143,7 +157,7 @@ impl<P: BusPort> ServoBus<P> {
                 };
                 match ids.iter().position(|&id| id == status.id) {
                     Some(i) if out[i].state.is_none() && status.params.len() == sts::PRESENT_BLOCK_LEN as usize => {
-                        out[i].error = status.error;
+                        out[i].error = flags_of_ft(status.error);
                         out[i].state = present(&status.params, order);
                         self.stats.replies = self.stats.replies.wrapping_add(1);
                         pending -= 1;
@@ -170,7 +184,7 @@ impl<P: BusPort> ServoBus<P> {
             return Err(SetupError::NoAnswer { id });
         };
         if identity.error.intersects(status::HARDWARE) {
-            return Err(SetupError::Error { id, error: identity.error });
+            return Err(SetupError::Error { id, error: flags_of_ft(identity.error) });
         }
         let at = |s: &super::Status, addr: u8, first: u8| s.u8_at((addr - first) as usize).unwrap_or(0xFF);
         let order = if at(&identity, sts::END, 0) == 0 { ByteOrder::Little } else { ByteOrder::Big };

@@ -224,3 +224,11 @@ fn setup_checks_the_model_and_writes_the_mode_once() {
     assert_eq!(block_on(bus.setup_ft(3, 1020, sts::MODE_PWM)), Err(SetupError::WrongModel { id: 3, found: 777, expected: 1020 }));
     assert_eq!(block_on(bus.setup_ft(4, sts::STS3215_MODEL, sts::MODE_PWM)), Err(SetupError::NoAnswer { id: 4 }));
 }
+
+#[test]
+fn over_current_is_a_hardware_condition_for_the_safety_machine() {
+    assert_eq!(flags_of_ft(status::OVERCURRENT), ErrorFlags::OVERLOAD);
+    assert!(flags_of_ft(status::OVERCURRENT).intersects(ErrorFlags::HARDWARE));
+    assert_eq!(flags_of_ft(status::OVERHEAT | status::ANGLE), ErrorFlags::OVERHEATING | ErrorFlags::ANGLE_LIMIT);
+    assert_eq!(flags_of_ft(status::VOLTAGE), ErrorFlags::INPUT_VOLTAGE);
+}
