@@ -340,3 +340,77 @@ fn a_port_that_goes_away_mid_run_is_one_line_and_the_log_is_kept() {
     let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("drive.json")).unwrap()).unwrap();
     assert_eq!(report["ended"]["kind"], "port-gone", "{}", report["ended"]);
 }
+
+/// The arm of files on two Feetech STS3215s (IDs 1 and 2, 7.4 V), its
+/// shoulder calibrated 48 counts off the chain's 2048, written into `dir`.
+fn sts_arm(dir: &Path) -> String {
+    let urdf = format!("{}/../examples/robots/arm2/arm2.urdf", env!("CARGO_MANIFEST_DIR"));
+    let toml = std::fs::read_to_string(arm())
+        .unwrap()
+        .replace("\"XM430-W350\"", "\"STS3215\"")
+        .replace("\"XL430-W250\"", "\"STS3215\"")
+        .replace("urdf = \"arm2.urdf\"", &format!("urdf = {urdf:?}"))
+        .replace("supply_v = 12.0", "supply_v = 7.4")
+        .replace("voltage_limit_v = 12.0", "voltage_limit_v = 7.4")
+        .replacen("zero_count = 2048", "zero_count = 2000", 1);
+    let path = dir.join("sts-arm.toml");
+    std::fs::write(&path, toml).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+/// `pada drive` on a Feetech bus: against `pada servos`' bare STS3215
+/// chain in lock step, each period is one SYNC READ and one SYNC WRITE
+/// (60 bytes for two servos), the positions come back through it, and
+/// torque is on for the episodes and off at the end.
+#[test]
+fn a_robot_of_sts3215s_runs_on_one_sync_read_and_one_sync_write_a_period() {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = sts_arm(dir.path());
+    let servos = Servos::start(dir.path(), &["--chain", "sts3215:1-2", "--lockstep"]);
+    let out = dir.path().join("drive");
+    let o = drive(&["--port", servos.port(), "--robot", &robot, "--lockstep", "--seconds", "2", "--json", "--out", out.to_str().unwrap()]);
+    let report: serde_json::Value = serde_json::from_str(&ok(&o)).expect("drive.json on stdout");
+    let summary = servos.stop();
+    assert_eq!(report["ended"]["kind"], "done");
+    let servo_lines = report["servos"].to_string();
+    assert!(servo_lines.contains("servo 2 (elbow): STS3215 (model 777)"), "{servo_lines}");
+    assert_eq!((report["bus"]["timeouts"].as_u64(), report["bus"]["checksum_errors"].as_u64()), (Some(0), Some(0)));
+    assert_eq!(report["bus"]["fast_sync_read"], false, "no Protocol 2.0 servo");
+    // SYNC READ 10 B, two answers of 14 B, SYNC WRITE 22 B.
+    let per_period = report["bus"]["bytes_per_period"].as_f64().unwrap();
+    assert!((per_period - 60.0).abs() < 1.0, "{per_period}");
+    // One SYNC WRITE a period ends each of the chain's lock-step periods.
+    let periods = report["clock"]["periods"].as_u64().unwrap();
+    assert!(periods > 100, "{periods}");
+    assert_eq!(summary["stats"]["sync_writes"].as_u64(), Some(periods));
+    // The shoulder reads 48 counts (0.074 rad) from its zero, the elbow 0.
+    let csv = std::fs::read_to_string(out.join("telemetry.csv")).unwrap();
+    let states: Vec<&str> = csv.lines().filter(|l| l.contains(",step,")).map(|l| l.split(',').nth(8).unwrap()).collect();
+    assert!(!states.is_empty() && states.iter().all(|s| *s == "0.074 0"), "{:?}", &states[..states.len().min(5)]);
+    for id in [1, 2] {
+        let servo = events(&summary, id);
+        assert_eq!(servo.first().map(String::as_str), Some("torque-on"), "servo {id}: {servo:?}");
+        assert_eq!(servo.last().map(String::as_str), Some("torque-off"), "servo {id}: {servo:?}");
+    }
+}
+
+/// A Feetech servo's overload (its Status bit 5, which unloads it) faults
+/// the robot: every servo's torque off in that period, one line.
+#[test]
+fn an_sts3215_overload_turns_every_servos_torque_off_in_its_period() {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = sts_arm(dir.path());
+    let servos = Servos::start(dir.path(), &["--chain", "sts3215:1-2", "--lockstep", "--fault", "error-bits:at=1:servo=2:bits=overload"]);
+    let out = dir.path().join("drive");
+    let o = drive(&["--port", servos.port(), "--robot", &robot, "--lockstep", "--seconds", "20", "--out", out.to_str().unwrap()]);
+    bad_input(&o, &["servo 2 (elbow)", "overload", "torque is off on every servo"]);
+    let summary = servos.stop();
+    let at = |id: u64, what: &str| {
+        summary["events"].as_array().unwrap().iter().find(|e| e["id"] == id && e["what"] == what).map(|e| e["at_us"].as_u64().unwrap())
+    };
+    let fault = at(2, "error-bits").expect("the overload was raised");
+    let off = at(1, "torque-off").expect("servo 1's torque went off");
+    assert!(off >= fault && off - fault <= 30_000, "overload at {fault} µs, servo 1 off at {off} µs");
+    let csv = std::fs::read_to_string(out.join("telemetry.csv")).unwrap();
+    assert!(csv.lines().any(|l| l.contains(",fault,") && l.contains("servo-error") && l.contains("servo: 2")), "{csv}");
+}

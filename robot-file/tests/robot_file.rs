@@ -165,6 +165,31 @@ fn a_zero_count_past_the_encoder_is_refused() {
 }
 
 #[test]
+fn a_feetech_sts3215_joint_reads_with_its_4096_counts_a_turn() {
+    // The elbow on an STS3215 leader variant: Feetech's protocol, its own
+    // encoding and gears.
+    let dir = tempfile::tempdir().unwrap();
+    let src = reacher();
+    let toml = std::fs::read_to_string(&src).unwrap().replace("\"XL330-M288\"", "\"sts3215-c046\"");
+    std::fs::write(dir.path().join("robot.toml"), toml).unwrap();
+    std::fs::copy(src.with_file_name("reacher.urdf"), dir.path().join("reacher.urdf")).unwrap();
+    let r = load(&dir.path().join("robot.toml")).unwrap();
+    let elbow = r.spec.joints[1];
+    assert_eq!(elbow.servo.name, "STS3215-C046");
+    assert_eq!(elbow.servo.protocol, pada_core::servo::ServoProtocol::Feetech);
+    assert_eq!(elbow.servo.datasheet.gear_ratio, 147.0);
+    // A quarter turn is 1024 of its 4096 counts; the encoder ends at 4095.
+    assert_eq!(elbow.counts_of(std::f64::consts::FRAC_PI_2), 2048 + 1024);
+    assert_eq!(elbow.counts_of(10.0), 4095);
+    assert!((elbow.angle_of(3072) - std::f32::consts::FRAC_PI_2).abs() < 1e-6);
+    // Its voltage command is Goal_Time in 0.1 % of the supply.
+    assert_eq!(elbow.drive(3.7, Some(7.4), 7.4), pada_core::servo::Drive::GoalTime { time: 500, full: 1000 });
+    // The same file with the C001 and a count past its encoder is refused.
+    let e = refused(|t| in_elbow(t, |j| j.replace("\"XL330-M288\"", "\"STS3215\"").replace("zero_count = 2048", "zero_count = 4096")), |u| u);
+    assert!(e.contains("joint[1].zero_count") && e.contains("4096 is not valid") && e.contains("STS3215's encoder, 0 to 4095"), "{e}");
+}
+
+#[test]
 fn a_soft_limit_past_the_urdfs_limits_is_refused() {
     let e = refused(|t| in_shoulder(t, |j| format!("{j}\nsoft_limit_rad = [-1.9, 2.1]")), |u| u);
     assert!(e.contains(":26:18:") && e.contains("joint[0].soft_limit_rad") && e.contains("[-1.9, 2.1] is not valid"), "{e}");

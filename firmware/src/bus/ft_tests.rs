@@ -232,3 +232,69 @@ fn over_current_is_a_hardware_condition_for_the_safety_machine() {
     assert_eq!(flags_of_ft(status::OVERHEAT | status::ANGLE), ErrorFlags::OVERHEATING | ErrorFlags::ANGLE_LIMIT);
     assert_eq!(flags_of_ft(status::VOLTAGE), ErrorFlags::INPUT_VOLTAGE);
 }
+
+/// A robot of two STS3215s on the fake chain, set up.
+fn robot_bus() -> crate::bus::RobotBus<FtFake> {
+    use pada_core::robot::{leo, JointSpec, RobotSpec};
+    static JOINTS: [JointSpec; 2] = {
+        let j = JointSpec { name: "s", servo: &pada_core::servo::STS3215, id: 1, zero: 2048, sign: 1, soft_limit: None };
+        [j, JointSpec { id: 2, ..j }]
+    };
+    let robot: &'static RobotSpec = Box::leak(Box::new(RobotSpec { joints: &JOINTS, ..leo::SPEC }));
+    let mut rb = crate::bus::RobotBus::new(FtFake::with_servos(&[1, 2]), BusConfig::default(), robot);
+    block_on(rb.stop_all());
+    let report = block_on(rb.setup());
+    assert!(report.iter().all(|(_, r)| r.is_ok()), "{report:?}");
+    rb.bus_mut().port_mut().sent.clear();
+    rb
+}
+
+#[test]
+fn a_robot_of_sts3215s_is_one_sync_read_and_one_sync_write_a_period() {
+    use crate::config::MAX_ROBOT_SERVOS;
+    use pada_core::servo::Drive;
+    let mut rb = robot_bus();
+    for id in [1, 2] {
+        assert_eq!(rb.bus_mut().port_mut().table(id)[sts::OPERATING_MODE as usize], sts::MODE_PWM);
+    }
+    let mut out = [ServoRead::default(); MAX_ROBOT_SERVOS];
+    block_on(rb.read(&mut out));
+    assert_eq!((out[0].state.unwrap().position, out[1].state.unwrap().position), (2001, 2002));
+    let commands = [(1, Drive::GoalTime { time: 500, full: 1000 }), (2, Drive::GoalTime { time: -300, full: 1000 })];
+    block_on(rb.write(true, &commands, false));
+    let fake = rb.bus_mut().port_mut();
+    assert_eq!(fake.sent.iter().map(|p| p[4]).collect::<std::vec::Vec<_>>(), [0x82, 0x83], "one SYNC READ, one SYNC WRITE");
+    let (t1, t2) = (*fake.table(1), *fake.table(2));
+    assert_eq!((t1[sts::TORQUE_ENABLE as usize], t2[sts::TORQUE_ENABLE as usize]), (1, 1));
+    assert_eq!(u16::from_le_bytes([t1[44], t1[45]]), 500);
+    assert_eq!(u16::from_le_bytes([t2[44], t2[45]]), 0x0400 | 300);
+    // Goal Position: where the servo is (unused in Operating Mode 2).
+    assert_eq!(u16::from_le_bytes([t2[42], t2[43]]), 2002);
+    // A fault: the same SYNC WRITE with torque off and no duty cycle.
+    block_on(rb.write(false, &commands, false));
+    let fake = rb.bus_mut().port_mut();
+    assert_eq!(fake.sent.len(), 3);
+    for id in [1, 2] {
+        let t = fake.table(id);
+        assert_eq!((t[sts::TORQUE_ENABLE as usize], t[44], t[45]), (0, 0, 0), "servo {id}");
+    }
+}
+
+#[test]
+fn a_silent_or_foreign_servo_is_refused_and_never_commanded() {
+    use pada_core::servo::Drive;
+    let mut rb = robot_bus();
+    // Servo 2 stops answering: read as silent, named.
+    rb.bus_mut().port_mut().silent = vec![2];
+    let mut out = [ServoRead::default(); crate::config::MAX_ROBOT_SERVOS];
+    block_on(rb.read(&mut out));
+    assert!(out[0].state.is_some() && out[1].state.is_none() && out[1].timeouts == 2);
+    // At set-up it is refused: the SYNC WRITE leaves it out.
+    let report = block_on(rb.setup());
+    assert_eq!(report[1], (2, Err(SetupError::NoAnswer { id: 2 })));
+    rb.bus_mut().port_mut().sent.clear();
+    block_on(rb.write(true, &[(1, Drive::GoalTime { time: 100, full: 1000 }), (2, Drive::GoalTime { time: 100, full: 1000 })], false));
+    let fake = rb.bus_mut().port_mut();
+    assert_eq!(fake.table(2)[sts::TORQUE_ENABLE as usize], 0);
+    assert_eq!(fake.table(1)[sts::TORQUE_ENABLE as usize], 1);
+}

@@ -1,6 +1,6 @@
 //! One interface for the part of a robot's bus that each protocol drives
 //! ([`ProtocolPart`]), and its implementations: Protocol 1.0 ([`V1Part`]),
-//! Protocol 2.0 ([`V2Part`]). [`super::RobotBus`] holds one part per
+//! Protocol 2.0 ([`V2Part`]), Feetech ([`FtPart`]). [`super::RobotBus`] holds one part per
 //! protocol and calls, in that order, each part whose servos the robot
 //! has: to stop them, set them up, read them and command them.
 //!
@@ -9,6 +9,9 @@
 
 use super::v2::{fast_read_firmware, flags_of, Read2};
 use super::{ServoBus, ServoRead, ServoSetup, SetupError};
+use pada_core::feetech::command::{self, Command};
+use pada_core::feetech::control_table::sts3215 as sts;
+use pada_core::feetech::ByteOrder;
 use crate::config::MAX_ROBOT_SERVOS;
 use crate::io::BusPort;
 use heapless::Vec;
@@ -173,5 +176,83 @@ impl ProtocolPart for V2Part {
         }
         bus.sync_write_pwm(&pwms).await.ok();
         self.torque_was = torque;
+    }
+}
+
+/// Feetech (the STS series, in Operating Mode 2): one SYNC READ of every
+/// servo's present block; torque and every duty cycle (Goal Time) in one
+/// SYNC WRITE. Feetech documents no bus watchdog: a servo keeps its last
+/// duty cycle while the controller is silent, so torque goes off in the
+/// period a fault is found, in that same SYNC WRITE.
+#[derive(Debug)]
+pub struct FtPart {
+    /// Each joint's byte order and Acceleration, from its set-up.
+    order: [ByteOrder; MAX_ROBOT_SERVOS],
+    acceleration: [u8; MAX_ROBOT_SERVOS],
+    /// Each joint's Present Position as last read \[steps\]: the Goal
+    /// Position the SYNC WRITE carries (which Operating Mode 2 does not
+    /// use), so that the block moves nothing if it were used.
+    position: [i32; MAX_ROBOT_SERVOS],
+}
+
+impl Default for FtPart {
+    fn default() -> Self {
+        FtPart { order: [ByteOrder::Little; MAX_ROBOT_SERVOS], acceleration: [0; MAX_ROBOT_SERVOS], position: [0; MAX_ROBOT_SERVOS] }
+    }
+}
+
+/// A duty cycle in 0.1 % of the supply from the controller's command.
+fn duty_of(drive: Drive) -> i32 {
+    match drive {
+        Drive::GoalTime { time, full } => time as i32 * command::MAX_DUTY / full.max(1) as i32,
+        other => libm::roundf(other.ratio() * command::MAX_DUTY as f32) as i32,
+    }
+}
+
+impl ProtocolPart for FtPart {
+    const PROTOCOL: ServoProtocol = ServoProtocol::Feetech;
+
+    async fn stop_all<P: BusPort>(&mut self, bus: &mut ServoBus<P>) {
+        bus.stop_all_ft().await.ok();
+    }
+
+    async fn setup<P: BusPort>(&mut self, bus: &mut ServoBus<P>, i: usize, joint: &JointSpec) -> Result<ServoSetup, SetupError> {
+        let s = bus.setup_ft(joint.id, joint.servo.model_number, sts::MODE_PWM).await?;
+        if i < MAX_ROBOT_SERVOS {
+            self.order[i] = s.order;
+            self.acceleration[i] = s.acceleration;
+        }
+        Ok(s.setup)
+    }
+
+    async fn read<P: BusPort>(&mut self, bus: &mut ServoBus<P>, joints: &[JointSpec], at: &[usize], out: &mut [ServoRead; MAX_ROBOT_SERVOS]) {
+        let ids: Vec<u8, MAX_ROBOT_SERVOS> = at.iter().map(|&i| joints[i].id).collect();
+        let mut reads = [ServoRead::default(); MAX_ROBOT_SERVOS];
+        // One SYNC READ decodes every answer in one byte order: the first
+        // servo's (every STS servo's is little endian).
+        let order = at.first().map_or(ByteOrder::Little, |&i| self.order[i]);
+        bus.read_present_ft(&ids, order, &mut reads).await;
+        for (&i, r) in at.iter().zip(&reads) {
+            if let Some(p) = r.state {
+                self.position[i] = p.position;
+            }
+            out[i] = *r;
+        }
+    }
+
+    async fn write<P: BusPort>(&mut self, bus: &mut ServoBus<P>, joints: &[JointSpec], torque: bool, commands: &[(usize, Drive)], _rearm: bool) {
+        let mut entries: Vec<(u8, Command), MAX_ROBOT_SERVOS> = Vec::new();
+        let mut order = None;
+        for &(i, drive) in commands {
+            let command = Command {
+                torque,
+                acceleration: self.acceleration[i],
+                goal_position: self.position[i],
+                duty: if torque { duty_of(drive) } else { 0 },
+            };
+            let _ = entries.push((joints[i].id, command));
+            order.get_or_insert(self.order[i]);
+        }
+        bus.sync_write_ft(&entries, order.unwrap_or(ByteOrder::Little)).await.ok();
     }
 }

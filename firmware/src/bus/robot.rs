@@ -4,11 +4,14 @@
 //!
 //! Per period, with the robot's joints grouped by protocol:
 //!
-//! | | Protocol 1.0 (RX-28, MX-28) | Protocol 2.0 (X series) |
-//! |---|---|---|
-//! | read | one READ of the present block per servo | one FAST SYNC READ (or SYNC READ) of every servo's present block; a Hardware Error Status READ after an alert |
-//! | write, torque on | SYNC_WRITE of Moving Speed, then Torque Enable 1 (broadcast) | Torque Enable 1 (broadcast), SYNC WRITE of Goal PWM; the Bus Watchdog cleared and armed first at every torque-on and after an overrun |
-//! | write, torque off | Torque Enable 0, Moving Speed 0 (broadcast) | Torque Enable 0 (broadcast), SYNC WRITE of Goal PWM 0 |
+//! | | Protocol 1.0 (RX-28, MX-28) | Protocol 2.0 (X series) | Feetech (STS3215) |
+//! |---|---|---|---|
+//! | read | one READ of the present block per servo | one FAST SYNC READ (or SYNC READ) of every servo's present block; a Hardware Error Status READ after an alert | one SYNC READ of every servo's present block |
+//! | write, torque on | SYNC_WRITE of Moving Speed, then Torque Enable 1 (broadcast) | Torque Enable 1 (broadcast), SYNC WRITE of Goal PWM; the Bus Watchdog cleared and armed first at every torque-on and after an overrun | one SYNC WRITE of Torque Enable 1 and Goal Time (the duty cycle, Operating Mode 2) |
+//! | write, torque off | Torque Enable 0, Moving Speed 0 (broadcast) | Torque Enable 0 (broadcast), SYNC WRITE of Goal PWM 0 | one SYNC WRITE of Torque Enable 0 and Goal Time 0 |
+//!
+//! Each protocol's part is an implementation of one interface
+//! ([`super::parts::ProtocolPart`]).
 //!
 //! Everything is sent every period, so a servo that missed a packet (or
 //! browned out) gets it again one period later. A robot of Protocol 1.0
@@ -25,7 +28,7 @@
 //! rebooted and set up again ([`RobotBus::reboot_alerted`]). If its cause
 //! persists, it alerts again and the robot faults again.
 
-use super::parts::{Joints, ProtocolPart, V1Part, V2Part};
+use super::parts::{FtPart, Joints, ProtocolPart, V1Part, V2Part};
 use super::{BusConfig, BusStats, ServoBus, ServoRead, ServoSetup, SetupError};
 use crate::config::MAX_ROBOT_SERVOS;
 use crate::io::BusPort;
@@ -59,6 +62,7 @@ pub struct RobotBus<P> {
     /// Each protocol's part, in the order they are called.
     v1: V1Part,
     v2: V2Part,
+    ft: FtPart,
 }
 
 impl<P: BusPort> RobotBus<P> {
@@ -70,6 +74,7 @@ impl<P: BusPort> RobotBus<P> {
             refused: [false; MAX_ROBOT_SERVOS],
             v1: V1Part,
             v2: V2Part::new(robot.period_us),
+            ft: FtPart::default(),
         }
     }
 
@@ -124,6 +129,9 @@ impl<P: BusPort> RobotBus<P> {
         if self.speaks(V2Part::PROTOCOL) {
             self.v2.stop_all(&mut self.bus).await;
         }
+        if self.speaks(FtPart::PROTOCOL) {
+            self.ft.stop_all(&mut self.bus).await;
+        }
     }
 
     /// Sets up every joint's servo (torque must be off:
@@ -136,6 +144,7 @@ impl<P: BusPort> RobotBus<P> {
             let result = match joint.servo.protocol {
                 ServoProtocol::V1 => self.v1.setup(&mut self.bus, i, joint).await,
                 ServoProtocol::V2 => self.v2.setup(&mut self.bus, i, joint).await,
+                ServoProtocol::Feetech => self.ft.setup(&mut self.bus, i, joint).await,
             };
             if let Some(r) = self.refused.get_mut(i) {
                 *r = result.is_err();
@@ -158,6 +167,10 @@ impl<P: BusPort> RobotBus<P> {
         let at = self.usable(V2Part::PROTOCOL);
         if !at.is_empty() {
             self.v2.read(&mut self.bus, self.joints, &at, out).await;
+        }
+        let at = self.usable(FtPart::PROTOCOL);
+        if !at.is_empty() {
+            self.ft.read(&mut self.bus, self.joints, &at, out).await;
         }
     }
 
@@ -186,6 +199,10 @@ impl<P: BusPort> RobotBus<P> {
             let own = of(V2Part::PROTOCOL);
             self.v2.write(&mut self.bus, self.joints, torque, &own, rearm).await;
         }
+        if self.speaks(FtPart::PROTOCOL) {
+            let own = of(FtPart::PROTOCOL);
+            self.ft.write(&mut self.bus, self.joints, torque, &own, rearm).await;
+        }
     }
 
     /// Reboots every Protocol 2.0 servo that alerted (since its set-up, or
@@ -213,7 +230,8 @@ impl<P: BusPort> RobotBus<P> {
     /// protocol of the robot's servos; `None` if it did not answer.
     pub async fn sensors(&mut self) -> Option<(u16, u8)> {
         match self.sensor_protocol() {
-            ServoProtocol::V1 => {
+            // A Feetech READ or WRITE is Protocol 1.0's packet to the byte.
+            ServoProtocol::V1 | ServoProtocol::Feetech => {
                 let e = self.bus.read(SENSOR_ID, sensor_table::ENCODER_COUNT, sensor_table::READ_LEN).await;
                 e.status.as_ref().and_then(|s| parse_sensor_read(&s.params))
             }
@@ -229,7 +247,8 @@ impl<P: BusPort> RobotBus<P> {
     pub async fn call_operator(&mut self, call: OperatorCall) {
         let data = [call as u8];
         match self.sensor_protocol() {
-            ServoProtocol::V1 => {
+            // A Feetech READ or WRITE is Protocol 1.0's packet to the byte.
+            ServoProtocol::V1 | ServoProtocol::Feetech => {
                 self.bus.write_no_reply(SENSOR_ID, sensor_table::OPERATOR, &data).await.ok();
             }
             ServoProtocol::V2 => {

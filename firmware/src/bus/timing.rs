@@ -53,8 +53,8 @@ impl PeriodTraffic {
             t.packets_out += 1;
             t.bytes_out += n as u32;
         };
-        let v1: usize = robot.joints.iter().filter(|j| j.servo.protocol == ServoProtocol::V1).count();
-        let v2: usize = robot.joints.len() - v1;
+        let count = |p: ServoProtocol| robot.joints.iter().filter(|j| j.servo.protocol == p).count();
+        let (v1, v2, ft) = (count(ServoProtocol::V1), count(ServoProtocol::V2), count(ServoProtocol::Feetech));
         if v1 > 0 {
             let read = len(dynamixel::read_data(1, table::PRESENT_BLOCK, table::PRESENT_BLOCK_LEN, &mut buf));
             for _ in 0..v1 {
@@ -76,10 +76,14 @@ impl PeriodTraffic {
             let pwms: [(u8, [u8; 2]); 8] = core::array::from_fn(|i| (i as u8 + 1, [0, 0]));
             out(&mut t, len(encoders::sync_write_values(x_series::GOAL_PWM, &pwms[..ids.len()], &mut buf)));
         }
+        if ft > 0 {
+            t.add_feetech(ft);
+        }
         if sensor {
             let first = robot.joints.first().map_or(ServoProtocol::V1, |j| j.servo.protocol);
             let (request, reply) = match first {
-                ServoProtocol::V1 => (len(dynamixel::read_data(100, 36, 3, &mut buf)), dynamixel::OVERHEAD + 3),
+                // A Feetech READ is Protocol 1.0's packet to the byte.
+                ServoProtocol::V1 | ServoProtocol::Feetech => (len(dynamixel::read_data(100, 36, 3, &mut buf)), dynamixel::OVERHEAD + 3),
                 ServoProtocol::V2 => (len(encoders::read(100, 36, 3, &mut buf)), status_len(3)),
             };
             out(&mut t, request);
@@ -169,6 +173,11 @@ mod tests {
         // of 50 µs: 1.78 ms, 5.9 % of a 30 ms period, 8.9 % of 20 ms.
         let t = PeriodTraffic::feetech(6);
         assert_eq!(t, PeriodTraffic { packets_out: 2, bytes_out: 14 + 50, packets_in: 6, bytes_in: 6 * 14 });
+        static FT6: [JointSpec; 6] = {
+            let j = JointSpec { name: "s", servo: &pada_core::servo::STS3215, id: 1, zero: 2048, sign: 1, soft_limit: None };
+            [j, JointSpec { id: 2, ..j }, JointSpec { id: 3, ..j }, JointSpec { id: 4, ..j }, JointSpec { id: 5, ..j }, JointSpec { id: 6, ..j }]
+        };
+        assert_eq!(PeriodTraffic::of(&with_servo(&leo::SPEC, &FT6), false), t);
         assert!((t.time_us(1_000_000, 50) - 1780.0).abs() < 1e-9);
         // LeRobot's return delay (0) and its 1 Mbaud: 1.48 ms.
         assert!((t.time_us(1_000_000, 0) - 1480.0).abs() < 1e-9);

@@ -268,10 +268,14 @@ fn run<R: RobotRules, W: WeightStore>(
         let mut readings = Readings { time_ms: (t / 1000) as u32, ..Readings::default() };
         for (i, joint) in joints.iter().enumerate() {
             // Each servo in its own model's units: an RX-28's Present
-            // Position … Temperature, an X-series servo's present block.
+            // Position … Temperature, an X-series servo's present block; an
+            // STS3215's present block holds the same signed values in its
+            // own units (4096 steps a turn, steps/s, load in 0.1 %).
             readings.servos[i].state = Some(match joint.servo.protocol {
                 ServoProtocol::V1 => rig.present(t, joint.id).into(),
-                ServoProtocol::V2 => crate::rig::x_reading(joint, rig.joint_state(t, joint.id), 0, rig.supply_v()).into(),
+                ServoProtocol::V2 | ServoProtocol::Feetech => {
+                    crate::rig::x_reading(joint, rig.joint_state(t, joint.id), 0, rig.supply_v()).into()
+                }
             });
         }
         let (count, contacts) = rig.sensors(t);

@@ -491,7 +491,7 @@ fn run<W: WeightStore>(setup: &DriveSetup, table: W, mut tm: TelemetryPipe) -> a
         bytes_in,
         bytes_per_period: (bytes_out + bytes_in) as f64 / periods.max(1) as f64,
         watchdog_ms: if spec.joints.iter().any(|j| j.servo.protocol == ServoProtocol::V2) { bus.watchdog_units() as u32 * 20 } else { 0 },
-        fast_sync_read: bus.fast_reads(),
+        fast_sync_read: bus.fast_reads() && spec.joints.iter().any(|j| j.servo.protocol == ServoProtocol::V2),
     };
     let learning_steps = protocol.learning_steps();
     let learning_episodes = protocol.learning_episodes();
@@ -554,10 +554,7 @@ fn run<W: WeightStore>(setup: &DriveSetup, table: W, mut tm: TelemetryPipe) -> a
 
 /// The zero command of a servo's kind.
 fn zero(d: Drive) -> Drive {
-    match d {
-        Drive::MovingSpeed(_) => Drive::MovingSpeed(0),
-        Drive::GoalPwm { full, .. } => Drive::GoalPwm { pwm: 0, full },
-    }
+    d.zeroed()
 }
 
 /// The policy as the command line names it.

@@ -712,6 +712,10 @@ fn device(model: &'static ServoModel, id: u8, bps: u32, joint: Option<JointSpec>
             "a virtual {} is not emulated on Protocol 1.0: valid models are RX-28, XM430-W350, XL430-W250, XL330-M288",
             model.name
         )),
+        ServoProtocol::Feetech => Err(format!(
+            "a robot's virtual {} is not emulated: `pada servos --chain sts3215:1-6` emulates a bare STS3215 chain",
+            model.name
+        )),
         ServoProtocol::V2 => {
             let table = control_table::by_model_number(model.model_number)
                 .ok_or_else(|| format!("no control table of {} (model {})", model.name, model.model_number))?;

@@ -46,7 +46,8 @@ impl SensorDevice {
     pub fn execute(&mut self, protocol: ServoProtocol, code: u8, params: &[u8]) -> (Option<Vec<u8>>, Option<u8>) {
         let mut buf = [0u8; 96];
         match protocol {
-            ServoProtocol::V1 => match dxl1::Instruction::parse(code, params) {
+            // Feetech's PING, READ and WRITE are Protocol 1.0's packets.
+            ServoProtocol::V1 | ServoProtocol::Feetech => match dxl1::Instruction::parse(code, params) {
                 Ok(dxl1::Instruction::Ping) => (encode1(&[], &mut buf), None),
                 Ok(dxl1::Instruction::Read { addr, len }) => {
                     let data = self.table.get(addr as usize..addr as usize + len as usize).map(<[u8]>::to_vec);

@@ -7,6 +7,7 @@
 //! | RX-28 | 1.0 | 0–1023 over 300° (clamped) | 0.111 rev/min | Moving Speed in wheel mode: a ratio of the output, 0–1023 CCW, 1024–2047 CW |
 //! | MX-28 | 1.0 | 0–4095 at 0.088° (4096 per turn; clamped) | 0.114 rev/min | Moving Speed in wheel mode, as the RX-28 |
 //! | XM430-W350, XL430-W250, XL330-M288 | 2.0 | 4096 per turn, multi-turn (signed 32 bits) in PWM Control Mode | 0.229 rev/min | Goal PWM in PWM Control Mode (Operating Mode 16): ±885 = ±100 % of the supply |
+//! | STS3215 (every gear variant) | Feetech | 0–4095 (4096 per turn) | 1 count/s = 60/4096 rev/min | Goal_Time in Operating_Mode 2 (PWM open loop): ±1000 = ±100 % of the supply, 50 the least non-zero |
 //!
 //! Sources: each model's e-Manual page (the [`super::ServoModel::source`]
 //! of its entry): the RX-28's and MX-28's "Present Position", "Moving
@@ -14,9 +15,13 @@
 //! and "Present Speed"; the X series' "Present Position" (4096 pulses per
 //! revolution; outside Position Control Mode it counts turns), "Present
 //! Velocity" (0.229 rev/min) and "PWM Limit"/"Goal PWM" (0–885 = 0–100 %,
-//! docs/reference/dynamixel.md § 5). Both commands are the paper's voltage
-//! actions: a fraction of the measured supply that the servo's H-bridge
-//! applies to its motor.
+//! docs/reference/dynamixel.md § 5); the STS3215's memory table (Present
+//! Position 0–4095, Present Velocity in steps per second, Goal_Time in
+//! 0.1 % "in the PWM open-loop speed control mode the value range is from
+//! 50 to 1000", docs/reference/feetech.md, "How pada acts through a
+//! Feetech servo"). All three commands are the paper's voltage actions: a
+//! fraction of the measured supply that the servo's H-bridge applies to
+//! its motor.
 //!
 //! [`Present`] is one servo's reading in its model's raw units, whatever
 //! its protocol, so that the controller reads every servo the same way;
@@ -79,6 +84,16 @@ pub enum CommandKind {
         /// Goal PWM of 100 % (the X series' PWM Limit range, 885).
         full: i16,
     },
+    /// Goal_Time in Operating_Mode 2, a Feetech servo's PWM open loop:
+    /// `±full` is ±100 % of the supply; a magnitude below `floor` is
+    /// outside the documented range and is sent as 0. On the wire the
+    /// sign is bit 10 (sign and magnitude), the bus's business.
+    GoalTime {
+        /// Goal_Time of 100 % (1000, in 0.1 %).
+        full: i16,
+        /// The least non-zero magnitude (50, 5 %).
+        floor: i16,
+    },
 }
 
 /// A servo model's units.
@@ -118,6 +133,22 @@ pub const X_SERIES: Encoding = Encoding {
     command: CommandKind::GoalPwm { full: X_PWM_FULL },
 };
 
+/// Goal_Time of 100 % on the STS3215 in Operating_Mode 2 (0.1 % units).
+pub const FT_TIME_FULL: i16 = 1000;
+
+/// The least non-zero Goal_Time the memory table documents in
+/// Operating_Mode 2 (5 %).
+pub const FT_TIME_FLOOR: i16 = 50;
+
+/// The STS3215 (Feetech): 0–4095 over one turn (4096 per turn, clamped as
+/// the MX-28's), Present Velocity in steps per second, Goal_Time in
+/// Operating_Mode 2.
+pub const STS3215: Encoding = Encoding {
+    position: PositionScale::Span { max: 4095, range_rad: core::f32::consts::TAU * (4095.0 / 4096.0) },
+    speed_unit_rpm: 60.0 / 4096.0,
+    command: CommandKind::GoalTime { full: FT_TIME_FULL, floor: FT_TIME_FLOOR },
+};
+
 /// The command sent to one servo in a control period.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -131,6 +162,14 @@ pub enum Drive {
         /// Goal PWM of 100 %.
         full: i16,
     },
+    /// Goal_Time (a Feetech servo's Operating_Mode 2), signed, within
+    /// `±full`; 0 or at least the floor in magnitude.
+    GoalTime {
+        /// The value, signed (the sign becomes bit 10 on the wire).
+        time: i16,
+        /// Goal_Time of 100 %.
+        full: i16,
+    },
 }
 
 impl Drive {
@@ -139,6 +178,16 @@ impl Drive {
         match kind {
             CommandKind::MovingSpeed => Drive::MovingSpeed(0),
             CommandKind::GoalPwm { full } => Drive::GoalPwm { pwm: 0, full },
+            CommandKind::GoalTime { full, .. } => Drive::GoalTime { time: 0, full },
+        }
+    }
+
+    /// The command of the same kind that applies 0 V.
+    pub const fn zeroed(self) -> Drive {
+        match self {
+            Drive::MovingSpeed(_) => Drive::MovingSpeed(0),
+            Drive::GoalPwm { full, .. } => Drive::GoalPwm { pwm: 0, full },
+            Drive::GoalTime { full, .. } => Drive::GoalTime { time: 0, full },
         }
     }
 
@@ -151,6 +200,13 @@ impl Drive {
                 let pwm = libm::roundf(r * full as f32).clamp(-(full as f32), full as f32) as i16;
                 Drive::GoalPwm { pwm, full }
             }
+            CommandKind::GoalTime { full, floor } => {
+                let r = if ratio.is_nan() { 0.0 } else { ratio.clamp(-1.0, 1.0) };
+                let time = libm::roundf(r * full as f32).clamp(-(full as f32), full as f32) as i16;
+                // Below the floor the mode's behaviour is undocumented: 0.
+                let time = if time.unsigned_abs() < floor.unsigned_abs() { 0 } else { time };
+                Drive::GoalTime { time, full }
+            }
         }
     }
 
@@ -160,6 +216,7 @@ impl Drive {
         match *self {
             Drive::MovingSpeed(v) => table::ratio_from_moving_speed(v),
             Drive::GoalPwm { pwm, full } => pwm as f32 / full.max(1) as f32,
+            Drive::GoalTime { time, full } => time as f32 / full.max(1) as f32,
         }
     }
 }
@@ -231,6 +288,26 @@ mod tests {
         assert_eq!(pwm(f32::NAN), Drive::zero(X_SERIES.command));
         assert!((pwm(0.25).ratio() - 0.25).abs() < 0.5 / 885.0);
         assert_eq!(Drive::zero(CommandKind::MovingSpeed).ratio(), 0.0);
+    }
+
+    #[test]
+    fn goal_time_is_a_fraction_of_1000_with_the_5_percent_floor() {
+        let t = |r| Drive::from_ratio(STS3215.command, r);
+        assert_eq!(t(1.0), Drive::GoalTime { time: 1000, full: 1000 });
+        assert_eq!(t(-2.0), Drive::GoalTime { time: -1000, full: 1000 });
+        assert_eq!(t(0.5), Drive::GoalTime { time: 500, full: 1000 });
+        assert_eq!(t(0.05), Drive::GoalTime { time: 50, full: 1000 });
+        assert_eq!(t(-0.05), Drive::GoalTime { time: -50, full: 1000 });
+        // Below 5 % of the supply: 0, not an undocumented command.
+        assert_eq!(t(0.049), Drive::zero(STS3215.command));
+        assert_eq!(t(-0.0494), Drive::zero(STS3215.command));
+        assert_eq!(t(f32::NAN), Drive::zero(STS3215.command));
+        assert!((t(-0.25).ratio() + 0.25).abs() < 0.5 / 1000.0);
+        assert_eq!(t(0.7).zeroed(), Drive::zero(STS3215.command));
+        assert_eq!(Drive::MovingSpeed(300).zeroed(), Drive::MovingSpeed(0));
+        assert!((STS3215.position.unit_rad() - 0.001_533_98).abs() < 1e-8);
+        assert_eq!(STS3215.position.counts(2048.0, 3000.0), 4095);
+        assert!((STS3215.speed_unit_rpm - 0.014_648_437).abs() < 1e-9);
     }
 
     #[test]

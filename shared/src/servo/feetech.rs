@@ -1,79 +1,79 @@
-//! The Feetech STS3215 (the SO-100/SO-101 arm's servo) as data: its gear
-//! variants with their sources, the DC-motor model of the follower's
-//! variant from its listing's stall torque, stall current and no-load
-//! speed ([`super::DcMotor::from_datasheet`], the same derivation as every
-//! ROBOTIS model but the RX-28's), and the defaults of its position loop
-//! ([`super::position_loop`]).
+//! The Feetech STS3215 (the SO-100/SO-101 arm's servo) in the servo table
+//! ([`super::SERVOS`]): its three gear variants, each a [`ServoModel`] on
+//! the Feetech protocol ([`ServoProtocol::Feetech`]), with the
+//! STS3215's encoding ([`super::encoding::STS3215`]: 4096 counts a turn,
+//! Goal_Time in Operating_Mode 2) and the factory gains of its own
+//! position loop ([`super::position_loop`]).
 //!
-//! The table is kept apart from [`super::SERVOS`] because a
-//! [`super::ServoModel`] names a Dynamixel protocol and command encoding,
-//! and the STS3215 speaks neither: its packets share Dynamixel 1.0's
-//! framing, but its control table (Goal_Position at 42, Operating_Mode at
-//! 33, …) and its voltage command (Goal_Time at 44 in Operating_Mode 2,
-//! bit 10 the direction) are its own. It joins [`super::SERVOS`] once
-//! pada-core speaks the Feetech protocol.
+//! - **STS3215** (C001, 1/345): the follower's six servos and the leader's
+//!   shoulder lift. Figures from Feetech's listing and DFRobot's; the
+//!   stall current from a third party's test (no Feetech page gives it).
+//! - **STS3215-C044** (1/191) and **STS3215-C046** (1/147): the leader's
+//!   other five. No listing gives their no-load speed or stall current, so
+//!   their figures are **estimates**: the C001's motor behind a different
+//!   gear ratio (same case, same supply, same product line), i.e. the
+//!   C001's stall torque × G/345, its no-load speed × 345/G, its stall
+//!   current. A Feetech representative's list gives "22 kg" (C044) and
+//!   "14 kg" (C046); with the C001's motor those would need an efficiency
+//!   above 1 at 1/191, so they are not used.
 //!
-//! Every figure and its source is in `docs/reference/feetech.md` ("The
-//! STS3215's motor and gears") and `docs/reference/servos.md`; the tests
-//! keep both equal to this data.
+//! The three variants share one gearbox entry, `STS3215` (an estimate:
+//! Table I's gear scaled with the case width, which is the same), and one
+//! model number, 777 (the bus cannot tell the gear ratio; a scan names the
+//! C001). Every figure and its source is in `docs/reference/feetech.md`
+//! ("The STS3215's motor and gears") and `docs/reference/servos.md` §1, §5;
+//! the tests keep both equal to this data.
 
-use super::gearbox::STS3215_GEARBOX;
-use super::position_loop::{LoopGains, PositionLoopSpec};
-use super::{Datasheet, DcMotor, Gearbox, UnknownName};
-
-/// One STS3215 variant: what a joint of an SO-101 names.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FeetechModel {
-    /// The name as users write it (matched case-insensitively by [`feetech_servo`]).
-    pub name: &'static str,
-    /// Feetech's variant code (C001: 7.4 V, 1/345).
-    pub variant: &'static str,
-    /// Model_Number (address 3) as LeRobot's table reads it.
-    pub model_number: u16,
-    /// Where the datasheet figures are taken from.
-    pub source: &'static str,
-    /// The figures; the stall current's source is weaker than the
-    /// others' (see `stall_current_source`).
-    pub datasheet: Datasheet,
-    /// Where the stall current comes from.
-    pub stall_current_source: &'static str,
-    /// The position loop's coefficients as the servo ships (P_Coefficient
-    /// at 21, D at 22, I at 23).
-    pub factory_gains: LoopGains,
-    /// Its gearbox.
-    pub gearbox: &'static Gearbox,
-}
-
-impl FeetechModel {
-    /// The motor model from the datasheet figures ([`DcMotor::from_datasheet`]).
-    pub fn motor(&self) -> DcMotor {
-        DcMotor::from_datasheet(&self.datasheet)
-    }
-
-    /// Its position loop with `gains` (LeRobot's are [`LoopGains::LEROBOT`]).
-    pub fn position_loop(&self, gains: LoopGains) -> PositionLoopSpec {
-        PositionLoopSpec::sts3215(gains)
-    }
-}
+use super::encoding;
+use super::position_loop::LoopGains;
+use super::{Datasheet, MotorSource, ServoModel, ServoProtocol};
 
 /// 19.5 kgf·cm in N·m (1 kgf·cm = 0.0980665 N·m).
 const STALL_TORQUE_C001_NM: f32 = 19.5 * 0.0980665;
+/// The C001's gear ratio and no-load speed \[rev/min\]: 0.192 s/60° at
+/// 7.4 V is 60/(6 × 0.192) = 52.1 rev/min; the listing rounds it to 52.
+const RATIO_C001: f32 = 345.0;
+const NO_LOAD_C001_RPM: f32 = 52.0;
+
+/// Where the C001's figures come from (docs/reference/feetech.md lists
+/// every page).
+const C001_SOURCE: &str = "Feetech STS3215 listing and DFRobot SER0069 (docs/reference/feetech.md, \"The STS3215's motor and gears\")";
+/// Where the leader variants' gear ratios come from.
+const LEADER_SOURCE: &str = "SO-ARM100 README, gear ratio only (docs/reference/feetech.md, \"The STS3215's motor and gears\")";
+
+/// A leader variant's figures: the C001's motor behind `ratio` (module
+/// documentation).
+const fn leader_datasheet(ratio: f32) -> Datasheet {
+    Datasheet {
+        rated_voltage_v: 7.4,
+        stall_torque_nm: STALL_TORQUE_C001_NM * ratio / RATIO_C001,
+        stall_current_a: 2.7,
+        no_load_speed_rpm: NO_LOAD_C001_RPM * RATIO_C001 / ratio,
+        gear_ratio: ratio,
+        max_voltage_v: 7.4,
+        backlash_arcmin: Some(30.0),
+        gear_material: "Metal (assumed as the C001's)",
+        case_mm: [24.7, 45.2, 35.0],
+    }
+}
+
+/// What is estimated in a leader variant's figures.
+const LEADER_ESTIMATES: &str = "estimate: the C001's motor behind this gear ratio (stall torque × G/345, no-load speed × 345/G, stall current 2.7 A); backlash and gear material as the C001's";
 
 /// The STS3215-C001: 7.4 V, 1/345 gears, the SO-101 follower's six servos
 /// and the leader's shoulder_lift.
-pub const STS3215: FeetechModel = FeetechModel {
+pub const STS3215: ServoModel = ServoModel {
     name: "STS3215",
-    variant: "C001",
+    protocol: ServoProtocol::Feetech,
     model_number: 777,
-    source: "Feetech STS3215 listing (https://www.feetech.cn/en/74v-19-kgcm-plastic-case-metal-tooth-magnetic-code-double-axis-ttl-series-steering-gear.html) and DFRobot SER0069 (https://littlebirdelectronics.com.au/products/st3215-serial-bus-servo-19-5kg-7-4v-360-magnetic-encoder)",
+    encoding: encoding::STS3215,
+    source: C001_SOURCE,
     datasheet: Datasheet {
         rated_voltage_v: 7.4,
         stall_torque_nm: STALL_TORQUE_C001_NM,
         stall_current_a: 2.7,
-        // 0.192 s/60° at 7.4 V: 60/(6 × 0.192) = 52.1 rev/min; the
-        // listing rounds it to 52.
-        no_load_speed_rpm: 52.0,
-        gear_ratio: 345.0,
+        no_load_speed_rpm: NO_LOAD_C001_RPM,
+        gear_ratio: RATIO_C001,
         max_voltage_v: 7.4,
         // "≤ 0.5°" (Feetech's datasheet as quoted by the SO-ARM100 issue
         // tracker and Robonine's test); measured ≈ 0.9–1°.
@@ -81,23 +81,31 @@ pub const STS3215: FeetechModel = FeetechModel {
         gear_material: "Metal (copper and aluminium)",
         case_mm: [24.7, 45.2, 35.0],
     },
-    stall_current_source: "Robonine, serial-servo driver board test (https://robonine.com/?p=1177): about 2.7 A; no Feetech page read gives it",
-    factory_gains: LoopGains::FACTORY,
-    gearbox: &STS3215_GEARBOX,
+    resistance_ohm: None,
+    torque_constant_nm_per_a: None,
+    motor_constants_source: None,
+    motor_source: MotorSource::Datasheet,
+    gearbox: "STS3215",
+    figure_notes: Some("stall current: Robonine's serial-servo driver board test (about 2.7 A); no Feetech page read gives it"),
+    loop_gains: Some(LoopGains::FACTORY),
 };
 
-/// Every Feetech model pada knows.
-pub static FEETECH_SERVOS: [FeetechModel; 1] = [STS3215];
+/// The STS3215-C044: 7.4 V, 1/191 gears, the SO-101 leader's shoulder pan
+/// and elbow flex. Figures estimated (module documentation).
+pub const STS3215_C044: ServoModel = ServoModel {
+    name: "STS3215-C044",
+    source: LEADER_SOURCE,
+    datasheet: leader_datasheet(191.0),
+    figure_notes: Some(LEADER_ESTIMATES),
+    ..STS3215
+};
 
-/// The names of [`FEETECH_SERVOS`], in order.
-pub static FEETECH_NAMES: [&str; 1] = [STS3215.name];
-
-/// The Feetech model called `name` (ASCII case-insensitive); an unknown
-/// name's error lists the valid ones.
-pub fn feetech_servo(name: &str) -> Result<&'static FeetechModel, UnknownName<'_>> {
-    FEETECH_SERVOS.iter().find(|s| s.name.eq_ignore_ascii_case(name.trim())).ok_or(UnknownName {
-        kind: "Feetech servo model",
-        name,
-        valid: &FEETECH_NAMES,
-    })
-}
+/// The STS3215-C046: 7.4 V, 1/147 gears, the SO-101 leader's wrist flex,
+/// wrist roll and gripper. Figures estimated (module documentation).
+pub const STS3215_C046: ServoModel = ServoModel {
+    name: "STS3215-C046",
+    source: LEADER_SOURCE,
+    datasheet: leader_datasheet(147.0),
+    figure_notes: Some(LEADER_ESTIMATES),
+    ..STS3215
+};

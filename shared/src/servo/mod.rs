@@ -12,7 +12,7 @@
 //! |---|---|
 //! | `mod.rs` | the servo models: datasheet figures, the DC motor, lookup by name |
 //! | `gearbox.rs` | the gearboxes: the last gear's Eqs. 3–7 parameters, each with its source, estimates marked |
-//! | `feetech.rs` | the Feetech STS3215: its figures and sources, kept apart until pada speaks its protocol |
+//! | `feetech.rs` | the Feetech STS3215's gear variants: their figures and sources, estimates marked |
 //! | `position_loop.rs` | a servo's own position loop (the STS3215's in Operating_Mode 0): goal error to motor voltage |
 //!
 //! # The DC motor from a datasheet
@@ -71,14 +71,18 @@ use crate::rx28;
 use core::fmt;
 
 pub use encoding::{CommandKind, Drive, Encoding, PositionScale, Present};
-pub use feetech::{feetech_servo, FeetechModel, FEETECH_SERVOS, STS3215};
+pub use feetech::{STS3215, STS3215_C044, STS3215_C046};
 pub use gearbox::{gearbox, Gearbox, GearboxSources, GEARBOXES};
 pub use position_loop::{ControlMode, LoopGains, PositionLoop, PositionLoopSpec};
 
-/// The Dynamixel protocol a servo model speaks (its firmware's default).
+/// The bus protocol a servo model speaks (its firmware's default): one of
+/// ROBOTIS' two Dynamixel protocols, or Feetech's.
 ///
-/// A stand-in for the Protocol type of the Dynamixel codec, to be unified with
-/// it; the number is what the e-Manual calls the protocol ("1.0", "2.0").
+/// The number is what the e-Manual calls the protocol ("1.0", "2.0");
+/// Feetech's packets are framed as Protocol 1.0's
+/// ([`crate::feetech`]), but its instructions, byte orders and control
+/// tables are its own, so a bus of Feetech servos is not a Protocol 1.0
+/// bus.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum ServoProtocol {
@@ -86,20 +90,43 @@ pub enum ServoProtocol {
     V1,
     /// Dynamixel Protocol 2.0 (every X-series servo).
     V2,
+    /// Feetech's SCS/STS protocol (the STS3215): Protocol 1.0's framing.
+    Feetech,
 }
 
 impl ServoProtocol {
-    /// The protocol's major number: 1 or 2.
+    /// The framing's major number: 1 or 2 (Feetech's packets are framed
+    /// as Protocol 1.0's: 1).
     pub const fn number(self) -> u8 {
         match self {
-            ServoProtocol::V1 => 1,
+            ServoProtocol::V1 | ServoProtocol::Feetech => 1,
             ServoProtocol::V2 => 2,
+        }
+    }
+
+    /// How the documentation names it: "1.0", "2.0" or "Feetech".
+    pub const fn name(self) -> &'static str {
+        match self {
+            ServoProtocol::V1 => "1.0",
+            ServoProtocol::V2 => "2.0",
+            ServoProtocol::Feetech => "Feetech",
+        }
+    }
+
+    /// The same protocol as the packet codec names it.
+    pub const fn codec(self) -> crate::dynamixel::Protocol {
+        match self {
+            ServoProtocol::V1 => crate::dynamixel::Protocol::V1,
+            ServoProtocol::V2 => crate::dynamixel::Protocol::V2,
+            ServoProtocol::Feetech => crate::dynamixel::Protocol::Feetech,
         }
     }
 }
 
-/// The figures a ROBOTIS e-Manual page gives for one servo model, in its
-/// units. All torques are at the output shaft (after the gears).
+/// The figures a maker's page gives for one servo model (a ROBOTIS
+/// e-Manual page, Feetech's listing), in its units; where a figure is not
+/// the page's, [`ServoModel::figure_notes`] says so. All torques are at the
+/// output shaft (after the gears).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Datasheet {
     /// The voltage the figures below are given at \[V\] (the recommended
@@ -153,8 +180,9 @@ pub struct ServoModel {
     /// How its control table says position, speed and the voltage command
     /// ([`encoding`]).
     pub encoding: Encoding,
-    /// The e-Manual page every datasheet figure (and the model number) is
-    /// taken from.
+    /// The page every datasheet figure (and the model number) is taken
+    /// from: the e-Manual page of a Dynamixel; for a Feetech servo the
+    /// listings, as `docs/reference/feetech.md` names them.
     pub source: &'static str,
     /// The datasheet figures.
     pub datasheet: Datasheet,
@@ -168,6 +196,14 @@ pub struct ServoModel {
     pub motor_source: MotorSource,
     /// The name of its gearbox in [`GEARBOXES`].
     pub gearbox: &'static str,
+    /// The figures not taken from `source`: where each comes from, and
+    /// "estimate: …" first where pada estimated them. `None` when every
+    /// figure is the source's.
+    pub figure_notes: Option<&'static str>,
+    /// The factory gains of the servo's own position loop, where pada
+    /// models it ([`position_loop`]: the STS3215's in Operating_Mode 0);
+    /// `None` for a servo whose position mode pada does not model.
+    pub loop_gains: Option<LoopGains>,
 }
 
 /// A voltage-driven DC motor behind a gearbox, the model GRL simulates the
@@ -340,6 +376,16 @@ impl ServoModel {
     pub fn gearbox(&self) -> Result<&'static Gearbox, UnknownName<'static>> {
         gearbox::gearbox(self.gearbox)
     }
+
+    /// Its own position loop with `gains` (LeRobot's are
+    /// [`LoopGains::LEROBOT`], the factory's [`Self::loop_gains`]); `None`
+    /// for a servo whose position loop pada does not model.
+    pub fn position_loop(&self, gains: LoopGains) -> Option<PositionLoopSpec> {
+        match (self.protocol, self.loop_gains) {
+            (ServoProtocol::Feetech, Some(_)) => Some(PositionLoopSpec::sts3215(gains)),
+            _ => None,
+        }
+    }
 }
 
 /// An unknown servo or gearbox name; it prints the valid ones.
@@ -397,6 +443,8 @@ pub const RX28: ServoModel = ServoModel {
     motor_constants_source: Some("docs/reference/grl.md §2.1 (GRL's DynamixelSpecs.h)"),
     motor_source: MotorSource::Given(DcMotor::RX28),
     gearbox: "RX-28",
+    figure_notes: None,
+    loop_gains: None,
 };
 
 /// The MX-28 (MX-28T/R/AT/AR) with its Protocol 1.0 firmware: model number
@@ -423,6 +471,8 @@ pub const MX28: ServoModel = ServoModel {
     motor_constants_source: None,
     motor_source: MotorSource::Datasheet,
     gearbox: "MX-28",
+    figure_notes: None,
+    loop_gains: None,
 };
 
 /// The XM430-W350 (-T/-R): Protocol 2.0, model number 1020.
@@ -448,6 +498,8 @@ pub const XM430_W350: ServoModel = ServoModel {
     motor_constants_source: None,
     motor_source: MotorSource::Datasheet,
     gearbox: "XM430-W350",
+    figure_notes: None,
+    loop_gains: None,
 };
 
 /// The XL430-W250-T: Protocol 2.0, model number 1060.
@@ -473,6 +525,8 @@ pub const XL430_W250: ServoModel = ServoModel {
     motor_constants_source: None,
     motor_source: MotorSource::Datasheet,
     gearbox: "XL430-W250",
+    figure_notes: None,
+    loop_gains: None,
 };
 
 /// The XL330-M288-T: Protocol 2.0, model number 1200.
@@ -498,18 +552,24 @@ pub const XL330_M288: ServoModel = ServoModel {
     motor_constants_source: None,
     motor_source: MotorSource::Datasheet,
     gearbox: "XL330-M288",
+    figure_notes: None,
+    loop_gains: None,
 };
 
-/// Every servo model pada knows.
-pub static SERVOS: [ServoModel; 5] = [RX28, MX28, XM430_W350, XL430_W250, XL330_M288];
+/// Every servo model pada knows. New models go at the end: a robot
+/// built from files names its servo by its index here.
+pub static SERVOS: [ServoModel; 8] = [RX28, MX28, XM430_W350, XL430_W250, XL330_M288, STS3215, STS3215_C044, STS3215_C046];
 
 /// The names of [`SERVOS`], in order.
-pub static SERVO_NAMES: [&str; 5] = [
+pub static SERVO_NAMES: [&str; 8] = [
     RX28.name,
     MX28.name,
     XM430_W350.name,
     XL430_W250.name,
     XL330_M288.name,
+    STS3215.name,
+    STS3215_C044.name,
+    STS3215_C046.name,
 ];
 
 /// The servo model called `name` (ASCII case-insensitive); an unknown name's
@@ -526,7 +586,9 @@ pub fn servo(name: &str) -> Result<&'static ServoModel, UnknownName<'_>> {
 }
 
 /// The servo model whose control table reads `model_number` (Model Number,
-/// address 0), if pada knows it.
+/// address 0; a Feetech servo's at address 3), if pada knows it. The
+/// STS3215's gear variants read the same number (777): this gives the
+/// first, the C001.
 pub fn servo_by_model_number(model_number: u16) -> Option<&'static ServoModel> {
     SERVOS.iter().find(|s| s.model_number == model_number)
 }

@@ -34,7 +34,7 @@ impl Joint {
     fn new(gains: LoopGains, friction: f32, q: f32) -> Joint {
         Joint {
             motor: STS3215.motor(),
-            servo: PositionLoop::new(STS3215.position_loop(gains)),
+            servo: PositionLoop::new(STS3215.position_loop(gains).expect("the STS3215 runs its own loop")),
             friction,
             q,
             qd: 0.0,
@@ -79,7 +79,7 @@ impl Joint {
 /// The half-width of the band where the loop's torque cannot overcome
 /// `friction` \[counts\].
 fn band_counts(gains: LoopGains, friction: f32) -> f32 {
-    let spec = STS3215.position_loop(gains);
+    let spec = STS3215.position_loop(gains).expect("the STS3215 runs its own loop");
     let motor = STS3215.motor();
     // The motor's torque is linear in the voltage below the clip.
     let torque_per_rad = motor.stall_torque(1.0) * spec.volts_per_rad(SUPPLY);
@@ -95,7 +95,7 @@ fn sts3215_loop_constants() {
     assert_eq!((s.cw_dead_zone, s.ccw_dead_zone, s.max_duty), (1, 1, 0.97));
     assert_eq!(LoopGains::FACTORY, LoopGains { p: 32, d: 32, i: 0 });
     assert_eq!(LoopGains::LEROBOT, LoopGains { p: 16, d: 32, i: 0 });
-    assert_eq!(STS3215.factory_gains, LoopGains::FACTORY);
+    assert_eq!(STS3215.loop_gains, Some(LoopGains::FACTORY));
 }
 
 #[test]
@@ -140,7 +140,7 @@ fn a_step_of_the_goal_settles_within_the_friction_band() {
         j.run(goal, 0.5);
         assert_eq!(j.q, settled, "{gains:?}: still moving after 1 s");
         assert_eq!(j.qd, 0.0);
-        let spec = STS3215.position_loop(gains);
+        let spec = STS3215.position_loop(gains).expect("the STS3215 runs its own loop");
         let e = (goal - j.q).abs() * spec.counts_per_rad;
         let band = band_counts(gains, friction);
         assert!(e <= band + 1.0, "{gains:?}: {e} counts off, band {band}");
@@ -148,7 +148,7 @@ fn a_step_of_the_goal_settles_within_the_friction_band() {
     // Without friction it settles to the dead zone.
     let mut j = Joint::new(LoopGains::FACTORY, 0.0, 0.0);
     j.run(0.5, 1.5);
-    let spec = STS3215.position_loop(LoopGains::FACTORY);
+    let spec = STS3215.position_loop(LoopGains::FACTORY).expect("the STS3215 runs its own loop");
     assert!((0.5 - j.q).abs() * spec.counts_per_rad <= 1.5, "{}", j.q);
 }
 
@@ -166,7 +166,7 @@ fn lerobots_p_of_16_leaves_a_dead_band_twice_the_factory_p_of_32s() {
     // friction; the band is inversely proportional to P.
     let friction = STS3215.motor().dry_friction;
     let goal = 0.2;
-    let spec = STS3215.position_loop(LoopGains::FACTORY);
+    let spec = STS3215.position_loop(LoopGains::FACTORY).expect("the STS3215 runs its own loop");
     let mut spreads = Vec::new();
     for gains in [LoopGains::LEROBOT, LoopGains::FACTORY] {
         let below = rest_from(gains, friction, goal, goal - 0.3);

@@ -109,7 +109,7 @@ fn a_joint_in_position_mode_follows_its_goal_through_the_servos_loop() {
     let robot = reacher();
     let model = UrdfModel::load(&robot).unwrap().with_steps(16, 4);
     let mut body = UrdfBody::new(&model).unwrap();
-    let spec = STS3215.position_loop(LoopGains::LEROBOT);
+    let spec = STS3215.position_loop(LoopGains::LEROBOT).expect("the STS3215 runs its own loop");
     assert!(body.set_control_mode(0, ControlMode::Position(spec)));
     assert!(!body.set_control_mode(MAX_SERVOS, ControlMode::Voltage));
     // Switched on, it holds where it is.

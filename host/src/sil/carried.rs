@@ -1,0 +1,43 @@
+//! Which servos the emulated board's bus carries: Dynamixel servos on
+//! Protocol 1.0 (the RX-28, `super::bus`) and 2.0 (the X series,
+//! `super::bus_v2`), not Feetech's. A robot with a Feetech joint is
+//! refused before the run, naming the joint, rather than meeting servos
+//! that answer as another model.
+
+use pada_core::robot::RobotSpec;
+use pada_core::servo::ServoProtocol;
+
+/// `Ok` if every joint's servo is emulated; otherwise the first that is
+/// not, and where the robot runs instead.
+pub fn check_servos(robot: &RobotSpec) -> Result<(), String> {
+    match robot.joints.iter().find(|j| j.servo.protocol == ServoProtocol::Feetech) {
+        Some(j) => Err(format!(
+            "joint {}: its {} speaks Feetech's protocol, which the emulated board's bus does not emulate (valid in `pada sil`: Dynamixel servos); `pada run --board` and `pada drive` run it",
+            j.name, j.servo.name
+        )),
+        None => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pendulum::PhysicalPendulumParams;
+    use crate::rig::PendulumRig;
+    use crate::sil::bus::BusEmulator;
+    use pada_core::robot::JointSpec;
+
+    #[test]
+    fn a_feetech_joint_is_refused_naming_it_and_dynamixel_robots_pass() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/robots/arm2/robot.toml");
+        let arm = pada_robot_file::load(&path).unwrap();
+        assert_eq!(check_servos(arm.spec), Ok(()));
+        assert_eq!(check_servos(&pada_core::robot::leo::SPEC), Ok(()));
+        let joints: Vec<JointSpec> = arm.spec.joints.iter().map(|j| JointSpec { servo: &pada_core::servo::STS3215, ..*j }).collect();
+        let spec = RobotSpec { joints: Box::leak(joints.into_boxed_slice()), ..*arm.spec };
+        let e = check_servos(&spec).unwrap_err();
+        assert!(e.contains("joint shoulder") && e.contains("STS3215") && e.contains("Feetech") && e.contains("pada drive"), "{e}");
+        let rig = PendulumRig::new(PhysicalPendulumParams::default());
+        assert_eq!(BusEmulator::new(&rig, &spec, vec![]).unwrap_err(), e);
+    }
+}
