@@ -25,19 +25,21 @@ mod tests {
     use crate::pendulum::PhysicalPendulumParams;
     use crate::rig::PendulumRig;
     use crate::sil::bus::BusEmulator;
-    use pada_core::robot::JointSpec;
 
     #[test]
     fn a_feetech_joint_is_refused_naming_it_and_dynamixel_robots_pass() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/robots/arm2/robot.toml");
-        let arm = pada_robot_file::load(&path).unwrap();
-        assert_eq!(check_servos(arm.spec), Ok(()));
+        let arm2 = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/robots/arm2");
+        assert_eq!(check_servos(pada_robot_file::load(&arm2.join("robot.toml")).unwrap().spec), Ok(()));
         assert_eq!(check_servos(&pada_core::robot::leo::SPEC), Ok(()));
-        let joints: Vec<JointSpec> = arm.spec.joints.iter().map(|j| JointSpec { servo: &pada_core::servo::STS3215, ..*j }).collect();
-        let spec = RobotSpec { joints: Box::leak(joints.into_boxed_slice()), ..*arm.spec };
-        let e = check_servos(&spec).unwrap_err();
-        assert!(e.contains("joint shoulder") && e.contains("STS3215") && e.contains("Feetech") && e.contains("pada drive"), "{e}");
+        // The arm with its elbow on an STS3215, as a robot.toml says it.
+        let dir = tempfile::tempdir().unwrap();
+        let toml = std::fs::read_to_string(arm2.join("robot.toml")).unwrap().replace("\"XL430-W250\"", "\"STS3215\"");
+        std::fs::write(dir.path().join("robot.toml"), toml).unwrap();
+        std::fs::copy(arm2.join("arm2.urdf"), dir.path().join("arm2.urdf")).unwrap();
+        let spec = pada_robot_file::load(&dir.path().join("robot.toml")).unwrap().spec;
+        let e = check_servos(spec).unwrap_err();
+        assert!(e.contains("joint elbow") && e.contains("STS3215") && e.contains("Feetech") && e.contains("pada drive"), "{e}");
         let rig = PendulumRig::new(PhysicalPendulumParams::default());
-        assert_eq!(BusEmulator::new(&rig, &spec, vec![]).unwrap_err(), e);
+        assert_eq!(BusEmulator::new(&rig, spec, vec![]).unwrap_err(), e);
     }
 }

@@ -71,13 +71,12 @@ mod tests {
 
     #[test]
     fn the_duty_floor_sign_and_block() {
-        assert_eq!(goal_time_of_duty(0), 0);
-        assert_eq!(goal_time_of_duty(49), 0);
-        assert_eq!(goal_time_of_duty(-49), 0);
-        assert_eq!(goal_time_of_duty(50), 50);
-        assert_eq!(goal_time_of_duty(-500), 0x0400 | 500);
-        assert_eq!(goal_time_of_duty(5000), 1000);
-        assert_eq!(goal_time_of_duty(i32::MIN), 0x0400 | 1000);
+        // (duty in 0.1 %, Goal Time's raw bits): the floor, the sign, the
+        // saturation.
+        let cases = [(0, 0), (49, 0), (-49, 0), (50, 50), (-500, 0x0400 | 500), (5000, 1000), (i32::MIN, 0x0400 | 1000)];
+        for (duty, raw) in cases {
+            assert_eq!(goal_time_of_duty(duty), raw, "duty {duty}");
+        }
         let c = Command { torque: true, acceleration: 254, goal_position: 2048, duty: -300 };
         assert_eq!(c.block(ByteOrder::Little), [1, 254, 0x00, 0x08, 0x2C, 0x05]);
         assert_eq!(c.block(ByteOrder::Big), [1, 254, 0x08, 0x00, 0x05, 0x2C]);
