@@ -379,6 +379,10 @@ fn a_robot_of_sts3215s_runs_on_one_sync_read_and_one_sync_write_a_period() {
     // SYNC READ 10 B, two answers of 14 B, SYNC WRITE 22 B.
     let per_period = report["bus"]["bytes_per_period"].as_f64().unwrap();
     assert!((per_period - 60.0).abs() < 1.0, "{per_period}");
+    // The same from the encoded packets: 0.60 ms on the wire at 1 Mbaud
+    // and two 50 µs Return Delays.
+    assert_eq!(report["bus"]["predicted_bytes_per_period"], 60);
+    assert!((report["bus"]["wire_ms_per_period"].as_f64().unwrap() - 0.70).abs() < 1e-9, "{}", report["bus"]);
     // One SYNC WRITE a period ends each of the chain's lock-step periods.
     let periods = report["clock"]["periods"].as_u64().unwrap();
     assert!(periods > 100, "{periods}");
@@ -413,4 +417,16 @@ fn an_sts3215_overload_turns_every_servos_torque_off_in_its_period() {
     assert!(off >= fault && off - fault <= 30_000, "overload at {fault} µs, servo 1 off at {off} µs");
     let csv = std::fs::read_to_string(out.join("telemetry.csv")).unwrap();
     assert!(csv.lines().any(|l| l.contains(",fault,") && l.contains("servo-error") && l.contains("servo: 2")), "{csv}");
+}
+
+#[test]
+fn a_missing_sts3215_is_one_line_naming_it_and_torque_never_goes_on() {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = sts_arm(dir.path());
+    let servos = Servos::start(dir.path(), &["--chain", "sts3215:1-1", "--lockstep"]);
+    let out = dir.path().join("drive");
+    let o = drive(&["--port", servos.port(), "--robot", &robot, "--lockstep", "--seconds", "2", "--out", out.to_str().unwrap()]);
+    bad_input(&o, &["servo 2 (elbow, STS3215) does not answer", "--scan", "torque is off"]);
+    let summary = servos.stop();
+    assert!(events(&summary, 1).iter().all(|e| e != "torque-on"), "{}", summary["events"]);
 }

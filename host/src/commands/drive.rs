@@ -258,8 +258,11 @@ pub fn run(args: DriveArgs) -> Result<(), CliError> {
         )?;
         outln!("  real time: {} (drive.json says why)", outcome.realtime.summary())?;
         outln!(
-            "  bus: {:.0} bytes a period, {} timeouts, {} damaged answers; telemetry: {} frames, {} lost, {} dropped",
+            "  bus: {:.0} bytes a period ({} from the packets: {:.2} ms on the wire, {:.1} % of the period), {} timeouts, {} damaged answers; telemetry: {} frames, {} lost, {} dropped",
             outcome.bus.bytes_per_period,
+            outcome.bus.predicted_bytes_per_period,
+            outcome.bus.wire_ms_per_period,
+            outcome.bus.wire_ms_per_period * 100.0 / (spec.period_us as f64 / 1000.0),
             outcome.bus.timeouts,
             outcome.bus.checksum_errors,
             t.link.frames,
