@@ -358,19 +358,34 @@ fn sts_arm(dir: &Path) -> String {
     path.to_str().unwrap().to_string()
 }
 
+/// `pada drive --lockstep --seconds SECONDS` of the STS3215 arm against
+/// `pada servos --chain CHAIN --lockstep` with `faults`: its output, the
+/// servos' summary and the run's directory (inside the returned tempdir).
+fn drive_sts(chain: &str, faults: &[&str], seconds: &str, json: bool) -> (std::process::Output, serde_json::Value, PathBuf, tempfile::TempDir) {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = sts_arm(dir.path());
+    let mut servos_args = vec!["--chain", chain, "--lockstep"];
+    for f in faults {
+        servos_args.extend(["--fault", f]);
+    }
+    let servos = Servos::start(dir.path(), &servos_args);
+    let out = dir.path().join("drive");
+    let mut args = vec!["--port", servos.port(), "--robot", &robot, "--lockstep", "--seconds", seconds, "--out", out.to_str().unwrap()];
+    if json {
+        args.push("--json");
+    }
+    let o = drive(&args);
+    (o, servos.stop(), out, dir)
+}
+
 /// `pada drive` on a Feetech bus: against `pada servos`' bare STS3215
 /// chain in lock step, each period is one SYNC READ and one SYNC WRITE
 /// (60 bytes for two servos), the positions come back through it, and
 /// torque is on for the episodes and off at the end.
 #[test]
 fn a_robot_of_sts3215s_runs_on_one_sync_read_and_one_sync_write_a_period() {
-    let dir = tempfile::tempdir().unwrap();
-    let robot = sts_arm(dir.path());
-    let servos = Servos::start(dir.path(), &["--chain", "sts3215:1-2", "--lockstep"]);
-    let out = dir.path().join("drive");
-    let o = drive(&["--port", servos.port(), "--robot", &robot, "--lockstep", "--seconds", "2", "--json", "--out", out.to_str().unwrap()]);
+    let (o, summary, out, _dir) = drive_sts("sts3215:1-2", &[], "2", true);
     let report: serde_json::Value = serde_json::from_str(&ok(&o)).expect("drive.json on stdout");
-    let summary = servos.stop();
     assert_eq!(report["ended"]["kind"], "done");
     let servo_lines = report["servos"].to_string();
     assert!(servo_lines.contains("servo 2 (elbow): STS3215 (model 777)"), "{servo_lines}");
@@ -402,13 +417,8 @@ fn a_robot_of_sts3215s_runs_on_one_sync_read_and_one_sync_write_a_period() {
 /// the robot: every servo's torque off in that period, one line.
 #[test]
 fn an_sts3215_overload_turns_every_servos_torque_off_in_its_period() {
-    let dir = tempfile::tempdir().unwrap();
-    let robot = sts_arm(dir.path());
-    let servos = Servos::start(dir.path(), &["--chain", "sts3215:1-2", "--lockstep", "--fault", "error-bits:at=1:servo=2:bits=overload"]);
-    let out = dir.path().join("drive");
-    let o = drive(&["--port", servos.port(), "--robot", &robot, "--lockstep", "--seconds", "20", "--out", out.to_str().unwrap()]);
+    let (o, summary, out, _dir) = drive_sts("sts3215:1-2", &["error-bits:at=1:servo=2:bits=overload"], "20", false);
     bad_input(&o, &["servo 2 (elbow)", "overload", "torque is off on every servo"]);
-    let summary = servos.stop();
     let at = |id: u64, what: &str| {
         summary["events"].as_array().unwrap().iter().find(|e| e["id"] == id && e["what"] == what).map(|e| e["at_us"].as_u64().unwrap())
     };
@@ -421,12 +431,8 @@ fn an_sts3215_overload_turns_every_servos_torque_off_in_its_period() {
 
 #[test]
 fn a_missing_sts3215_is_one_line_naming_it_and_torque_never_goes_on() {
-    let dir = tempfile::tempdir().unwrap();
-    let robot = sts_arm(dir.path());
-    let servos = Servos::start(dir.path(), &["--chain", "sts3215:1-1", "--lockstep"]);
-    let out = dir.path().join("drive");
-    let o = drive(&["--port", servos.port(), "--robot", &robot, "--lockstep", "--seconds", "2", "--out", out.to_str().unwrap()]);
+    // A chain of servo 1 only.
+    let (o, summary, _, _dir) = drive_sts("sts3215:1-1", &[], "2", false);
     bad_input(&o, &["servo 2 (elbow, STS3215) does not answer", "--scan", "torque is off"]);
-    let summary = servos.stop();
     assert!(events(&summary, 1).iter().all(|e| e != "torque-on"), "{}", summary["events"]);
 }
