@@ -376,3 +376,99 @@ fn drive_from_host_weights_in_lock_step_learns_as_pada_run_board_from_them() {
     assert_eq!(curve(&out), curve(&from), "the learning curve over the pty is pada run --board --weights's");
     assert_ne!(curve(&from), curve(&fresh), "the weights changed nothing");
 }
+
+/// The arm of files on two Feetech STS3215s (IDs 1 and 2, 7.4 V), its
+/// shoulder calibrated 48 counts off the chain's 2048, written into `dir`.
+fn sts_arm(dir: &Path) -> String {
+    let urdf = format!("{}/../examples/robots/arm2/arm2.urdf", env!("CARGO_MANIFEST_DIR"));
+    let toml = std::fs::read_to_string(arm())
+        .unwrap()
+        .replace("\"XM430-W350\"", "\"STS3215\"")
+        .replace("\"XL430-W250\"", "\"STS3215\"")
+        .replace("urdf = \"arm2.urdf\"", &format!("urdf = {urdf:?}"))
+        .replace("supply_v = 12.0", "supply_v = 7.4")
+        .replace("voltage_limit_v = 12.0", "voltage_limit_v = 7.4")
+        .replacen("zero_count = 2048", "zero_count = 2000", 1);
+    let path = dir.join("sts-arm.toml");
+    std::fs::write(&path, toml).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+/// `pada drive --lockstep --seconds SECONDS` of the STS3215 arm against
+/// `pada servos --chain CHAIN --lockstep` with `faults`: its output, the
+/// servos' summary and the run's directory (inside the returned tempdir).
+fn drive_sts(chain: &str, faults: &[&str], seconds: &str, json: bool) -> (std::process::Output, serde_json::Value, PathBuf, tempfile::TempDir) {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = sts_arm(dir.path());
+    let mut servos_args = vec!["--chain", chain, "--lockstep"];
+    for f in faults {
+        servos_args.extend(["--fault", f]);
+    }
+    let servos = Servos::start(dir.path(), &servos_args);
+    let out = dir.path().join("drive");
+    let mut args = vec!["--port", servos.port(), "--robot", &robot, "--lockstep", "--seconds", seconds, "--out", out.to_str().unwrap()];
+    if json {
+        args.push("--json");
+    }
+    let o = drive(&args);
+    (o, servos.stop(), out, dir)
+}
+
+/// `pada drive` on a Feetech bus: against `pada servos`' bare STS3215
+/// chain in lock step, each period is one SYNC READ and one SYNC WRITE
+/// (60 bytes for two servos), the positions come back through it, and
+/// torque is on for the episodes and off at the end.
+#[test]
+fn a_robot_of_sts3215s_runs_on_one_sync_read_and_one_sync_write_a_period() {
+    let (o, summary, out, _dir) = drive_sts("sts3215:1-2", &[], "2", true);
+    let report: serde_json::Value = serde_json::from_str(&ok(&o)).expect("drive.json on stdout");
+    assert_eq!(report["ended"]["kind"], "done");
+    let servo_lines = report["servos"].to_string();
+    assert!(servo_lines.contains("servo 2 (elbow): STS3215 (model 777)"), "{servo_lines}");
+    assert_eq!((report["bus"]["timeouts"].as_u64(), report["bus"]["checksum_errors"].as_u64()), (Some(0), Some(0)));
+    assert_eq!(report["bus"]["fast_sync_read"], false, "no Protocol 2.0 servo");
+    // SYNC READ 10 B, two answers of 14 B, SYNC WRITE 22 B.
+    let per_period = report["bus"]["bytes_per_period"].as_f64().unwrap();
+    assert!((per_period - 60.0).abs() < 1.0, "{per_period}");
+    // The same from the encoded packets: 0.60 ms on the wire at 1 Mbaud
+    // and two 50 µs Return Delays.
+    assert_eq!(report["bus"]["predicted_bytes_per_period"], 60);
+    assert!((report["bus"]["wire_ms_per_period"].as_f64().unwrap() - 0.70).abs() < 1e-9, "{}", report["bus"]);
+    // One SYNC WRITE a period ends each of the chain's lock-step periods.
+    let periods = report["clock"]["periods"].as_u64().unwrap();
+    assert!(periods > 100, "{periods}");
+    assert_eq!(summary["stats"]["sync_writes"].as_u64(), Some(periods));
+    // The shoulder reads 48 counts (0.074 rad) from its zero, the elbow 0.
+    let csv = std::fs::read_to_string(out.join("telemetry.csv")).unwrap();
+    let states: Vec<&str> = csv.lines().map(|l| l.split(',').collect::<Vec<_>>()).filter(|f| f[2] == "step").map(|f| f[8]).collect();
+    assert!(!states.is_empty() && states.iter().all(|s| *s == "0.074 0"), "{:?}", &states[..states.len().min(5)]);
+    for id in [1, 2] {
+        let servo = events(&summary, id);
+        assert_eq!(servo.first().map(String::as_str), Some("torque-on"), "servo {id}: {servo:?}");
+        assert_eq!(servo.last().map(String::as_str), Some("torque-off"), "servo {id}: {servo:?}");
+    }
+}
+
+/// A Feetech servo's overload (its Status bit 5, which unloads it) faults
+/// the robot: every servo's torque off in that period, one line.
+#[test]
+fn an_sts3215_overload_turns_every_servos_torque_off_in_its_period() {
+    let (o, summary, out, _dir) = drive_sts("sts3215:1-2", &["error-bits:at=1:servo=2:bits=overload"], "20", false);
+    bad_input(&o, &["servo 2 (elbow)", "overload", "torque is off on every servo"]);
+    let at = |id: u64, what: &str| {
+        summary["events"].as_array().unwrap().iter().find(|e| e["id"] == id && e["what"] == what).map(|e| e["at_us"].as_u64().unwrap())
+    };
+    let fault = at(2, "error-bits").expect("the overload was raised");
+    let off = at(1, "torque-off").expect("servo 1's torque went off");
+    assert!(off >= fault && off - fault <= 30_000, "overload at {fault} µs, servo 1 off at {off} µs");
+    let csv = std::fs::read_to_string(out.join("telemetry.csv")).unwrap();
+    assert!(csv.lines().any(|l| l.contains(",fault,") && l.contains("servo-error") && l.contains("servo: 2")), "{csv}");
+}
+
+#[test]
+fn a_missing_sts3215_is_one_line_naming_it_and_torque_never_goes_on() {
+    // A chain of servo 1 only.
+    let (o, summary, _, _dir) = drive_sts("sts3215:1-1", &[], "2", false);
+    bad_input(&o, &["servo 2 (elbow, STS3215) does not answer", "--scan", "torque is off"]);
+    assert!(events(&summary, 1).iter().all(|e| e != "torque-on"), "{}", summary["events"]);
+}

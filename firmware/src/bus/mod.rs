@@ -1,8 +1,9 @@
 //! Dynamixel transactions on a [`BusPort`], in the protocol each servo
 //! speaks, with bounded timeouts and retries.
 //!
-//! The packets come from `pada_core::dynamixel` (Protocol 1.0) and
-//! `pada_core::dynamixel::v2` (Protocol 2.0); this module adds the
+//! The packets come from `pada_core::dynamixel` (Protocol 1.0),
+//! `pada_core::dynamixel::v2` (Protocol 2.0) and `pada_core::feetech`
+//! (Feetech, on Protocol 1.0's framing); this module adds the
 //! conversation: send an instruction, listen for the status packet of the
 //! servo that was asked until a deadline, retry a bounded number of times,
 //! and report every timeout, checksum error, error bit and hardware alert
@@ -13,12 +14,16 @@
 //! | `mod.rs` | the bus: its port, decoders, buffers, timing and counters |
 //! | `v1.rs` | Protocol 1.0 (RX-28, MX-28): READ, PING, WRITE, SYNC_WRITE of Moving Speed, wheel-mode set-up |
 //! | `v2.rs` | Protocol 2.0 (X series): PING, READ, WRITE, SYNC_WRITE of Goal PWM, (fast) sync read of the present block, PWM-mode set-up, the Bus Watchdog |
+//! | `ft.rs` | Feetech (STS series) on Protocol 1.0's framing and transactions: SYNC READ of the present block, SYNC WRITE of torque and command, the set-up |
+//! | `parts.rs` | the interface of one protocol's part of a robot's bus (stop, set up, read, write), and its implementations |
 //! | `robot.rs` | one robot's period on the bus: every joint read and commanded in its servo's protocol, the sensor device, the boot |
 //! | `timing.rs` | the bytes each period's transactions put on the wire, and their time at a baud rate |
 //!
 //! The same code runs on the chip (embassy, its USART) and on a PC (`pada
 //! drive`, a USB serial adapter), whose port blocks instead of awaiting.
 
+pub mod ft;
+pub mod parts;
 mod v1;
 pub mod robot;
 pub mod timing;
@@ -216,6 +221,19 @@ impl<P: BusPort> ServoBus<P> {
         &mut self.port
     }
 
+    /// Waits until `deadline` (µs) for bytes into the receive buffer: how
+    /// many came, or `None` at the deadline or on a line error (counted).
+    async fn receive(&mut self, deadline: u64) -> Option<usize> {
+        match self.port.receive(&mut self.rx, deadline).await {
+            Ok(0) => None,
+            Ok(got) => Some(got),
+            Err(_) => {
+                self.stats.line_errors = self.stats.line_errors.wrapping_add(1);
+                None
+            }
+        }
+    }
+
     /// Sends the first `n` bytes of the transmit buffer.
     async fn send(&mut self, n: usize) -> Result<(), PortError> {
         self.stats.requests = self.stats.requests.wrapping_add(1);
@@ -225,4 +243,21 @@ impl<P: BusPort> ServoBus<P> {
         }
         result
     }
+}
+
+/// The wire of the tests' fake buses: answers waiting in `inbox` are
+/// handed out in chunks of at most `chunk` bytes, at 10 µs a byte; with
+/// none, the clock `now` jumps to the deadline.
+#[cfg(test)]
+pub(crate) fn fake_receive(inbox: &mut std::collections::VecDeque<u8>, now: &mut u64, buf: &mut [u8], deadline_us: u64, chunk: usize) -> usize {
+    if inbox.is_empty() {
+        *now = (*now).max(deadline_us);
+        return 0;
+    }
+    let n = buf.len().min(inbox.len()).min(chunk);
+    for (b, byte) in buf.iter_mut().zip(inbox.drain(..n)) {
+        *b = byte;
+    }
+    *now += n as u64 * 10;
+    n
 }

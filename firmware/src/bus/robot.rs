@@ -4,11 +4,14 @@
 //!
 //! Per period, with the robot's joints grouped by protocol:
 //!
-//! | | Protocol 1.0 (RX-28, MX-28) | Protocol 2.0 (X series) |
-//! |---|---|---|
-//! | read | one READ of the present block per servo | one FAST SYNC READ (or SYNC READ) of every servo's present block; a Hardware Error Status READ after an alert |
-//! | write, torque on | SYNC_WRITE of Moving Speed, then Torque Enable 1 (broadcast) | Torque Enable 1 (broadcast), SYNC WRITE of Goal PWM; the Bus Watchdog cleared and armed first at every torque-on and after an overrun |
-//! | write, torque off | Torque Enable 0, Moving Speed 0 (broadcast) | Torque Enable 0 (broadcast), SYNC WRITE of Goal PWM 0 |
+//! | | Protocol 1.0 (RX-28, MX-28) | Protocol 2.0 (X series) | Feetech (STS3215) |
+//! |---|---|---|---|
+//! | read | one READ of the present block per servo | one FAST SYNC READ (or SYNC READ) of every servo's present block; a Hardware Error Status READ after an alert | one SYNC READ of every servo's present block |
+//! | write, torque on | SYNC_WRITE of Moving Speed, then Torque Enable 1 (broadcast) | Torque Enable 1 (broadcast), SYNC WRITE of Goal PWM; the Bus Watchdog cleared and armed first at every torque-on and after an overrun | one SYNC WRITE of Torque Enable 1 and Goal Time (the duty cycle, Operating Mode 2) |
+//! | write, torque off | Torque Enable 0, Moving Speed 0 (broadcast) | Torque Enable 0 (broadcast), SYNC WRITE of Goal PWM 0 | one SYNC WRITE of Torque Enable 0 and Goal Time 0 |
+//!
+//! Each protocol's part is an implementation of one interface
+//! ([`super::parts::ProtocolPart`]).
 //!
 //! Everything is sent every period, so a servo that missed a packet (or
 //! browned out) gets it again one period later. A robot of Protocol 1.0
@@ -25,13 +28,12 @@
 //! rebooted and set up again ([`RobotBus::reboot_alerted`]). If its cause
 //! persists, it alerts again and the robot faults again.
 
-use super::v2::{fast_read_firmware, flags_of, watchdog_units, Read2};
+use super::parts::{FtPart, Joints, ProtocolPart, V1Part, V2Part};
 use super::{BusConfig, BusStats, ServoBus, ServoRead, ServoSetup, SetupError};
 use crate::config::MAX_ROBOT_SERVOS;
 use crate::io::BusPort;
 use crate::sensor_device::{parse_sensor_read, sensor_table, SENSOR_ID};
 use heapless::Vec;
-use pada_core::dynamixel::control_table::x_series::HardwareError;
 use pada_core::robot::{JointSpec, RobotSpec};
 use pada_core::servo::{Drive, ServoProtocol};
 
@@ -57,15 +59,10 @@ pub struct RobotBus<P> {
     /// Joints whose servo failed its set-up: never commanded, read as
     /// silent.
     refused: [bool; MAX_ROBOT_SERVOS],
-    /// Whether every Protocol 2.0 servo answers FAST SYNC READ.
-    fast: bool,
-    /// The Bus Watchdog value (20 ms units) for the robot's period.
-    watchdog: u8,
-    /// Torque as last written.
-    torque_was: bool,
-    /// Joints whose Protocol 2.0 servo raised its Alert bit since it was
-    /// last set up: rebooted when a fault is cleared.
-    alerted: [bool; MAX_ROBOT_SERVOS],
+    /// Each protocol's part, in the order they are called.
+    v1: V1Part,
+    v2: V2Part,
+    ft: FtPart,
 }
 
 impl<P: BusPort> RobotBus<P> {
@@ -75,10 +72,9 @@ impl<P: BusPort> RobotBus<P> {
             bus: ServoBus::new(port, config),
             joints: robot.joints,
             refused: [false; MAX_ROBOT_SERVOS],
-            fast: true,
-            watchdog: watchdog_units(robot.period_us),
-            torque_was: false,
-            alerted: [false; MAX_ROBOT_SERVOS],
+            v1: V1Part,
+            v2: V2Part::new(robot.period_us),
+            ft: FtPart::default(),
         }
     }
 
@@ -94,16 +90,28 @@ impl<P: BusPort> RobotBus<P> {
 
     /// The Bus Watchdog value armed on Protocol 2.0 servos \[20 ms\].
     pub fn watchdog_units(&self) -> u8 {
-        self.watchdog
+        self.v2.watchdog
     }
 
     /// Whether the Protocol 2.0 servos are read with FAST SYNC READ.
     pub fn fast_reads(&self) -> bool {
-        self.fast
+        self.v2.fast
     }
 
+    /// Whether any of the robot's servos speaks `protocol`.
     fn speaks(&self, protocol: ServoProtocol) -> bool {
         self.joints.iter().any(|j| j.servo.protocol == protocol)
+    }
+
+    /// The joints whose servo speaks `protocol` and passed its set-up.
+    fn usable(&self, protocol: ServoProtocol) -> Joints {
+        let mut at = Joints::new();
+        for (i, j) in self.joints.iter().enumerate() {
+            if j.servo.protocol == protocol && !self.refused[i] {
+                let _ = at.push(i);
+            }
+        }
+        at
     }
 
     /// The protocol of the robot's first servo: the sensor device's.
@@ -115,15 +123,15 @@ impl<P: BusPort> RobotBus<P> {
     /// protocol the robot's servos speak (at boot, whatever the servos did
     /// before; and on the way out).
     pub async fn stop_all(&mut self) {
-        if self.speaks(ServoProtocol::V1) {
-            self.bus.torque_all(false).await.ok();
-            self.bus.stop_all().await.ok();
+        if self.speaks(V1Part::PROTOCOL) {
+            self.v1.stop_all(&mut self.bus).await;
         }
-        if self.speaks(ServoProtocol::V2) {
-            self.bus.torque_all2(false).await.ok();
-            self.bus.stop_all2().await.ok();
+        if self.speaks(V2Part::PROTOCOL) {
+            self.v2.stop_all(&mut self.bus).await;
         }
-        self.torque_was = false;
+        if self.speaks(FtPart::PROTOCOL) {
+            self.ft.stop_all(&mut self.bus).await;
+        }
     }
 
     /// Sets up every joint's servo (torque must be off:
@@ -131,32 +139,15 @@ impl<P: BusPort> RobotBus<P> {
     /// definition; a servo that fails is refused from now on.
     pub async fn setup(&mut self) -> SetupReport {
         let mut report = SetupReport::new();
-        self.fast = true;
+        self.v2.fast = true;
         for (i, joint) in self.joints.iter().enumerate() {
-            let expected = joint.servo.model_number;
             let result = match joint.servo.protocol {
-                ServoProtocol::V1 => match self.bus.setup(joint.id).await {
-                    Ok(s) if s.model != expected => Err(SetupError::WrongModel { id: joint.id, found: s.model, expected }),
-                    other => other,
-                },
-                ServoProtocol::V2 => {
-                    let r = self.bus.setup2(joint.id, expected, self.watchdog).await;
-                    if let Ok(s) = r {
-                        self.fast &= s.firmware >= fast_read_firmware(s.model);
-                    }
-                    r
-                }
-                // This bus does not speak Feetech's instructions: such a
-                // servo is refused (read as silent, so the safety machine
-                // faults on it) rather than driven blind.
-                ServoProtocol::Feetech => Err(SetupError::NoAnswer { id: joint.id }),
+                ServoProtocol::V1 => self.v1.setup(&mut self.bus, i, joint).await,
+                ServoProtocol::V2 => self.v2.setup(&mut self.bus, i, joint).await,
+                ServoProtocol::Feetech => self.ft.setup(&mut self.bus, i, joint).await,
             };
             if let Some(r) = self.refused.get_mut(i) {
                 *r = result.is_err();
-            }
-            // An alert found at set-up: rebooted when that fault is cleared.
-            if let Some(a) = self.alerted.get_mut(i) {
-                *a = matches!(result, Err(SetupError::Alert { .. }));
             }
             let _ = report.push((joint.id, result));
         }
@@ -166,54 +157,20 @@ impl<P: BusPort> RobotBus<P> {
     /// Every joint's present state, in joint order, into `out`.
     pub async fn read(&mut self, out: &mut [ServoRead; MAX_ROBOT_SERVOS]) {
         let attempts = self.bus.config().attempts.max(1);
-        let mut ids2: Vec<u8, MAX_ROBOT_SERVOS> = Vec::new();
-        let mut at2: Vec<usize, MAX_ROBOT_SERVOS> = Vec::new();
-        for (i, (joint, read)) in self.joints.iter().zip(out.iter_mut()).enumerate() {
-            if self.refused[i] {
-                *read = ServoRead { timeouts: attempts, ..ServoRead::default() };
-                continue;
-            }
-            match joint.servo.protocol {
-                ServoProtocol::V1 => {
-                    let (state, exchange) = self.bus.read_present(joint.id).await;
-                    *read = ServoRead {
-                        state: state.map(Into::into),
-                        error: exchange.error(),
-                        hardware_error: None,
-                        timeouts: exchange.timeouts,
-                        checksum_errors: exchange.checksum_errors,
-                    };
-                }
-                ServoProtocol::V2 => {
-                    let _ = ids2.push(joint.id);
-                    let _ = at2.push(i);
-                }
-                // Refused at set-up (see `setup`).
-                ServoProtocol::Feetech => *read = ServoRead { timeouts: attempts, ..ServoRead::default() },
-            }
+        for (read, _) in out.iter_mut().zip(self.refused).filter(|(_, refused)| *refused) {
+            *read = ServoRead { timeouts: attempts, ..ServoRead::default() };
         }
-        if ids2.is_empty() {
-            return;
+        let at = self.usable(V1Part::PROTOCOL);
+        if !at.is_empty() {
+            self.v1.read(&mut self.bus, self.joints, &at, out).await;
         }
-        let mut reads = [Read2::default(); MAX_ROBOT_SERVOS];
-        self.bus.read_present2(&ids2, self.fast, &mut reads).await;
-        for ((&i, &id), r) in at2.iter().zip(&ids2).zip(&reads) {
-            // The Alert bit: which hardware error (one more READ, only
-            // then).
-            let hardware_error = match (r.state, r.error.alert()) {
-                (Some(_), true) => Some(self.bus.hardware_error(id).await.unwrap_or(HardwareError(0))),
-                _ => None,
-            };
-            if hardware_error.is_some() {
-                self.alerted[i] = true;
-            }
-            out[i] = ServoRead {
-                state: r.state.map(Into::into),
-                error: flags_of(r.error),
-                hardware_error,
-                timeouts: r.timeouts,
-                checksum_errors: r.checksum_errors,
-            };
+        let at = self.usable(V2Part::PROTOCOL);
+        if !at.is_empty() {
+            self.v2.read(&mut self.bus, self.joints, &at, out).await;
+        }
+        let at = self.usable(FtPart::PROTOCOL);
+        if !at.is_empty() {
+            self.ft.read(&mut self.bus, self.joints, &at, out).await;
         }
     }
 
@@ -222,38 +179,30 @@ impl<P: BusPort> RobotBus<P> {
     /// Protocol 2.0 servos' Bus Watchdog before torque goes on (after an
     /// overrun, which may have tripped it: a tripped servo takes no goal).
     pub async fn write(&mut self, torque: bool, commands: &[(u8, Drive)], rearm: bool) {
-        let allowed = |id: u8, joints: &[JointSpec], refused: &[bool; MAX_ROBOT_SERVOS]| {
-            joints.iter().position(|j| j.id == id).is_some_and(|i| !refused[i])
-        };
-        if self.speaks(ServoProtocol::V1) {
-            if torque {
-                let mut speeds: Vec<(u8, u16), MAX_ROBOT_SERVOS> = Vec::new();
-                for &(id, drive) in commands {
-                    if let (Drive::MovingSpeed(v), true) = (drive, allowed(id, self.joints, &self.refused)) {
-                        let _ = speeds.push((id, v));
-                    }
-                }
-                self.bus.write_speeds(&speeds).await.ok();
-                self.bus.torque_all(true).await.ok();
-            } else {
-                self.bus.torque_all(false).await.ok();
-                self.bus.stop_all().await.ok();
-            }
-        }
-        if self.speaks(ServoProtocol::V2) {
-            if torque && (!self.torque_was || rearm) {
-                self.bus.arm_watchdog2(self.watchdog).await.ok();
-            }
-            self.bus.torque_all2(torque).await.ok();
-            let mut pwms: Vec<(u8, i16), MAX_ROBOT_SERVOS> = Vec::new();
+        // Each protocol's allowed joints' commands, as joint index and
+        // command, in the controller's order.
+        let of = |protocol: ServoProtocol| {
+            let mut own: Vec<(usize, Drive), MAX_ROBOT_SERVOS> = Vec::new();
             for &(id, drive) in commands {
-                if let (Drive::GoalPwm { pwm, .. }, true) = (drive, allowed(id, self.joints, &self.refused)) {
-                    let _ = pwms.push((id, if torque { pwm } else { 0 }));
+                let i = self.joints.iter().position(|j| j.id == id);
+                if let Some(i) = i.filter(|&i| !self.refused[i] && self.joints[i].servo.protocol == protocol) {
+                    let _ = own.push((i, drive));
                 }
             }
-            self.bus.sync_write_pwm(&pwms).await.ok();
+            own
+        };
+        if self.speaks(V1Part::PROTOCOL) {
+            let own = of(V1Part::PROTOCOL);
+            self.v1.write(&mut self.bus, self.joints, torque, &own, rearm).await;
         }
-        self.torque_was = torque;
+        if self.speaks(V2Part::PROTOCOL) {
+            let own = of(V2Part::PROTOCOL);
+            self.v2.write(&mut self.bus, self.joints, torque, &own, rearm).await;
+        }
+        if self.speaks(FtPart::PROTOCOL) {
+            let own = of(FtPart::PROTOCOL);
+            self.ft.write(&mut self.bus, self.joints, torque, &own, rearm).await;
+        }
     }
 
     /// Reboots every Protocol 2.0 servo that alerted (since its set-up, or
@@ -265,12 +214,12 @@ impl<P: BusPort> RobotBus<P> {
     pub async fn reboot_alerted(&mut self) -> Vec<(u8, bool), MAX_ROBOT_SERVOS> {
         let mut rebooted = Vec::new();
         for (i, joint) in self.joints.iter().enumerate() {
-            if !self.alerted[i] || joint.servo.protocol != ServoProtocol::V2 {
+            if !self.v2.alerted[i] || joint.servo.protocol != ServoProtocol::V2 {
                 continue;
             }
             self.bus.reboot2(joint.id).await.ok();
-            let back = self.bus.setup2(joint.id, joint.servo.model_number, self.watchdog).await.is_ok();
-            self.alerted[i] = !back;
+            let back = self.bus.setup2(joint.id, joint.servo.model_number, self.v2.watchdog).await.is_ok();
+            self.v2.alerted[i] = !back;
             self.refused[i] = !back;
             let _ = rebooted.push((joint.id, back));
         }

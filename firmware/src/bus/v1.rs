@@ -8,7 +8,7 @@
 //! about 0.25 ms per servo (8-byte READ, 14-byte status, 50 µs return
 //! delay).
 
-use super::{Exchange, ServoBus, ServoSetup, SetupError, Status, RETURN_DELAY, STATUS_RETURN_LEVEL};
+use super::{BusStats, Exchange, ServoBus, ServoSetup, SetupError, Status, RETURN_DELAY, STATUS_RETURN_LEVEL};
 use crate::io::{BusPort, PortError};
 use pada_core::dynamixel::{self, table, DecodeError, ErrorFlags, Reply, BROADCAST_ID};
 
@@ -16,13 +16,19 @@ impl<P: BusPort> ServoBus<P> {
     /// READ `len` bytes at `addr` of servo `id`, with up to
     /// [`BusConfig::attempts`] attempts.
     pub async fn read(&mut self, id: u8, addr: u8, len: u8) -> Exchange {
+        self.read_within(id, addr, len, self.config.attempts.max(1)).await
+    }
+
+    /// READ with `attempts` attempts (a Feetech servo that a SYNC READ
+    /// missed gets the attempts left).
+    pub(super) async fn read_within(&mut self, id: u8, addr: u8, len: u8, attempts: u8) -> Exchange {
         let mut exchange = Exchange { status: None, timeouts: 0, checksum_errors: 0 };
         let Ok(n) = dynamixel::read_data(id, addr, len, &mut self.tx).map(|p| p.len()) else {
             // Only an invalid ID gets here; it can never answer.
             exchange.timeouts = 1;
             return exchange;
         };
-        for _ in 0..self.config.attempts.max(1) {
+        for _ in 0..attempts {
             match self.request(Reply { id, params: len }, n, &mut exchange.checksum_errors).await {
                 Some(status) if status.params.len() == len as usize => {
                     exchange.status = Some(status);
@@ -130,7 +136,7 @@ impl<P: BusPort> ServoBus<P> {
         Ok(ServoSetup { model, firmware: 0, wrote })
     }
 
-    async fn write_maybe_reply(&mut self, id: u8, addr: u8, data: &[u8], reply: bool) {
+    pub(super) async fn write_maybe_reply(&mut self, id: u8, addr: u8, data: &[u8], reply: bool) {
         if reply {
             let Ok(n) = dynamixel::write_data(id, addr, data, &mut self.tx).map(|p| p.len()) else {
                 return;
@@ -154,14 +160,7 @@ impl<P: BusPort> ServoBus<P> {
         self.send(n).await.ok()?;
         let deadline = self.port.now_us() + self.config.reply_timeout_us as u64;
         loop {
-            let got = match self.port.receive(&mut self.rx, deadline).await {
-                Ok(0) => break,
-                Ok(got) => got,
-                Err(_) => {
-                    self.stats.line_errors = self.stats.line_errors.wrapping_add(1);
-                    break;
-                }
-            };
+            let Some(got) = self.receive(deadline).await else { break };
             let mut found = None;
             let mut corrupted = false;
             for result in self.decoder.feed(&self.rx[..got]) {
@@ -170,14 +169,7 @@ impl<P: BusPort> ServoBus<P> {
                         found = Some(status);
                         break;
                     }
-                    Err(DecodeError::BadChecksum { .. }) => {
-                        self.stats.checksum_errors = self.stats.checksum_errors.wrapping_add(1);
-                        *checksum_errors = checksum_errors.saturating_add(1);
-                        corrupted = true;
-                    }
-                    Err(DecodeError::UnexpectedId { .. } | DecodeError::BadLength { .. } | DecodeError::BroadcastStatus) => {
-                        self.stats.stray_packets = self.stats.stray_packets.wrapping_add(1);
-                    }
+                    Err(e) => corrupted |= count_refusal(&mut self.stats, e, checksum_errors),
                 }
             }
             if found.is_some() {
@@ -192,6 +184,23 @@ impl<P: BusPort> ServoBus<P> {
         }
         self.stats.timeouts = self.stats.timeouts.wrapping_add(1);
         None
+    }
+}
+
+/// Counts a status packet the decoder refused: a bad checksum (a damaged
+/// answer, also in `checksum_errors`; returns true) or a stray packet
+/// (another ID, an impossible length, a broadcast status).
+pub(super) fn count_refusal(stats: &mut BusStats, e: DecodeError, checksum_errors: &mut u8) -> bool {
+    match e {
+        DecodeError::BadChecksum { .. } => {
+            stats.checksum_errors = stats.checksum_errors.wrapping_add(1);
+            *checksum_errors = checksum_errors.saturating_add(1);
+            true
+        }
+        DecodeError::UnexpectedId { .. } | DecodeError::BadLength { .. } | DecodeError::BroadcastStatus => {
+            stats.stray_packets = stats.stray_packets.wrapping_add(1);
+            false
+        }
     }
 }
 
@@ -319,16 +328,7 @@ pub(crate) mod tests {
         }
 
         async fn receive(&mut self, buf: &mut [u8], deadline_us: u64) -> Result<usize, PortError> {
-            if self.inbox.is_empty() {
-                self.now = self.now.max(deadline_us);
-                return Ok(0);
-            }
-            let n = buf.len().min(self.inbox.len()).min(5);
-            for b in buf.iter_mut().take(n) {
-                *b = self.inbox.pop_front().unwrap();
-            }
-            self.now += n as u64 * 10;
-            Ok(n)
+            Ok(crate::bus::fake_receive(&mut self.inbox, &mut self.now, buf, deadline_us, 5))
         }
 
         fn now_us(&self) -> u64 {

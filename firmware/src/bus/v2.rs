@@ -116,14 +116,7 @@ impl<P: BusPort> ServoBus<P> {
         let wire = (expect_bytes as u64).saturating_mul(self.config.byte_us as u64);
         let deadline = self.port.now_us() + self.config.reply_timeout_us as u64 + wire;
         loop {
-            let got = match self.port.receive(&mut self.rx, deadline).await {
-                Ok(0) => break,
-                Ok(got) => got,
-                Err(_) => {
-                    self.stats.line_errors = self.stats.line_errors.wrapping_add(1);
-                    break;
-                }
-            };
+            let Some(got) = self.receive(deadline).await else { break };
             let mut corrupted = false;
             for i in 0..got {
                 let mut next = self.decoder2.push(self.rx[i]);

@@ -279,8 +279,11 @@ pub fn run(args: DriveArgs) -> Result<(), CliError> {
         )?;
         outln!("  real time: {} (drive.json says why)", outcome.realtime.summary())?;
         outln!(
-            "  bus: {:.0} bytes a period, {} timeouts, {} damaged answers; telemetry: {} frames, {} lost, {} dropped",
+            "  bus: {:.0} bytes a period ({} from the packets: {:.2} ms on the wire, {:.1} % of the period), {} timeouts, {} damaged answers; telemetry: {} frames, {} lost, {} dropped",
             outcome.bus.bytes_per_period,
+            outcome.bus.predicted_bytes_per_period,
+            outcome.bus.wire_ms_per_period,
+            outcome.bus.wire_ms_per_period * 100.0 / (spec.period_us as f64 / 1000.0),
             outcome.bus.timeouts,
             outcome.bus.checksum_errors,
             t.link.frames,
@@ -304,14 +307,22 @@ pub fn run(args: DriveArgs) -> Result<(), CliError> {
     }
 }
 
-/// What stops the servos when the PC cannot reach them.
+/// What stops the servos when the PC cannot reach them: only the X
+/// series has a bus watchdog; Protocol 1.0 and Feetech servos keep their
+/// last command.
 fn stop_line(setup: &DriveSetup) -> String {
-    let x = setup.robot.spec.joints.iter().any(|j| j.servo.protocol == pada_core::servo::ServoProtocol::V2);
-    let rx = setup.robot.spec.joints.iter().any(|j| j.servo.protocol == pada_core::servo::ServoProtocol::V1);
+    use pada_core::servo::ServoProtocol;
+    let has = |p: ServoProtocol| setup.robot.spec.joints.iter().any(|j| j.servo.protocol == p);
     let watchdog = pada_firmware::bus::v2::watchdog_units(setup.robot.spec.period_us) as u32 * 20;
-    match (x, rx) {
-        (true, false) => format!("the X-series servos stop by their Bus Watchdog within {watchdog} ms of the last instruction"),
-        (false, _) => "Protocol 1.0 servos have no bus watchdog: they keep their last command until their power is cut — cut it now".to_string(),
-        (true, true) => format!("the X-series servos stop by their Bus Watchdog within {watchdog} ms; the Protocol 1.0 servos keep their last command until their power is cut"),
+    let blind: Vec<&str> = [(ServoProtocol::V1, "Protocol 1.0 servos"), (ServoProtocol::Feetech, "Feetech servos")]
+        .into_iter()
+        .filter(|(p, _)| has(*p))
+        .map(|(_, name)| name)
+        .collect();
+    let blind = blind.join(" and the ");
+    match (has(ServoProtocol::V2), blind.is_empty()) {
+        (true, true) => format!("the X-series servos stop by their Bus Watchdog within {watchdog} ms of the last instruction"),
+        (false, _) => format!("{blind} have no bus watchdog: they keep their last command until their power is cut — cut it now"),
+        (true, false) => format!("the X-series servos stop by their Bus Watchdog within {watchdog} ms; the {blind} keep their last command until their power is cut"),
     }
 }

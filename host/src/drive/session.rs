@@ -142,6 +142,13 @@ pub struct BusReport {
     pub bytes_in: u64,
     /// Bytes per period, both ways (the wire time's share).
     pub bytes_per_period: f64,
+    /// The bytes of a steady period counted from the packets the bus
+    /// encodes (`pada_firmware::bus::timing::PeriodTraffic`), both ways.
+    pub predicted_bytes_per_period: u32,
+    /// Their time on the wire at the port's rate, with the servos' 50 µs
+    /// Return Delay before each answer \[ms\]: the bus time stated
+    /// against the period (a USB adapter's latency comes on top).
+    pub wire_ms_per_period: f64,
     /// The Bus Watchdog armed on the X-series servos \[ms\] (0: none).
     pub watchdog_ms: u32,
     /// Whether the X-series servos were read with FAST SYNC READ.
@@ -497,6 +504,7 @@ fn run<W: WeightStore>(setup: &DriveSetup, table: W, mut tm: TelemetryPipe) -> a
     let stats = bus.stats();
     let port = bus.bus_mut().port_mut();
     let (bytes_out, bytes_in) = (port.bytes_out, port.bytes_in);
+    let traffic = pada_firmware::bus::timing::PeriodTraffic::of(spec, has_sensors);
     let bus_report = BusReport {
         requests: stats.requests,
         replies: stats.replies,
@@ -506,8 +514,10 @@ fn run<W: WeightStore>(setup: &DriveSetup, table: W, mut tm: TelemetryPipe) -> a
         bytes_out,
         bytes_in,
         bytes_per_period: (bytes_out + bytes_in) as f64 / periods.max(1) as f64,
+        predicted_bytes_per_period: traffic.bytes(),
+        wire_ms_per_period: traffic.time_us(setup.baud, 2 * pada_firmware::bus::RETURN_DELAY as u32) / 1000.0,
         watchdog_ms: if spec.joints.iter().any(|j| j.servo.protocol == ServoProtocol::V2) { bus.watchdog_units() as u32 * 20 } else { 0 },
-        fast_sync_read: bus.fast_reads(),
+        fast_sync_read: bus.fast_reads() && spec.joints.iter().any(|j| j.servo.protocol == ServoProtocol::V2),
     };
     let learning_steps = protocol.learning_steps();
     let learning_episodes = protocol.learning_episodes();

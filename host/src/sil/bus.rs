@@ -214,6 +214,7 @@ impl BusEmulator {
     /// `robot`'s joints), the sensor device, and `faults`; the error says
     /// why a fault cannot apply.
     pub fn new(rig: &dyn Rig, robot: &RobotSpec, faults: Vec<FaultSpec>) -> Result<Self, String> {
+        super::carried::check_servos(robot)?;
         let mut servos = servos(robot, rig.servo_ids());
         check_faults_on(&servos, robot, &faults)?;
         let x = XServos::new(robot, rig.servo_ids(), rig.supply_v())?;

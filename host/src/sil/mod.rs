@@ -13,7 +13,8 @@
 //! - [`bus`]: RX-28 servos and the sensor device on the emulated Dynamixel
 //!   bus, with `--fault` injection ([`fault`]); [`bus_v2`]: its X-series
 //!   servos on Protocol 2.0 (`pada servos`' virtual servo,
-//!   `crate::servos::p2`);
+//!   `crate::servos::p2`); [`carried`]: which servos it carries (no
+//!   Feetech servo);
 //! - the robot behind the bus: a [`crate::rig::Rig`] (the physical
 //!   pendulum's model, or the rapier3d LEO with its operator);
 //! - [`qemu`]: starting QEMU and its channel (and cutting its power);
@@ -33,6 +34,7 @@
 
 pub mod bus;
 pub mod bus_v2;
+pub mod carried;
 pub mod check;
 pub mod config;
 pub mod fault;

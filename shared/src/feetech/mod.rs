@@ -31,7 +31,9 @@
 //!   (bit 15 for speeds and positions, bit 11 for the homing offset,
 //!   bit 10 for the load);
 //! - the meaning of the status packet's ERROR bits ([`status`]);
-//! - the memory maps ([`control_table`]).
+//! - the memory maps ([`control_table`]);
+//! - the present block a controller reads ([`present`]) and the command
+//!   block it writes ([`command`]) every period.
 //!
 //! # A firmware bus task, in outline
 //!
@@ -55,8 +57,10 @@
 //! assert_eq!(ByteOrder::Little.u16_at(&packet.params, 0), Some(2048));
 //! ```
 
+pub mod command;
 pub mod control_table;
 pub mod instruction;
+pub mod present;
 pub mod status;
 pub mod value;
 
@@ -65,7 +69,9 @@ pub use crate::dynamixel::{
     ErrorFlags, Feed, InstructionDecoder, InstructionPacket, Reply, StatusDecoder, StatusPacket, BROADCAST_ID,
     DEFAULT_PACKET_LEN, HEADER, MAX_PARAMS, OVERHEAD,
 };
+pub use command::Command;
 pub use instruction::{sync_read, Instruction, InstructionError};
+pub use present::present;
 pub use status::ServoStatus;
 pub use value::ByteOrder;
 
