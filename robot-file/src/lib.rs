@@ -15,6 +15,7 @@
 //! | `urdf.rs` | the URDF: its joints, links and kinematic chains |
 //! | `definition.rs` | the checks, and the [`RobotSpec`] they make |
 //! | `codegen.rs` | the definition as Rust source for the firmware |
+//! | `plant.rs` | `[plant]`: how far the real robot may differ from its model |
 //! | `template.rs` | a new robot's files, commented field by field (`pada new-robot`) |
 //! | `error.rs` | one error in one line, pointing at the line of the file |
 //! | `type_error.rs` | toml's type and length errors, reworded with the field and the valid values |
@@ -24,6 +25,7 @@
 mod codegen;
 mod definition;
 mod error;
+pub mod plant;
 pub mod schema;
 pub mod template;
 mod type_error;
