@@ -168,6 +168,34 @@ pub fn run_trial_observed<T: Task>(
     progress: &(dyn Fn(u64) + Sync),
     observer: Option<TrialObserver<'_>>,
 ) -> anyhow::Result<(TrialResult, HostAgent, bool)> {
+    run_trial_from(task, cfg, trial, progress, observer, None).map(|(r, a, s, _)| (r, a, s))
+}
+
+/// The books of a trial at each of its test runs, in the order of
+/// [`TrialResult::curve`]: what learning had cost by then.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TestBooks {
+    /// The fatigue counter's cumulative damage of the most damaged counted
+    /// gearbox (the paper's torques, Eqs. 3–7; 1 is its expected failure).
+    pub damage: Vec<f64>,
+    /// The same from the simulated gear torques.
+    pub physical_damage: Vec<f64>,
+    /// Learning episodes that had ended in an absorbing state.
+    pub learning_falls: Vec<u64>,
+}
+
+/// [`run_trial_observed`], learning on from `start`'s weights when given
+/// (an agent for `task` with `cfg`'s policy: its weights are kept)
+/// instead of from nothing, and returning the books at every test
+/// run ([`TestBooks`]).
+pub fn run_trial_from<T: Task>(
+    task: &T,
+    cfg: &RunConfig,
+    trial: u32,
+    progress: &(dyn Fn(u64) + Sync),
+    observer: Option<TrialObserver<'_>>,
+    start: Option<HostAgent>,
+) -> anyhow::Result<(TrialResult, HostAgent, bool, TestBooks)> {
     let spec = task.spec();
     anyhow::ensure!(
         spec.episode_steps >= 1,
@@ -175,8 +203,12 @@ pub fn run_trial_observed<T: Task>(
         spec.name
     );
     let mut rng = trial_rng(cfg.seed, trial);
-    let mut agent = build_agent(spec, cfg.policy)?;
-    agent.reset_weights(&mut rng);
+    // From weights, the initial weights are drawn all the same and
+    // dropped, so that the trial's generator goes on as from nothing's:
+    // the same seed explores the same way and meets the same plant.
+    let mut drawn = build_agent(spec, cfg.policy)?;
+    drawn.reset_weights(&mut rng);
+    let mut agent = start.unwrap_or(drawn);
     let fatigue = FatigueCounter::with_gearboxes(
         |c| spec.gearbox(c),
         spec.control_period_s,
@@ -214,6 +246,7 @@ pub fn run_trial_observed<T: Task>(
         cycle: Episodes::new(spec.episode_rules()),
         governor,
         progress,
+        books: TestBooks::default(),
     };
 
     let budget = (cfg.seconds / spec.control_period_s).round() as u64;
@@ -278,7 +311,7 @@ pub fn run_trial_observed<T: Task>(
         governor: t.governor.as_ref().map(|g| g.finish(mtbf_s, physical_mtbf_s)),
         curve: t.curve,
     };
-    Ok((result, t.agent, switched))
+    Ok((result, t.agent, switched, t.books))
 }
 
 /// The state of a running trial.
@@ -310,6 +343,8 @@ struct Trial<'a, 'o, 'p, P: Plant> {
     governor: Option<TrialGovernor>,
     /// Told the environment steps after every episode.
     progress: &'p (dyn Fn(u64) + Sync),
+    /// The books at every test run.
+    books: TestBooks,
 }
 
 impl<P: Plant> Trial<'_, '_, '_, P> {
@@ -443,6 +478,12 @@ impl<P: Plant> Trial<'_, '_, '_, P> {
                 claimed_slots: pada_core::weights::WeightStore::occupancy(self.agent.weights()).map(|o| o.claimed),
             });
             self.test_steps += report.length as u64;
+            let most = |c: &FatigueCounter<MAX_ACTION_DIMS>| {
+                c.joints()[..spec.gearboxes.min(MAX_ACTION_DIMS)].iter().map(|j| j.damage()).fold(0.0, f64::max)
+            };
+            self.books.damage.push(most(&self.fatigue));
+            self.books.physical_damage.push(most(&self.physical));
+            self.books.learning_falls.push(self.learning_falls);
         }
         Ok(mode)
     }
