@@ -33,6 +33,7 @@ pub mod seed;
 pub mod serial_link;
 pub mod servos;
 pub mod sil;
+pub mod start_weights;
 pub mod stats;
 pub mod console;
 pub mod summary;

@@ -61,6 +61,7 @@ mod commands;
 mod episodes;
 mod governor;
 mod host_kept;
+mod import;
 mod period;
 mod persist;
 mod telemetry;

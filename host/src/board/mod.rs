@@ -11,6 +11,8 @@
 //! board will learn; `pada sil` shows that the binary does the same, bit
 //! for bit.
 //!
+//! - [`export`]: weights learned on the host in the board's table;
+//! - [`exported`]: a board's checkpoint image of exported weights;
 //! - [`demand`]: the slots a trial writes against the board's claim
 //!   table, known before flashing;
 //! - [`protocol`]: the run protocol and seeds, shared with `pada sil`;
@@ -22,6 +24,8 @@
 //!   [`TrialResult`]s (and so the same `summary.json`) as `pada run`.
 
 pub mod demand;
+pub mod export;
+pub mod exported;
 pub mod fault_line;
 pub mod protocol;
 pub mod readable;
@@ -35,7 +39,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 pub use protocol::{EpisodeOutcome, Phase, RunProtocol};
-pub use trial::{run_board_trial, run_board_trial_on, BoardTrial};
+pub use trial::{run_board_trial, run_board_trial_from, run_board_trial_on, run_board_trial_on_from, BoardStart, BoardTrial};
 
 /// A board's learner, as `summary.json` reports it.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -103,7 +107,18 @@ pub fn run_board(
     cfg: &RunConfig,
     progress: &(dyn Fn(u64) + Sync),
 ) -> anyhow::Result<Vec<BoardTrial>> {
-    (0..cfg.trials).into_par_iter().map(|i| run_board_trial(profile, robot, cfg, i, progress)).collect()
+    run_board_from(profile, robot, cfg, BoardStart::Fresh, progress)
+}
+
+/// [`run_board`] with every trial's learner starting as `start` says.
+pub fn run_board_from(
+    profile: LearnerProfile,
+    robot: &crate::robots::SimRobot,
+    cfg: &RunConfig,
+    start: BoardStart<'_>,
+    progress: &(dyn Fn(u64) + Sync),
+) -> anyhow::Result<Vec<BoardTrial>> {
+    (0..cfg.trials).into_par_iter().map(|i| run_board_trial_from(profile, robot, cfg, i, start, progress)).collect()
 }
 
 /// The per-trial results of board trials.

@@ -101,6 +101,22 @@ pub fn table_len(profile: &LearnerProfile, policy: PolicyKind) -> anyhow::Result
     profile.robot.exact_table_len::<TILINGS>(policy).map_err(|e| anyhow!("{e}"))
 }
 
+/// Where a board trial's learner starts.
+#[derive(Debug, Clone, Copy, Default)]
+pub enum BoardStart<'a> {
+    /// A fresh learner from the trial's seed (`SetPolicy`).
+    #[default]
+    Fresh,
+    /// The fresh learner with these table entries written over its table
+    /// before the first Start (`Controller::import_entries`: weights
+    /// exported from the host, [`super::export`]).
+    Entries(&'a [u8]),
+    /// The learner of this checkpoint image (a slot's, as the host keeps
+    /// it for a board), loaded as the firmware loads one at boot; no
+    /// `SetPolicy` then, only the Start.
+    Checkpoint(&'a [u8]),
+}
+
 /// Trial `trial` of `cfg` with `profile`'s learner against its robot's
 /// rig ([`SimRobot::board_rig`]).
 pub fn run_board_trial(
@@ -110,8 +126,20 @@ pub fn run_board_trial(
     trial: u32,
     progress: &(dyn Fn(u64) + Sync),
 ) -> anyhow::Result<BoardTrial> {
+    run_board_trial_from(profile, robot, cfg, trial, BoardStart::Fresh, progress)
+}
+
+/// [`run_board_trial`] with the learner starting as `start` says.
+pub fn run_board_trial_from(
+    profile: LearnerProfile,
+    robot: &SimRobot,
+    cfg: &RunConfig,
+    trial: u32,
+    start: BoardStart<'_>,
+    progress: &(dyn Fn(u64) + Sync),
+) -> anyhow::Result<BoardTrial> {
     let mut rig = robot.board_rig()?;
-    run_board_trial_on(profile, robot, cfg, trial, rig.as_mut(), progress)
+    run_board_trial_on_from(profile, robot, cfg, trial, rig.as_mut(), start, progress)
 }
 
 /// `$body` applied to `n` 16-bit weights shifted by `$shift`: the shift
@@ -182,6 +210,19 @@ pub fn run_board_trial_on(
     rig: &mut dyn Rig,
     progress: &(dyn Fn(u64) + Sync),
 ) -> anyhow::Result<BoardTrial> {
+    run_board_trial_on_from(profile, robot, cfg, trial, rig, BoardStart::Fresh, progress)
+}
+
+/// [`run_board_trial_on`] with the learner starting as `start` says.
+pub fn run_board_trial_on_from(
+    profile: LearnerProfile,
+    robot: &SimRobot,
+    cfg: &RunConfig,
+    trial: u32,
+    rig: &mut dyn Rig,
+    start: BoardStart<'_>,
+    progress: &(dyn Fn(u64) + Sync),
+) -> anyhow::Result<BoardTrial> {
     let n = table_len(&profile, cfg.policy)?;
     let seed = trial_seed(cfg.seed, trial);
     anyhow::ensure!(robot.robot == profile.robot, "the profile is {}'s, the robot {}", profile.robot.name, robot.robot.name);
@@ -193,15 +234,16 @@ pub fn run_board_trial_on(
         cfg: &'a RunConfig,
         trial: u32,
         seed: u64,
+        start: BoardStart<'a>,
         progress: &'a (dyn Fn(u64) + Sync),
     }
     impl TableVisitor for Visit<'_> {
         type Output = BoardTrial;
         fn visit<W: WeightStore>(self, table: W) -> anyhow::Result<BoardTrial> {
-            run(self.profile, table, self.rules, self.rig, self.cfg, self.trial, self.seed, self.progress)
+            run(self.profile, table, self.rules, self.rig, self.cfg, self.trial, self.seed, self.start, self.progress)
         }
     }
-    with_table(&profile, n, Visit { profile, rules, rig, cfg, trial, seed, progress })
+    with_table(&profile, n, Visit { profile, rules, rig, cfg, trial, seed, start, progress })
 }
 
 /// Carries out a host command, as the board would; a refusal is an error.
@@ -218,6 +260,7 @@ fn run<R: RobotRules, W: WeightStore>(
     cfg: &RunConfig,
     trial: u32,
     seed: u64,
+    start: BoardStart<'_>,
     progress: &(dyn Fn(u64) + Sync),
 ) -> anyhow::Result<BoardTrial> {
     let spec = rules.spec();
@@ -227,12 +270,24 @@ fn run<R: RobotRules, W: WeightStore>(
     // As the SIL run: the board boots with SARSA, the host sets the policy
     // (a fresh learner from the seed) and starts the first test run.
     let mut ctl = Controller::new(rules, profile, PolicyKind::Sarsa, table, seed).map_err(|e| anyhow!("{e}"))?;
-    for cmd in RunProtocol::start(cfg.policy) {
+    if let BoardStart::Checkpoint(image) = start {
+        // As the firmware's boot with a kept checkpoint: its learner, then
+        // the run's Start.
+        super::exported::load_image(&mut ctl, image)?;
+        command(&mut ctl, ToChip::Start(pada_core::wire::RunMode::Testing))?;
+    }
+    let protocol_start = if matches!(start, BoardStart::Checkpoint(_)) { None } else { Some(RunProtocol::start(cfg.policy)) };
+    for cmd in protocol_start.into_iter().flatten() {
         let starts = matches!(cmd, ToChip::Start(_));
         if let (true, Some(budget)) = (starts, cfg.mtbf_budget_s) {
             // As the host would: the wire command, after the policy and
             // before the first run (torque off).
             command(&mut ctl, ToChip::SetMtbfBudget(Some(budget)))?;
+        }
+        if let (true, BoardStart::Entries(entries)) = (starts, start) {
+            // The exported weights over the fresh learner's table, last
+            // before the first run.
+            ctl.import_entries(entries).map_err(|e| anyhow!("the exported weights: {e}"))?;
         }
         command(&mut ctl, cmd).map_err(|e| anyhow!("--algo {:?} on board {}: {e}", cfg.policy, profile.board.name()))?;
     }

@@ -7,7 +7,8 @@ use crate::display::{fmt_estimate, fmt_mtbf};
 use crate::error::{usage, CliError};
 use crate::experiment::algo::{label, parameter_of, policy_kind_of, Algo, PolicyFlags};
 use crate::board::trial::table_len;
-use crate::board::{robot_of_task, run_board};
+use crate::board::export::{export, ExportReport};
+use crate::board::{robot_of_task, run_board_from, BoardStart};
 use crate::experiment::task::{Task, TaskSpec};
 use crate::experiment::tasks::{visit_task, TaskVisitor};
 use crate::summary::{board_files, BoardSummary};
@@ -27,6 +28,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 use crate::commands::options::TrialOptions;
 use crate::experiment::tasks::TaskName;
+use crate::start_weights::StartWeights;
 use clap::Args;
 
 /// `pada run`.
@@ -98,6 +100,16 @@ pub struct RunArgs {
     /// a checksum; read by `pada render`).
     #[arg(long, value_name = "FILE")]
     pub save_weights: Option<PathBuf>,
+    /// Continue from weights saved by `pada run --save-weights`: every
+    /// trial starts from them instead of the task's initial weights, and
+    /// learns on as a run from nothing would (the same seeds). The file
+    /// must be for the same task, table and learner (sarsa, pada, lowpass
+    /// and the gentle explorations share one); one that is not is refused
+    /// with the first difference. With --board: the weights are exported
+    /// into the board's table first (docs/board.md, "Weights from the
+    /// host"), and what that changed is printed.
+    #[arg(long, value_name = "FILE")]
+    pub weights: Option<PathBuf>,
     /// Run a board's own learner instead of the host's: the firmware's
     /// controller built for the host, with the board's learner profile
     /// (table layout, size, weight format), its sensors (servo counts,
@@ -363,11 +375,26 @@ fn run_on_board(args: RunArgs, board: Board, sim: crate::robots::SimRobot) -> Re
             }
         }
     }
+    let entries = match &args.weights {
+        Some(path) => {
+            let (entries, report) = exported_weights(path, &sim, &task_spec, &profile, policy, weights)?;
+            for line in report.lines(board.name()) {
+                if args.json {
+                    eprintln!("{line}");
+                } else {
+                    outln!("{line}")?;
+                }
+            }
+            Some(entries)
+        }
+        None => None,
+    };
+    let start_from = entries.as_deref().map_or(BoardStart::Fresh, BoardStart::Entries);
     let total = cfg.trials as u64
         * cfg.expected_steps(task_spec.control_period_s, task_spec.episode_steps, task_spec.test_interval);
     let bar = steps_bar(total, &format!("{} {} on {}", task_spec.name, label(&policy), board.name()));
     let start = Instant::now();
-    let trials = run_board(profile, &sim, &cfg, &|n| bar.inc(n))?;
+    let trials = run_board_from(profile, &sim, &cfg, start_from, &|n| bar.inc(n))?;
     let wall = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
     let summary = BoardSummary::new(&task_spec, &cfg, &profile, &trials, wall);
@@ -390,6 +417,36 @@ fn run_on_board(args: RunArgs, board: Board, sim: crate::robots::SimRobot) -> Re
         outln!("wrote {}", out.path().display())?;
     }
     Ok(())
+}
+
+/// The host's weights in `path` (saved by `pada run` for `sim`'s robot,
+/// with the host's table), exported into `profile`'s table of `n`
+/// entries for a board run of `board_spec` with `policy`: the entries'
+/// bytes and what the export changed. A file for another robot, table or
+/// learner is refused with one line.
+pub fn exported_weights(
+    path: &std::path::Path,
+    sim: &crate::robots::SimRobot,
+    board_spec: &TaskSpec,
+    profile: &LearnerProfile,
+    policy: pada_core::policy::PolicyKind,
+    n: usize,
+) -> Result<(Vec<u8>, ExportReport), CliError> {
+    let host_profile = Board::Host.profile(sim.robot).map_err(|e| usage(e.to_string()))?;
+    let host_spec = sim.task_spec(host_profile).map_err(|e| usage(e.to_string()))?;
+    let w = StartWeights::load(path, &host_spec, policy).map_err(|e| usage(format!("--weights {e}")))?;
+    // The board's learner is the host's but for its table.
+    let mut host = crate::weights::WeightsHeader::new(&host_spec, policy, false, 0);
+    let on_board = crate::weights::WeightsHeader::new(board_spec, policy, false, 0);
+    (host.table, host.entry_bytes) = (on_board.table.clone(), on_board.entry_bytes);
+    if let Some((name, h, b)) = host.mismatch(&on_board) {
+        return Err(usage(format!(
+            "--weights {}: board {}'s learner differs from the host's in more than its table: {name} is {b} on the board but {h} on the host",
+            path.display(),
+            profile.board.name()
+        )));
+    }
+    export(&w, &host_spec, profile, n).map_err(|e| usage(format!("--weights {e}")))
 }
 
 /// The run's label: the policy, or the governed policy and its budget.
@@ -456,11 +513,17 @@ impl TaskVisitor for RunVisitor {
             .unwrap_or_else(|| PathBuf::from(format!("pada-out/run-{}-{}", spec.name, args.algo)));
         let out = OutDir::check(&out_path)?;
         let mode = args.cluster.mode(out.path())?;
-        if mode != Mode::Local && (args.telemetry.is_some() || args.mcap.is_some() || args.save_weights.is_some()) {
+        if mode != Mode::Local
+            && (args.telemetry.is_some() || args.mcap.is_some() || args.save_weights.is_some() || args.weights.is_some())
+        {
             return Err(usage(
-                "--telemetry, --mcap and --save-weights need the trials in this process: they do not combine with --plan, --merge or --slurm",
+                "--telemetry, --mcap, --save-weights and --weights need the trials in this process: they do not combine with --plan, --merge or --slurm",
             ));
         }
+        let start = match &args.weights {
+            Some(p) => Some(StartWeights::load(p, spec, policy).map_err(|e| usage(format!("--weights {e}")))?),
+            None => None,
+        };
         let mut telemetry = match &args.telemetry {
             Some(t) => Some(TelemetrySink::open(&parse_target(t)?)?),
             None => None,
@@ -484,7 +547,7 @@ impl TaskVisitor for RunVisitor {
                     spec.test_interval,
                 );
             let bar = steps_bar(total, &format!("{} {}", spec.name, label(&policy)));
-            let results = if telemetry.is_none() && mcap.is_none() && args.save_weights.is_none() {
+            let results = if telemetry.is_none() && mcap.is_none() && args.save_weights.is_none() && start.is_none() {
                 run_trials(task, &cfg, &|n| bar.inc(n))?
             } else {
                 let weight_count = pada_core::weights::WeightStore::len(build_agent(spec, policy)?.weights()) as u32;
@@ -522,6 +585,7 @@ impl TaskVisitor for RunVisitor {
                     observer
                         .as_mut()
                         .map(|o| o as &mut (dyn FnMut(ToHost) + Send)),
+                    start.as_ref(),
                 )?;
                 if let Some(path) = &args.save_weights {
                     crate::weights::save(path, spec, cfg.policy, switched, &agent)?;
@@ -565,6 +629,14 @@ impl TaskVisitor for RunVisitor {
             outln!("{}", summary.to_json())?;
         } else {
             print_summary(&summary, &run_label(&policy, cfg.mtbf_budget_s))?;
+            if let Some(s) = &start {
+                outln!(
+                    "  started from         {} ({} weights learned by {})",
+                    s.path.display(),
+                    s.header.weights,
+                    crate::experiment::algo::label(&s.header.policy)
+                )?;
+            }
             outln!("wrote {}", out.path().display())?;
         }
         Ok(())

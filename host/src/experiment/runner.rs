@@ -5,7 +5,8 @@
 use super::agent_setup::HostAgent;
 /// The run configuration, where the runner's users have found it.
 pub use super::config::RunConfig;
-use super::trial::{run_trial, run_trial_keep, run_trial_observed, TrialObserver, TrialResult};
+use super::trial::{run_trial_keep, run_trial_observed, TrialObserver, TrialResult};
+use crate::start_weights::StartWeights;
 use crate::experiment::task::Task;
 use rayon::prelude::*;
 
@@ -21,19 +22,20 @@ pub fn run_trials<T: Task>(
 /// [`run_trials`], with trial 0 told to `observer` (telemetry) if given,
 /// and trial 0's learned agent returned with whether it had switched back
 /// to SARSA(λ) (for saving its weights). The other trials run in parallel
-/// with it.
+/// with it. Every trial starts from `start`'s weights if given.
 pub fn run_trials_observed<T: Task>(
     task: &T,
     cfg: &RunConfig,
     progress: &(dyn Fn(u64) + Sync),
     observer: Option<TrialObserver<'_>>,
+    start: Option<&StartWeights>,
 ) -> anyhow::Result<(Vec<TrialResult>, HostAgent, bool)> {
     let (first, rest) = rayon::join(
-        || run_trial_observed(task, cfg, 0, progress, observer),
+        || run_trial_observed(task, cfg, 0, progress, observer, start),
         || {
             (1..cfg.trials)
                 .into_par_iter()
-                .map(|t| run_trial(task, cfg, t, progress))
+                .map(|t| run_trial_observed(task, cfg, t, progress, None, start).map(|(r, _, _)| r))
                 .collect::<anyhow::Result<Vec<_>>>()
         },
     );

@@ -27,6 +27,7 @@ use super::config::RunConfig;
 use crate::board::fault_line::{fault_explained, Faulted};
 use crate::experiment::task::{Plant, Task, TaskSpec};
 use crate::seed::{trial_rng, trial_seed};
+use crate::start_weights::StartWeights;
 use anyhow::anyhow;
 use pada_core::action_space::MAX_ACTION_DIMS;
 use pada_core::agent::Mode;
@@ -146,7 +147,7 @@ pub fn run_trial<T: Task>(
     trial: u32,
     progress: &(dyn Fn(u64) + Sync),
 ) -> anyhow::Result<TrialResult> {
-    run_trial_observed(task, cfg, trial, progress, None).map(|(r, _, _)| r)
+    run_trial_observed(task, cfg, trial, progress, None, None).map(|(r, _, _)| r)
 }
 
 /// [`run_trial`], also returning the agent as learned at the end (for
@@ -157,18 +158,32 @@ pub fn run_trial_keep<T: Task>(
     trial: u32,
     progress: &(dyn Fn(u64) + Sync),
 ) -> anyhow::Result<(TrialResult, HostAgent, bool)> {
-    run_trial_observed(task, cfg, trial, progress, None)
+    run_trial_observed(task, cfg, trial, progress, None, None)
 }
 
-/// [`run_trial_keep`], telling `observer` every agent call and episode.
+/// [`run_trial_keep`], telling `observer` every agent call and episode,
+/// and starting from `start`'s weights if given ([`StartWeights`]).
 pub fn run_trial_observed<T: Task>(
     task: &T,
     cfg: &RunConfig,
     trial: u32,
     progress: &(dyn Fn(u64) + Sync),
     observer: Option<TrialObserver<'_>>,
+    start: Option<&StartWeights>,
 ) -> anyhow::Result<(TrialResult, HostAgent, bool)> {
-    run_trial_from(task, cfg, trial, progress, observer, None).map(|(r, a, s, _)| (r, a, s))
+    let start = start.map_or(TrialStart::Nothing, TrialStart::Weights);
+    run_trial_from(task, cfg, trial, progress, observer, start).map(|(r, a, s, _)| (r, a, s))
+}
+
+/// Where a trial's weights start.
+pub enum TrialStart<'w> {
+    /// The learner's initial weights.
+    Nothing,
+    /// Saved weights ([`StartWeights`], `pada run --weights`).
+    Weights(&'w StartWeights),
+    /// A learned agent for the task with the run's policy (its weights and
+    /// state are kept).
+    Agent(HostAgent),
 }
 
 /// The books of a trial at each of its test runs, in the order of
@@ -184,17 +199,15 @@ pub struct TestBooks {
     pub learning_falls: Vec<u64>,
 }
 
-/// [`run_trial_observed`], learning on from `start`'s weights when given
-/// (an agent for `task` with `cfg`'s policy: its weights are kept)
-/// instead of from nothing, and returning the books at every test
-/// run ([`TestBooks`]).
+/// [`run_trial_observed`], starting as `start` says, and returning the
+/// books at every test run ([`TestBooks`]).
 pub fn run_trial_from<T: Task>(
     task: &T,
     cfg: &RunConfig,
     trial: u32,
     progress: &(dyn Fn(u64) + Sync),
     observer: Option<TrialObserver<'_>>,
-    start: Option<HostAgent>,
+    start: TrialStart<'_>,
 ) -> anyhow::Result<(TrialResult, HostAgent, bool, TestBooks)> {
     let spec = task.spec();
     anyhow::ensure!(
@@ -203,12 +216,17 @@ pub fn run_trial_from<T: Task>(
         spec.name
     );
     let mut rng = trial_rng(cfg.seed, trial);
-    // From weights, the initial weights are drawn all the same and
-    // dropped, so that the trial's generator goes on as from nothing's:
-    // the same seed explores the same way and meets the same plant.
-    let mut drawn = build_agent(spec, cfg.policy)?;
-    drawn.reset_weights(&mut rng);
-    let mut agent = start.unwrap_or(drawn);
+    // The initial weights are drawn even when the trial starts from
+    // others: the trial's random numbers afterwards are those of the trial
+    // from nothing (the same seed explores the same way and meets the
+    // same plant).
+    let mut agent = build_agent(spec, cfg.policy)?;
+    agent.reset_weights(&mut rng);
+    match start {
+        TrialStart::Nothing => {}
+        TrialStart::Weights(w) => w.apply(&mut agent)?,
+        TrialStart::Agent(a) => agent = a,
+    }
     let fatigue = FatigueCounter::with_gearboxes(
         |c| spec.gearbox(c),
         spec.control_period_s,

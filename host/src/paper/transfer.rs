@@ -24,7 +24,7 @@
 //! ended in an absorbing state). A trial that never reaches it counts its
 //! whole run, a lower bound.
 
-use crate::experiment::{run_trial_from, run_trial_keep, HostAgent, RunConfig, TestBooks, TrialResult};
+use crate::experiment::{run_trial_from, run_trial_keep, HostAgent, RunConfig, TestBooks, TrialResult, TrialStart};
 use crate::stats::Estimate;
 use pada_core::policy::PolicyKind;
 use pada_sim::task::Task;
@@ -195,7 +195,8 @@ pub fn measure<T: Vary + Clone>(
     let runs: Vec<(Start, u32, TrialResult, TestBooks)> = starts
         .into_par_iter()
         .map(|(start, t, agent)| {
-            let (r, _, _, books) = run_trial_from(&plant, &on_plant, t, progress, None, agent)?;
+            let from = agent.map_or(TrialStart::Nothing, TrialStart::Agent);
+            let (r, _, _, books) = run_trial_from(&plant, &on_plant, t, progress, None, from)?;
             Ok((start, t, r, books))
         })
         .collect::<anyhow::Result<_>>()?;
@@ -271,7 +272,7 @@ mod tests {
     #[test]
     fn the_objective_is_met_at_the_first_test_run_past_it_with_the_books_of_then() {
         let task = PhysicalPendulumTask::default();
-        let (r, _, _, b) = run_trial_from(&task, &cfg(60.0, 2), 0, &|_| {}, None, None).unwrap();
+        let (r, _, _, b) = run_trial_from(&task, &cfg(60.0, 2), 0, &|_| {}, None, TrialStart::Nothing).unwrap();
         assert_eq!((b.damage.len(), b.physical_damage.len(), b.learning_falls.len()), (r.curve.len(), r.curve.len(), r.curve.len()));
         assert!(b.damage.windows(2).all(|w| w[0] <= w[1]) && *b.damage.last().unwrap() > 0.0, "{:?}", b.damage);
         let best = r.curve.iter().map(|p| p.test_return).fold(f64::MIN, f64::max);
@@ -288,11 +289,11 @@ mod tests {
     fn a_trial_from_no_weights_is_the_trial_as_before_and_from_weights_starts_where_they_left_off() {
         let task = PhysicalPendulumTask::default();
         let before = run_trial(&task, &cfg(30.0, 5), 0, &|_| {}).unwrap();
-        let (now, agent, _, _) = run_trial_from(&task, &cfg(30.0, 5), 0, &|_| {}, None, None).unwrap();
+        let (now, agent, _, _) = run_trial_from(&task, &cfg(30.0, 5), 0, &|_| {}, None, TrialStart::Nothing).unwrap();
         assert_eq!(now, before);
         // The model is deterministic and the test run greedy: learning on
         // from the weights, the first test run repeats the last one.
-        let (on, _, _, _) = run_trial_from(&task, &cfg(30.0, 6), 0, &|_| {}, None, Some(agent)).unwrap();
+        let (on, _, _, _) = run_trial_from(&task, &cfg(30.0, 6), 0, &|_| {}, None, TrialStart::Agent(agent)).unwrap();
         assert_eq!(on.curve[0].test_return, before.curve.last().unwrap().test_return);
         assert_ne!(on.curve[0].test_return, before.curve[0].test_return);
     }
