@@ -81,8 +81,13 @@ fn one<T: Vary + Clone>(task: &T, ranges: PlantRanges, o: &TransferOptions) -> R
 /// `x ± ci` in `digits` decimals (or in scientific notation when small).
 fn est(e: &crate::stats::Estimate) -> String {
     let ci = if e.ci95.is_finite() { e.ci95 } else { 0.0 };
-    if e.mean != 0.0 && e.mean.abs() < 0.01 {
+    let a = e.mean.abs();
+    if e.mean == 0.0 && ci == 0.0 {
+        "0".into()
+    } else if a < 0.01 || a >= 1e5 {
         format!("{:.2e} ± {:.1e}", e.mean, ci)
+    } else if a >= 10.0 {
+        format!("{:.1} ± {:.1}", e.mean, ci)
     } else {
         format!("{:.3} ± {:.3}", e.mean, ci)
     }
@@ -113,22 +118,28 @@ pub fn render(results: &[RobotTransfer], command: &str) -> String {
             o.pretrain_seconds,
             r.objective
         );
-        let _ = writeln!(s, "| start | reached | damage until the objective | × less than from nothing | physical damage | learning time [s] | failures | first test return | end performance | MTBF, 1200 actions [s] |");
-        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
+        let _ = writeln!(s, "| start | reached | damage until the objective | × less than from nothing | damage saved (paired) | physical damage | learning time [s] | failures | first test return | end performance | inside the objective | MTBF, 1200 actions [s] |");
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|");
         for w in &r.ways {
             let _ = writeln!(
                 s,
-                "| {} | {}/{} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                "| {} | {}/{} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
                 w.start.label(),
                 w.reached,
                 w.trials.len(),
                 est(&w.damage),
-                if w.start == Start::Nothing { "1".to_string() } else { format!("{:.1}", r.saving(w.start)) },
+                match (w.start, r.saving(w.start)) {
+                    (Start::Nothing, _) => "1".to_string(),
+                    (_, x) if x.is_finite() => format!("{x:.1}"),
+                    _ => "∞ (none spent)".to_string(),
+                },
+                if w.start == Start::Nothing { "—".to_string() } else { est(&w.damage_saved) },
                 est(&w.physical_damage),
                 est(&w.time_s),
                 est(&w.failures),
                 est(&w.first_return),
                 est(&w.end_performance),
+                if w.end_inside_objective { "yes" } else { "**no**" },
                 est(&w.mtbf_s),
             );
         }

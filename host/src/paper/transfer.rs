@@ -122,6 +122,11 @@ pub struct Way {
     pub first_return: Estimate,
     /// The paper's MTBF over the first 1200 learning actions on the plant \[s\].
     pub mtbf_s: Estimate,
+    /// Damage until the objective saved against the same trial from
+    /// nothing (trial by trial: the same plant and random numbers).
+    pub damage_saved: Estimate,
+    /// Whether the mean end performance lies inside the objective.
+    pub end_inside_objective: bool,
 }
 
 /// One robot's measurement.
@@ -210,10 +215,14 @@ pub fn measure<T: Vary + Clone>(
     let first = mean(&|r| r.curve.first().map_or(f64::NAN, |p| p.test_return));
     let end = mean(&|r| r.end_performance);
     let objective = first + OBJECTIVE_SHARE * (end - first);
+    let rising = end >= first;
+    let base: Vec<Outcome> = nothing.iter().map(|(_, _, r, b)| outcome(r, b, objective, rising)).collect();
     let ways = Start::ALL
         .iter()
         .map(|&s| {
-            let trials: Vec<Outcome> = of(s).iter().map(|(_, _, r, b)| outcome(r, b, objective, end >= first)).collect();
+            let trials: Vec<Outcome> = of(s).iter().map(|(_, _, r, b)| outcome(r, b, objective, rising)).collect();
+            let saved: Vec<f64> = base.iter().zip(&trials).map(|(n, t)| n.damage - t.damage).collect();
+            let end_mean = trials.iter().map(|t| t.end_performance).sum::<f64>() / trials.len().max(1) as f64;
             let est = |f: fn(&Outcome) -> f64| Estimate::of(&trials.iter().map(f).collect::<Vec<_>>());
             Way {
                 start: s,
@@ -225,6 +234,8 @@ pub fn measure<T: Vary + Clone>(
                 end_performance: est(|t| t.end_performance),
                 first_return: est(|t| t.first_return),
                 mtbf_s: Estimate::of(&of(s).iter().map(|r| r.2.mtbf_s).collect::<Vec<_>>()),
+                damage_saved: Estimate::of(&saved),
+                end_inside_objective: if rising { end_mean >= objective } else { end_mean <= objective },
                 trials,
             }
         })

@@ -70,7 +70,7 @@ where
         .configure_mesh()
         .disable_x_mesh()
         .x_labels(0)
-        .y_label_formatter(&|v| if *v != 0.0 && (v.abs() < 0.01 || v.abs() >= 1e4) { format!("{v:.1e}") } else { format!("{v:.3}") })
+        .y_label_formatter(&|v| tick(*v))
         .label_style((FONT, 12))
         .draw()
         .map_err(plot_err)?;
@@ -90,4 +90,20 @@ where
         }
     }
     Ok(())
+}
+
+/// A tick's label: no more digits than its size needs.
+fn tick(v: f64) -> String {
+    let a = v.abs();
+    if v == 0.0 {
+        "0".into()
+    } else if !(0.01..1e5).contains(&a) {
+        format!("{v:.1e}")
+    } else if a >= 10.0 {
+        format!("{v:.0}")
+    } else if a >= 1.0 {
+        format!("{v:.1}")
+    } else {
+        format!("{v:.2}")
+    }
 }
