@@ -340,3 +340,39 @@ fn a_port_that_goes_away_mid_run_is_one_line_and_the_log_is_kept() {
     let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("drive.json")).unwrap()).unwrap();
     assert_eq!(report["ended"]["kind"], "port-gone", "{}", report["ended"]);
 }
+
+/// `pada drive --weights`: the host's weights, exported into the F405's
+/// table, continue over the pty in lock step exactly as `pada run --board
+/// f405 --weights` continues them.
+#[test]
+fn drive_from_host_weights_in_lock_step_learns_as_pada_run_board_from_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let w = dir.path().join("host.wts");
+    ok(&common::pada(&[
+        "run", "--task", "physical-pendulum", "--algo", "pada", "--seconds", "60", "--trials", "1",
+        "--out", dir.path().join("host").to_str().unwrap(), "--save-weights", w.to_str().unwrap(),
+    ]));
+    let servos = Servos::start(dir.path(), &["--robot", "pendulum", "--lockstep"]);
+    let out = dir.path().join("drive");
+    let o = drive(&[
+        "--port", servos.port(), "--robot", "pendulum", "--lockstep", "--board", "f405", "--algo", "pada", "--seed", "3",
+        "--seconds", "30", "--out", out.to_str().unwrap(), "--weights", w.to_str().unwrap(),
+    ]);
+    ok(&o);
+    let said = String::from_utf8_lossy(&o.stderr);
+    assert!(said.contains("learned features of the host's exact"), "{said}");
+    servos.stop();
+    let (from, fresh) = (dir.path().join("run-w"), dir.path().join("run-fresh"));
+    let board = |o: &Path, extra: &[&str]| {
+        ok(&common::pada(&[
+            &["run", "--board", "f405", "--task", "physical-pendulum", "--algo", "pada", "--seed", "3", "--seconds", "30",
+            "--trials", "1", "--out", o.to_str().unwrap()][..],
+            extra,
+        ].concat()))
+    };
+    board(&from, &["--weights", w.to_str().unwrap()]);
+    board(&fresh, &[]);
+    let curve = |d: &Path| std::fs::read_to_string(d.join("trial-000.csv")).unwrap();
+    assert_eq!(curve(&out), curve(&from), "the learning curve over the pty is pada run --board --weights's");
+    assert_ne!(curve(&from), curve(&fresh), "the weights changed nothing");
+}

@@ -74,3 +74,47 @@ fn weights_for_another_configuration_are_refused_with_one_line() {
         &["--weights", "junk.wts", "bad magic"],
     );
 }
+
+/// `pada run --board B --weights`: a file for another robot, one whose
+/// table cannot go into the board's, and one for another learner are each
+/// refused with one line naming the difference.
+#[test]
+fn board_runs_refuse_weights_of_another_robot_board_or_learner_with_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = |n: &str| dir.path().join(n).display().to_string();
+    let (leo, pp) = (out("leo.wts"), out("pp.wts"));
+    ok(&pada(&["run", "--task", "leo", "--algo", "pada", "--trials", "1", "--seconds", "5", "--out", &out("a"), "--save-weights", &leo]));
+    ok(&pada(&[
+        "run", "--task", "physical-pendulum", "--algo", "pada", "--trials", "1", "--seconds", "10", "--out", &out("b"), "--save-weights", &pp,
+    ]));
+    let board = |extra: &[&str], o: &str| -> Vec<String> {
+        [&["run", "--task", "physical-pendulum", "--board", "f405", "--algo", "pada", "--trials", "1", "--seconds", "5", "--out"][..], &[o], extra]
+            .concat()
+            .iter()
+            .map(|s| s.to_string())
+            .collect()
+    };
+    let refused = |args: Vec<String>, needles: &[&str]| {
+        let a: Vec<&str> = args.iter().map(String::as_str).collect();
+        assert_bad_input(&a, needles);
+    };
+    // Another robot: LEO's weights for the pendulum.
+    refused(board(&["--weights", &leo], &out("c")), &["--weights", "leo.wts", "task is \"leo\" in the file but \"physical-pendulum\" here"]);
+    // Another board: the pendulum's exact table into a hashed one.
+    refused(
+        board(&["--weights", &pp, "--table-log2", "12"], &out("d")),
+        &["--weights", "pp.wts", "does not go into board f405's hashed 2^12"],
+    );
+    // Another learner: a Markov filter adds a state dimension to PADA's.
+    let markov: Vec<String> = [
+        "run", "--task", "leo", "--board", "f405", "--algo", "markov-lowpass", "--trials", "1", "--seconds", "5", "--out", &out("e"),
+        "--weights", &leo,
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    refused(markov, &["--weights", "leo.wts", "written for another learner", "markov-lowpass"]);
+    // And the same file goes in where it fits.
+    let o = ok(&pada(&board(&["--weights", &pp], &out("f")).iter().map(String::as_str).collect::<Vec<_>>()));
+    assert!(o.contains("weights: ") && o.contains("0 dropped"), "{o}");
+}

@@ -44,3 +44,40 @@ where
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::control::test_support::*;
+    use pada_core::fixed::Q16;
+    use pada_core::policy::PolicyKind;
+    use pada_core::safety::RunMode;
+
+    fn entries_of(n: usize, f: impl Fn(usize) -> i32) -> std::vec::Vec<u8> {
+        (0..n).flat_map(|i| f(i).to_le_bytes()).collect()
+    }
+
+    #[test]
+    fn imported_entries_become_the_table_and_its_checksum() {
+        let mut c = Controller::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Sarsa, table(), 5).unwrap();
+        let n = c.weights().len();
+        let fresh = c.agent().weights_checksum();
+        c.import_entries(&entries_of(n, |i| i as i32 * 3 - 7)).unwrap();
+        assert!((0..n).all(|i| c.weights().get(i) == Q16(i as i32 * 3 - 7)));
+        // The kept checksum follows the imported table.
+        assert_eq!(c.agent().weights_checksum(), c.weights().checksum());
+        assert_ne!(c.agent().weights_checksum(), fresh);
+    }
+
+    #[test]
+    fn entries_of_another_length_or_with_torque_on_change_nothing() {
+        let mut c = Controller::new(Pendulum::at_33hz(), profile(&SPEC_33HZ), PolicyKind::Sarsa, table(), 5).unwrap();
+        let n = c.weights().len();
+        let before = c.weights().checksum();
+        assert_eq!(c.import_entries(&entries_of(n - 1, |_| 1)).unwrap_err().param, "entries");
+        assert_eq!(c.weights().checksum(), before);
+        start(&mut c, RunMode::Learning);
+        assert_eq!(c.import_entries(&entries_of(n, |_| 1)).unwrap_err().param, "torque");
+        assert_eq!(c.weights().checksum(), before);
+    }
+}

@@ -87,6 +87,14 @@ pub struct DriveArgs {
     /// saved at the end.
     #[arg(long, value_name = "FILE")]
     pub checkpoint: Option<PathBuf>,
+    /// Start from weights learned on the host (`pada run --save-weights`
+    /// for this robot): exported into the learner's table (--board's) as
+    /// `pada run --board B --weights` does, with the same summary of what
+    /// the export changed; the learner then continues from them. A robot,
+    /// table or learner the file was not saved for is refused with one
+    /// line.
+    #[arg(long, value_name = "FILE")]
+    pub weights: Option<PathBuf>,
     /// Also stream the telemetry to FILE or tcp:HOST:PORT (`pada watch
     /// --listen tcp:127.0.0.1:9000` shows it live).
     #[arg(long, value_name = "FILE|tcp:HOST:PORT")]
@@ -144,6 +152,18 @@ pub fn run(args: DriveArgs) -> Result<(), CliError> {
         }
     }
     let cfg = RunConfig { policy, switch_at_s: args.switch_at, mtbf_budget_s: args.mtbf_budget, seconds, trials: 1, seed: args.seed };
+    let exported = match &args.weights {
+        Some(path) => {
+            let sim = robot.sim();
+            let board_spec = sim.task_spec(profile).map_err(|e| usage(e.to_string()))?;
+            let (entries, report) = crate::commands::run::exported_weights(path, sim, &board_spec, &profile, policy, weights)?;
+            for line in report.lines(args.board.name()) {
+                errln!("drive: {line}");
+            }
+            Some(entries)
+        }
+        None => None,
+    };
     let out_path = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("pada-out/drive-{}-{}", robot.spec.name, args.algo)));
     let out = OutDir::check(&out_path)?;
     std::fs::create_dir_all(out.path()).map_err(|e| usage(format!("--out {}: {e}", out.path().display())))?;
@@ -184,6 +204,7 @@ pub fn run(args: DriveArgs) -> Result<(), CliError> {
         baud: args.baud,
         lock_step: args.lockstep,
         checkpoint: Some(checkpoint),
+        weights: exported,
         stop,
         latency: lat,
         realtime: !args.no_realtime,

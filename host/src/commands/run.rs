@@ -355,6 +355,22 @@ fn run_on_board(args: RunArgs, board: Board, sim: crate::robots::SimRobot) -> Re
     });
     let out = OutDir::check(&out_path)?;
     set_threads(args.trial.threads)?;
+    // The host's weights in the board's table, checked before anything
+    // runs.
+    let entries = match &args.weights {
+        Some(path) => {
+            let (entries, report) = exported_weights(path, &sim, &task_spec, &profile, policy, weights)?;
+            for line in report.lines(board.name()) {
+                if args.json {
+                    eprintln!("{line}");
+                } else {
+                    outln!("{line}")?;
+                }
+            }
+            Some(entries)
+        }
+        None => None,
+    };
     // Before the board's run: the slots this robot's learning writes
     // against the board's claim table, from a host trial (cached).
     if profile.layout != Layout::Exact && crate::board::demand::has_claim_table(&sim) {
@@ -375,20 +391,6 @@ fn run_on_board(args: RunArgs, board: Board, sim: crate::robots::SimRobot) -> Re
             }
         }
     }
-    let entries = match &args.weights {
-        Some(path) => {
-            let (entries, report) = exported_weights(path, &sim, &task_spec, &profile, policy, weights)?;
-            for line in report.lines(board.name()) {
-                if args.json {
-                    eprintln!("{line}");
-                } else {
-                    outln!("{line}")?;
-                }
-            }
-            Some(entries)
-        }
-        None => None,
-    };
     let start_from = entries.as_deref().map_or(BoardStart::Fresh, BoardStart::Entries);
     let total = cfg.trials as u64
         * cfg.expected_steps(task_spec.control_period_s, task_spec.episode_steps, task_spec.test_interval);

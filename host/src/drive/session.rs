@@ -75,6 +75,9 @@ pub struct DriveSetup {
     pub lock_step: bool,
     /// The checkpoint file.
     pub checkpoint: Option<PathBuf>,
+    /// Table entries exported from the host's weights, imported over the
+    /// fresh learner's table before the first episode (`--weights`).
+    pub weights: Option<Vec<u8>>,
     /// Set by Ctrl-C.
     pub stop: Arc<AtomicBool>,
     /// The adapter's latency timer.
@@ -294,14 +297,27 @@ fn run<W: WeightStore>(setup: &DriveSetup, table: W, mut tm: TelemetryPipe) -> a
         .into());
     }
 
+    if resumed && setup.weights.is_some() {
+        block_on(bus.stop_all());
+        let _ = tm.finish();
+        let path = setup.checkpoint.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
+        return Err(BadBus(format!(
+            "--weights starts a new learner, but the checkpoint {path} holds one already: give another --checkpoint or --out"
+        ))
+        .into());
+    }
+
     // The run protocol's start: a fresh learner (unless one was loaded),
-    // the budget, the first test episode.
+    // the budget, the exported weights, the first test episode.
     for cmd in RunProtocol::start(cfg.policy) {
         if resumed && matches!(cmd, ToChip::SetPolicy(_)) {
             continue;
         }
         if let (ToChip::Start(_), Some(budget)) = (&cmd, cfg.mtbf_budget_s) {
             command(&mut ctl, ToChip::SetMtbfBudget(Some(budget)))?;
+        }
+        if let (ToChip::Start(_), Some(entries)) = (&cmd, &setup.weights) {
+            ctl.import_entries(entries).map_err(|e| anyhow::anyhow!("the exported weights: {e}"))?;
         }
         let (result, t) = ctl.command(&cmd);
         result.map_err(|e| anyhow::anyhow!("{cmd:?} refused: {e:?}"))?;
