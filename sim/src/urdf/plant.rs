@@ -143,6 +143,7 @@ impl<R: RobotRules + Send> Plant for RulesPlant<R> {
 }
 
 /// A robot of files as a task of the experiment runner.
+#[derive(Clone)]
 pub struct UrdfTask {
     spec: TaskSpec,
     model: UrdfModel,
