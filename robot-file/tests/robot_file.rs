@@ -252,3 +252,23 @@ fn an_observation_too_fine_for_an_exact_table_takes_a_claim_table() {
     let e = refused(|t| fine(t).replace("[robot]\n", "[robot]\ntable = \"exact\"\n"), |u| u);
     assert!(e.contains("robot.table") && e.contains("exact") && e.contains("claim"), "{e}");
 }
+
+#[test]
+fn plant_ranges_are_read_and_a_bad_one_is_refused_at_its_line() {
+    // Without [plant] the robot is its model; with one, its ranges.
+    assert!(load(&reacher()).unwrap().plant.is_model());
+    let dir = tempfile::tempdir().unwrap();
+    let src = reacher();
+    let toml = std::fs::read_to_string(&src).unwrap() + "\n[plant]\nmass = [0.9, 1.1]\ndelay_periods = [0.0, 1.0]\n";
+    std::fs::write(dir.path().join("robot.toml"), toml).unwrap();
+    std::fs::copy(src.with_file_name("reacher.urdf"), dir.path().join("reacher.urdf")).unwrap();
+    let r = load(&dir.path().join("robot.toml")).unwrap();
+    assert_eq!((r.plant.mass.lo, r.plant.mass.hi, r.plant.delay_periods.hi), (0.9, 1.1, 1.0));
+    assert_eq!(r.plant.motor_constant.lo, 1.0);
+    let e = refused(|t| t + "\n[plant]\nmotor_constant = [0.1, 1.0]\n", |u| u);
+    assert!(e.contains("plant.motor_constant") && e.contains("valid is 0.2 to 5"), "{e}");
+    let e = refused(|t| t + "\n[plant]\ndelay_periods = [0.0, 1.5]\n", |u| u);
+    assert!(e.contains("plant.delay_periods") && e.contains("whole"), "{e}");
+    let e = refused(|t| t + "\n[plant]\nstiffness = [1.0, 2.0]\n", |u| u);
+    assert!(e.contains("stiffness"), "{e}");
+}

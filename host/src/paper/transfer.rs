@@ -299,8 +299,8 @@ mod tests {
     #[test]
     fn a_trial_from_no_weights_is_the_trial_as_before_and_from_weights_starts_where_they_left_off() {
         let task = PhysicalPendulumTask::default();
-        let before = run_trial(&task, &cfg(30.0, 5), 0, &|_| {}).unwrap();
-        let (now, agent, _, _) = run_trial_from(&task, &cfg(30.0, 5), 0, &|_| {}, None, TrialStart::Nothing).unwrap();
+        let before = run_trial(&task, &cfg(600.0, 5), 0, &|_| {}).unwrap();
+        let (now, agent, _, _) = run_trial_from(&task, &cfg(600.0, 5), 0, &|_| {}, None, TrialStart::Nothing).unwrap();
         assert_eq!(now, before);
         // The model is deterministic and the test run greedy: learning on
         // from the weights, the first test run repeats the last one.
@@ -313,7 +313,7 @@ mod tests {
     fn the_measurement_runs_three_ways_on_the_same_plants() {
         let task = PhysicalPendulumTask::default();
         let ranges = PlantRanges::MODEL.with_arg("motor_constant=0.8..0.9").unwrap();
-        let o = TransferOptions { trials: 2, seconds: 30.0, pretrain_seconds: 60.0, seed: 1, policy: PolicyKind::Sarsa };
+        let o = TransferOptions { trials: 2, seconds: 300.0, pretrain_seconds: 600.0, seed: 1, policy: PolicyKind::Sarsa };
         let r = measure(&task, ranges, &o, &|_| {}).unwrap();
         assert_eq!(r.ways.iter().map(|w| (w.start, w.trials.len())).collect::<Vec<_>>(), Start::ALL.map(|s| (s, 2)).to_vec());
         let n = r.way(Start::Nothing);
