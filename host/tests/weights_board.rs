@@ -3,8 +3,9 @@
 //! --weights`) equals, bit for bit, the board booting from the checkpoint
 //! image of those entries (the firmware's restore at boot: the file the
 //! host keeps for it, the flash slot), on the F405's hashed 16-bit table
-//! and the F429's claim table; and a board from exported weights learns
-//! otherwise than one from nothing.
+//! and the F429's claim table; a board from exported weights learns
+//! otherwise than one from nothing; and the image is one the host's
+//! checkpoint keeper serves to a board of that configuration.
 
 mod common;
 use common::{ok, pada};
@@ -51,6 +52,14 @@ fn continue_on(board: Board, robot: &'static pada_core::robot::RobotSpec, weight
     assert_eq!(imported.weights_checksum, booted.weights_checksum);
     assert_eq!(imported, booted, "{}: the trials differ", board.name());
     assert_ne!(imported.episodes[0].weights_checksum, fresh.episodes[0].weights_checksum, "{}: the exported weights did not arrive", board.name());
+    // The image is what the host keeps for a board whose checkpoint fits
+    // no flash: its keeper reads it back for the board's configuration.
+    let dir = tempfile::tempdir().unwrap();
+    let kept = dir.path().join("checkpoint.bin");
+    std::fs::write(&kept, &image).unwrap();
+    let restore = pada::checkpoint_keeper::restore_for(&kept, imported.config_hash, image.len() as u64, None).unwrap();
+    assert_eq!(restore.image(), &image[..]);
+    assert!(pada::checkpoint_keeper::restore_for(&kept, imported.config_hash ^ 1, image.len() as u64, None).is_err());
 }
 
 #[test]

@@ -40,6 +40,7 @@ fn config(board: Board, task: SilTask, policy: PolicyKind, seconds: f64, out: &P
         hang_timeout: Duration::from_secs(120),
         progress: false,
         telemetry: None,
+        weights: None,
     }
 }
 

@@ -78,6 +78,7 @@ impl Run {
             hang_timeout: Duration::from_secs(120),
             progress: false,
             telemetry: None,
+            weights: None,
         }
     }
 

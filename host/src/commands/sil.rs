@@ -114,6 +114,13 @@ pub struct SilArgs {
     /// or to tcp:HOST:PORT (loopback only).
     #[arg(long, value_name = "FILE|tcp:HOST:PORT")]
     pub telemetry: Option<String>,
+    /// Start from weights learned on the host (`pada run --save-weights`):
+    /// exported into the board's table as `pada run --board B --weights`
+    /// does (the same summary), saved as the learner's checkpoint, which
+    /// the host keeps and the board restores at its first boot. Only a
+    /// board whose checkpoint the host keeps (f429-sdram with LEO) yet.
+    #[arg(long, value_name = "FILE")]
+    pub weights: Option<PathBuf>,
     /// Print the summary as JSON on stdout.
     #[arg(long)]
     pub json: bool,
@@ -210,6 +217,30 @@ pub fn run(args: SilArgs) -> Result<(), CliError> {
         Some(p) => return Err(usage(format!("--elf {}: no such file", p.display()))),
         None => build_image(task, board)?,
     };
+    let weights = match &args.weights {
+        Some(path) => {
+            let sim = task.sim().map_err(|e| usage(format!("{e:#}")))?;
+            let n = crate::board::trial::table_len(&profile, policy).map_err(|e| usage(e.to_string()))?;
+            let ckpt = sil::power_cut::checkpoint_bytes(n, profile.entry_bytes());
+            if ckpt <= pada_firmware::sil::CHECKPOINT_SLOT_LEN {
+                return Err(usage(format!(
+                    "--weights on board {}: its checkpoint lives in flash, which the emulation starts erased; \
+                     only a board whose checkpoint the host keeps (f429-sdram with LEO) starts from exported weights in pada sil",
+                    board.name()
+                )));
+            }
+            let board_spec = sim.task_spec(profile).map_err(|e| usage(e.to_string()))?;
+            let (entries, report) = crate::commands::run::exported_weights(path, &sim, &board_spec, &profile, policy, n)?;
+            for line in report.lines(board.name()) {
+                eprintln!("{line}");
+            }
+            let seed = crate::seed::trial_seed(args.seed, 0);
+            let image = crate::board::exported::image_of(profile, &sim, policy, args.mtbf_budget, seed, n, &entries)
+                .map_err(|e| usage(format!("--weights {}: {e:#}", path.display())))?;
+            Some(sil::config::SilWeights { entries, image })
+        }
+        None => None,
+    };
     let cfg = SilConfig {
         qemu: args.qemu.clone(),
         elf,
@@ -229,6 +260,7 @@ pub fn run(args: SilArgs) -> Result<(), CliError> {
         hang_timeout: Duration::from_secs(args.hang_timeout),
         progress: !args.json,
         telemetry,
+        weights,
     };
     let summary = sil::run(&cfg)?;
     if args.json {

@@ -71,6 +71,22 @@ pub struct SilConfig {
     /// Also stream the firmware's telemetry, as it comes, to a file or a
     /// loopback TCP listener.
     pub telemetry: Option<crate::telemetry::TelemetryTarget>,
+    /// Weights exported from the host to start from (`--weights`): the
+    /// board boots from their checkpoint image, which the host keeps for
+    /// it; `None`: a fresh learner.
+    pub weights: Option<SilWeights>,
+}
+
+/// Exported weights a SIL run starts from.
+#[derive(Debug, Clone)]
+pub struct SilWeights {
+    /// The board table's entries (`crate::board::export`), for the host
+    /// comparison's trial.
+    pub entries: Vec<u8>,
+    /// The checkpoint image of the learner holding them
+    /// (`crate::board::exported::image_of`), restored by the board at its
+    /// first boot.
+    pub image: Vec<u8>,
 }
 
 impl SilConfig {

@@ -72,6 +72,13 @@ pub struct ReplayReport {
 /// Replays `records` through a fresh host agent of the board's learner
 /// `profile` with `policy` and `seed`.
 pub fn replay(profile: &LearnerProfile, policy: PolicyKind, seed: u64, records: &[Record]) -> ReplayReport {
+    replay_from(profile, policy, seed, None, records)
+}
+
+/// [`replay`] of a run whose learner started from exported table
+/// `entries` (`pada sil --weights`), written over the fresh learner's
+/// table as the board's import does.
+pub fn replay_from(profile: &LearnerProfile, policy: PolicyKind, seed: u64, entries: Option<&[u8]>, records: &[Record]) -> ReplayReport {
     let mut report = ReplayReport::default();
     let Some(weights) = profile.weights() else {
         report.error = Some(format!("board profile {} has no fixed table size", profile.board.name()));
@@ -103,6 +110,18 @@ pub fn replay(profile: &LearnerProfile, policy: PolicyKind, seed: u64, records: 
     };
     let mut rng = Pcg32::seed_from_u64(seed);
     agent.reset_weights(&mut rng);
+    if let Some(entries) = entries {
+        let eb = pada_core::weights::WeightStore::entry_bytes(agent.weights());
+        for (i, src) in entries.chunks_exact(eb).enumerate() {
+            pada_core::weights::WeightStore::load_le(agent.weights_mut(), i, src);
+        }
+        let state = agent.state();
+        if let Err(e) = agent.restore_state(&state) {
+            report.error = Some(format!("the exported weights do not restore: {e}"));
+            return report;
+        }
+        agent.rehash();
+    }
     // What a boot without a checkpoint starts from (the run sends
     // `SetPolicy` again: a fresh learner from the seed), and the last save.
     let mut saved = (agent.state(), agent.weights().clone(), rng.clone());

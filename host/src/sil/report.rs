@@ -18,10 +18,10 @@
 
 use super::bus::{BusEmulator, BusStats};
 use super::forecast::ForecastStats;
-use super::replay::{replay, Record, ReplayReport};
+use super::replay::{replay_from, Record, ReplayReport};
 use super::config::{machine, SilConfig, SilTask};
 use super::wall::WallTime;
-use crate::board::{run_board_trial, run_board_trial_on, RunProtocol};
+use crate::board::{run_board_trial_from, run_board_trial_on, BoardStart, RunProtocol};
 use crate::capture::{Latest, MessageCounts};
 use crate::experiment::runner::RunConfig;
 use crate::experiment::{end_performance, rise_time, TestPoint};
@@ -306,7 +306,8 @@ fn compare(cfg: &SilConfig, episodes: &[Episode]) -> anyhow::Result<HostComparis
         // The same rig behind the bus as behind `pada run --board`'s
         // controller: the same trial, bit for bit.
         SilTask::Leo | SilTask::File(_) => {
-            let t = run_board_trial(profile, &cfg.task.sim()?, &run(1), 0, &none)?;
+            let start = cfg.weights.as_ref().map_or(BoardStart::Fresh, |w| BoardStart::Entries(&w.entries));
+            let t = run_board_trial_from(profile, &cfg.task.sim()?, &run(1), 0, start, &none)?;
             let first = first_difference(episodes, &t.episodes);
             let (what, body) = match cfg.task {
                 SilTask::File(f) => (format!("--robot {}", f.path.display()), "the same URDF in rapier3d"),
@@ -363,7 +364,7 @@ pub fn summarize(cfg: &SilConfig, facts: Facts<'_>) -> SilSummary {
     let curve = facts.protocol.curve().to_vec();
     let returns: Vec<f64> = curve.iter().map(|p| p.test_return).collect();
     let times: Vec<f64> = curve.iter().map(|p| p.learning_time_s).collect();
-    let replay = replay(&profile, cfg.policy, cfg.learner_seed(), &facts.records);
+    let replay = replay_from(&profile, cfg.policy, cfg.learner_seed(), cfg.weights.as_ref().map(|w| &w.entries[..]), &facts.records);
     let episodes: Vec<Episode> = facts
         .records
         .iter()

@@ -92,6 +92,9 @@ pub struct Session<'a> {
     /// it at boot ([`crate::checkpoint_keeper`]); `None` when the board's
     /// checkpoint fits its flash.
     kept: Option<HostKept>,
+    /// The first boot restores exported weights (`--weights`), and the run
+    /// starts with its first test episode once it has.
+    from_weights: bool,
 }
 
 /// The checkpoint the host keeps for the board, in the run's directory.
@@ -145,11 +148,23 @@ impl<'a> Session<'a> {
                 }
                 _ => {}
             }
+            // Exported weights: the checkpoint the board restores at its
+            // first boot.
+            if let Some(w) = &cfg.weights {
+                crate::output::write_atomic(&path, &w.image)?;
+            }
             let keeper = CheckpointKeeper::new(&path).with_context(|| format!("cannot keep a checkpoint at {}", path.display()))?;
             Some(HostKept { keeper, server: RestoreServer::new(&path) })
         } else {
             None
         };
+        if cfg.weights.is_some() && kept.is_none() {
+            bail!(
+                "--weights on board {}: its checkpoint lives in flash, which the emulation starts erased; \
+                 only a board whose checkpoint the host keeps (f429-sdram with LEO) starts from exported weights in pada sil",
+                cfg.board.name()
+            );
+        }
         let bar = cfg
             .progress
             .then(|| crate::progress::steps_bar((cfg.seconds * 1000.0).round() as u64, "sil: learning ms"));
@@ -188,6 +203,7 @@ impl<'a> Session<'a> {
             bar,
             power,
             kept,
+            from_weights: cfg.weights.is_some(),
         })
     }
 
@@ -605,7 +621,13 @@ impl<'a> Session<'a> {
                     RestoreOutcome::Denied(RestoreDenied::NoCheckpoint) => self.boot_loaded(None, None),
                     other => self.boot_loaded(None, Some(format!("{other:?}"))),
                 }
-                if std::mem::take(&mut self.power.start_after_restore) {
+                if std::mem::take(&mut self.from_weights) {
+                    if !matches!(outcome, RestoreOutcome::Loaded { .. }) {
+                        bail!("the board did not restore the exported weights at its first boot: {outcome:?}");
+                    }
+                    // The protocol's first run: the greedy test episode.
+                    self.command_at(at_us + FIRST_COMMAND_US, ToChip::Start(RunMode::Testing));
+                } else if std::mem::take(&mut self.power.start_after_restore) {
                     self.command_at(at_us + FIRST_COMMAND_US, ToChip::Start(RunMode::Learning));
                 }
             }

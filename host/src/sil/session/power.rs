@@ -206,6 +206,11 @@ impl Session<'_> {
             }
             return Ok(());
         }
+        if first && self.from_weights {
+            // The board restores the exported weights' checkpoint (policy,
+            // budget and table in it) and starts once it reports that.
+            return Ok(());
+        }
         // A first boot, or a reboot with no save to load: the run starts
         // again (after a watchdog reset the board is in Fault; the Fault
         // report clears it).
