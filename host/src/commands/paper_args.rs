@@ -63,6 +63,10 @@ pub struct PaperArgs {
     /// (default: examples/robots/arm2 and arm3).
     #[arg(long = "robot", value_name = "robot.toml")]
     pub robots: Vec<PathBuf>,
+    /// `pada paper transfer`: ranges over the robots of files' [plant]
+    /// (not the pendulum's), as `pada run --plant-ranges` takes them.
+    #[arg(long, value_name = "RANGES")]
+    pub plant_ranges: Option<String>,
     /// `pada paper transfer`: learning time of each pretraining trial on
     /// the model [s] (default: the learning time on the plant).
     #[arg(long, value_name = "S")]

@@ -45,11 +45,12 @@ pub fn run(args: PaperArgs) -> Result<(), CliError> {
     let mut results = Vec::new();
     results.push(one(&crate::pendulum::PhysicalPendulumTask::default(), physical_pendulum_ranges(), &options(PENDULUM_SECONDS)?)?);
     for f in &files {
-        if f.plant.is_model() {
+        let ranges = crate::commands::plant_args::with_ranges_arg(f.plant, args.plant_ranges.as_deref())?;
+        if ranges.is_model() {
             return Err(usage(format!("{}: its [plant] states no range: the robot would be its model", f.path.display())));
         }
         let task = pada_sim::urdf::UrdfTask::new(f).map_err(|e| usage(e.to_string()))?;
-        results.push(one(&task, f.plant, &options(ROBOT_SECONDS)?)?);
+        results.push(one(&task, ranges, &options(ROBOT_SECONDS)?)?);
     }
     let mut command = format!("pada paper transfer --seed {} --trials {trials}", args.trial.seed);
     for r in &args.robots {
@@ -60,6 +61,9 @@ pub fn run(args: PaperArgs) -> Result<(), CliError> {
     }
     if let Some(s) = args.pretrain_seconds {
         command += &format!(" --pretrain-seconds {s}");
+    }
+    if let Some(r) = &args.plant_ranges {
+        command += &format!(" --plant-ranges {r}");
     }
     let report = render(&results, &command);
     let json = serde_json::to_string_pretty(&results).map_err(anyhow::Error::from)? + "\n";
