@@ -38,6 +38,8 @@ pub struct RobotFile {
     pub substeps: u32,
     /// rapier's solver iterations per physics step.
     pub solver_iterations: u32,
+    /// How far the real robot may differ from this model (`[plant]`).
+    pub plant: crate::plant::PlantRanges,
 }
 
 impl RobotFile {
@@ -182,6 +184,7 @@ fn build(path: &Path, at: &Locator, t: RobotToml) -> Result<RobotFile, RobotFile
     let ends = ends(at, &t, &signals)?;
     let reset = reset(at, &t.reset)?;
     let (substeps, solver_iterations) = simulation(at, &t.simulation)?;
+    let plant = crate::plant::plant(at, &t.plant)?;
 
     let vocabulary: &'static Vocabulary = Box::leak(Box::new(Vocabulary {
         observation: leak(observation),
@@ -224,7 +227,7 @@ fn build(path: &Path, at: &Locator, t: RobotToml) -> Result<RobotFile, RobotFile
     Vocab::check(spec, vocabulary).map_err(|e| at.field(e.param, e.to_string()))?;
     spec.params.validate().map_err(|e| at.field(format!("learning.{}", e.param), e.to_string()))?;
     spec.motor().map_err(|e| at.field("action", e.to_string()))?;
-    Ok(RobotFile { path: path.to_path_buf(), urdf, spec, substeps, solver_iterations })
+    Ok(RobotFile { path: path.to_path_buf(), urdf, spec, substeps, solver_iterations, plant })
 }
 
 /// `[robot]`, checked.

@@ -15,6 +15,7 @@
 //! | `urdf.rs` | the URDF: its joints, links and kinematic chains |
 //! | `definition.rs` | the checks, and the [`RobotSpec`] they make |
 //! | `codegen.rs` | the definition as Rust source for the firmware |
+//! | `plant.rs` | `[plant]`: how far the real robot may differ from its model |
 //! | `template.rs` | a new robot's files, commented field by field (`pada new-robot`) |
 //! | `error.rs` | one error in one line, pointing at the line of the file |
 //! | `type_error.rs` | toml's type and length errors, reworded with the field and the valid values |
@@ -26,6 +27,7 @@ mod definition;
 mod error;
 /// Gearbox files: the Table I fields of a gearbox by name or from TOML.
 pub mod gearbox_file;
+pub mod plant;
 pub mod schema;
 pub mod template;
 mod type_error;

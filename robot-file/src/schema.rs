@@ -42,6 +42,9 @@ pub struct RobotToml {
     /// `[simulation]`: how the host simulates the body.
     #[serde(default)]
     pub simulation: SimulationSection,
+    /// `[plant]`: how far the real robot may differ from this model.
+    #[serde(default)]
+    pub plant: PlantSection,
 }
 
 /// `[robot]`.
@@ -383,4 +386,24 @@ fn d_substeps() -> Spanned<u32> {
 
 fn d_iterations() -> Spanned<u32> {
     Spanned::new(0..0, 2)
+}
+
+/// `[plant]`: the ranges within which the real robot may differ from its
+/// model, each `[low, high]` (`crate::plant`; docs/your-robot.md, "A
+/// robot that is not its model"). Absent: the model's value.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlantSection {
+    /// Factor on every link's mass and inertia.
+    pub mass: Option<Spanned<[f64; 2]>>,
+    /// Factor on each motor's torque constant.
+    pub motor_constant: Option<Spanned<[f64; 2]>>,
+    /// Dry friction added at each joint \[N·m\].
+    pub friction_nm: Option<Spanned<[f64; 2]>>,
+    /// Play between each joint's sensor and its link \[rad\].
+    pub backlash_rad: Option<Spanned<[f64; 2]>>,
+    /// Control periods each command arrives late.
+    pub delay_periods: Option<Spanned<[f64; 2]>>,
+    /// Noise on each angle reading, standard deviation \[rad\].
+    pub noise_rad: Option<Spanned<[f64; 2]>>,
 }

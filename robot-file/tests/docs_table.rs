@@ -20,6 +20,7 @@ fn schema_fields() -> BTreeSet<String> {
         "EndSection" => Some("end"),
         "ResetSection" => Some("reset"),
         "SimulationSection" => Some("simulation"),
+        "PlantSection" => Some("plant"),
         _ => None,
     };
     let mut out = BTreeSet::new();

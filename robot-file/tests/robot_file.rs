@@ -308,3 +308,23 @@ fn the_so101_example_is_six_sts3215_two_learned() {
     assert_eq!(s.table, TableNeed::Exact { weights: 25_600 });
     assert!(r.profile(Board::F405).is_ok());
 }
+
+#[test]
+fn plant_ranges_are_read_and_a_bad_one_is_refused_at_its_line() {
+    // Without [plant] the robot is its model; with one, its ranges.
+    assert!(load(&reacher()).unwrap().plant.is_model());
+    let dir = tempfile::tempdir().unwrap();
+    let src = reacher();
+    let toml = std::fs::read_to_string(&src).unwrap() + "\n[plant]\nmass = [0.9, 1.1]\ndelay_periods = [0.0, 1.0]\n";
+    std::fs::write(dir.path().join("robot.toml"), toml).unwrap();
+    std::fs::copy(src.with_file_name("reacher.urdf"), dir.path().join("reacher.urdf")).unwrap();
+    let r = load(&dir.path().join("robot.toml")).unwrap();
+    assert_eq!((r.plant.mass.lo, r.plant.mass.hi, r.plant.delay_periods.hi), (0.9, 1.1, 1.0));
+    assert_eq!(r.plant.motor_constant.lo, 1.0);
+    let e = refused(|t| t + "\n[plant]\nmotor_constant = [0.1, 1.0]\n", |u| u);
+    assert!(e.contains("plant.motor_constant") && e.contains("valid is 0.2 to 5"), "{e}");
+    let e = refused(|t| t + "\n[plant]\ndelay_periods = [0.0, 1.5]\n", |u| u);
+    assert!(e.contains("plant.delay_periods") && e.contains("whole"), "{e}");
+    let e = refused(|t| t + "\n[plant]\nstiffness = [1.0, 2.0]\n", |u| u);
+    assert!(e.contains("stiffness"), "{e}");
+}

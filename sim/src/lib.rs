@@ -11,6 +11,7 @@
 //! | [`rig`] | the robot behind a board's servos and sensors, for `pada run --board` and `pada sil` |
 //! | [`robots`] | which body and rules each of pada's robots has |
 //! | [`urdf`] | a robot of the user's own: its URDF in rapier, driven through its rules and servos |
+//! | [`variation`] | a robot that is not its model: plants drawn within ranges, per trial or per episode |
 //! | [`integrator`] | RK4 for the pendulums |
 //! | [`model_presets`] | settings of LEO's model that its checks share |
 //! | [`world_state`] | a rapier world's state, copied and put back (LEO's snapshots, a URDF body's reset) |
@@ -27,4 +28,5 @@ pub mod rig;
 pub mod robots;
 pub mod task;
 pub mod urdf;
+pub mod variation;
 pub mod world_state;

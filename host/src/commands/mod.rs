@@ -12,6 +12,8 @@ pub mod paper;
 pub mod paper_args;
 pub mod paper_leo;
 pub mod paper_wear;
+pub mod paper_transfer;
+pub mod plant_args;
 pub mod new_robot;
 pub mod render;
 pub mod run;

@@ -28,6 +28,7 @@ pub fn run(args: PaperArgs) -> Result<(), CliError> {
         PaperExperiment::Pendulum => pendulum_cmd(args),
         PaperExperiment::Leo => super::paper_leo::run(args),
         PaperExperiment::Wear => super::paper_wear::run(args),
+        PaperExperiment::Transfer => super::paper_transfer::run(args),
     }
 }
 

@@ -18,6 +18,11 @@ pub enum PaperExperiment {
     /// explorations) over a sweep and the wear governor at three budgets;
     /// end performance against both MTBFs with the Pareto front.
     Wear,
+    /// Learn in simulation, finish on the robot: the gear damage until the
+    /// objective on plants that differ from the model, from nothing against
+    /// from weights pretrained on the model and randomised (the physical
+    /// pendulum and the robots of --robot).
+    Transfer,
 }
 
 /// The task of `pada paper wear`.
@@ -53,6 +58,19 @@ pub struct PaperArgs {
     /// Learning time per trial on the physical pendulum [s].
     #[arg(long, value_name = "S", default_value_t = 1500.0)]
     pub physical_seconds: f64,
+    /// `pada paper transfer`: robots of files to measure besides the
+    /// physical pendulum, each with its robot.toml's [plant] ranges
+    /// (default: examples/robots/arm2 and arm3).
+    #[arg(long = "robot", value_name = "robot.toml")]
+    pub robots: Vec<PathBuf>,
+    /// `pada paper transfer`: ranges over the robots of files' [plant]
+    /// (not the pendulum's), as `pada run --plant-ranges` takes them.
+    #[arg(long, value_name = "RANGES")]
+    pub plant_ranges: Option<String>,
+    /// `pada paper transfer`: learning time of each pretraining trial on
+    /// the model [s] (default: the learning time on the plant).
+    #[arg(long, value_name = "S")]
+    pub pretrain_seconds: Option<f64>,
     /// Seed and threads.
     #[command(flatten)]
     pub trial: TrialOptions,

@@ -145,6 +145,18 @@ pub struct RunArgs {
     /// share them (the F405's own for robots with many features).
     #[arg(long, value_name = "BEHAVIOUR", requires = "board")]
     pub table_full: Option<TableFull>,
+    /// Learn on a plant that is not the model: drawn once per trial within
+    /// the ranges (robot.toml's [plant], the pendulums' stated ones, or
+    /// --plant-ranges), or randomised anew every episode (domain
+    /// randomisation); seeded by --seed (docs/your-robot.md, "A robot that
+    /// is not its model").
+    #[arg(long, value_enum, value_name = "HOW")]
+    pub plant: Option<crate::commands::plant_args::PlantMode>,
+    /// With --plant: ranges over the robot's, as NAME=VALUE or
+    /// NAME=LOW..HIGH separated by commas (mass, motor_constant,
+    /// friction_nm, backlash_rad, delay_periods, noise_rad).
+    #[arg(long, value_name = "RANGES", requires = "plant")]
+    pub plant_ranges: Option<String>,
     /// Seed and threads.
     #[command(flatten)]
     pub trial: TrialOptions,
@@ -166,6 +178,9 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
         };
         return run_on_board(args, board, robot);
     }
+    if let Some(mode) = args.plant {
+        return run_on_plant(args, file, mode);
+    }
     match file {
         Some(f) => {
             if args.cluster.plan.is_some() || args.cluster.merge.is_some() || args.cluster.slurm {
@@ -175,6 +190,42 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
             RunVisitor(args).visit(&task)
         }
         None => visit_task(args.task, RunVisitor(args)),
+    }
+}
+
+/// `pada run --plant`: the trials on plants drawn within the ranges.
+fn run_on_plant(
+    args: RunArgs,
+    file: Option<pada_robot_file::RobotFile>,
+    mode: crate::commands::plant_args::PlantMode,
+) -> Result<(), CliError> {
+    use crate::commands::plant_args::{task_ranges, with_ranges_arg};
+    use pada_sim::variation::Varied;
+    if args.cluster.plan.is_some() || args.cluster.merge.is_some() || args.cluster.slurm {
+        return Err(usage("--plant runs the trials in this process: it does not combine with --plan, --merge or --slurm"));
+    }
+    let base = match &file {
+        Some(f) => f.plant,
+        None => task_ranges(args.task)?,
+    };
+    let ranges = with_ranges_arg(base, args.plant_ranges.as_deref())?;
+    if !args.json {
+        outln!("plant: {} within {}", match mode {
+            crate::commands::plant_args::PlantMode::Drawn => "drawn once per trial",
+            crate::commands::plant_args::PlantMode::Randomised => "drawn anew every episode",
+        }, ranges.to_arg())?;
+    }
+    let redraw = mode.redraw();
+    match file {
+        Some(f) => {
+            let task = pada_sim::urdf::UrdfTask::new(&f).map_err(|e| usage(e.to_string()))?;
+            RunVisitor(args).visit(&Varied::new(task, ranges, redraw))
+        }
+        None => match args.task {
+            TaskName::Pendulum => RunVisitor(args).visit(&Varied::new(crate::pendulum::SimulatedPendulumTask::default(), ranges, redraw)),
+            TaskName::PhysicalPendulum => RunVisitor(args).visit(&Varied::new(crate::pendulum::PhysicalPendulumTask::default(), ranges, redraw)),
+            TaskName::Leo => Err(usage("--plant does not vary LEO")),
+        },
     }
 }
 
@@ -220,6 +271,9 @@ fn with_table_full(profile: LearnerProfile, full: TableFull) -> Result<LearnerPr
 /// `pada run --board`: the board's own learner ([`crate::board`]).
 fn run_on_board(args: RunArgs, board: Board, sim: crate::robots::SimRobot) -> Result<(), CliError> {
     let robot = sim.robot;
+    if args.plant.is_some() {
+        return Err(usage("--plant is not available with --board: the board's run drives the model's plant"));
+    }
     for (flag, given) in [
         ("--telemetry", args.telemetry.is_some()),
         ("--mcap", args.mcap.is_some()),

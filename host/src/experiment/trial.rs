@@ -174,6 +174,45 @@ pub fn run_trial_observed<T: Task>(
     observer: Option<TrialObserver<'_>>,
     start: Option<StartWith<'_>>,
 ) -> anyhow::Result<(TrialResult, HostAgent, bool)> {
+    let start = start.map_or(TrialStart::Nothing, TrialStart::With);
+    run_trial_from(task, cfg, trial, progress, observer, start).map(|(r, a, s, _)| (r, a, s))
+}
+
+/// Where a trial's weights start.
+pub enum TrialStart<'w> {
+    /// The learner's initial weights.
+    Nothing,
+    /// What an initialiser puts in ([`StartWith`]: saved weights, `pada
+    /// run --weights`).
+    With(StartWith<'w>),
+    /// A learned agent for the task with the run's policy (its weights and
+    /// state are kept).
+    Agent(HostAgent),
+}
+
+/// The books of a trial at each of its test runs, in the order of
+/// [`TrialResult::curve`]: what learning had cost by then.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TestBooks {
+    /// The fatigue counter's cumulative damage of the most damaged counted
+    /// gearbox (the paper's torques, Eqs. 3–7; 1 is its expected failure).
+    pub damage: Vec<f64>,
+    /// The same from the simulated gear torques.
+    pub physical_damage: Vec<f64>,
+    /// Learning episodes that had ended in an absorbing state.
+    pub learning_falls: Vec<u64>,
+}
+
+/// [`run_trial_observed`], starting as `start` says, and returning the
+/// books at every test run ([`TestBooks`]).
+pub fn run_trial_from<T: Task>(
+    task: &T,
+    cfg: &RunConfig,
+    trial: u32,
+    progress: &(dyn Fn(u64) + Sync),
+    observer: Option<TrialObserver<'_>>,
+    start: TrialStart<'_>,
+) -> anyhow::Result<(TrialResult, HostAgent, bool, TestBooks)> {
     let spec = task.spec();
     anyhow::ensure!(
         spec.episode_steps >= 1,
@@ -181,12 +220,16 @@ pub fn run_trial_observed<T: Task>(
         spec.name
     );
     let mut rng = trial_rng(cfg.seed, trial);
+    // The initial weights are drawn even when the trial starts from
+    // others: the trial's random numbers afterwards are those of the trial
+    // from nothing (the same seed explores the same way and meets the
+    // same plant).
     let mut agent = build_agent(spec, cfg.policy)?;
-    // Drawn even when `start` replaces them: the trial's random numbers
-    // afterwards are those of the trial from nothing.
     agent.reset_weights(&mut rng);
-    if let Some(start) = start {
-        start(&mut agent)?;
+    match start {
+        TrialStart::Nothing => {}
+        TrialStart::With(put) => put(&mut agent)?,
+        TrialStart::Agent(a) => agent = a,
     }
     let fatigue = FatigueCounter::with_gearboxes(
         |c| spec.gearbox(c),
@@ -225,6 +268,7 @@ pub fn run_trial_observed<T: Task>(
         cycle: Episodes::new(spec.episode_rules()),
         governor,
         progress,
+        books: TestBooks::default(),
     };
 
     let budget = (cfg.seconds / spec.control_period_s).round() as u64;
@@ -289,7 +333,7 @@ pub fn run_trial_observed<T: Task>(
         governor: t.governor.as_ref().map(|g| g.finish(mtbf_s, physical_mtbf_s)),
         curve: t.curve,
     };
-    Ok((result, t.agent, switched))
+    Ok((result, t.agent, switched, t.books))
 }
 
 /// The state of a running trial.
@@ -321,6 +365,8 @@ struct Trial<'a, 'o, 'p, P: Plant> {
     governor: Option<TrialGovernor>,
     /// Told the environment steps after every episode.
     progress: &'p (dyn Fn(u64) + Sync),
+    /// The books at every test run.
+    books: TestBooks,
 }
 
 impl<P: Plant> Trial<'_, '_, '_, P> {
@@ -454,6 +500,12 @@ impl<P: Plant> Trial<'_, '_, '_, P> {
                 claimed_slots: pada_core::weights::WeightStore::occupancy(self.agent.weights()).map(|o| o.claimed),
             });
             self.test_steps += report.length as u64;
+            let most = |c: &FatigueCounter<MAX_ACTION_DIMS>| {
+                c.joints()[..spec.gearboxes.min(MAX_ACTION_DIMS)].iter().map(|j| j.damage()).fold(0.0, f64::max)
+            };
+            self.books.damage.push(most(&self.fatigue));
+            self.books.physical_damage.push(most(&self.physical));
+            self.books.learning_falls.push(self.learning_falls);
         }
         Ok(mode)
     }

@@ -6,6 +6,7 @@ pub mod claims;
 pub mod compare;
 pub mod figures;
 pub mod legend;
+pub mod transfer;
 pub mod wear;
 
 use plotters::coord::Shift;

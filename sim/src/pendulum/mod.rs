@@ -33,6 +33,18 @@ pub(crate) fn swing(mut x: [f64; 2], period_s: f64, substeps: u32, gain: f64, dr
     x
 }
 
+/// [`swing`] with dry friction `k[3]` (per unit inertia) against the
+/// motion: `θ̈ = k[0]·sin θ + k[1] − k[2]·θ̇ − k[3]·tanh(θ̇/ω_s)`, the sign
+/// smoothed over ω_s, at least 0.05 rad/s and wide enough that RK4 stays
+/// stable at the model's step (the friction's slope times the step at most
+/// 1) (a plant that differs from its model: [`crate::variation`]).
+pub(crate) fn swing_dry(x: [f64; 2], period_s: f64, substeps: u32, k: [f64; 4]) -> [f64; 2] {
+    let smooth = (k[3] * period_s / substeps as f64).max(0.05);
+    crate::integrator::integrate(x, period_s, substeps, |y| {
+        [y[1], k[0] * y[0].sin() + k[1] - k[2] * y[1] - k[3] * (y[1] / smooth).tanh()]
+    })
+}
+
 /// A pendulum's observation `[θ wrapped to (−π, π], θ̇]` of its state
 /// `[θ (unwrapped), θ̇]`.
 pub(crate) fn observe(x: &[f64; 2], obs: &mut [f32]) {
@@ -50,6 +62,8 @@ pub trait PendulumModel: Clone + Send + Sync {
     fn advance(&self, x: [f64; 2], u: f64) -> [f64; 2];
     /// The gearbox torque of the motor command `command` \[N·m\].
     fn gearbox_torque(&self, command: f32) -> f32;
+    /// The model with `draw`'s mass, motor constant and friction.
+    fn varied(&self, draw: &crate::variation::PlantDraw) -> Self;
 }
 
 /// A pendulum plant of model `M`: state `[θ, θ̇]` with θ unwrapped
@@ -59,12 +73,28 @@ pub trait PendulumModel: Clone + Send + Sync {
 pub struct Pendulum<M> {
     params: M,
     x: [f64; 2],
+    /// The angle's reading on a plant that is not its model (`None`: the
+    /// model's exact angle).
+    sensor: Option<crate::variation::Sensor>,
 }
 
 impl<M: PendulumModel> Pendulum<M> {
     /// A pendulum hanging down at rest.
     pub fn new(params: M) -> Self {
-        Pendulum { params, x: [PI, 0.0] }
+        Pendulum { params, x: [PI, 0.0], sensor: None }
+    }
+
+    /// A pendulum whose angle is read through `sensor` (play and noise).
+    pub fn with_sensor(params: M, sensor: Option<crate::variation::Sensor>) -> Self {
+        Pendulum { params, x: [PI, 0.0], sensor }
+    }
+
+    /// The observation, the angle through the sensor if there is one.
+    fn sense(&mut self, obs: &mut [f32]) {
+        observe(&self.x, obs);
+        if let Some(s) = self.sensor.as_mut() {
+            obs[0] = wrap_angle(s.read(0, self.x[0])) as f32;
+        }
     }
 
     /// The internal state `[θ (unwrapped), θ̇]`.
@@ -76,14 +106,17 @@ impl<M: PendulumModel> Pendulum<M> {
 impl<M: PendulumModel> Plant for Pendulum<M> {
     fn reset(&mut self, _rng: &mut dyn RngCore, obs: &mut [f32]) {
         self.x = [PI, 0.0];
-        observe(&self.x, obs);
+        if let Some(s) = self.sensor.as_mut() {
+            s.settle(0, PI);
+        }
+        self.sense(obs);
     }
 
     fn step(&mut self, command: &[f32], obs: &mut [f32]) -> Step {
         let limit = self.params.drive_limit();
         let u = (command[0] as f64).clamp(-limit, limit);
         self.x = self.params.advance(self.x, u);
-        observe(&self.x, obs);
+        self.sense(obs);
         let reward = swing_up_reward(wrap_angle(self.x[0]), self.x[1], u);
         Step { reward: reward as f32, terminal: false }
     }

@@ -45,6 +45,9 @@ pub struct PhysicalPendulumParams {
     pub period_s: f64,
     /// RK4 sub-steps per control period.
     pub substeps: u32,
+    /// Dry friction at the axis \[N·m\] (0 in the model; a plant that
+    /// differs from it may have some: [`crate::variation`]).
+    pub dry_friction_nm: f64,
 }
 
 impl Default for PhysicalPendulumParams {
@@ -60,6 +63,7 @@ impl Default for PhysicalPendulumParams {
             voltage_limit: robot::VOLTAGE_LIMIT,
             period_s: robot::SPEC_33HZ.period_s(),
             substeps: 10,
+            dry_friction_nm: 0.0,
         }
     }
 }
@@ -86,6 +90,10 @@ impl PhysicalPendulumParams {
         let gain = self.mass_kg * self.gravity * self.length_m / self.inertia_kg_m2;
         let drive = k_over_r * u / self.inertia_kg_m2;
         let friction = (self.damping + self.torque_constant * k_over_r) / self.inertia_kg_m2;
+        if self.dry_friction_nm != 0.0 {
+            let dry = self.dry_friction_nm / self.inertia_kg_m2;
+            return super::swing_dry(x, self.period_s, self.substeps, [gain, drive, friction, dry]);
+        }
         super::swing(x, self.period_s, self.substeps, gain, drive, friction)
     }
 
@@ -106,6 +114,16 @@ impl super::PendulumModel for PhysicalPendulumParams {
 
     fn advance(&self, x: [f64; 2], u: f64) -> [f64; 2] {
         PhysicalPendulumParams::advance(self, x, u)
+    }
+
+    fn varied(&self, draw: &crate::variation::PlantDraw) -> Self {
+        PhysicalPendulumParams {
+            mass_kg: self.mass_kg * draw.mass,
+            inertia_kg_m2: self.inertia_kg_m2 * draw.mass,
+            torque_constant: self.torque_constant * draw.motor_constant,
+            dry_friction_nm: self.dry_friction_nm + draw.friction_nm,
+            ..*self
+        }
     }
 
     fn gearbox_torque(&self, command: f32) -> f32 {
@@ -149,6 +167,13 @@ impl PhysicalPendulumTask {
     /// The constants.
     pub fn params(&self) -> &PhysicalPendulumParams {
         &self.params
+    }
+}
+
+impl crate::variation::Vary for PhysicalPendulumTask {
+    fn plant_with(&self, draw: &crate::variation::PlantDraw, seed: u64) -> PhysicalPendulum {
+        use super::PendulumModel;
+        PhysicalPendulum::with_sensor(self.params.varied(draw), crate::variation::Sensor::of(draw, seed))
     }
 }
 

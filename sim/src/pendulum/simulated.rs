@@ -38,6 +38,12 @@ pub struct SimulatedPendulumParams {
     pub period_s: f64,
     /// RK4 sub-steps per control period.
     pub substeps: u32,
+    /// Dry friction at the joint \[N·m\] (0 in the model; a plant that
+    /// differs from it may have some: [`crate::variation`]).
+    pub dry_friction_nm: f64,
+    /// Factor on the torque the command asks for (1 in the model: the
+    /// motor's constant as the learner assumes it).
+    pub motor_factor: f64,
 }
 
 impl Default for SimulatedPendulumParams {
@@ -51,6 +57,8 @@ impl Default for SimulatedPendulumParams {
             torque_limit: 1.5,
             period_s: 0.05,
             substeps: 30,
+            dry_friction_nm: 0.0,
+            motor_factor: 1.0,
         }
     }
 }
@@ -74,6 +82,10 @@ impl SimulatedPendulumParams {
         // The constants of the derivative, once per control period.
         let gain = self.mass_kg * self.gravity * self.length_m / self.inertia_kg_m2;
         let (drive, friction) = (u / self.inertia_kg_m2, self.damping / self.inertia_kg_m2);
+        if self.dry_friction_nm != 0.0 || self.motor_factor != 1.0 {
+            let dry = self.dry_friction_nm / self.inertia_kg_m2;
+            return super::swing_dry(x, self.period_s, self.substeps, [gain, drive * self.motor_factor, friction, dry]);
+        }
         super::swing(x, self.period_s, self.substeps, gain, drive, friction)
     }
 
@@ -95,6 +107,16 @@ impl super::PendulumModel for SimulatedPendulumParams {
 
     fn advance(&self, x: [f64; 2], u: f64) -> [f64; 2] {
         SimulatedPendulumParams::advance(self, x, u)
+    }
+
+    fn varied(&self, draw: &crate::variation::PlantDraw) -> Self {
+        SimulatedPendulumParams {
+            mass_kg: self.mass_kg * draw.mass,
+            inertia_kg_m2: self.inertia_kg_m2 * draw.mass,
+            motor_factor: self.motor_factor * draw.motor_constant,
+            dry_friction_nm: self.dry_friction_nm + draw.friction_nm,
+            ..*self
+        }
     }
 
     fn gearbox_torque(&self, command: f32) -> f32 {
@@ -162,6 +184,13 @@ impl SimulatedPendulumTask {
     /// The pendulum constants.
     pub fn params(&self) -> &SimulatedPendulumParams {
         &self.params
+    }
+}
+
+impl crate::variation::Vary for SimulatedPendulumTask {
+    fn plant_with(&self, draw: &crate::variation::PlantDraw, seed: u64) -> SimulatedPendulum {
+        use super::PendulumModel;
+        SimulatedPendulum::with_sensor(self.params.varied(draw), crate::variation::Sensor::of(draw, seed))
     }
 }
 

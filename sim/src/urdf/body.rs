@@ -27,6 +27,7 @@ use pada_core::rx28::ReducedJoint;
 use pada_core::servo::{ControlMode, PositionLoop};
 use pada_robot_file::RobotFile;
 use rapier3d::prelude::*;
+use rapier3d::dynamics::RigidBodyAdditionalMassProps;
 use rapier3d_urdf::{UrdfLoaderOptions, UrdfMultibodyOptions, UrdfRobot};
 use crate::world_state::WorldState;
 
@@ -88,9 +89,41 @@ pub struct UrdfModel {
     start: Vec<f32>,
     substeps: u32,
     solver_iterations: u32,
+    /// Motor constants and friction of a plant that is not its model
+    /// (`None`: the model's).
+    differs: Option<MotorsDiffer>,
+}
+
+/// How the servos of a plant that is not its model differ from it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct MotorsDiffer {
+    /// Factor on each motor's torque constant.
+    motor_constant: f32,
+    /// Dry friction at each joint \[N·m\].
+    friction_nm: f32,
 }
 
 impl UrdfModel {
+    /// The same body with `draw`'s masses (every link's mass and inertia
+    /// times its factor), motor constants and dry friction
+    /// ([`crate::variation`]).
+    pub fn varied(&self, draw: &crate::variation::PlantDraw) -> UrdfModel {
+        let mut m = self.clone();
+        if draw.mass != 1.0 {
+            let f = draw.mass as f32;
+            for link in &mut m.urdf.links {
+                let added = link.body.mass_properties().additional_local_mprops.as_deref().cloned();
+                if let Some(RigidBodyAdditionalMassProps::MassProps(mut p)) = added {
+                    p.inv_mass /= f;
+                    p.inv_principal_inertia /= f;
+                    link.body.set_additional_mass_properties(p, false);
+                }
+            }
+        }
+        m.differs = Some(MotorsDiffer { motor_constant: draw.motor_constant as f32, friction_nm: draw.friction_nm as f32 });
+        m
+    }
+
     /// The robot's definition.
     pub fn spec(&self) -> &'static pada_core::robot::RobotSpec {
         self.spec
@@ -131,6 +164,7 @@ impl UrdfModel {
             start: robot.vocabulary().start.to_vec(),
             substeps: robot.substeps,
             solver_iterations: robot.solver_iterations,
+            differs: None,
         };
         UrdfBody::new(&model).map_err(|e| anyhow::anyhow!("{}: {e}", robot.urdf.path.display()))?;
         Ok(model)
@@ -140,7 +174,7 @@ impl UrdfModel {
 impl UrdfBody {
     /// A body of `model`, at rest in its start pose.
     pub fn new(model: &UrdfModel) -> anyhow::Result<UrdfBody> {
-        let UrdfModel { urdf, joint_names, axes, spec, start, substeps, solver_iterations } = model.clone();
+        let UrdfModel { urdf, joint_names, axes, spec, start, substeps, solver_iterations, differs } = model.clone();
         let mut world = PhysicsWorld::new();
         world.gravity = Vector::new(0.0, 0.0, -GRAVITY);
         world.integration_parameters.dt = spec.period_s() as f32 / substeps as f32;
@@ -173,7 +207,14 @@ impl UrdfBody {
                 child: h.link2,
                 parent: h.link1,
                 axis: Vector::new((axis[0] / n) as f32, (axis[1] / n) as f32, (axis[2] / n) as f32),
-                servo: spec.servo.motor().to_rx28().reduced(),
+                servo: match differs {
+                    None => spec.servo.motor().to_rx28().reduced(),
+                    Some(d) => {
+                        let mut motor = spec.servo.motor();
+                        motor.torque_constant_nm_per_a *= d.motor_constant;
+                        motor.to_rx28().reduced()
+                    }
+                },
                 position: None,
             });
         }
@@ -189,6 +230,9 @@ impl UrdfBody {
             j.dof = mb.link(j.link).ok_or_else(|| anyhow::anyhow!("no link"))?.assembly_id();
             mb.damping_mut()[j.dof] = j.servo.damping;
             mb.armature_mut()[j.dof] = j.servo.armature;
+            if let Some(d) = differs {
+                mb.frictions_mut()[j.dof] = d.friction_nm;
+            }
         }
         let built = WorldState::of(&world);
         let mut body = UrdfBody {

@@ -16,6 +16,7 @@ use pada_core::profile::{Board, LearnerProfile};
 use pada_core::robot::{PerServo, RobotRules, Sensed, Vocab};
 use pada_core::safety::FaultCause;
 use pada_robot_file::RobotFile;
+use crate::variation::{PlantDraw, Sensor, Vary};
 use rand_core::RngCore;
 
 /// The body of a robot of files driven by the robot's rules `R`.
@@ -26,12 +27,21 @@ pub struct RulesPlant<R> {
     volts: PerServo,
     /// The soft-limit fault of the last reading, if any.
     fault: Option<FaultCause>,
+    /// The joints' readings on a plant that is not its model (`None`: the
+    /// simulated angles as they are).
+    sensor: Option<Sensor>,
 }
 
 impl<R: RobotRules> RulesPlant<R> {
     /// `rules` driving `body`.
     pub fn new(body: UrdfBody, rules: R) -> Self {
-        RulesPlant { body, rules, volts: [0.0; MAX_SERVOS], fault: None }
+        RulesPlant { body, rules, volts: [0.0; MAX_SERVOS], fault: None, sensor: None }
+    }
+
+    /// `rules` driving `body`, its joints read through `sensor` (play and
+    /// noise).
+    pub fn with_sensor(body: UrdfBody, rules: R, sensor: Option<Sensor>) -> Self {
+        RulesPlant { sensor, ..RulesPlant::new(body, rules) }
     }
 
     /// The rules (for inspection).
@@ -49,7 +59,10 @@ impl<R: RobotRules> RulesPlant<R> {
         let n = self.rules.spec().joints.len().min(MAX_SERVOS);
         let mut angles = [None; MAX_SERVOS];
         for k in 0..n {
-            angles[k] = Some(q[k]);
+            angles[k] = Some(match self.sensor.as_mut() {
+                Some(s) => s.read(k, q[k] as f64) as f32,
+                None => q[k],
+            });
         }
         // The board's safety machine sees every reading first.
         self.fault = self.rules.spec().soft_limit_fault(&angles[..n]);
@@ -70,6 +83,12 @@ impl<R: RobotRules + Send> Plant for RulesPlant<R> {
         let _ = self.body.reset();
         self.volts = [0.0; MAX_SERVOS];
         self.rules.start_episode();
+        if let Some(s) = self.sensor.as_mut() {
+            let q = self.body.angles();
+            for (k, a) in q.iter().enumerate() {
+                s.settle(k, *a as f64);
+            }
+        }
         self.sense();
         self.observe(obs);
     }
@@ -124,6 +143,7 @@ impl<R: RobotRules + Send> Plant for RulesPlant<R> {
 }
 
 /// A robot of files as a task of the experiment runner.
+#[derive(Clone)]
 pub struct UrdfTask {
     spec: TaskSpec,
     model: UrdfModel,
@@ -165,5 +185,14 @@ impl Task for UrdfTask {
         let body = UrdfBody::new(&self.model).unwrap_or_else(|e| unreachable!("the body built at load: {e}"));
         let rules = Vocab::new(self.robot).unwrap_or_else(|e| unreachable!("checked at load: {e}"));
         RulesPlant::new(body, rules)
+    }
+}
+
+impl Vary for UrdfTask {
+    fn plant_with(&self, draw: &PlantDraw, seed: u64) -> RulesPlant<Vocab> {
+        // The model's body built at load; its masses scaled stay positive.
+        let body = UrdfBody::new(&self.model.varied(draw)).unwrap_or_else(|e| unreachable!("the body built at load: {e}"));
+        let rules = Vocab::new(self.robot).unwrap_or_else(|e| unreachable!("checked at load: {e}"));
+        RulesPlant::with_sensor(body, rules, Sensor::of(draw, seed))
     }
 }
