@@ -1,8 +1,9 @@
 //! Software in the loop: the firmware image in QEMU against the simulated
 //! plant (`pada sil`): the pendulum on the F405's emulation
 //! (netduinoplus2), LEO on the F429I-DISC1's (mps2-an386, its 8 MiB table in
-//! PSRAM) and the F405's, and the example arm of files
-//! (examples/robots/arm2) on the F405's. Each test boots the real image in
+//! PSRAM) and the F405's, and the example arms of files
+//! (examples/robots/arm2 on Protocol 2.0, examples/robots/so101 on Feetech
+//! STS3215s) on the F405's. Each test boots the real image in
 //! qemu-system-arm; none is skipped when QEMU is missing.
 
 mod common;
@@ -384,4 +385,23 @@ fn a_robot_of_files_in_qemu_replays_bit_for_bit_and_equals_pada_run_board() {
     let host_agent = pada::experiment::build_agent(&task, run.policy).unwrap();
     assert_eq!(hello.config_hash, pada_core::profile::config_hash(&profile, &host_agent), "{hello:?}");
     assert_eq!((hello.robot.as_str(), hello.robot_hash), ("arm2", run.task.robot().definition_hash()));
+}
+
+/// The SO-101 of files: six Feetech STS3215s on the emulated bus (one SYNC
+/// READ and one SYNC WRITE a period, Operating Mode 2's duty cycles)
+/// learn in QEMU what `pada run --board f405 --robot
+/// examples/robots/so101/robot.toml --seed 1` learns.
+#[test]
+fn the_so101_on_feetech_servos_in_qemu_replays_bit_for_bit_and_equals_pada_run_board() {
+    let dir = tempfile::tempdir().unwrap();
+    let task = SilTask::of_file(&common::root().join("examples/robots/so101/robot.toml")).unwrap_or_else(|e| panic!("{e:#}"));
+    let run = Run { board: Board::F405, task, policy: PolicyKind::Pada { delta: 0.5 }, seconds: 20.0, faults: vec![], forecast: true, compare: true, mtbf_budget_s: None };
+    let s = run.go(dir.path());
+    assert!(s.passed, "{:#?}", check_failures(&s));
+    assert_eq!((s.robot, s.board), ("so101", "f405"));
+    assert!(s.replay.identical && s.replay.actions_compared >= 500, "{:?}", s.replay);
+    let host = s.host.as_ref().expect("the host comparison ran");
+    assert_eq!(host.identical, Some(true), "{host:?}");
+    assert!(host.episodes_compared >= 5, "{host:?}");
+    assert_eq!(Some(host.weights_checksum), s.replay.final_checksum_firmware);
 }
