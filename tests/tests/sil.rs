@@ -51,6 +51,13 @@ impl Run {
         }
     }
 
+    /// The SO-101 of files (examples/robots/so101: six Feetech STS3215s),
+    /// learning with PADA.
+    fn so101(seconds: f64) -> Run {
+        let task = SilTask::of_file(&common::root().join("examples/robots/so101/robot.toml")).unwrap_or_else(|e| panic!("{e:#}"));
+        Run { board: Board::F405, task, policy: PolicyKind::Pada { delta: 0.5 }, seconds, faults: vec![], forecast: true, compare: false, mtbf_budget_s: None }
+    }
+
     /// The example arm of files (examples/robots/arm2: two X-series
     /// servos on Protocol 2.0), learning with PADA.
     fn arm2(seconds: f64) -> Run {
@@ -265,6 +272,13 @@ fn servo_error_bits_fault_within_one_period_and_resume() {
     fault_test(Run::pendulum(PolicyKind::Sarsa, 9.0), "error-bits:at=12:for=1:bits=overheating", "servo-error");
 }
 
+/// An STS3215's overload (its Status bit 5) on the SO-101's elbow: the
+/// board faults within its period, every servo's torque off, and resumes.
+#[test]
+fn an_sts3215_overload_faults_within_one_period_and_resumes() {
+    fault_test(Run::so101(10.0), "error-bits:at=4:for=1:bits=overload:servo=3", "servo-error");
+}
+
 /// An X-series servo's hardware alert latches until a REBOOT: the board
 /// faults within its period, and after the operator's ClearFault and
 /// Start it reboots the servo, sets it up again and learns on.
@@ -394,8 +408,8 @@ fn a_robot_of_files_in_qemu_replays_bit_for_bit_and_equals_pada_run_board() {
 #[test]
 fn the_so101_on_feetech_servos_in_qemu_replays_bit_for_bit_and_equals_pada_run_board() {
     let dir = tempfile::tempdir().unwrap();
-    let task = SilTask::of_file(&common::root().join("examples/robots/so101/robot.toml")).unwrap_or_else(|e| panic!("{e:#}"));
-    let run = Run { board: Board::F405, task, policy: PolicyKind::Pada { delta: 0.5 }, seconds: 20.0, faults: vec![], forecast: true, compare: true, mtbf_budget_s: None };
+    let mut run = Run::so101(20.0);
+    run.compare = true;
     let s = run.go(dir.path());
     assert!(s.passed, "{:#?}", check_failures(&s));
     assert_eq!((s.robot, s.board), ("so101", "f405"));
