@@ -175,8 +175,10 @@ fn check_faults_on(servos: &[Servo], robot: &RobotSpec, faults: &[FaultSpec]) ->
             let ids: Vec<String> = servos.iter().map(|s| s.id.to_string()).collect();
             return Err(format!("--fault {f}: no servo {} on {}'s bus (its servos: {})", f.servo, robot.name, ids.join(", ")));
         };
-        if f.kind == FaultKind::PastLimit && servo.joint.is_some_and(|(j, _)| j.servo.protocol == pada_core::servo::ServoProtocol::Feetech) {
-            return Err(format!("--fault {f}: past-limit is not emulated on servo {}'s Feetech STS3215 (valid: drop, corrupt, delay, error-bits)", f.servo));
+        let feetech = servo.joint.is_some_and(|(j, _)| j.servo.protocol == pada_core::servo::ServoProtocol::Feetech);
+        if f.kind == FaultKind::PastLimit && feetech {
+            let valid = "valid: drop, corrupt, delay, error-bits";
+            return Err(format!("--fault {f}: past-limit is not emulated on servo {}'s Feetech STS3215 ({valid})", f.servo));
         }
         if f.kind == FaultKind::PastLimit && servo.joint.is_none_or(|(_, l)| l.is_none()) {
             return Err(format!("--fault {f}: servo {}'s joint has no soft limit on {}", f.servo, robot.name));

@@ -50,7 +50,8 @@ impl FtServos {
         for &id in ids {
             let Some(joint) = robot.joints.iter().find(|j| j.id == id && j.servo.protocol == ServoProtocol::Feetech) else { continue };
             if joint.servo.model_number != STS3215.model_number {
-                return Err(format!("joint {}: a virtual {} is not emulated on Feetech's protocol: the valid model is STS3215", joint.name, joint.servo.name));
+                let (name, model) = (joint.name, joint.servo.name);
+                return Err(format!("joint {name}: a virtual {model} is not emulated on Feetech's protocol: the valid model is STS3215"));
             }
             let baud = baud_value(&STS3215, BUS_BPS).ok_or_else(|| format!("the {} takes no {BUS_BPS} bps", joint.servo.name))?;
             servos.push((P1Servo::of(&STS3215_LAYOUT, id, baud, Some(*joint)), ft::Output::default()));

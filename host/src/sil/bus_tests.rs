@@ -157,4 +157,8 @@ fn an_sts3215_answers_the_sync_read_and_its_sync_write_drives_the_rig() {
     assert!(bus.receive(1_000, &write, &mut rig).is_empty());
     assert_eq!(bus.torque(1), Some(true));
     assert_eq!(bus.stats().packets, 2);
+    // A fault the STS3215 does not emulate is refused before the run.
+    let past = vec![fault::parse("past-limit:at=1:servo=1").unwrap()];
+    let e = BusEmulator::new(&rig, spec, past).unwrap_err();
+    assert!(e.contains("past-limit is not emulated") && e.contains("valid: drop"), "{e}");
 }
