@@ -156,6 +156,45 @@ fn the_arm_of_files_on_protocol_2_in_lock_step_learns_as_pada_run_board() {
     assert_eq!(curve(&out), curve(&run), "the arm over the pty learns as pada run --board's, episode for episode");
 }
 
+/// The SO-101 of files: six STS3215s in Operating Mode 2 behind the
+/// robot's simulated physics, one SYNC READ and one SYNC WRITE a period,
+/// learn what `pada run --board` learns (the duty cycles in 0.1 %, the
+/// held joints' P law and the 5 V supply reading on both paths).
+#[test]
+fn the_so101_on_feetech_servos_in_lock_step_learns_as_pada_run_board() {
+    let dir = tempfile::tempdir().unwrap();
+    let so101 = format!("{}/../examples/robots/so101", env!("CARGO_MANIFEST_DIR"));
+    let servos = Servos::start(dir.path(), &["--robot", &so101, "--lockstep"]);
+    let out = dir.path().join("drive");
+    let o = drive(&[
+        "--port", servos.port(), "--robot", &so101, "--lockstep", "--board", "f405", "--algo", "pada", "--seed", "2", "--seconds", "60",
+        "--json", "--out", out.to_str().unwrap(),
+    ]);
+    let report: serde_json::Value = serde_json::from_str(&ok(&o)).expect("drive.json on stdout");
+    let summary = servos.stop();
+    assert_eq!(report["ended"]["kind"], "done");
+    assert_eq!((report["bus"]["timeouts"].as_u64(), report["bus"]["checksum_errors"].as_u64()), (Some(0), Some(0)));
+    assert_eq!(summary["stats"]["damaged"], 0);
+    // One SYNC WRITE ends each lock-step period.
+    assert_eq!(summary["stats"]["sync_writes"].as_u64(), report["clock"]["periods"].as_u64());
+    for id in 1..=6 {
+        let servo = events(&summary, id);
+        assert_eq!(servo.first().map(String::as_str), Some("torque-on"), "servo {id}: {servo:?}");
+        assert_eq!(servo.last().map(String::as_str), Some("torque-off"), "servo {id}: {servo:?}");
+    }
+    let run = dir.path().join("run");
+    ok(&common::pada(&[
+        "run", "--board", "f405", "--robot", &so101, "--algo", "pada", "--seed", "2", "--seconds", "60", "--trials", "1", "--out",
+        run.to_str().unwrap(),
+    ]));
+    let curve = |d: &Path| std::fs::read_to_string(d.join("trial-000.csv")).unwrap();
+    let driven = curve(&out);
+    assert!(driven.lines().count() >= 3, "a test episode before and after learning: {driven}");
+    let returns: Vec<&str> = driven.lines().skip(1).map(|l| l.rsplit(',').next().unwrap()).collect();
+    assert!(returns.windows(2).any(|w| w[0] != w[1]), "the arm moved between the tests: {driven}");
+    assert_eq!(driven, curve(&run), "the SO-101 over the pty learns as pada run --board's, episode for episode");
+}
+
 #[test]
 fn ctrl_c_turns_torque_off_and_keeps_the_log() {
     let dir = tempfile::tempdir().unwrap();

@@ -1,8 +1,9 @@
 //! Software in the loop: the firmware image in QEMU against the simulated
 //! plant (`pada sil`): the pendulum on the F405's emulation
 //! (netduinoplus2), LEO on the F429I-DISC1's (mps2-an386, its 8 MiB table in
-//! PSRAM) and the F405's, and the example arm of files
-//! (examples/robots/arm2) on the F405's. Each test boots the real image in
+//! PSRAM) and the F405's, and the example arms of files
+//! (examples/robots/arm2 on Protocol 2.0, examples/robots/so101 on Feetech
+//! STS3215s) on the F405's. Each test boots the real image in
 //! qemu-system-arm; none is skipped when QEMU is missing.
 
 mod common;
@@ -48,6 +49,13 @@ impl Run {
             compare: false,
             mtbf_budget_s: None,
         }
+    }
+
+    /// The SO-101 of files (examples/robots/so101: six Feetech STS3215s),
+    /// learning with PADA.
+    fn so101(seconds: f64) -> Run {
+        let task = SilTask::of_file(&common::root().join("examples/robots/so101/robot.toml")).unwrap_or_else(|e| panic!("{e:#}"));
+        Run { board: Board::F405, task, policy: PolicyKind::Pada { delta: 0.5 }, seconds, faults: vec![], forecast: true, compare: false, mtbf_budget_s: None }
     }
 
     /// The example arm of files (examples/robots/arm2: two X-series
@@ -264,6 +272,13 @@ fn servo_error_bits_fault_within_one_period_and_resume() {
     fault_test(Run::pendulum(PolicyKind::Sarsa, 9.0), "error-bits:at=12:for=1:bits=overheating", "servo-error");
 }
 
+/// An STS3215's overload (its Status bit 5) on the SO-101's elbow: the
+/// board faults within its period, every servo's torque off, and resumes.
+#[test]
+fn an_sts3215_overload_faults_within_one_period_and_resumes() {
+    fault_test(Run::so101(10.0), "error-bits:at=4:for=1:bits=overload:servo=3", "servo-error");
+}
+
 /// An X-series servo's hardware alert latches until a REBOOT: the board
 /// faults within its period, and after the operator's ClearFault and
 /// Start it reboots the servo, sets it up again and learns on.
@@ -384,4 +399,23 @@ fn a_robot_of_files_in_qemu_replays_bit_for_bit_and_equals_pada_run_board() {
     let host_agent = pada::experiment::build_agent(&task, run.policy).unwrap();
     assert_eq!(hello.config_hash, pada_core::profile::config_hash(&profile, &host_agent), "{hello:?}");
     assert_eq!((hello.robot.as_str(), hello.robot_hash), ("arm2", run.task.robot().definition_hash()));
+}
+
+/// The SO-101 of files: six Feetech STS3215s on the emulated bus (one SYNC
+/// READ and one SYNC WRITE a period, Operating Mode 2's duty cycles)
+/// learn in QEMU what `pada run --board f405 --robot
+/// examples/robots/so101/robot.toml --seed 1` learns.
+#[test]
+fn the_so101_on_feetech_servos_in_qemu_replays_bit_for_bit_and_equals_pada_run_board() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut run = Run::so101(20.0);
+    run.compare = true;
+    let s = run.go(dir.path());
+    assert!(s.passed, "{:#?}", check_failures(&s));
+    assert_eq!((s.robot, s.board), ("so101", "f405"));
+    assert!(s.replay.identical && s.replay.actions_compared >= 500, "{:?}", s.replay);
+    let host = s.host.as_ref().expect("the host comparison ran");
+    assert_eq!(host.identical, Some(true), "{host:?}");
+    assert!(host.episodes_compared >= 5, "{host:?}");
+    assert_eq!(Some(host.weights_checksum), s.replay.final_checksum_firmware);
 }

@@ -29,6 +29,7 @@ use crate::sil::fault::{FaultKind, FaultSpec};
 use pada_core::dynamixel::control_table::{self, rx28, x_series::HardwareError};
 use pada_core::dynamixel::v2::{self as dxl2, ErrorNumber, StatusError};
 use pada_core::dynamixel::{self as dxl1, ErrorFlags, BROADCAST_ID};
+use pada_core::feetech::control_table::sts3215;
 use pada_core::feetech::{self, Instruction as ft_ins};
 use pada_core::robot::{JointSpec, RobotSpec};
 use pada_core::servo::{ServoModel, ServoProtocol};
@@ -190,7 +191,7 @@ impl VirtualBus {
     /// A bare chain of STS3215s at `ids` (no robot: [`super::chain`]),
     /// at `bps`; lock step ends a period of `period_us` at each SYNC WRITE.
     pub fn chain(ids: &[u8], bps: u32, clock: Clock, faults: Vec<FaultSpec>, period_us: u64) -> Result<Self, String> {
-        let table = &feetech::control_table::sts3215::STS3215;
+        let table = &sts3215::STS3215;
         let baud = baud_value(table, bps).ok_or_else(|| baud_error(table, bps))?;
         let devices: Vec<Device> = ids.iter().map(|&id| Device::P1(P1Servo::of(&super::ft::STS3215_LAYOUT, id, baud, None))).collect();
         if let Some(f) = faults.iter().find(|f| !ids.contains(&f.servo)) {
@@ -386,7 +387,15 @@ impl VirtualBus {
         let supply = self.supply_v;
         if let Device::P1(s) = &mut self.devices[i] {
             if let Some(mut out) = s.own_loop.take() {
-                let dropped = super::ft::advance(s, &mut out, now);
+                // A robot's STS3215 reads its joint; a bare one, its own loop.
+                let dropped = match s.joint {
+                    Some(joint) => {
+                        let state = self.rig.joint_state(now, joint.id);
+                        let present = crate::rig::x_reading(&joint, state, 0, supply).into();
+                        super::ft::with_robot(s, &mut out, &present, now)
+                    }
+                    None => super::ft::advance(s, &mut out, now),
+                };
                 s.own_loop = Some(out);
                 if dropped {
                     self.events.push(Event { at_us: now, id: s.id(), what: "unloaded" });
@@ -712,10 +721,11 @@ fn device(model: &'static ServoModel, id: u8, bps: u32, joint: Option<JointSpec>
             "a virtual {} is not emulated on Protocol 1.0: valid models are RX-28, XM430-W350, XL430-W250, XL330-M288",
             model.name
         )),
-        ServoProtocol::Feetech => Err(format!(
-            "a robot's virtual {} is not emulated: `pada servos --chain sts3215:1-6` emulates a bare STS3215 chain",
-            model.name
-        )),
+        ServoProtocol::Feetech if model.model_number == sts3215::STS3215_MODEL => {
+            let baud = baud_value(&sts3215::STS3215, bps).ok_or_else(|| baud_error(&sts3215::STS3215, bps))?;
+            Ok(Device::P1(P1Servo::of(&super::ft::STS3215_LAYOUT, id, baud, joint)))
+        }
+        ServoProtocol::Feetech => Err(format!("a virtual {} is not emulated on Feetech's protocol: the valid model is STS3215", model.name)),
         ServoProtocol::V2 => {
             let table = control_table::by_model_number(model.model_number)
                 .ok_or_else(|| format!("no control table of {} (model {})", model.name, model.model_number))?;

@@ -1,7 +1,8 @@
 //! `pada servos --chain sts3215:1-6`: a bare chain of servos that move
 //! under their own position loops ([`super::ft`]), with no robot behind
 //! them: what a client library's test or an SO-101 owner's bring-up
-//! script talks to before any robot definition exists.
+//! script talks to before any robot definition exists (a robot's
+//! STS3215s have its physics behind them: [`super::ft::with_robot`]).
 
 use pada_core::dynamixel::table::PresentState;
 use pada_sim::rig::{JointState, Rig};

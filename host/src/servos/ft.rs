@@ -23,6 +23,13 @@
 //! servo's P/D/I loop, not a model of it: a bare chain has no load, and a
 //! robot's plant models the loop where it learns through it.
 //!
+//! # A robot's STS3215
+//!
+//! Behind a robot's servo is its joint in the robot's simulated physics
+//! ([`with_robot`]): the present block is the joint's, and in Operating
+//! Mode 2 with torque on Goal Time's duty cycle is the motor's voltage
+//! ([`volts`]), as `pada run --board` applies it.
+//!
 //! # Alarms
 //!
 //! Status (65) and every answer's ERROR byte carry the conditions in
@@ -34,7 +41,11 @@
 
 use super::p1::{Layout, P1Servo};
 use pada_core::feetech::control_table::sts3215::{self as sts, STS3215};
-use pada_core::feetech::value::{from_sign_magnitude, to_sign_magnitude_saturating, POSITION_SIGN_BIT, VELOCITY_SIGN_BIT};
+use pada_core::feetech::command::{DUTY_SIGN_BIT, MAX_DUTY};
+use pada_core::feetech::value::{
+    from_sign_magnitude, to_sign_magnitude_saturating, HOMING_OFFSET_SIGN_BIT, LOAD_SIGN_BIT, POSITION_SIGN_BIT, VELOCITY_SIGN_BIT,
+};
+use pada_core::servo::Present;
 use pada_core::dynamixel::ErrorFlags;
 use pada_core::feetech::status::{self, ServoStatus};
 
@@ -160,6 +171,50 @@ pub fn advance(servo: &mut P1Servo, out: &mut Output, now_us: u64) -> bool {
     t[sts::PRESENT_POSITION as usize..][..2].copy_from_slice(&position.to_le_bytes());
     t[sts::PRESENT_VELOCITY as usize..][..2].copy_from_slice(&velocity.to_le_bytes());
     t[sts::MOVING as usize] = u8::from(out.velocity.abs() > 1.0);
+    alarms(servo, out)
+}
+
+/// A robot's STS3215: its present values are its joint's in the robot's
+/// simulated physics (`present`, in the servo's own units: steps through
+/// the joint's calibration, steps/s, load in 0.1 %, the supply), less the
+/// Homing Offset; then Status and Moving as [`advance`] writes them.
+/// Returns whether the torque was dropped now.
+pub fn with_robot(servo: &mut P1Servo, out: &mut Output, present: &Present, now_us: u64) -> bool {
+    let t = &mut servo.table;
+    out.at_us = out.at_us.max(now_us);
+    // The raw steps, before the Homing Offset (Torque Enable 128 takes
+    // the middle from them).
+    out.position = present.position as f64;
+    out.velocity = present.speed as f64;
+    let offset = from_sign_magnitude(u16_at(t, sts::HOMING_OFFSET), HOMING_OFFSET_SIGN_BIT);
+    let signed = |v: i32, bit: u8| to_sign_magnitude_saturating(v, bit).to_le_bytes();
+    t[sts::PRESENT_POSITION as usize..][..2].copy_from_slice(&signed(present.position - offset, POSITION_SIGN_BIT));
+    t[sts::PRESENT_VELOCITY as usize..][..2].copy_from_slice(&signed(present.speed, VELOCITY_SIGN_BIT));
+    t[sts::PRESENT_LOAD as usize..][..2].copy_from_slice(&signed(present.load.clamp(-1000, 1000), LOAD_SIGN_BIT));
+    t[sts::PRESENT_VOLTAGE as usize] = present.voltage_dv.min(255) as u8;
+    t[sts::PRESENT_TEMPERATURE as usize] = present.temperature;
+    t[sts::MOVING as usize] = u8::from(present.speed != 0);
+    alarms(servo, out)
+}
+
+/// The voltage a robot's STS3215 applies on `supply_v` \[V\]: in Operating
+/// Mode 2 with torque on, Goal Time's duty cycle (0.1 % of the supply, sign
+/// bit 10, at most 100 %), as the ratio `pada run --board` applies
+/// (`pada_core::servo::Drive::ratio`); in the other modes none (the
+/// position loop moves only a bare chain's output).
+pub fn volts(servo: &P1Servo, supply_v: f64) -> f64 {
+    let t = &servo.table;
+    if t[sts::TORQUE_ENABLE as usize] != 1 || t[sts::OPERATING_MODE as usize] != sts::MODE_PWM {
+        return 0.0;
+    }
+    let duty = from_sign_magnitude(u16_at(t, sts::GOAL_TIME), DUTY_SIGN_BIT).clamp(-MAX_DUTY, MAX_DUTY);
+    (duty as f32 / MAX_DUTY as f32) as f64 * supply_v
+}
+
+/// Status from the conditions in force and the injected ones; the torque
+/// dropped on one that Unloading Condition names.
+fn alarms(servo: &mut P1Servo, out: &Output) -> bool {
+    let t = &mut servo.table;
     let status = conditions(t).union(out.injected);
     t[sts::STATUS as usize] = status.bits();
     let unload = status.intersects(ErrorFlags(t[sts::UNLOADING_CONDITION as usize]));
@@ -269,6 +324,34 @@ mod tests {
         s.table[sts::MAX_TEMPERATURE_LIMIT as usize] = 30;
         advance(&mut s, &mut out, 1);
         assert_eq!(error_byte(&s), status::OVERHEAT.bits());
+    }
+
+    #[test]
+    fn a_robots_servo_reads_its_joint_and_applies_its_duty_cycle() {
+        let (mut s, mut out) = servo();
+        // Torque on in Operating Mode 0: no voltage (only a bare chain's
+        // output follows the position loop).
+        s.table[sts::TORQUE_ENABLE as usize] = 1;
+        s.table[sts::GOAL_TIME as usize..][..2].copy_from_slice(&(0x0400u16 | 300).to_le_bytes());
+        assert_eq!(volts(&s, 5.0), 0.0);
+        // Mode 2: −30 % of 5 V; past 100 %, 100 %; torque off, none.
+        s.table[sts::OPERATING_MODE as usize] = sts::MODE_PWM;
+        assert!((volts(&s, 5.0) + 1.5).abs() < 1e-6, "{}", volts(&s, 5.0));
+        s.table[sts::GOAL_TIME as usize..][..2].copy_from_slice(&1023u16.to_le_bytes());
+        assert_eq!(volts(&s, 5.0), 5.0);
+        s.table[sts::TORQUE_ENABLE as usize] = 0;
+        assert_eq!(volts(&s, 5.0), 0.0);
+        // The joint's values in the servo's units and sign bits, less the
+        // Homing Offset.
+        s.table[sts::HOMING_OFFSET as usize..][..2].copy_from_slice(&(0x0800u16 | 10).to_le_bytes());
+        let p = Present { position: 2100, speed: -40, load: -1500, voltage_dv: 50, temperature: 40 };
+        assert!(!with_robot(&mut s, &mut out, &p, 30_000));
+        let block = &s.table[sts::PRESENT_BLOCK as usize..][..8];
+        let back = pada_core::feetech::present(block, pada_core::feetech::ByteOrder::Little).unwrap();
+        assert_eq!(back, Present { position: 2110, load: -1000, ..p });
+        assert_eq!((s.table[sts::MOVING as usize], out.position), (1, 2100.0));
+        // 5 V is inside the factory's 4–14 V: no alarm.
+        assert_eq!(error_byte(&s), 0);
     }
 
     #[test]

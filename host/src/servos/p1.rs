@@ -177,11 +177,12 @@ impl P1Servo {
     }
 
     /// The voltage its Moving Speed applies in wheel mode on `supply` \[V\]
-    /// (0 in joint mode, whose position control is not emulated).
+    /// (0 in joint mode, whose position control is not emulated); an
+    /// STS3215's, its duty cycle's ([`super::ft::volts`]).
     pub fn volts(&self, supply: f64) -> f64 {
         if !self.is_rx28() {
-            // The STS3215 runs its own position loop (`super::ft`).
-            return 0.0;
+            // The STS3215's duty cycle in Operating Mode 2 (`super::ft`).
+            return super::ft::volts(self, supply);
         }
         let wheel = self.table[table::CW_ANGLE_LIMIT as usize..table::CCW_ANGLE_LIMIT as usize + 2].iter().all(|&b| b == 0);
         if wheel {

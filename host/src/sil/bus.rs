@@ -15,6 +15,7 @@
 //! request comes, with its effects (counters, fault traces, the present
 //! values in the control table).
 
+use super::bus_ft::{FtAnswer, FtServos};
 use super::bus_v2::{self, XServos};
 use super::fault::{FaultKind, FaultSpec};
 use crate::rig::Rig;
@@ -174,6 +175,11 @@ fn check_faults_on(servos: &[Servo], robot: &RobotSpec, faults: &[FaultSpec]) ->
             let ids: Vec<String> = servos.iter().map(|s| s.id.to_string()).collect();
             return Err(format!("--fault {f}: no servo {} on {}'s bus (its servos: {})", f.servo, robot.name, ids.join(", ")));
         };
+        let feetech = servo.joint.is_some_and(|(j, _)| j.servo.protocol == pada_core::servo::ServoProtocol::Feetech);
+        if f.kind == FaultKind::PastLimit && feetech {
+            let valid = "valid: drop, corrupt, delay, error-bits";
+            return Err(format!("--fault {f}: past-limit is not emulated on servo {}'s Feetech STS3215 ({valid})", f.servo));
+        }
         if f.kind == FaultKind::PastLimit && servo.joint.is_none_or(|(_, l)| l.is_none()) {
             return Err(format!("--fault {f}: servo {}'s joint has no soft limit on {}", f.servo, robot.name));
         }
@@ -196,6 +202,8 @@ pub struct BusEmulator {
     servos: Vec<Servo>,
     /// The Protocol 2.0 servos, if the robot has any.
     x: Option<XServos>,
+    /// The Feetech servos, if the robot has any.
+    ft: Option<FtServos>,
     /// Whether Protocol 1.0 is spoken (an RX-28, or the sensor device).
     p1: bool,
     /// Where the Protocol 2.0 packet being received started in the bytes.
@@ -218,9 +226,10 @@ impl BusEmulator {
         let mut servos = servos(robot, rig.servo_ids());
         check_faults_on(&servos, robot, &faults)?;
         let x = XServos::new(robot, rig.servo_ids(), rig.supply_v())?;
-        let v2 = |id: u8| robot.joints.iter().any(|j| j.id == id && j.servo.protocol == pada_core::servo::ServoProtocol::V2);
-        servos.retain(|s| !v2(s.id));
-        let p1 = x.is_none() || !servos.is_empty();
+        let ft = FtServos::new(robot, rig.servo_ids(), rig.supply_v())?;
+        let v1 = |id: u8| robot.joints.iter().all(|j| j.id != id || j.servo.protocol == pada_core::servo::ServoProtocol::V1);
+        servos.retain(|s| v1(s.id));
+        let p1 = x.is_none() || !servos.is_empty() || ft.is_some();
         let mut sensor = [0u8; sensor_table::TABLE_LEN];
         sensor[sensor_table::MODEL_NUMBER as usize..][..2].copy_from_slice(&sensor_table::MODEL.to_le_bytes());
         sensor[table::ID as usize] = SENSOR_ID;
@@ -229,6 +238,7 @@ impl BusEmulator {
             decoder: InstructionDecoder::new(),
             servos,
             x,
+            ft,
             p1,
             x_start: 0,
             sensor,
@@ -251,12 +261,16 @@ impl BusEmulator {
         if let Some(x) = &mut self.x {
             x.power_off(t_us, rig);
         }
+        if let Some(ft) = &mut self.ft {
+            ft.power_off(t_us, rig);
+        }
     }
 
     /// Every servo's torque (both protocols).
     fn torques(&self) -> Vec<bool> {
         let mut all: Vec<bool> = self.servos.iter().map(Servo::torque).collect();
         all.extend(self.x.iter().flat_map(|x| x.torques().map(|(_, on)| on)));
+        all.extend(self.ft.iter().flat_map(|ft| ft.torques().map(|(_, on)| on)));
         all
     }
 
@@ -285,7 +299,7 @@ impl BusEmulator {
 
     /// Whether servo `id` has torque.
     pub fn torque(&self, id: u8) -> Option<bool> {
-        let x = self.x.iter().flat_map(|x| x.torques()).find(|s| s.0 == id).map(|s| s.1);
+        let x = self.x.iter().flat_map(|x| x.torques()).chain(self.ft.iter().flat_map(|f| f.torques())).find(|s| s.0 == id).map(|s| s.1);
         self.servos.iter().find(|s| s.id == id).map(Servo::torque).or(x)
     }
 
@@ -312,6 +326,12 @@ impl BusEmulator {
                 self.stats.bad_packets += 1;
                 continue;
             };
+            if self.ft.as_ref().is_some_and(|ft| packet.id != SENSOR_ID && ft.concerns(packet.id, packet.code)) {
+                self.stats.packets += 1;
+                let done = now_us + (i as u64 + 1) * BYTE_US;
+                replies.extend(self.receive_ft(done, packet.id, packet.code, &packet.params, &request, rig));
+                continue;
+            }
             let Ok(instruction) = packet.instruction() else {
                 self.stats.bad_packets += 1;
                 continue;
@@ -333,7 +353,7 @@ impl BusEmulator {
     pub fn forecast(&self, at_us: u64, request: &[u8], rig: &dyn Rig) -> Option<Reply> {
         // The rigs cannot tell an X-series reading without simulating
         // ahead: no forecasts on Protocol 2.0.
-        if self.x.is_some() || self.decoder.buffered() > 0 {
+        if self.x.is_some() || self.ft.is_some() || self.decoder.buffered() > 0 {
             // Bytes of an unfinished packet would come first.
             return None;
         }
@@ -640,6 +660,31 @@ impl BusEmulator {
         Some(replies)
     }
 
+    /// A packet to the Feetech servos, complete at `t`: their answers one
+    /// after the other, after the faults in force on each (error bits ride
+    /// on the Status byte, whose bits are Protocol 1.0's there).
+    fn receive_ft(&mut self, t: u64, id: u8, code: u8, params: &[u8], request: &[u8], rig: &mut dyn Rig) -> Vec<Reply> {
+        let all_on = self.torques().iter().all(|on| *on);
+        let answers = self.ft.as_mut().map(|ft| ft.execute(id, code, params, t, rig)).unwrap_or_default();
+        self.torque_changed(t);
+        let mut replies = Vec::new();
+        let mut at = t;
+        for FtAnswer { id, mut bytes, return_delay_us } in answers {
+            let (mut a, delay, bits) = self.in_force(|f| f.applies(t, id));
+            if !a.dropped && bytes.len() > 5 {
+                let n = bytes.len();
+                bytes[4] |= bits.bits();
+                bytes[n - 1] = pada_core::dynamixel::checksum(&bytes[2..n - 1]);
+                bytes[if n > 6 { 5 } else { 4 }] ^= if a.corrupted { 0x5A } else { 0 };
+                (a.delayed, a.flagged, a.past_limit) = (delay > 0, bytes[4] != 0, false);
+                at += return_delay_us + bytes.len() as u64 * BYTE_US + delay;
+                a.reply = Some(Reply { at_us: at, bytes, request: request.to_vec() });
+            }
+            replies.extend(self.apply_with(t, a, all_on));
+        }
+        replies
+    }
+
     /// Counts `a` and opens the fault windows it is the onset of.
     fn apply(&mut self, _i: usize, t: u64, a: Answer) -> Option<Reply> {
         let all_on = self.torques().iter().all(|on| *on);
@@ -664,134 +709,5 @@ impl BusEmulator {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::leo::model::ModelOptions;
-    use crate::pendulum::PhysicalPendulumParams;
-    use crate::rig::{LeoRig, PendulumRig};
-    use crate::sil::fault;
-    use pada_core::dynamixel::{self, StatusDecoder};
-
-    fn packet(f: impl FnOnce(&mut [u8]) -> usize) -> Vec<u8> {
-        let mut buf = [0u8; 64];
-        let n = f(&mut buf);
-        buf[..n].to_vec()
-    }
-
-    fn read(id: u8, addr: u8, len: u8) -> Vec<u8> {
-        packet(|b| dynamixel::read_data(id, addr, len, b).unwrap().len())
-    }
-
-    fn decode(bytes: &[u8]) -> Result<StatusPacket<64>, dynamixel::DecodeError> {
-        let mut d: StatusDecoder<64> = StatusDecoder::new();
-        d.feed(bytes).next().expect("a whole packet")
-    }
-
-    fn pendulum_bus(faults: &[&str]) -> (PendulumRig, BusEmulator) {
-        let rig = PendulumRig::new(PhysicalPendulumParams::default());
-        let faults = faults.iter().map(|f| fault::parse(f).unwrap()).collect();
-        let bus = BusEmulator::new(&rig, &pada_core::robot::pendulum::SPEC_33HZ, faults).unwrap();
-        (rig, bus)
-    }
-
-    #[test]
-    fn answers_reads_after_the_wire_time_and_return_delay() {
-        let (mut rig, mut bus) = pendulum_bus(&[]);
-        let req = read(1, table::PRESENT_BLOCK, table::PRESENT_BLOCK_LEN);
-        let forecast = bus.forecast(1000, &req, &rig).unwrap();
-        let replies = bus.receive(1000, &req, &mut rig);
-        assert_eq!(replies.len(), 1);
-        let r = &replies[0];
-        assert_eq!(*r, forecast, "the forecast is the answer");
-        assert_eq!(r.request, req);
-        // 8 bytes out, factory return delay 500 µs, 14 bytes back.
-        assert_eq!(r.at_us, 1000 + 80 + 500 + 140);
-        let status = decode(&r.bytes).unwrap();
-        assert_eq!(status.id, 1);
-        let present = table::PresentState::from_bytes(&status.params).unwrap();
-        assert_eq!((present.voltage, present.temperature), (120, 40));
-        // The sensor device: encoder 0 hanging at boot.
-        let sensor_read = read(SENSOR_ID, sensor_table::ENCODER_COUNT, 3);
-        let forecast = bus.forecast(2000, &sensor_read, &rig).unwrap();
-        let replies = bus.receive(2000, &sensor_read, &mut rig);
-        assert_eq!(replies, vec![forecast]);
-        assert_eq!(decode(&replies[0].bytes).unwrap().params.as_slice(), &[0, 0, 0]);
-        // Nobody answers an unknown ID; a write gets no forecast.
-        assert!(bus.receive(3000, &read(9, 0, 2), &mut rig).is_empty());
-        assert!(bus.forecast(3000, &read(9, 0, 2), &rig).is_none());
-        let torque = packet(|b| dynamixel::write_data(1, table::TORQUE_ENABLE, &[1], b).unwrap().len());
-        assert!(bus.forecast(4000, &torque, &rig).is_none());
-        let stats = bus.stats();
-        assert_eq!((stats.packets, stats.replies), (3, 2), "forecasts count nothing");
-    }
-
-    #[test]
-    fn speed_and_torque_writes_drive_the_rig_with_its_supply() {
-        let (mut rig, mut bus) = pendulum_bus(&[]);
-        let speed = packet(|b| dynamixel::sync_write_u16(table::MOVING_SPEED, &[(1, 256)], b).unwrap().len());
-        let torque = packet(|b| dynamixel::write_data(BROADCAST_ID, table::TORQUE_ENABLE, &[1], b).unwrap().len());
-        assert!(bus.receive(0, &[speed, torque].concat(), &mut rig).is_empty());
-        assert_eq!(bus.torque(1), Some(true));
-        assert!((rig.gear_torque(1) - pada_core::robot::pendulum::gearbox_torque(256.0 / 1023.0 * 12.0) as f32).abs() < 1e-6);
-        rig.advance_to(30_000);
-        assert!(rig.state()[1] > 0.0, "256/1023 of 12 V turns it");
-        // LEO's servos run on its 14 V.
-        let leo = LeoRig::new(ModelOptions::default()).unwrap();
-        assert_eq!(BusEmulator::new(&leo, &pada_core::robot::leo::SPEC, vec![]).unwrap().supply_v, 14.0);
-    }
-
-    #[test]
-    fn faults_drop_corrupt_delay_and_flag_answers_in_their_window() {
-        let req = read(1, table::PRESENT_BLOCK, table::PRESENT_BLOCK_LEN);
-        let run = |spec: &str, t: u64| {
-            let (mut rig, mut bus) = pendulum_bus(&[spec]);
-            let forecast = bus.forecast(t, &req, &rig);
-            let replies = bus.receive(t, &req, &mut rig);
-            assert_eq!(forecast.into_iter().collect::<Vec<_>>(), replies, "{spec}: forecast and answer");
-            (replies, bus)
-        };
-        let (r, bus) = run("drop:at=1:for=1", 1_500_000);
-        assert!(r.is_empty());
-        assert_eq!(bus.faults().next().unwrap().1.onset_us, Some(1_500_080));
-        let (r, _) = run("drop:at=1:for=1", 2_000_000);
-        assert_eq!(r.len(), 1, "the window is over");
-        let (r, _) = run("corrupt:at=1", 1_000_000);
-        assert!(matches!(decode(&r[0].bytes), Err(dynamixel::DecodeError::BadChecksum { .. })));
-        let (r, _) = run("delay:at=1:ms=5", 1_000_000);
-        assert_eq!(r[0].at_us, 1_000_000 + 80 + 500 + 140 + 5000);
-        let (r, _) = run("error-bits:at=1", 1_000_000);
-        assert_eq!(decode(&r[0].bytes).unwrap().error, ErrorFlags::OVERHEATING);
-        // Another servo's fault leaves servo 1 alone (LEO has seven).
-        let mut leo = LeoRig::new(ModelOptions::default()).unwrap();
-        let mut bus = BusEmulator::new(&leo, &pada_core::robot::leo::SPEC, vec![fault::parse("drop:at=1:servo=4").unwrap()]).unwrap();
-        assert_eq!(bus.receive(1_000_000, &req, &mut leo).len(), 1);
-        assert!(bus.receive(1_001_000, &read(4, table::PRESENT_BLOCK, table::PRESENT_BLOCK_LEN), &mut leo).is_empty());
-        // No servo 9 on LEO's bus; the pendulum's joint has no soft limit.
-        assert!(BusEmulator::new(&leo, &pada_core::robot::leo::SPEC, vec![fault::parse("drop:servo=9").unwrap()]).unwrap_err().contains("no servo 9"));
-        let pendulum = PendulumRig::new(PhysicalPendulumParams::default());
-        let e = BusEmulator::new(&pendulum, &pada_core::robot::pendulum::SPEC_33HZ, vec![fault::parse("past-limit").unwrap()]).unwrap_err();
-        assert!(e.contains("no soft limit"), "{e}");
-    }
-
-    #[test]
-    fn past_limit_reads_the_joint_beyond_its_soft_limit() {
-        let mut leo = LeoRig::new(ModelOptions::default()).unwrap();
-        let mut bus = BusEmulator::new(&leo, &pada_core::robot::leo::SPEC, vec![fault::parse("past-limit:at=1:servo=4").unwrap()]).unwrap();
-        let req = read(4, table::PRESENT_BLOCK, table::PRESENT_BLOCK_LEN);
-        let angle = |bus: &mut BusEmulator, leo: &mut LeoRig, t: u64| {
-            let r = bus.receive(t, &req, leo);
-            let p = table::PresentState::from_bytes(&decode(&r[0].bytes).unwrap().params).unwrap();
-            let hw = pada_core::robot::leo::SPEC;
-            let k = hw.joints.iter().position(|j| j.id == 4).unwrap();
-            (hw.joints[k].angle(p.position), hw.joints[k].soft_limit.unwrap())
-        };
-        let (before, limit) = angle(&mut bus, &mut leo, 500_000);
-        assert!(before < limit.max, "{before} inside {limit:?}");
-        let (during, _) = angle(&mut bus, &mut leo, 1_200_000);
-        assert!(during > limit.max + 0.5 * PAST_LIMIT_RAD, "{during} past {limit:?}");
-        let (after, _) = angle(&mut bus, &mut leo, 2_100_000);
-        assert_eq!(after, before);
-        assert_eq!(bus.stats().past_limit, 1);
-        assert_eq!(bus.faults().next().unwrap().1.onset_us, Some(1_200_080));
-    }
-}
+#[path = "bus_tests.rs"]
+mod tests;

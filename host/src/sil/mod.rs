@@ -13,8 +13,9 @@
 //! - [`bus`]: RX-28 servos and the sensor device on the emulated Dynamixel
 //!   bus, with `--fault` injection ([`fault`]); [`bus_v2`]: its X-series
 //!   servos on Protocol 2.0 (`pada servos`' virtual servo,
-//!   `crate::servos::p2`); [`carried`]: which servos it carries (no
-//!   Feetech servo);
+//!   `crate::servos::p2`); [`bus_ft`]: its Feetech STS3215s (`pada
+//!   servos`' virtual STS3215, `crate::servos::ft`); [`carried`]: which
+//!   servos it carries;
 //! - the robot behind the bus: a [`crate::rig::Rig`] (the physical
 //!   pendulum's model, or the rapier3d LEO with its operator);
 //! - [`qemu`]: starting QEMU and its channel (and cutting its power);
@@ -33,6 +34,7 @@
 //! them is `pada_firmware::sil`.
 
 pub mod bus;
+pub mod bus_ft;
 pub mod bus_v2;
 pub mod carried;
 pub mod check;
