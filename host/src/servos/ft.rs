@@ -41,7 +41,6 @@
 
 use super::p1::{Layout, P1Servo};
 use pada_core::feetech::control_table::sts3215::{self as sts, STS3215};
-use pada_core::feetech::command::{DUTY_SIGN_BIT, MAX_DUTY};
 use pada_core::feetech::value::{
     from_sign_magnitude, to_sign_magnitude_saturating, HOMING_OFFSET_SIGN_BIT, LOAD_SIGN_BIT, POSITION_SIGN_BIT, VELOCITY_SIGN_BIT,
 };
@@ -197,20 +196,6 @@ pub fn with_robot(servo: &mut P1Servo, out: &mut Output, present: &Present, now_
     alarms(servo, out)
 }
 
-/// The voltage a robot's STS3215 applies on `supply_v` \[V\]: in Operating
-/// Mode 2 with torque on, Goal Time's duty cycle (0.1 % of the supply, sign
-/// bit 10, at most 100 %), as the ratio `pada run --board` applies
-/// (`pada_core::servo::Drive::ratio`); in the other modes none (the
-/// position loop moves only a bare chain's output).
-pub fn volts(servo: &P1Servo, supply_v: f64) -> f64 {
-    let t = &servo.table;
-    if t[sts::TORQUE_ENABLE as usize] != 1 || t[sts::OPERATING_MODE as usize] != sts::MODE_PWM {
-        return 0.0;
-    }
-    let duty = from_sign_magnitude(u16_at(t, sts::GOAL_TIME), DUTY_SIGN_BIT).clamp(-MAX_DUTY, MAX_DUTY);
-    (duty as f32 / MAX_DUTY as f32) as f64 * supply_v
-}
-
 /// Status from the conditions in force and the injected ones; the torque
 /// dropped on one that Unloading Condition names.
 fn alarms(servo: &mut P1Servo, out: &Output) -> bool {
@@ -333,14 +318,14 @@ mod tests {
         // output follows the position loop).
         s.table[sts::TORQUE_ENABLE as usize] = 1;
         s.table[sts::GOAL_TIME as usize..][..2].copy_from_slice(&(0x0400u16 | 300).to_le_bytes());
-        assert_eq!(volts(&s, 5.0), 0.0);
+        assert_eq!(crate::servos::ft_output::volts(&s.table, 5.0), 0.0);
         // Mode 2: −30 % of 5 V; past 100 %, 100 %; torque off, none.
         s.table[sts::OPERATING_MODE as usize] = sts::MODE_PWM;
-        assert!((volts(&s, 5.0) + 1.5).abs() < 1e-6, "{}", volts(&s, 5.0));
+        assert!((crate::servos::ft_output::volts(&s.table, 5.0) + 1.5).abs() < 1e-6, "{}", crate::servos::ft_output::volts(&s.table, 5.0));
         s.table[sts::GOAL_TIME as usize..][..2].copy_from_slice(&1023u16.to_le_bytes());
-        assert_eq!(volts(&s, 5.0), 5.0);
+        assert_eq!(crate::servos::ft_output::volts(&s.table, 5.0), 5.0);
         s.table[sts::TORQUE_ENABLE as usize] = 0;
-        assert_eq!(volts(&s, 5.0), 0.0);
+        assert_eq!(crate::servos::ft_output::volts(&s.table, 5.0), 0.0);
         // The joint's values in the servo's units and sign bits, less the
         // Homing Offset.
         s.table[sts::HOMING_OFFSET as usize..][..2].copy_from_slice(&(0x0800u16 | 10).to_le_bytes());

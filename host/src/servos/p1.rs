@@ -5,7 +5,7 @@
 //! docs/reference/feetech.md), which answer the instructions they share
 //! alike; [`Layout`] says where each keeps what the answers depend on.
 //! The STS3215's own parts (SYNC READ, its position loop, its alarms) are
-//! [`super::ft`].
+//! the STS3215's own module (`ft.rs`).
 //!
 //! | instruction | answered (Status Return Level) | what it does |
 //! |---|---|---|
@@ -119,7 +119,7 @@ pub struct P1Servo {
     pub table: Vec<u8>,
     /// The joint it drives (the robot's calibration), if any.
     pub joint: Option<JointSpec>,
-    /// An STS3215's output under its own position loop ([`super::ft`]);
+    /// An STS3215's output under its own position loop (`ft.rs`);
     /// `None` for an RX-28, whose output is the rig's.
     pub own_loop: Option<super::ft_output::Output>,
     /// The Baud Rate value it came with (a RESET restores the factory's).
@@ -178,11 +178,11 @@ impl P1Servo {
 
     /// The voltage its Moving Speed applies in wheel mode on `supply` \[V\]
     /// (0 in joint mode, whose position control is not emulated); an
-    /// STS3215's, its duty cycle's ([`super::ft::volts`]).
+    /// STS3215's, its duty cycle's ([`super::ft_output::volts`]).
     pub fn volts(&self, supply: f64) -> f64 {
         if !self.is_rx28() {
-            // The STS3215's duty cycle in Operating Mode 2 (`super::ft`).
-            return super::ft::volts(self, supply);
+            // The STS3215's duty cycle in Operating Mode 2.
+            return super::ft_output::volts(&self.table, supply);
         }
         let wheel = self.table[table::CW_ANGLE_LIMIT as usize..table::CCW_ANGLE_LIMIT as usize + 2].iter().all(|&b| b == 0);
         if wheel {
