@@ -32,7 +32,9 @@ pub mod robot_arg;
 pub mod robots;
 pub mod seed;
 pub mod serial_link;
-pub mod servos;
+/// The virtual servos (`pada servos`) and the emulated board's bus
+/// (`pada sil`): the crate `pada_servos`.
+pub use pada_servos as servos;
 pub mod sil;
 pub mod start_weights;
 pub mod stats;

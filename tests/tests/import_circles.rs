@@ -1,9 +1,9 @@
 //! No two source modules import each other, directly or through a circle.
 //!
-//! Reads the sources of pada-core (`shared/src`), the host (`host/src`) and
-//! the firmware (`firmware/src`) as text, takes every path a module names
-//! that starts with `crate::`, `super::` or `self::` (in `use` trees and in
-//! code), resolves it to the module file that defines the item (following
+//! Reads the sources of every crate of pada (pada-core in `shared/src`, the
+//! host in `host/src`, the firmware in `firmware/src`, …) as text, takes
+//! every path a module names that starts with `crate::`, `super::` or
+//! `self::` (in `use` trees and in code), resolves it to the module file that defines the item (following
 //! the `pub use` re-exports of a parent module), and looks for circles in
 //! that graph of files. A module's use of its own parent does not count: a
 //! child may use what its parent declares (the parent's use of its children
@@ -430,6 +430,7 @@ fn graph(root: &Path) -> BTreeMap<Module, BTreeSet<Module>> {
         ("robot-file", "robot-file/src"),
         ("sim", "sim/src"),
         ("telemetry", "telemetry/src"),
+        ("servos", "servos/src"),
         ("host", "host/src"),
         ("firmware", "firmware/src"),
         ("python", "python/src"),

@@ -195,7 +195,7 @@ pub fn run(args: SilArgs) -> Result<(), CliError> {
             spec.episode_steps as f64 * spec.period_us as f64 * 1e-6,
         )
     }));
-    sil::carried::check_servos(task.robot()).map_err(|e| usage(format!("{}: {e}", task.robot().name)))?;
+    sil::bus::carried::check_servos(task.robot()).map_err(|e| usage(format!("{}: {e}", task.robot().name)))?;
     sil::bus::check_faults(task.robot(), &faults).map_err(usage)?;
     if !(1..=3600).contains(&args.hang_timeout) {
         return Err(usage(format!(

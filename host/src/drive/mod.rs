@@ -17,7 +17,8 @@
 pub mod clock;
 pub mod latency;
 pub mod port;
-pub mod realtime;
+/// A real-time thread: `pada_servos`'s, which `pada servos` shares.
+pub use pada_servos::realtime;
 pub mod session;
 pub mod store;
 pub mod telemetry;

@@ -10,12 +10,10 @@
 //!  └──────────────────────────────────────┘   clock ──────────── the lock-step loop (session.rs)
 //! ```
 //!
-//! - [`bus`]: RX-28 servos and the sensor device on the emulated Dynamixel
-//!   bus, with `--fault` injection ([`fault`]); [`bus_v2`]: its X-series
-//!   servos on Protocol 2.0 (`pada servos`' virtual servo,
-//!   `crate::servos::p2`); [`bus_ft`]: its Feetech STS3215s (`pada
-//!   servos`' virtual STS3215, `crate::servos::ft`); [`carried`]: which
-//!   servos it carries;
+//! - [`bus`]: the emulated board's bus, the crate `pada_servos`'s
+//!   `board_bus` (RX-28s on Protocol 1.0, X-series servos on 2.0, Feetech
+//!   STS3215s and the sensor device: `pada servos`' virtual servos at a
+//!   1 Mbps bus's times), with `--fault` injection ([`fault`]);
 //! - the robot behind the bus: a [`crate::rig::Rig`] (the physical
 //!   pendulum's model, or the rapier3d LEO with its operator);
 //! - [`qemu`]: starting QEMU and its channel (and cutting its power);
@@ -33,13 +31,8 @@
 //! The board side is `firmware/src/board/lockstep/`; the protocol between
 //! them is `pada_firmware::sil`.
 
-pub mod bus;
-pub mod bus_ft;
-pub mod bus_v2;
-pub mod carried;
 pub mod check;
 pub mod config;
-pub mod fault;
 pub mod forecast;
 pub mod power_cut;
 pub mod qemu;
@@ -49,6 +42,9 @@ pub mod run;
 pub mod session;
 pub mod wall;
 
+/// The emulated board's bus and its faults: `pada_servos`'s, which
+/// `pada servos` shares.
+pub use pada_servos::{board_bus as bus, fault};
 pub use report::{SilSummary, LEARNING_CHECK_S, WALKING_CHECK_S};
 pub use config::{machine, SilConfig, SilTask};
 pub use run::run;

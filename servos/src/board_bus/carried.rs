@@ -1,6 +1,6 @@
 //! Which servos the emulated board's bus carries: Dynamixel servos on
-//! Protocol 1.0 (the RX-28, `super::bus`) and 2.0 (the X series,
-//! `super::bus_v2`), and Feetech's STS3215 (`super::bus_ft`). A robot
+//! Protocol 1.0 (the RX-28, [`super`]) and 2.0 (the X series,
+//! [`super::v2`]), and Feetech's STS3215 ([`super::ft`]). A robot
 //! with another Feetech model is refused before the run, naming the joint,
 //! rather than meeting servos that answer as another model.
 
@@ -23,9 +23,9 @@ pub fn check_servos(robot: &RobotSpec) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::pendulum::PhysicalPendulumParams;
-    use crate::rig::PendulumRig;
-    use crate::sil::bus::BusEmulator;
+    use pada_sim::pendulum::PhysicalPendulumParams;
+    use pada_sim::rig::PendulumRig;
+    use super::super::BusEmulator;
 
     #[test]
     fn dynamixel_robots_and_sts3215s_pass() {

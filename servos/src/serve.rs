@@ -5,13 +5,13 @@
 //! summary says what the bus carried and what every servo did.
 //!
 //! In real time the loop's thread asks for `pada drive`'s real-time
-//! treatment (`SCHED_FIFO`, locked memory: [`crate::drive::realtime`]):
+//! treatment (`SCHED_FIFO`, locked memory: [`crate::realtime`]):
 //! the virtual servos stand in for hardware that a busy PC cannot slow
 //! down. The summary says what was granted.
 
 use super::bus::{BusStats, Event, Reply, VirtualBus};
 use super::pty::Pty;
-use crate::drive::realtime::{Linux, Realtime, RealtimeReport};
+use crate::realtime::{Linux, Realtime, RealtimeReport};
 use serde::Serialize;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -73,7 +73,7 @@ pub fn serve(bus: &mut VirtualBus, pty: &Pty, stop: &AtomicBool, opts: &ServeOpt
     let why_not = if lock_step { "lock step: the servos wait for the client" } else { "--no-realtime" };
     let mut rt = Realtime::enter(Linux, opts.realtime && !lock_step, why_not);
     for line in rt.report().lines() {
-        crate::console::errln!("servos: real time: {line}");
+        errln(format_args!("servos: real time: {line}"));
     }
     let started = Instant::now();
     let mut pending: Vec<Reply> = Vec::new();
@@ -104,7 +104,7 @@ pub fn serve(bus: &mut VirtualBus, pty: &Pty, stop: &AtomicBool, opts: &ServeOpt
         let wait = pending.first().map_or(POLL, |r| Duration::from_micros(r.at_us.saturating_sub(now)).min(POLL));
         let n = pty.read(&mut buf, wait)?;
         for e in &bus.events()[logged..] {
-            crate::console::errln!("servos: {:.6} s: {} {}", e.at_us as f64 * 1e-6, device_name(e.id), e.what);
+            errln(format_args!("servos: {:.6} s: {} {}", e.at_us as f64 * 1e-6, device_name(e.id), e.what));
         }
         logged = bus.events().len();
         if n == 0 {
@@ -115,7 +115,7 @@ pub fn serve(bus: &mut VirtualBus, pty: &Pty, stop: &AtomicBool, opts: &ServeOpt
             // The servos hear garbage: nothing they decode, no answer.
             wrong_rate_bytes += n as u64;
             if !wrong_rates.contains(&line) {
-                crate::console::errln!("servos: bytes at {line} bps; no servo listens at that rate (they were started at {bps} bps): not heard");
+                errln(format_args!("servos: bytes at {line} bps; no servo listens at that rate (they were started at {bps} bps): not heard"));
                 wrong_rates.push(line);
             }
             continue;
@@ -147,4 +147,13 @@ fn device_name(id: u8) -> String {
     } else {
         format!("servo {id}")
     }
+}
+
+/// One line on standard error. A standard error that cannot be written
+/// (a closed pipe) is dropped, as the `pada` command's own messages are:
+/// there is nowhere left to report it, and `eprintln!` would panic.
+fn errln(args: std::fmt::Arguments<'_>) {
+    use std::io::Write;
+    let mut err = std::io::stderr().lock();
+    let _ = err.write_fmt(args).and_then(|()| err.write_all(b"\n"));
 }

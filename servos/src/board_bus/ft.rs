@@ -1,19 +1,18 @@
 //! The Feetech side of the emulated bus: a robot's STS3215s, each the
 //! virtual servo of `pada servos` ([`P1Servo`] of the STS3215's layout,
-//! its joint in the rig behind it: `crate::servos::ft`). Feetech's framing
+//! its joint in the rig behind it: [`crate::ft`]). Feetech's framing
 //! is Protocol 1.0's, so the bus's Protocol 1.0 decoder hands over the
 //! packets for these servos (and broadcasts); this file decides which
 //! servos an instruction concerns and what they answer. When the answers
-//! arrive, the faults and the counters are the bus's (`BusEmulator` in
-//! sil/bus.rs).
+//! arrive, the faults and the counters are the bus's ([`super::BusEmulator`]).
 //!
 //! A SYNC READ (the firmware's read of every servo, once a period) gets one
 //! status packet per servo, in the order of its IDs, one after the other.
 
-use crate::rig::Rig;
-use crate::servos::bus::baud_value;
-use crate::servos::ft::{self, STS3215_LAYOUT};
-use crate::servos::p1::P1Servo;
+use pada_sim::rig::Rig;
+use crate::bus::baud_value;
+use crate::ft::{self, STS3215_LAYOUT};
+use crate::p1::P1Servo;
 use pada_core::dynamixel::{self as dxl1, ErrorFlags, Instruction as DxlInstruction, BROADCAST_ID};
 use pada_core::feetech::control_table::sts3215::STS3215;
 use pada_core::feetech::Instruction;
@@ -107,7 +106,7 @@ impl FtServos {
             let (s, out) = &mut self.servos[i];
             if reads {
                 if let Some(joint) = s.joint {
-                    let present = crate::rig::x_reading(&joint, rig.joint_state(t, joint.id), 0, self.supply_v).into();
+                    let present = pada_sim::rig::x_reading(&joint, rig.joint_state(t, joint.id), 0, self.supply_v).into();
                     ft::with_robot(s, out, &present, t);
                 }
             }

@@ -1,5 +1,5 @@
 //! The Dynamixel bus emulator: RX-28 servos (Protocol 1.0), X-series
-//! servos (Protocol 2.0, [`super::bus_v2`]) and the sensor device,
+//! servos (Protocol 2.0, [`v2`]), Feetech's STS3215 ([`ft`]) and the sensor device,
 //! answering the firmware's instruction packets at the times a real 1 Mbps
 //! bus would, backed by a [`Rig`], with `--fault` injection.
 //!
@@ -15,10 +15,14 @@
 //! request comes, with its effects (counters, fault traces, the present
 //! values in the control table).
 
-use super::bus_ft::{FtAnswer, FtServos};
-use super::bus_v2::{self, XServos};
-use super::fault::{FaultKind, FaultSpec};
-use crate::rig::Rig;
+pub mod carried;
+pub mod ft;
+pub mod v2;
+
+use ft::{FtAnswer, FtServos};
+use v2::{self as bus_v2, XServos};
+use crate::fault::{FaultKind, FaultSpec};
+use pada_sim::rig::Rig;
 use pada_core::dynamixel::table::PresentState;
 use pada_core::dynamixel::{table, ErrorFlags, Instruction, InstructionDecoder, StatusPacket, BROADCAST_ID};
 use pada_core::robot::RobotSpec;
@@ -30,7 +34,7 @@ use serde::Serialize;
 /// Microseconds per byte at 1 Mbps, 8N1.
 pub const BYTE_US: u64 = 10;
 
-pub use super::fault::PAST_LIMIT_RAD;
+pub use crate::fault::PAST_LIMIT_RAD;
 
 /// A status packet on its way to the firmware.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -222,7 +226,7 @@ impl BusEmulator {
     /// `robot`'s joints), the sensor device, and `faults`; the error says
     /// why a fault cannot apply.
     pub fn new(rig: &dyn Rig, robot: &RobotSpec, faults: Vec<FaultSpec>) -> Result<Self, String> {
-        super::carried::check_servos(robot)?;
+        carried::check_servos(robot)?;
         let mut servos = servos(robot, rig.servo_ids());
         check_faults_on(&servos, robot, &faults)?;
         let x = XServos::new(robot, rig.servo_ids(), rig.supply_v())?;
@@ -709,5 +713,4 @@ impl BusEmulator {
 }
 
 #[cfg(test)]
-#[path = "bus_tests.rs"]
 mod tests;

@@ -3,17 +3,17 @@
 //! table, every instruction, alerts, the Bus Watchdog), and the sensor
 //! device in Protocol 2.0. This file decides which servos an instruction
 //! concerns and what they answer; when the answer arrives, the faults and
-//! the counters are the bus's (the SIL bus emulator's, `BusEmulator` in sil/bus.rs).
+//! the counters are the bus's ([`super::BusEmulator`]).
 //!
 //! A FAST SYNC READ (the firmware's read of every servo, once a period)
 //! gets one status packet with each servo's block, after the first servo's
 //! Return Delay Time.
 
-use crate::rig::{JointState, Rig};
-use crate::servos::bus::{baud_value, hardware_error_of};
-use crate::servos::p2::{self, P2Servo, PACKET_LEN};
-use crate::servos::sensor::SensorDevice;
-use crate::sil::fault::{FaultKind, FaultSpec};
+use pada_sim::rig::{JointState, Rig};
+use crate::bus::{baud_value, hardware_error_of};
+use crate::p2::{self, P2Servo, PACKET_LEN};
+use crate::sensor::SensorDevice;
+use crate::fault::{FaultKind, FaultSpec};
 use pada_core::dynamixel::control_table;
 use pada_core::dynamixel::v2::{self as dxl2, Instruction as I, StatusError};
 use pada_core::dynamixel::BROADCAST_ID;
@@ -208,7 +208,7 @@ impl XServos {
 fn planted(mut s: JointState, joint: &JointSpec, t: u64, faults: &[FaultSpec]) -> JointState {
     let past = faults.iter().any(|f| f.kind == FaultKind::PastLimit && f.applies(t, joint.id));
     if let (true, Some(limit)) = (past, joint.soft_limit) {
-        s.angle = (limit.max + super::bus::PAST_LIMIT_RAD) as f64;
+        s.angle = (limit.max + crate::fault::PAST_LIMIT_RAD) as f64;
     }
     s
 }
@@ -222,16 +222,17 @@ pub fn drives(p: &dxl2::InstructionPacket<PACKET_LEN>) -> bool {
 
 #[cfg(test)]
 mod tests {
-    use super::super::bus::{BusEmulator, BYTE_US};
-    use crate::robots::SilTask;
-    use crate::sil::fault;
+    use super::super::{BusEmulator, BYTE_US};
+    use crate::fault;
     use pada_core::dynamixel::control_table::x_series;
     use pada_core::dynamixel::v2::encoders;
     use pada_core::dynamixel::BROADCAST_ID;
     use pada_firmware::bus::v2::{fast_reply_len, PRESENT_LEN};
 
-    fn arm() -> SilTask {
-        SilTask::of_file(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/robots/arm2/robot.toml")).unwrap()
+    /// arm2, as `pada sil` runs it: its robot and the rig behind its bus.
+    fn arm() -> (&'static pada_core::robot::RobotSpec, Box<dyn pada_sim::rig::Rig>) {
+        let file = pada_robot_file::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/robots/arm2/robot.toml")).unwrap();
+        (file.spec, pada_sim::robots::from_file(&file).unwrap().sil_rig().unwrap())
     }
 
     fn packet(f: impl FnOnce(&mut [u8]) -> usize) -> Vec<u8> {
@@ -242,12 +243,11 @@ mod tests {
 
     #[test]
     fn the_arms_x_series_servos_answer_a_fast_sync_read_and_drive_the_rig() {
-        let task = arm();
-        let mut rig = task.rig().unwrap();
+        let (robot, mut rig) = arm();
         // The operator lets go of the arm (it holds it until a start).
         rig.episode_started(0);
         let faults = vec![fault::parse("drop:at=1:for=1:servo=1").unwrap()];
-        let mut bus = BusEmulator::new(rig.as_ref(), task.robot(), faults).unwrap();
+        let mut bus = BusEmulator::new(rig.as_ref(), robot, faults).unwrap();
         let read = packet(|b| encoders::fast_sync_read(x_series::PRESENT_BLOCK, PRESENT_LEN, &[1, 2], b).unwrap().len());
         let replies = bus.receive(1000, &read, rig.as_mut());
         assert_eq!(replies.len(), 1, "one reply for both servos");

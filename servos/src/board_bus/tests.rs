@@ -1,10 +1,10 @@
-//! The emulated bus's tests (sil/bus.rs).
+//! The emulated board's bus's tests.
 
 use super::*;
-use crate::leo::model::ModelOptions;
-use crate::pendulum::PhysicalPendulumParams;
-use crate::rig::{LeoRig, PendulumRig};
-use crate::sil::fault;
+use pada_sim::leo::model::ModelOptions;
+use pada_sim::pendulum::PhysicalPendulumParams;
+use pada_sim::rig::{LeoRig, PendulumRig};
+use crate::fault;
 use pada_core::dynamixel::{self, StatusDecoder};
 
 fn packet(f: impl FnOnce(&mut [u8]) -> usize) -> Vec<u8> {

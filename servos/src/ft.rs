@@ -318,14 +318,14 @@ mod tests {
         // output follows the position loop).
         s.table[sts::TORQUE_ENABLE as usize] = 1;
         s.table[sts::GOAL_TIME as usize..][..2].copy_from_slice(&(0x0400u16 | 300).to_le_bytes());
-        assert_eq!(crate::servos::ft_output::volts(&s.table, 5.0), 0.0);
+        assert_eq!(crate::ft_output::volts(&s.table, 5.0), 0.0);
         // Mode 2: −30 % of 5 V; past 100 %, 100 %; torque off, none.
         s.table[sts::OPERATING_MODE as usize] = sts::MODE_PWM;
-        assert!((crate::servos::ft_output::volts(&s.table, 5.0) + 1.5).abs() < 1e-6, "{}", crate::servos::ft_output::volts(&s.table, 5.0));
+        assert!((crate::ft_output::volts(&s.table, 5.0) + 1.5).abs() < 1e-6, "{}", crate::ft_output::volts(&s.table, 5.0));
         s.table[sts::GOAL_TIME as usize..][..2].copy_from_slice(&1023u16.to_le_bytes());
-        assert_eq!(crate::servos::ft_output::volts(&s.table, 5.0), 5.0);
+        assert_eq!(crate::ft_output::volts(&s.table, 5.0), 5.0);
         s.table[sts::TORQUE_ENABLE as usize] = 0;
-        assert_eq!(crate::servos::ft_output::volts(&s.table, 5.0), 0.0);
+        assert_eq!(crate::ft_output::volts(&s.table, 5.0), 0.0);
         // The joint's values in the servo's units and sign bits, less the
         // Homing Offset.
         s.table[sts::HOMING_OFFSET as usize..][..2].copy_from_slice(&(0x0800u16 | 10).to_le_bytes());

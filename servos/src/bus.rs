@@ -24,8 +24,8 @@
 use super::p1::P1Servo;
 use super::p2::P2Servo;
 use super::sensor::SensorDevice;
-use crate::rig::Rig;
-use crate::sil::fault::{FaultKind, FaultSpec};
+use pada_sim::rig::Rig;
+use crate::fault::{FaultKind, FaultSpec};
 use pada_core::dynamixel::control_table::{self, rx28, x_series::HardwareError};
 use pada_core::dynamixel::v2::{self as dxl2, ErrorNumber, StatusError};
 use pada_core::dynamixel::{self as dxl1, ErrorFlags, BROADCAST_ID};
@@ -391,7 +391,7 @@ impl VirtualBus {
                 let dropped = match s.joint {
                     Some(joint) => {
                         let state = self.rig.joint_state(now, joint.id);
-                        let present = crate::rig::x_reading(&joint, state, 0, supply).into();
+                        let present = pada_sim::rig::x_reading(&joint, state, 0, supply).into();
                         super::ft::with_robot(s, &mut out, &present, now)
                     }
                     None => super::ft::advance(s, &mut out, now),
@@ -429,7 +429,7 @@ impl VirtualBus {
     fn plant(&self, t: u64, joint: JointSpec, mut p: pada_core::dynamixel::table::PresentState) -> pada_core::dynamixel::table::PresentState {
         let past = self.faults.iter().any(|f| f.kind == FaultKind::PastLimit && f.applies(t, joint.id));
         if let (true, Some(limit)) = (past, joint.soft_limit) {
-            p.position = joint.position_of((limit.max + crate::sil::fault::PAST_LIMIT_RAD) as f64);
+            p.position = joint.position_of((limit.max + crate::fault::PAST_LIMIT_RAD) as f64);
         }
         p
     }

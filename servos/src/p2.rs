@@ -32,7 +32,7 @@ use pada_core::dynamixel::control_table::{ControlTable, TableError};
 use pada_core::dynamixel::v2::{self as dxl2, fast::FastBlock, ErrorNumber, Instruction, PingReply, ResetMode, StatusError};
 use pada_core::robot::JointSpec;
 use pada_core::servo::ServoModel;
-use crate::rig::{x_reading, JointState};
+use pada_sim::rig::{x_reading, JointState};
 
 /// Bytes of the longest packet a virtual servo decodes or answers.
 pub const PACKET_LEN: usize = 1024;
