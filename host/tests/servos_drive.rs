@@ -320,7 +320,10 @@ fn a_hardware_alert_is_cleared_by_pada_servos_reboot_and_the_next_run_goes() {
     bad_input(&run("10"), &["servo 2 (elbow)", "hardware alert", "overheating", "pada servos --reboot 2"]);
     // Still latched: the next run refuses at its set-up, with the same way out.
     bad_input(&run("2"), &["servo 2 (elbow, XL430-W250)", "hardware error", "pada servos --reboot 2"]);
-    let reboot = |id: &str| Command::new(PADA).args(["servos", "--reboot", id, "--port", servos.port()]).output().unwrap();
+    // 100 ms for an answer, not the default 5: the virtual servos are a
+    // process of their own, which a loaded machine (CI's two cores) holds
+    // back longer than a real servo takes to answer.
+    let reboot = |id: &str| Command::new(PADA).args(["servos", "--reboot", id, "--port", servos.port(), "--timeout-ms", "100"]).output().unwrap();
     let r = reboot("2");
     let stdout = String::from_utf8_lossy(&r.stdout);
     assert_eq!(r.status.code(), Some(0), "{}", String::from_utf8_lossy(&r.stderr));
