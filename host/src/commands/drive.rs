@@ -17,7 +17,8 @@ use crate::drive::latency::latency;
 use crate::drive::session::{drive, BadBus, DriveSetup, Ended};
 use crate::drive::telemetry::TelemetryPipe;
 use crate::error::{usage, CliError};
-use crate::experiment::algo::{label, policy_kind_of, Algo, PolicyFlags};
+use crate::commands::policy_args::PolicyArgs;
+use crate::experiment::algo::{label, Algo};
 use crate::experiment::RunConfig;
 use crate::output::OutDir;
 use crate::robot_arg::RobotArg;
@@ -56,16 +57,9 @@ pub struct DriveArgs {
     /// The algorithm (Section V).
     #[arg(long, value_parser = crate::experiment::algo::algo_parser(), default_value = "pada")]
     pub algo: Algo,
-    /// Low-pass α of Eq. 8 (lowpass, markov-lowpass; default 0.834).
-    #[arg(long)]
-    pub alpha: Option<f32>,
-    /// Δ relative to the action range (pada and the integrators; default 0.5).
-    #[arg(long)]
-    pub delta: Option<f32>,
-    /// Learn on a wear budget: the predicted MTBF [s] the governor keeps
-    /// (pada, lowpass).
-    #[arg(long, value_name = "SECONDS")]
-    pub mtbf_budget: Option<f32>,
+    /// α, Δ or a wear budget.
+    #[command(flatten)]
+    pub learner: PolicyArgs,
     /// Switch back to SARSA(λ) after this much learning time [s].
     #[arg(long, value_name = "SECONDS")]
     pub switch_at: Option<f64>,
@@ -134,11 +128,7 @@ pub fn run(args: DriveArgs) -> Result<(), CliError> {
     if !(9_600..=4_500_000).contains(&args.baud) {
         return Err(usage(format!("--baud {} is out of range: valid is 9600 to 4500000 (57600 and 1000000 are usual)", args.baud)));
     }
-    let flags = PolicyFlags { alpha: args.alpha, delta: args.delta, theta: None, sigma: None, weight: None };
-    if let Some(b) = args.mtbf_budget {
-        crate::experiment::algo::check_mtbf_budget(args.algo, args.alpha.is_some(), args.delta.is_some(), b).map_err(usage)?;
-    }
-    let policy = policy_kind_of(args.algo, &flags).map_err(|e| usage(e.0))?;
+    let policy = args.learner.policy(args.algo)?;
     let profile = args.board.profile(robot.spec).map_err(|e| usage(e.to_string()))?;
     let weights = table_len(&profile, policy).map_err(|e| usage(e.to_string()))?;
     robot
@@ -151,12 +141,10 @@ pub fn run(args: DriveArgs) -> Result<(), CliError> {
             return Err(usage(format!("--switch-at {s}: valid is 0 <= switch-at <= seconds ({seconds}), with an algorithm other than sarsa")));
         }
     }
-    let cfg = RunConfig { policy, switch_at_s: args.switch_at, mtbf_budget_s: args.mtbf_budget, seconds, trials: 1, seed: args.seed };
+    let cfg = RunConfig { policy, switch_at_s: args.switch_at, mtbf_budget_s: args.learner.mtbf_budget, seconds, trials: 1, seed: args.seed };
     let exported = match &args.weights {
         Some(path) => {
-            let sim = robot.sim();
-            let board_spec = sim.task_spec(profile).map_err(|e| usage(e.to_string()))?;
-            let (entries, report) = crate::commands::run::exported_weights(path, sim, &board_spec, &profile, policy, weights)?;
+            let (entries, report) = crate::commands::run::exported_weights(path, robot.sim(), &profile, policy, weights)?;
             for line in report.lines(args.board.name()) {
                 errln!("drive: {line}");
             }

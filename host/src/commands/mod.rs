@@ -14,6 +14,7 @@ pub mod paper_leo;
 pub mod paper_wear;
 pub mod paper_transfer;
 pub mod plant_args;
+pub mod policy_args;
 pub mod new_robot;
 pub mod render;
 pub mod run;

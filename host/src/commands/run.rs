@@ -5,7 +5,7 @@ use crate::console::outln;
 use crate::commands::options::{check_seconds, set_threads};
 use crate::display::{fmt_estimate, fmt_mtbf};
 use crate::error::{usage, CliError};
-use crate::experiment::algo::{label, parameter_of, policy_kind_of, Algo, PolicyFlags};
+use crate::experiment::algo::{label, parameter_of, Algo, PolicyFlags};
 use crate::board::trial::table_len;
 use crate::board::export::{export, ExportReport};
 use crate::board::{robot_of_task, run_board_from, BoardStart};
@@ -359,7 +359,7 @@ fn run_on_board(args: RunArgs, board: Board, sim: crate::robots::SimRobot) -> Re
     // runs.
     let entries = match &args.weights {
         Some(path) => {
-            let (entries, report) = exported_weights(path, &sim, &task_spec, &profile, policy, weights)?;
+            let (entries, report) = exported_weights(path, &sim, &profile, policy, weights)?;
             for line in report.lines(board.name()) {
                 if args.json {
                     eprintln!("{line}");
@@ -423,17 +423,17 @@ fn run_on_board(args: RunArgs, board: Board, sim: crate::robots::SimRobot) -> Re
 
 /// The host's weights in `path` (saved by `pada run` for `sim`'s robot,
 /// with the host's table), exported into `profile`'s table of `n`
-/// entries for a board run of `board_spec` with `policy`: the entries'
-/// bytes and what the export changed. A file for another robot, table or
-/// learner is refused with one line.
+/// entries for a board run with `policy`: the entries' bytes and what the
+/// export changed. A file for another robot, table or learner is refused
+/// with one line.
 pub fn exported_weights(
     path: &std::path::Path,
     sim: &crate::robots::SimRobot,
-    board_spec: &TaskSpec,
     profile: &LearnerProfile,
     policy: pada_core::policy::PolicyKind,
     n: usize,
 ) -> Result<(Vec<u8>, ExportReport), CliError> {
+    let board_spec = &sim.task_spec(*profile).map_err(|e| usage(e.to_string()))?;
     let host_profile = Board::Host.profile(sim.robot).map_err(|e| usage(e.to_string()))?;
     let host_spec = sim.task_spec(host_profile).map_err(|e| usage(e.to_string()))?;
     let w = StartWeights::load(path, &host_spec, policy).map_err(|e| usage(format!("--weights {e}")))?;
@@ -459,11 +459,7 @@ fn run_label(policy: &pada_core::policy::PolicyKind, budget_s: Option<f32>) -> S
 /// The policy of the flags, checked.
 fn policy_of(args: &RunArgs) -> Result<pada_core::policy::PolicyKind, CliError> {
     let flags = PolicyFlags { alpha: args.alpha, delta: args.delta, theta: args.theta, sigma: args.sigma, weight: args.weight };
-    if let Some(b) = args.mtbf_budget {
-        crate::experiment::algo::check_mtbf_budget(args.algo, args.alpha.is_some(), args.delta.is_some(), b)
-            .map_err(usage)?;
-    }
-    policy_kind_of(args.algo, &flags).map_err(|e| usage(e.0))
+    crate::commands::policy_args::checked_policy(args.algo, &flags, args.mtbf_budget)
 }
 
 /// The run's configuration from the flags, checked.

@@ -4,7 +4,8 @@
 use crate::console::{errln, outln};
 use crate::commands::options::check_seconds;
 use crate::error::{usage, CliError};
-use crate::experiment::algo::{label, policy_kind, Algo};
+use crate::commands::policy_args::PolicyArgs;
+use crate::experiment::algo::{label, Algo};
 use crate::output::OutDir;
 use crate::sil::{self, fault, SilConfig, SilSummary, SilTask};
 use anyhow::{anyhow, Context};
@@ -54,20 +55,10 @@ pub struct SilArgs {
     /// The algorithm the firmware learns with (Section V).
     #[arg(long, value_parser = crate::experiment::algo::algo_parser(), default_value_t = Algo::Sarsa)]
     pub algo: Algo,
-    /// Low-pass α (lowpass, markov-lowpass; default 0.834).
-    #[arg(long)]
-    pub alpha: Option<f32>,
-    /// Δ relative to the action range (integrator, markov-integrator, pada;
-    /// default 0.5).
-    #[arg(long)]
-    pub delta: Option<f32>,
-    /// Learn on a wear budget: the firmware's wear governor (`SetMtbfBudget`,
-    /// sent after the policy and before the first run) moves PADA's Δ or the
-    /// low-pass filter's α to keep the predicted MTBF over the last 1200
-    /// learning actions at or above SECONDS (pada or lowpass; not with
-    /// --delta or --alpha).
-    #[arg(long, value_name = "SECONDS")]
-    pub mtbf_budget: Option<f32>,
+    /// α, Δ or a wear budget (the firmware's wear governor: `SetMtbfBudget`,
+    /// sent after the policy and before the first run).
+    #[command(flatten)]
+    pub learner: PolicyArgs,
     /// Inject a fault on the servo bus (repeatable):
     /// KIND[:at=S][:for=S][:servo=ID][:ms=MS][:bits=NAME] with KIND drop,
     /// corrupt, delay, error-bits or past-limit; or `hang[:at=S]` (the
@@ -128,11 +119,7 @@ pub struct SilArgs {
 
 /// Runs `pada sil`.
 pub fn run(args: SilArgs) -> Result<(), CliError> {
-    if let Some(b) = args.mtbf_budget {
-        crate::experiment::algo::check_mtbf_budget(args.algo, args.alpha.is_some(), args.delta.is_some(), b)
-            .map_err(usage)?;
-    }
-    let policy = policy_kind(args.algo, args.alpha, args.delta).map_err(|e| usage(e.0))?;
+    let policy = args.learner.policy(args.algo)?;
     // A bad robot file is the user's mistake: one line, exit code 2.
     let task = match &args.robot {
         Some(path) => SilTask::of_file(path).map_err(|e| usage(format!("--robot: {e:#}")))?,
@@ -230,13 +217,12 @@ pub fn run(args: SilArgs) -> Result<(), CliError> {
                     board.name()
                 )));
             }
-            let board_spec = sim.task_spec(profile).map_err(|e| usage(e.to_string()))?;
-            let (entries, report) = crate::commands::run::exported_weights(path, &sim, &board_spec, &profile, policy, n)?;
+            let (entries, report) = crate::commands::run::exported_weights(path, &sim, &profile, policy, n)?;
             for line in report.lines(board.name()) {
                 eprintln!("{line}");
             }
             let seed = crate::seed::trial_seed(args.seed, 0);
-            let image = crate::board::exported::image_of(profile, &sim, policy, args.mtbf_budget, seed, n, &entries)
+            let image = crate::board::exported::image_of(profile, &sim, policy, args.learner.mtbf_budget, seed, n, &entries)
                 .map_err(|e| usage(format!("--weights {}: {e:#}", path.display())))?;
             Some(sil::config::SilWeights { entries, image })
         }
@@ -248,7 +234,7 @@ pub fn run(args: SilArgs) -> Result<(), CliError> {
         task,
         board,
         policy,
-        mtbf_budget_s: args.mtbf_budget,
+        mtbf_budget_s: args.learner.mtbf_budget,
         seconds,
         seed: args.seed,
         faults,

@@ -57,24 +57,11 @@ struct Servo {
 }
 
 impl Servo {
-    /// Factory settings of an RX-28 at 1 Mbps (the firmware writes wheel
-    /// mode, return delay and status return level itself).
+    /// Factory settings of an RX-28 at 1 Mbps, as `pada servos`' RX-28 has
+    /// them (the firmware writes wheel mode, return delay and status return
+    /// level itself).
     fn new(id: u8, joint: Option<(Joint, Option<SoftLimit>)>) -> Self {
-        let mut t = [0u8; table::TABLE_LEN];
-        t[table::MODEL_NUMBER as usize..][..2].copy_from_slice(&table::RX28_MODEL.to_le_bytes());
-        t[table::FIRMWARE_VERSION as usize] = 0x24;
-        t[table::ID as usize] = id;
-        t[table::BAUD_RATE as usize] = table::BAUD_1MBPS;
-        t[table::RETURN_DELAY_TIME as usize] = 250;
-        t[table::CCW_ANGLE_LIMIT as usize..][..2].copy_from_slice(&table::POSITION_MAX.to_le_bytes());
-        t[table::HIGHEST_LIMIT_TEMPERATURE as usize] = 80;
-        t[table::LOWEST_LIMIT_VOLTAGE as usize] = 60;
-        t[table::HIGHEST_LIMIT_VOLTAGE as usize] = 160;
-        t[table::MAX_TORQUE as usize..][..2].copy_from_slice(&table::MAGNITUDE_MAX.to_le_bytes());
-        t[table::STATUS_RETURN_LEVEL as usize] = 2;
-        t[table::ALARM_LED as usize] = 0x24;
-        t[table::ALARM_SHUTDOWN as usize] = 0x24;
-        t[table::TORQUE_LIMIT as usize..][..2].copy_from_slice(&table::MAGNITUDE_MAX.to_le_bytes());
+        let t = crate::p1::factory_table(id, table::BAUD_1MBPS);
         Servo { id, table: t, joint }
     }
 
