@@ -19,7 +19,8 @@ pub mod display;
 pub mod drive;
 pub mod error;
 pub mod experiment;
-pub mod foxglove;
+/// Foxglove's live WebSocket channels: the crate `pada_telemetry`'s.
+pub use pada_telemetry::foxglove;
 pub mod gait;
 pub mod mcap;
 pub mod motion;

@@ -146,7 +146,7 @@ impl StreamRecord {
         }
         let mut server = None;
         if let Some(spec) = &self.foxglove {
-            let addr = crate::foxglove::parse_addr(spec)?;
+            let addr = crate::foxglove::parse_addr(spec).map_err(usage)?;
             let s = crate::foxglove::server::FoxgloveServer::start(addr)
                 .map_err(|e| usage(format!("--foxglove {spec}: cannot listen: {e}")))?;
             crate::console::errln!("{command}: foxglove: ws://{} (Foxglove: Open connection, Foxglove WebSocket)", s.addr);

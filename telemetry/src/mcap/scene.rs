@@ -7,8 +7,8 @@
 //! (`Step::footstep`). The shoulder and the ankles are not in the
 //! telemetry: they are drawn at their P laws' set points, where the held
 //! joints are driven. The bodies are placed by the LEO model's own
-//! forward kinematics ([`crate::leo::model::assemble`]) from its anchors
-//! (`crate::leo::constants`), and the stance foot's heel stands on the
+//! forward kinematics ([`pada_sim::leo::model::assemble`]) from its anchors
+//! (`pada_sim::leo::constants`), and the stance foot's heel stands on the
 //! floor; at a footstep the new stance foot stays where it was, so a
 //! walking robot moves forwards along x. The left leg is drawn at y =
 //! +3 cm, the right at −3 cm.
@@ -16,14 +16,14 @@
 //! The pendulum's arm turns about the axis at the origin, θ = 0 upright,
 //! to its centre of mass (`PhysicalPendulumParams::length_m`).
 
-use crate::leo::constants::{
+use pada_sim::leo::constants::{
     ANKLE_GAIN_SETPOINT, ARM_HAND, ARM_SHOULDER_ANCHOR, FOOT_ANKLE_ANCHOR, FOOT_HEEL, FOOT_TOE,
     INIT_LEFT_FOOT_POINT, SHANK_ANKLE_ANCHOR, SHANK_KNEE_ANCHOR, SHOULDER_GAIN_SETPOINT,
     THIGH_HIP_ANCHOR, THIGH_KNEE_ANCHOR, TORSO_HIP_ANCHOR, TORSO_SHOULDER_ANCHOR,
 };
-use crate::leo::model::{assemble, Body, InitialPose};
+use pada_sim::leo::model::{assemble, Body, InitialPose};
 use pada_core::robot::leo::Leg;
-use crate::robots::{sim_robot, Body as SimBody};
+use pada_sim::robots::{sim_robot, Body as SimBody};
 use pada_core::robot::RobotSpec;
 use pada_core::wire::{Step, StepKind};
 
@@ -207,7 +207,7 @@ impl SceneBuilder {
 
 fn pendulum(s: &Step) -> Option<Vec<Strip>> {
     let theta = *s.state.first()? as f64;
-    let l = crate::pendulum::PhysicalPendulumParams::default().length_m;
+    let l = pada_sim::pendulum::PhysicalPendulumParams::default().length_m;
     let tip = Vec3 { x: l * theta.sin(), y: 0.0, z: l * theta.cos() };
     let origin = Vec3 { x: 0.0, y: 0.0, z: 0.0 };
     Some(vec![
@@ -309,10 +309,10 @@ mod tests {
         // wheel radius (3.5 mm) up.
         let left = &lines[1]["points"];
         let heel_z = left[5]["z"].as_f64().unwrap() as f32;
-        assert!((heel_z - crate::leo::constants::WHEEL_RADIUS).abs() < 2e-4, "{left}");
+        assert!((heel_z - pada_sim::leo::constants::WHEEL_RADIUS).abs() < 2e-4, "{left}");
         // The thigh is the model's: hip to knee anchor.
         let thigh = left[0]["z"].as_f64().unwrap() - left[1]["z"].as_f64().unwrap();
-        let want = (crate::leo::constants::THIGH_HIP_ANCHOR[1] - crate::leo::constants::THIGH_KNEE_ANCHOR[1]) as f64;
+        let want = (pada_sim::leo::constants::THIGH_HIP_ANCHOR[1] - pada_sim::leo::constants::THIGH_KNEE_ANCHOR[1]) as f64;
         assert!((thigh - want).abs() < 2e-4, "{thigh} {want}");
         // The hips of both legs meet at the torso's hip anchor.
         assert_eq!(lines[1]["points"][0]["x"], lines[2]["points"][0]["x"]);
