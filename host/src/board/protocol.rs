@@ -222,4 +222,28 @@ mod tests {
         assert_eq!((curve[1].learning_time_s, curve[1].learning_episodes), (20.0 * (30_000.0 * 1e-6), 1));
         assert_eq!((curve[2].fell, curve[2].walked_m, curve[2].duration_s), (true, Some(0.5), 5.0 * (30_000.0 * 1e-6)));
     }
+
+    #[test]
+    fn the_counts_are_the_test_episodes_steps_and_the_learning_falls() {
+        let (none, fell) = (
+            EpisodeOutcome { fell: false, walked_m: None, claimed_slots: None },
+            EpisodeOutcome { fell: true, walked_m: None, claimed_slots: None },
+        );
+        let mut p = RunProtocol::new(1.0, 30_000);
+        for (mode, length, outcome) in [
+            (RunMode::Testing, 10, fell),
+            (RunMode::Learning, 20, fell),
+            (RunMode::Learning, 5, none),
+            (RunMode::Learning, 9, fell),
+            (RunMode::Testing, 4, none),
+        ] {
+            p.on_episode(&episode(mode, length), outcome);
+        }
+        assert!(p.done());
+        let (counts, curve) = p.into_counts(3, 77, AgentStats::default(), None, None);
+        assert_eq!((counts.trial, counts.seed), (3, 77));
+        assert_eq!((counts.learning_steps, counts.learning_episodes, counts.learning_falls), (34, 3, 2));
+        assert_eq!(counts.test_steps, 14);
+        assert_eq!(curve.len(), 2);
+    }
 }

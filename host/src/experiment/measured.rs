@@ -99,3 +99,57 @@ impl TrialResult {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pada_core::fatigue::GearboxParams;
+
+    fn counts() -> TrialCounts {
+        TrialCounts {
+            trial: 2,
+            seed: 5,
+            learning_steps: 100,
+            test_steps: 30,
+            learning_falls: 1,
+            learning_episodes: 4,
+            stats: AgentStats { saturations: 3, trace_drops: 4, ..AgentStats::default() },
+            table: None,
+            governor: None,
+        }
+    }
+
+    fn point(k: u32, walked_m: Option<f64>) -> TestPoint {
+        TestPoint {
+            learning_time_s: k as f64,
+            learning_episodes: k,
+            test_return: k as f64,
+            walked_m,
+            fell: k % 2 == 1,
+            duration_s: 2.0,
+            claimed_slots: None,
+        }
+    }
+
+    #[test]
+    fn the_end_is_the_last_tenth_of_the_test_runs_and_an_empty_curve_walked_nothing() {
+        let counter = FatigueCounter::<2>::new(GearboxParams::default(), 0.05, Some(1200)).unwrap();
+        // 11 test runs: the last tenth is the last two.
+        let curve: Vec<TestPoint> = (0..11).map(|k| point(k, Some(k as f64))).collect();
+        let r = TrialResult::measured(counts(), curve, &counter, &counter, 2);
+        assert_eq!((r.trial, r.seed, r.saturations, r.trace_drops), (2, 5, 3, 4));
+        assert_eq!(r.end_performance, 9.5);
+        assert_eq!((r.end_walked_m, r.end_speed_m_s), (Some(9.5), Some(19.0 / 4.0)));
+        assert_eq!(r.test_falls, 5);
+        assert_eq!((r.mtbf_s, r.joint_mtbf_s.len()), (f64::INFINITY, 2));
+        // One test run without a distance: no walking measures.
+        let mut curve: Vec<TestPoint> = (0..11).map(|k| point(k, Some(1.0))).collect();
+        curve[10].walked_m = None;
+        let r = TrialResult::measured(counts(), curve, &counter, &counter, 2);
+        assert_eq!((r.end_walked_m, r.end_speed_m_s), (None, None));
+        // No test run (a drive stopped before its first).
+        let r = TrialResult::measured(counts(), Vec::new(), &counter, &counter, 2);
+        assert!(r.end_performance.is_nan() && r.rise_time_s.is_nan());
+        assert_eq!((r.end_walked_m, r.end_speed_m_s), (Some(0.0), Some(0.0)));
+    }
+}
