@@ -2,7 +2,7 @@
 //! no files; good input gives the documented outputs.
 
 mod common;
-use common::{assert_bad_input, pada};
+use common::{assert_bad_input, ok, pada};
 
 use std::path::Path;
 
@@ -152,12 +152,7 @@ fn mtbf_of_a_known_log() {
         "4",
         "--json",
     ]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    ok(&out);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let a = &v["joints"][0]["report"];
     assert_eq!(a["reengagements"], 9);
@@ -197,7 +192,7 @@ fn bang_bang_log(dir: &Path) -> String {
 
 fn mtbf_json(args: &[&str]) -> serde_json::Value {
     let out = pada(args);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    ok(&out);
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
@@ -314,12 +309,7 @@ fn run_json_prints_the_summary_and_writes_the_files() {
         out_dir.to_str().unwrap(),
     ];
     let out = pada(&args);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    ok(&out);
     let v: serde_json::Value =
         serde_json::from_slice(&out.stdout).expect("stdout is the JSON summary");
     assert_eq!(v["task"], "pendulum");
@@ -373,12 +363,7 @@ fn paper_pendulum_writes_the_report_and_the_figures() {
     let mut args: Vec<&str> = "paper pendulum --trials 2 --seconds 30 --physical-seconds 30 --out".split(' ').collect();
     args.push(out_dir.to_str().unwrap());
     let out = pada(&args);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    ok(&out);
     let report = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
     for needle in [
         "SARSA(λ) on the simulated pendulum",
@@ -439,7 +424,7 @@ fn paper_wear_writes_the_report_the_figures_and_a_plan() {
     let out_dir = dir.path().join("wear");
     let args = ["paper", "wear", "--trials", "2", "--seconds", "60", "--out", out_dir.to_str().unwrap()];
     let out = pada(&args);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    ok(&out);
     let report = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
     for needle in [
         "# Learning on a wear budget (pendulum)",
@@ -469,7 +454,7 @@ fn paper_wear_writes_the_report_the_figures_and_a_plan() {
     // As a plan for a cluster: one trial file per trial.
     let plan = dir.path().join("plan");
     let out = pada(&["paper", "wear", "--trials", "2", "--seconds", "60", "--plan", plan.to_str().unwrap()]);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    ok(&out);
     let plan_json = std::fs::read_to_string(plan.join("plan.json")).unwrap();
     assert!(plan_json.contains("\"paper-wear\"") && plan_json.contains("\"mtbf_budget_s\""), "{plan_json}");
     assert_eq!(std::fs::read_dir(plan.join("trials")).unwrap().count(), 46);
@@ -482,7 +467,7 @@ fn paper_wear_writes_the_report_the_figures_and_a_plan() {
     let out = pada(&[
         "paper", "wear", "--trials", "2", "--seconds", "60", "--merge", plan.to_str().unwrap(), "--out", merged.to_str().unwrap(),
     ]);
-    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    ok(&out);
     assert_eq!(std::fs::read_to_string(merged.join("report.md")).unwrap(), report);
 }
 
@@ -494,7 +479,7 @@ fn pada_run_on_a_board_learns_on_a_wear_budget() {
             "run", "--board", "f405", "--task", "physical-pendulum", "--algo", "pada", "--mtbf-budget", "1.1e8", "--trials", "2",
             "--seconds", "120", "--json", "--out", dir.path().join(name).to_str().unwrap(),
         ]);
-        assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+        ok(&out);
         serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
     };
     let a = run("a");

@@ -48,15 +48,7 @@ fn json_has_the_documented_keys_and_they_agree() {
         assert!((s["time_s"].as_f64().unwrap() - (k + 1) as f64 * period).abs() < 1e-4);
         let q = s["joint_angles_rad"].as_object().unwrap();
         assert_eq!(q.len(), 7, "{q:?}");
-        for name in [
-            "shoulder",
-            "hip_left",
-            "hip_right",
-            "knee_left",
-            "knee_right",
-            "ankle_left",
-            "ankle_right",
-        ] {
+        for name in pada_core::robot::leo::JOINT_SPECS.map(|j| j.name) {
             assert!(q[name].as_f64().unwrap().is_finite(), "{name}");
         }
         let u = &s["ankle_voltages_v"];

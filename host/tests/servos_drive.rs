@@ -85,6 +85,50 @@ fn drive(args: &[&str]) -> std::process::Output {
     Command::new(PADA).arg("drive").args(args).output().expect("pada drive runs")
 }
 
+/// `pada drive --lockstep` of the pendulum on `port` for as long as it
+/// takes, started, once it is learning (its telemetry log in `out` grows
+/// past 20 kB).
+fn start_drive_until_learning(port: &str, out: &Path) -> Child {
+    let child = Command::new(PADA)
+        .args(["drive", "--port", port, "--robot", "pendulum", "--lockstep", "--seconds", "100000"])
+        .args(["--out", out.to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let csv = out.join("telemetry.csv");
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while std::fs::metadata(&csv).map_or(0, |m| m.len()) < 20_000 {
+        assert!(Instant::now() < deadline, "pada drive did not get going");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    child
+}
+
+/// When servo `id` first did `what` \[µs of bus time\].
+fn event_at(summary: &serde_json::Value, id: u64, what: &str) -> Option<u64> {
+    summary["events"].as_array().unwrap().iter().find(|e| e["id"] == id && e["what"] == what).map(|e| e["at_us"].as_u64().unwrap())
+}
+
+/// Asserts that each servo of `ids` turned torque on first and off last.
+fn assert_torque_on_then_off(summary: &serde_json::Value, ids: impl IntoIterator<Item = u64>) {
+    for id in ids {
+        let servo = events(summary, id);
+        assert_eq!(servo.first().map(String::as_str), Some("torque-on"), "servo {id}: {servo:?}");
+        assert_eq!(servo.last().map(String::as_str), Some("torque-off"), "servo {id}: {servo:?}");
+    }
+}
+
+/// The learning curve of the first trial in `dir`.
+fn curve(dir: &Path) -> String {
+    std::fs::read_to_string(dir.join("trial-000.csv")).unwrap()
+}
+
+/// The report `pada drive` wrote in `out`.
+fn drive_report(out: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(out.join("drive.json")).unwrap()).unwrap()
+}
+
 #[test]
 fn drive_on_virtual_servos_in_lock_step_learns_as_pada_run_board() {
     let dir = tempfile::tempdir().unwrap();
@@ -98,9 +142,7 @@ fn drive_on_virtual_servos_in_lock_step_learns_as_pada_run_board() {
     assert!(stdout.contains("0 overruns"), "{stdout}");
     let summary = servos.stop();
     // Torque on for the episodes, off at the end.
-    let servo = events(&summary, 1);
-    assert_eq!(servo.first().map(String::as_str), Some("torque-on"), "{servo:?}");
-    assert_eq!(servo.last().map(String::as_str), Some("torque-off"), "{servo:?}");
+    assert_torque_on_then_off(&summary, [1]);
     assert_eq!(summary["stats"]["damaged"], 0);
 
     let run = dir.path().join("run");
@@ -108,12 +150,11 @@ fn drive_on_virtual_servos_in_lock_step_learns_as_pada_run_board() {
         "run", "--board", "f405", "--task", "physical-pendulum", "--algo", "pada", "--seed", "3", "--seconds", "30",
         "--trials", "1", "--out", run.to_str().unwrap(),
     ]));
-    let curve = |d: &Path| std::fs::read_to_string(d.join("trial-000.csv")).unwrap();
     let (driven, simulated) = (curve(&out), curve(&run));
     assert!(driven.lines().count() >= 3, "a test episode before and after learning: {driven}");
     assert_eq!(driven, simulated, "the learning curve over the pty is pada run --board's, episode for episode");
 
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("drive.json")).unwrap()).unwrap();
+    let report = drive_report(&out);
     assert_eq!(report["ended"]["kind"], "done");
     assert_eq!(report["bus"]["checksum_errors"], 0);
     assert_eq!(report["bus"]["timeouts"], 0, "every request answered");
@@ -151,7 +192,6 @@ fn the_arm_of_files_on_protocol_2_in_lock_step_learns_as_pada_run_board() {
         "run", "--board", "f405", "--robot", &arm, "--algo", "pada", "--seed", "1", "--seconds", "30", "--trials", "1",
         "--out", run.to_str().unwrap(),
     ]));
-    let curve = |d: &Path| std::fs::read_to_string(d.join("trial-000.csv")).unwrap();
     assert!(curve(&out).lines().count() >= 3);
     assert_eq!(curve(&out), curve(&run), "the arm over the pty learns as pada run --board's, episode for episode");
 }
@@ -177,17 +217,12 @@ fn the_so101_on_feetech_servos_in_lock_step_learns_as_pada_run_board() {
     assert_eq!(summary["stats"]["damaged"], 0);
     // One SYNC WRITE ends each lock-step period.
     assert_eq!(summary["stats"]["sync_writes"].as_u64(), report["clock"]["periods"].as_u64());
-    for id in 1..=6 {
-        let servo = events(&summary, id);
-        assert_eq!(servo.first().map(String::as_str), Some("torque-on"), "servo {id}: {servo:?}");
-        assert_eq!(servo.last().map(String::as_str), Some("torque-off"), "servo {id}: {servo:?}");
-    }
+    assert_torque_on_then_off(&summary, 1..=6);
     let run = dir.path().join("run");
     ok(&common::pada(&[
         "run", "--board", "f405", "--robot", &so101, "--algo", "pada", "--seed", "2", "--seconds", "60", "--trials", "1", "--out",
         run.to_str().unwrap(),
     ]));
-    let curve = |d: &Path| std::fs::read_to_string(d.join("trial-000.csv")).unwrap();
     let driven = curve(&out);
     assert!(driven.lines().count() >= 3, "a test episode before and after learning: {driven}");
     let returns: Vec<&str> = driven.lines().skip(1).map(|l| l.rsplit(',').next().unwrap()).collect();
@@ -200,20 +235,9 @@ fn ctrl_c_turns_torque_off_and_keeps_the_log() {
     let dir = tempfile::tempdir().unwrap();
     let servos = Servos::start(dir.path(), &["--robot", "pendulum", "--lockstep"]);
     let out = dir.path().join("drive");
-    let child = Command::new(PADA)
-        .args(["drive", "--port", servos.port(), "--robot", "pendulum", "--lockstep", "--seconds", "100000"])
-        .args(["--out", out.to_str().unwrap()])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    // Until it learns (the telemetry log grows), then Ctrl-C.
+    // Until it learns, then Ctrl-C.
+    let child = start_drive_until_learning(servos.port(), &out);
     let csv = out.join("telemetry.csv");
-    let deadline = Instant::now() + Duration::from_secs(60);
-    while std::fs::metadata(&csv).map_or(0, |m| m.len()) < 20_000 {
-        assert!(Instant::now() < deadline, "pada drive did not get going");
-        std::thread::sleep(Duration::from_millis(50));
-    }
     interrupt(&child);
     let o = child.wait_with_output().unwrap();
     ok(&o);
@@ -222,7 +246,7 @@ fn ctrl_c_turns_torque_off_and_keeps_the_log() {
     let summary = servos.stop();
     let servo = events(&summary, 1);
     assert_eq!(servo.last().map(String::as_str), Some("torque-off"), "{servo:?}");
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("drive.json")).unwrap()).unwrap();
+    let report = drive_report(&out);
     assert_eq!(report["ended"]["kind"], "interrupted");
     assert!(out.join("checkpoint.bin").is_file());
     assert!(std::fs::metadata(&csv).unwrap().len() >= 20_000);
@@ -294,9 +318,7 @@ fn a_hardware_alert_turns_every_servos_torque_off_in_its_period_and_is_in_the_te
     let o = drive(&["--port", servos.port(), "--robot", &arm, "--lockstep", "--seconds", "30", "--out", out.to_str().unwrap()]);
     bad_input(&o, &["servo 2 (elbow)", "hardware alert", "overload", "torque is off on every servo"]);
     let summary = servos.stop();
-    let at = |id: u64, what: &str| {
-        summary["events"].as_array().unwrap().iter().find(|e| e["id"] == id && e["what"] == what).map(|e| e["at_us"].as_u64().unwrap())
-    };
+    let at = |id: u64, what: &str| event_at(&summary, id, what);
     let alert = at(2, "alert").expect("the alert was raised");
     assert_eq!(alert, 3_000_000);
     // Servo 1 (no alert of its own) off within one period of the alert.
@@ -344,9 +366,7 @@ fn a_storm_of_damaged_answers_faults_with_torque_off_in_its_period() {
     let o = drive(&["--port", servos.port(), "--robot", "pendulum", "--lockstep", "--seconds", "30", "--out", out.to_str().unwrap()]);
     bad_input(&o, &["damaged answers", "torque is off on every servo"]);
     let summary = servos.stop();
-    let at = |what: &str| {
-        summary["events"].as_array().unwrap().iter().find(|e| e["id"] == 1 && e["what"] == what).map(|e| e["at_us"].as_u64().unwrap())
-    };
+    let at = |what: &str| event_at(&summary, 1, what);
     let (corrupt, off) = (at("corrupt").expect("the fault began"), at("torque-off").expect("torque went off"));
     assert!(off >= corrupt && off - corrupt <= 30_000, "corrupted from {corrupt} µs, torque off at {off} µs");
     assert!(out.join("telemetry.csv").is_file() && out.join("checkpoint.bin").is_file());
@@ -357,19 +377,7 @@ fn a_port_that_goes_away_mid_run_is_one_line_and_the_log_is_kept() {
     let dir = tempfile::tempdir().unwrap();
     let mut servos = Servos::start(dir.path(), &["--robot", "pendulum", "--lockstep"]);
     let out = dir.path().join("drive");
-    let child = Command::new(PADA)
-        .args(["drive", "--port", servos.port(), "--robot", "pendulum", "--lockstep", "--seconds", "100000"])
-        .args(["--out", out.to_str().unwrap()])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let csv = out.join("telemetry.csv");
-    let deadline = Instant::now() + Duration::from_secs(60);
-    while std::fs::metadata(&csv).map_or(0, |m| m.len()) < 20_000 {
-        assert!(Instant::now() < deadline, "pada drive did not get going");
-        std::thread::sleep(Duration::from_millis(50));
-    }
+    let child = start_drive_until_learning(servos.port(), &out);
     // The adapter pulled: the virtual servos' process killed outright.
     let mut s = servos.child.take().unwrap();
     s.kill().unwrap();
@@ -379,7 +387,7 @@ fn a_port_that_goes_away_mid_run_is_one_line_and_the_log_is_kept() {
     for f in ["drive.json", "checkpoint.bin", "trial-000.csv"] {
         assert!(out.join(f).is_file(), "{f}");
     }
-    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("drive.json")).unwrap()).unwrap();
+    let report = drive_report(&out);
     assert_eq!(report["ended"]["kind"], "port-gone", "{}", report["ended"]);
 }
 
@@ -414,7 +422,6 @@ fn drive_from_host_weights_in_lock_step_learns_as_pada_run_board_from_them() {
     };
     board(&from, &["--weights", w.to_str().unwrap()]);
     board(&fresh, &[]);
-    let curve = |d: &Path| std::fs::read_to_string(d.join("trial-000.csv")).unwrap();
     assert_eq!(curve(&out), curve(&from), "the learning curve over the pty is pada run --board --weights's");
     assert_ne!(curve(&from), curve(&fresh), "the weights changed nothing");
 }
@@ -484,11 +491,7 @@ fn a_robot_of_sts3215s_runs_on_one_sync_read_and_one_sync_write_a_period() {
     let csv = std::fs::read_to_string(out.join("telemetry.csv")).unwrap();
     let states: Vec<&str> = csv.lines().map(|l| l.split(',').collect::<Vec<_>>()).filter(|f| f[2] == "step").map(|f| f[8]).collect();
     assert!(!states.is_empty() && states.iter().all(|s| *s == "0.074 0"), "{:?}", &states[..states.len().min(5)]);
-    for id in [1, 2] {
-        let servo = events(&summary, id);
-        assert_eq!(servo.first().map(String::as_str), Some("torque-on"), "servo {id}: {servo:?}");
-        assert_eq!(servo.last().map(String::as_str), Some("torque-off"), "servo {id}: {servo:?}");
-    }
+    assert_torque_on_then_off(&summary, [1, 2]);
 }
 
 /// A Feetech servo's overload (its Status bit 5, which unloads it) faults
@@ -497,9 +500,7 @@ fn a_robot_of_sts3215s_runs_on_one_sync_read_and_one_sync_write_a_period() {
 fn an_sts3215_overload_turns_every_servos_torque_off_in_its_period() {
     let (o, summary, out, _dir) = drive_sts("sts3215:1-2", &["error-bits:at=1:servo=2:bits=overload"], "20", false);
     bad_input(&o, &["servo 2 (elbow)", "overload", "torque is off on every servo"]);
-    let at = |id: u64, what: &str| {
-        summary["events"].as_array().unwrap().iter().find(|e| e["id"] == id && e["what"] == what).map(|e| e["at_us"].as_u64().unwrap())
-    };
+    let at = |id: u64, what: &str| event_at(&summary, id, what);
     let fault = at(2, "error-bits").expect("the overload was raised");
     let off = at(1, "torque-off").expect("servo 1's torque went off");
     assert!(off >= fault && off - fault <= 30_000, "overload at {fault} µs, servo 1 off at {off} µs");

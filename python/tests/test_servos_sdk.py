@@ -146,19 +146,14 @@ def test_bulk_read_and_bulk_write(x_servos):
         else:
             assert write.addParam(i, PWM_LIMIT, 2, [100 + i, 0])
     assert write.txPacket() == dxl.COMM_SUCCESS
-    read = dxl.GroupBulkRead(s.port, s.ph)
-    for i in X_IDS:
-        assert read.addParam(i, LED, 1) if i % 2 else read.addParam(i, PWM_LIMIT, 2)
-    assert read.txRxPacket() == dxl.COMM_SUCCESS
-    got = [read.getData(i, LED, 1) if i % 2 else read.getData(i, PWM_LIMIT, 2) for i in X_IDS]
-    assert got == [1 if i % 2 else 100 + i for i in X_IDS]
-    # Fast Bulk Read of the same.
-    fast = dxl.GroupBulkRead(s.port, s.ph)
-    for i in X_IDS:
-        assert fast.addParam(i, LED, 1) if i % 2 else fast.addParam(i, PWM_LIMIT, 2)
-    assert fast.fastBulkRead() == dxl.COMM_SUCCESS
-    got = [fast.getData(i, LED, 1) if i % 2 else fast.getData(i, PWM_LIMIT, 2) for i in X_IDS]
-    assert got == [1 if i % 2 else 100 + i for i in X_IDS]
+    # Read back by Bulk Read, then by Fast Bulk Read of the same.
+    for send in (dxl.GroupBulkRead.txRxPacket, dxl.GroupBulkRead.fastBulkRead):
+        read = dxl.GroupBulkRead(s.port, s.ph)
+        for i in X_IDS:
+            assert read.addParam(i, LED, 1) if i % 2 else read.addParam(i, PWM_LIMIT, 2)
+        assert send(read) == dxl.COMM_SUCCESS
+        got = [read.getData(i, LED, 1) if i % 2 else read.getData(i, PWM_LIMIT, 2) for i in X_IDS]
+        assert got == [1 if i % 2 else 100 + i for i in X_IDS], send.__name__
 
 
 def test_reg_write_action_reboot_clear_and_factory_reset(x_servos):

@@ -91,24 +91,25 @@ def test_pada_wrapper_box_and_discrete():
     assert info["pada_action"].tolist() == [4, 2, 3]
 
 
-def test_pada_wrapper_governor_holds_the_budget():
-    budget = 3000.0
-    env = PadaWrapper(MtbfWrapper(gym.make("Pendulum-v1")), mtbf_budget=budget, torque=None)
+def random_steps(env, steps):
+    """The info of the last of `steps` random actions on `env` (seed 0),
+    reset after each episode."""
     env.reset(seed=0)
     env.action_space.seed(0)
-    for _ in range(4000):
+    for _ in range(steps):
         _, _, te, tr, info = env.step(env.action_space.sample())
         if te or tr:
             env.reset()
+    return info
+
+
+def test_pada_wrapper_governor_holds_the_budget():
+    budget = 3000.0
+    env = PadaWrapper(MtbfWrapper(gym.make("Pendulum-v1")), mtbf_budget=budget, torque=None)
+    info = random_steps(env, 4000)
     g = info["governor"]
     assert g["moves"] > 0 and g["window_mtbf_s"] >= budget * 0.9
-    free = MtbfWrapper(gym.make("Pendulum-v1"))
-    free.reset(seed=0)
-    free.action_space.seed(0)
-    for _ in range(4000):
-        _, _, te, tr, finfo = free.step(free.action_space.sample())
-        if te or tr:
-            free.reset()
+    finfo = random_steps(MtbfWrapper(gym.make("Pendulum-v1")), 4000)
     assert finfo["robot_mtbf_s"] < budget < info["robot_mtbf_s"]
 
 

@@ -7,17 +7,12 @@
 #    with each behaviour of a full table: refuse, replace, collide.
 set -euo pipefail
 cd "$(dirname "$0")/../../.."
-out=${1:-pada-out/arm3}
-robot=examples/robots/arm3/robot.toml
-cargo build --release -q -p pada
-pada=target/release/pada
-mkdir -p "$out"
+source examples/robots/measure-lib.sh arm3 "$@"
 
 for algo in sarsa pada; do
-    "$pada" run --robot "$robot" --algo "$algo" --trials 10 --seconds 1200 --out "$out/host-$algo"
+    learn "$algo" 1200 "$out/host-$algo" --trials 10
 done
 "$pada" claims --robot "$robot" --board f405 --seconds 1200
 for full in refuse replace collide; do
-    "$pada" run --robot "$robot" --board f405 --table-full "$full" --algo pada --trials 10 --seconds 1200 \
-        --out "$out/f405-$full"
+    learn pada 1200 "$out/f405-$full" --board f405 --table-full "$full" --trials 10
 done

@@ -9,32 +9,15 @@
 # 3. The F405's learner on the host: one trial of 1200 s.
 set -euo pipefail
 cd "$(dirname "$0")/../../.."
-out=${1:-pada-out/so101}
-cargo build --release -q -p pada
+source examples/robots/measure-lib.sh so101 "$@"
 
-# learn ALGO SECONDS DIR [pada run's other flags…]: one `pada run` of the arm.
-learn() {
-    local algo=$1 secs=$2 dir=$3
-    shift 3
-    mkdir -p "$dir"
-    target/release/pada run --robot examples/robots/so101 --algo "$algo" --seconds "$secs" --threads 1 --out "$dir/run" "$@"
-}
-
-learn sarsa 1200 "$out/sarsa" --trials 20
-learn pada 1200 "$out/pada" --trials 20
+learn sarsa 1200 "$out/sarsa/run" --trials 20 --threads 1
+learn pada 1200 "$out/pada/run" --trials 20 --threads 1
 
 for algo in pada sarsa; do
     for secs in 600 1200; do
-        held=0
-        for seed in $(seq 1 10); do
-            dir="$out/hold-$algo-$secs/seed-$seed"
-            learn "$algo" "$secs" "$dir" --trials 1 --seed "$seed" --save-weights "$dir/weights.wts" > /dev/null
-            line=$(target/release/pada render --robot examples/robots/so101 --policy "$dir/weights.wts" --out "$dir/render" | grep '^grip:')
-            echo "$algo, $secs s, seed $seed: $line"
-            [[ $line == *"not held"* ]] || held=$((held + 1))
-        done
-        echo "$algo, $secs s of learning: the grip point held within 2 cm in $held of 10 trials"
+        hold "$algo" "$secs" "$out/hold-$algo-$secs" grip "grip point" --threads 1
     done
 done
 
-learn pada 1200 "$out/board-f405" --trials 1 --board f405
+learn pada 1200 "$out/board-f405/run" --trials 1 --board f405 --threads 1

@@ -23,7 +23,11 @@
 //! the firmware's generator alike. (A real board, which no host
 //! configures, seeds it with `pada_firmware::config::DEFAULT_SEED`.)
 
+use crate::experiment::governed::GovernorTrial;
+use crate::experiment::measured::TrialCounts;
 use crate::experiment::TestPoint;
+use pada_core::agent::AgentStats;
+use pada_core::claim_table::Occupancy;
 use pada_core::policy::PolicyKind;
 use pada_core::wire::{Episode, RunMode, ToChip};
 
@@ -48,6 +52,10 @@ pub struct RunProtocol {
     budget_steps: u64,
     learning_steps: u64,
     learning_episodes: u32,
+    /// Learning episodes that ended in an absorbing state (falls).
+    learning_falls: u64,
+    /// Steps of the test episodes.
+    test_steps: u64,
     curve: Vec<TestPoint>,
 }
 
@@ -75,6 +83,8 @@ impl RunProtocol {
             budget_steps: (seconds / period_s).round() as u64,
             learning_steps: 0,
             learning_episodes: 0,
+            learning_falls: 0,
+            test_steps: 0,
             curve: Vec::new(),
         }
     }
@@ -91,16 +101,20 @@ impl RunProtocol {
             RunMode::Learning => {
                 self.learning_steps += e.length as u64;
                 self.learning_episodes += 1;
+                self.learning_falls += outcome.fell as u64;
             }
-            RunMode::Testing => self.curve.push(TestPoint {
-                learning_time_s: self.learning_time_s(),
-                learning_episodes: self.learning_episodes,
-                test_return: e.total_reward as f64,
-                walked_m: outcome.walked_m,
-                fell: outcome.fell,
-                duration_s: e.length as f64 * self.period_s,
-                claimed_slots: outcome.claimed_slots,
-            }),
+            RunMode::Testing => {
+                self.test_steps += e.length as u64;
+                self.curve.push(TestPoint {
+                    learning_time_s: self.learning_time_s(),
+                    learning_episodes: self.learning_episodes,
+                    test_return: e.total_reward as f64,
+                    walked_m: outcome.walked_m,
+                    fell: outcome.fell,
+                    duration_s: e.length as f64 * self.period_s,
+                    claimed_slots: outcome.claimed_slots,
+                })
+            }
         }
         let (next, command) = match (self.phase, e.mode) {
             (Phase::FirstTest, RunMode::Testing) => (Phase::Learning, Some(ToChip::Start(RunMode::Learning))),
@@ -153,6 +167,30 @@ impl RunProtocol {
     pub fn into_curve(self) -> Vec<TestPoint> {
         self.curve
     }
+
+    /// What the run counted, with the driver's `trial`, `seed`, learner's
+    /// `stats`, claim `table` and wear `governor`; and the learning curve.
+    pub fn into_counts(
+        self,
+        trial: u32,
+        seed: u64,
+        stats: AgentStats,
+        table: Option<Occupancy>,
+        governor: Option<GovernorTrial>,
+    ) -> (TrialCounts, Vec<TestPoint>) {
+        let counts = TrialCounts {
+            trial,
+            seed,
+            learning_steps: self.learning_steps,
+            test_steps: self.test_steps,
+            learning_falls: self.learning_falls,
+            learning_episodes: self.learning_episodes,
+            stats,
+            table,
+            governor,
+        };
+        (counts, self.curve)
+    }
 }
 
 #[cfg(test)]
@@ -183,5 +221,29 @@ mod tests {
         assert_eq!(curve.len(), 3);
         assert_eq!((curve[1].learning_time_s, curve[1].learning_episodes), (20.0 * (30_000.0 * 1e-6), 1));
         assert_eq!((curve[2].fell, curve[2].walked_m, curve[2].duration_s), (true, Some(0.5), 5.0 * (30_000.0 * 1e-6)));
+    }
+
+    #[test]
+    fn the_counts_are_the_test_episodes_steps_and_the_learning_falls() {
+        let (none, fell) = (
+            EpisodeOutcome { fell: false, walked_m: None, claimed_slots: None },
+            EpisodeOutcome { fell: true, walked_m: None, claimed_slots: None },
+        );
+        let mut p = RunProtocol::new(1.0, 30_000);
+        for (mode, length, outcome) in [
+            (RunMode::Testing, 10, fell),
+            (RunMode::Learning, 20, fell),
+            (RunMode::Learning, 5, none),
+            (RunMode::Learning, 9, fell),
+            (RunMode::Testing, 4, none),
+        ] {
+            p.on_episode(&episode(mode, length), outcome);
+        }
+        assert!(p.done());
+        let (counts, curve) = p.into_counts(3, 77, AgentStats::default(), None, None);
+        assert_eq!((counts.trial, counts.seed), (3, 77));
+        assert_eq!((counts.learning_steps, counts.learning_episodes, counts.learning_falls), (34, 3, 2));
+        assert_eq!(counts.test_steps, 14);
+        assert_eq!(curve.len(), 2);
     }
 }

@@ -33,7 +33,7 @@
 use super::fault_line::{fault_explained, Faulted};
 use super::protocol::{EpisodeOutcome, RunProtocol};
 use crate::experiment::governed::GovernorStats;
-use crate::experiment::metrics::{end_performance, rise_time};
+use crate::experiment::measured::robot_mtbf_s;
 use crate::experiment::RunConfig;
 use crate::experiment::TrialResult;
 use crate::rig::Rig;
@@ -50,7 +50,7 @@ use pada_core::robot::RobotRules;
 use pada_core::servo::ServoProtocol;
 use pada_core::tile_coding::Layout;
 use pada_core::weights::{Half, WeightFormat, WeightStore};
-use pada_core::wire::{Episode, RunMode, StepKind, ToChip};
+use pada_core::wire::{Episode, StepKind, ToChip};
 use pada_firmware::control::{Controller, PeriodOutput, Readings};
 use pada_firmware::io::CycleCounter;
 use serde::Serialize;
@@ -309,7 +309,7 @@ fn run<R: RobotRules, W: WeightStore>(
     let switch_step = cfg.switch_at_s.map(|s| (s / period_s).round() as u64);
     let mut switched = false;
     let mut out = PeriodOutput::default();
-    let (mut learning_actions, mut test_steps, mut learning_falls) = (0u64, 0u64, 0u64);
+    let mut learning_actions = 0u64;
     let mut last_kind = StepKind::Start;
     // Generous: every episode may be followed by a wait of up to 15 s.
     let limit = (protocol.budget_steps() + 1) * 20 + 100_000;
@@ -397,10 +397,6 @@ fn run<R: RobotRules, W: WeightStore>(
         }
         let Some((e, outcome)) = ended else { continue };
         progress(e.length as u64);
-        match e.mode {
-            RunMode::Learning => learning_falls += outcome.fell as u64,
-            RunMode::Testing => test_steps += e.length as u64,
-        }
         episodes.push(e);
         if let Some(cmd) = protocol.on_episode(&e, outcome) {
             command(&mut ctl, cmd)?;
@@ -409,52 +405,15 @@ fn run<R: RobotRules, W: WeightStore>(
             break;
         }
     }
-    let learning_steps = protocol.learning_steps();
-    let learning_episodes = protocol.learning_episodes();
-    let curve = protocol.into_curve();
-    let times: Vec<f64> = curve.iter().map(|p| p.learning_time_s).collect();
-    let returns: Vec<f64> = curve.iter().map(|p| p.test_return).collect();
-    let tail_n = curve.len().div_ceil(10).max(1).min(curve.len());
-    let tail = &curve[curve.len() - tail_n..];
-    let walked: Option<f64> = tail.iter().map(|p| p.walked_m).sum();
-    let stats = ctl.agent_stats();
-    let result = TrialResult {
-        trial,
-        seed,
-        end_performance: end_performance(&returns).unwrap_or(f64::NAN),
-        rise_time_s: rise_time(&times, &returns).unwrap_or(f64::NAN),
-        mtbf_s: paper.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
-        window_reengagements: paper.joints().iter().filter_map(|j| j.window_reengagements()).sum(),
-        run_mtbf_s: paper.robot_mtbf_s(),
-        physical_mtbf_s: simulated.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
-        physical_window_reengagements: simulated.joints().iter().filter_map(|j| j.window_reengagements()).sum(),
-        joint_mtbf_s: (0..ids.len()).map(|j| paper.windowed_mtbf_s(j).unwrap_or(f64::INFINITY)).collect(),
-        physical_joint_mtbf_s: (0..ids.len()).map(|j| simulated.windowed_mtbf_s(j).unwrap_or(f64::INFINITY)).collect(),
-        learning_steps,
-        test_steps,
-        learning_falls,
-        learning_episodes,
-        test_falls: curve.iter().filter(|p| p.fell).count() as u32,
-        end_walked_m: walked.map(|w| w / tail_n as f64),
-        end_speed_m_s: walked.map(|w| w / tail.iter().map(|p| p.duration_s).sum::<f64>()),
-        saturations: stats.saturations,
-        trace_drops: stats.trace_drops,
-        table: ctl.weights().occupancy(),
-        governor: ctl.governor().map(|g| {
-            governed.finish(
-                g,
-                paper.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
-                simulated.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
-            )
-        }),
-        curve,
-    };
+    let governor = ctl.governor().map(|g| governed.finish(g, robot_mtbf_s(&paper), robot_mtbf_s(&simulated)));
+    let (counts, curve) = protocol.into_counts(trial, seed, ctl.agent_stats(), ctl.weights().occupancy(), governor);
+    let result = TrialResult::measured(counts, curve, &paper, &simulated, ids.len());
     Ok(BoardTrial {
         result,
         config_hash: ctl.config_hash(),
         weights,
         weights_checksum: ctl.weights().checksum(),
-        board_estimated_mtbf_s: estimated.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
+        board_estimated_mtbf_s: robot_mtbf_s(&estimated),
         periods: k,
         episodes,
     })

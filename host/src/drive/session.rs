@@ -34,7 +34,7 @@ use super::telemetry::TelemetryPipe;
 use crate::board::protocol::{EpisodeOutcome, RunProtocol};
 use crate::board::trial::{command, table_len, with_table, BoardTrial, TableVisitor};
 use crate::experiment::governed::GovernorStats;
-use crate::experiment::metrics::{end_performance, rise_time};
+use crate::experiment::measured::robot_mtbf_s;
 use crate::experiment::{RunConfig, TrialResult};
 use crate::robot_arg::RobotArg;
 use crate::seed::trial_seed;
@@ -47,7 +47,7 @@ use pada_core::robot::RobotRules;
 use pada_core::safety::Transition;
 use pada_core::servo::{Drive, ServoProtocol};
 use pada_core::weights::WeightStore;
-use pada_core::wire::{self, RunMode, StepKind, ToChip, ToHost};
+use pada_core::wire::{self, StepKind, ToChip, ToHost};
 use pada_firmware::bus::{BusConfig, BusStats, OperatorCall, RobotBus, SetupError};
 use pada_firmware::control::{Controller, PeriodOutput, Readings};
 use pada_firmware::io::CycleCounter;
@@ -354,7 +354,7 @@ fn run<W: WeightStore>(setup: &DriveSetup, table: W, mut tm: TelemetryPipe) -> a
     let mut governed = GovernorStats::default();
     let switch_step = cfg.switch_at_s.map(|s| (s / period_s).round() as u64);
     let mut switched = false;
-    let (mut learning_actions, mut test_steps, mut learning_falls) = (0u64, 0u64, 0u64);
+    let mut learning_actions = 0u64;
     let mut last_kind = StepKind::Start;
     let mut episodes = Vec::new();
     let mut readings = Readings::default();
@@ -449,10 +449,6 @@ fn run<W: WeightStore>(setup: &DriveSetup, table: W, mut tm: TelemetryPipe) -> a
                 walked_m: ctl.walked_m().map(f64::from),
                 claimed_slots: ctl.weights().occupancy().map(|o| o.claimed),
             };
-            match e.mode {
-                RunMode::Learning => learning_falls += outcome.fell as u64,
-                RunMode::Testing => test_steps += e.length as u64,
-            }
             episodes.push(e);
             if let Some(cmd) = protocol.on_episode(&e, outcome) {
                 let (result, t) = ctl.command(&cmd);
@@ -519,49 +515,18 @@ fn run<W: WeightStore>(setup: &DriveSetup, table: W, mut tm: TelemetryPipe) -> a
         watchdog_ms: if spec.joints.iter().any(|j| j.servo.protocol == ServoProtocol::V2) { bus.watchdog_units() as u32 * 20 } else { 0 },
         fast_sync_read: bus.fast_reads() && spec.joints.iter().any(|j| j.servo.protocol == ServoProtocol::V2),
     };
-    let learning_steps = protocol.learning_steps();
-    let learning_episodes = protocol.learning_episodes();
-    let curve = protocol.into_curve();
-    let times: Vec<f64> = curve.iter().map(|p| p.learning_time_s).collect();
-    let returns: Vec<f64> = curve.iter().map(|p| p.test_return).collect();
-    let tail_n = curve.len().div_ceil(10).max(1).min(curve.len().max(1));
-    let tail = &curve[curve.len().saturating_sub(tail_n)..];
-    let walked: Option<f64> = tail.iter().map(|p| p.walked_m).sum();
-    let stats = ctl.agent_stats();
-    let paper_mtbf = paper.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY);
-    let result = TrialResult {
-        trial: 0,
-        seed,
-        end_performance: end_performance(&returns).unwrap_or(f64::NAN),
-        rise_time_s: rise_time(&times, &returns).unwrap_or(f64::NAN),
-        mtbf_s: paper_mtbf,
-        window_reengagements: paper.joints().iter().filter_map(|j| j.window_reengagements()).sum(),
-        run_mtbf_s: paper.robot_mtbf_s(),
-        // No simulation's gear torques on real servos: the board's own
-        // estimate stands in.
-        physical_mtbf_s: estimated.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
-        physical_window_reengagements: estimated.joints().iter().filter_map(|j| j.window_reengagements()).sum(),
-        joint_mtbf_s: (0..n_counted).map(|j| paper.windowed_mtbf_s(j).unwrap_or(f64::INFINITY)).collect(),
-        physical_joint_mtbf_s: (0..n_counted).map(|j| estimated.windowed_mtbf_s(j).unwrap_or(f64::INFINITY)).collect(),
-        learning_steps,
-        test_steps,
-        learning_falls,
-        learning_episodes,
-        test_falls: curve.iter().filter(|p| p.fell).count() as u32,
-        end_walked_m: walked.map(|w| w / tail_n as f64),
-        end_speed_m_s: walked.map(|w| w / tail.iter().map(|p| p.duration_s).sum::<f64>().max(1e-9)),
-        saturations: stats.saturations,
-        trace_drops: stats.trace_drops,
-        table: ctl.weights().occupancy(),
-        governor: ctl.governor().map(|g| governed.finish(g, paper_mtbf, paper_mtbf)),
-        curve,
-    };
+    let paper_mtbf = robot_mtbf_s(&paper);
+    let governor = ctl.governor().map(|g| governed.finish(g, paper_mtbf, paper_mtbf));
+    let (counts, curve) = protocol.into_counts(0, seed, ctl.agent_stats(), ctl.weights().occupancy(), governor);
+    // No simulation's gear torques on real servos: the board's own
+    // estimate stands in.
+    let result = TrialResult::measured(counts, curve, &paper, &estimated, n_counted);
     let trial = BoardTrial {
         result,
         config_hash: ctl.config_hash(),
         weights: ctl.weights().len(),
         weights_checksum: ctl.weights().checksum(),
-        board_estimated_mtbf_s: estimated.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY),
+        board_estimated_mtbf_s: robot_mtbf_s(&estimated),
         periods,
         episodes,
     };

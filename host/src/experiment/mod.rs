@@ -21,6 +21,7 @@ pub mod agent_setup;
 pub mod algo;
 pub mod config;
 pub mod governed;
+pub mod measured;
 pub mod metrics;
 pub mod runner;
 pub mod table;

@@ -22,7 +22,7 @@
 
 use super::agent_setup::{build_agent, HostAgent};
 use super::governed::{GovernorTrial, TrialGovernor};
-use super::metrics::{end_performance, rise_time};
+use super::measured::{robot_mtbf_s, TrialCounts};
 use super::config::RunConfig;
 use crate::board::fault_line::{fault_explained, Faulted};
 use crate::experiment::task::{Plant, Task, TaskSpec};
@@ -123,14 +123,6 @@ pub struct TrialResult {
     /// The learning curve.
     #[serde(skip)]
     pub curve: Vec<TestPoint>,
-}
-
-/// The windowed MTBF of each of the first `dims` gearboxes of `counter`
-/// \[s\] (`+∞` where nothing re-engaged).
-pub fn joint_mtbf_s(counter: &FatigueCounter<MAX_ACTION_DIMS>, dims: usize) -> Vec<f64> {
-    (0..dims.min(MAX_ACTION_DIMS))
-        .map(|j| counter.windowed_mtbf_s(j).unwrap_or(f64::INFINITY))
-        .collect()
 }
 
 /// Receives the trial as telemetry: a `Step` for every agent call and an
@@ -286,53 +278,21 @@ pub fn run_trial_from<T: Task>(
     // The agent as a finished run leaves it: learning (for saving).
     t.agent.set_mode(Mode::Learning);
 
-    let times: Vec<f64> = t.curve.iter().map(|p| p.learning_time_s).collect();
-    let returns: Vec<f64> = t.curve.iter().map(|p| p.test_return).collect();
-    let stats = t.agent.stats();
-    let k = t.curve.len().div_ceil(10).max(1).min(t.curve.len());
-    let tail = &t.curve[t.curve.len() - k..];
-    // Walking metrics exist only when every test run measured a distance.
-    let walked: Option<f64> = tail.iter().map(|p| p.walked_m).sum();
-    let end_walked_m = walked.map(|w| w / k as f64);
-    let end_speed_m_s = walked.map(|w| w / tail.iter().map(|p| p.duration_s).sum::<f64>());
     let switched = cfg.switch_at_s.is_some() && t.switch_step.is_none();
-    let mtbf_s = t.fatigue.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY);
-    let physical_mtbf_s = t.physical.robot_windowed_mtbf_s().unwrap_or(f64::INFINITY);
-    let result = TrialResult {
+    let governor = t.governor.as_ref().map(|g| g.finish(robot_mtbf_s(&t.fatigue), robot_mtbf_s(&t.physical)));
+    let counts = TrialCounts {
         trial,
         seed: trial_seed(cfg.seed, trial),
-        end_performance: end_performance(&returns).unwrap_or(f64::NAN),
-        rise_time_s: rise_time(&times, &returns).unwrap_or(f64::NAN),
-        mtbf_s,
-        physical_mtbf_s,
-        run_mtbf_s: t.fatigue.robot_mtbf_s(),
-        joint_mtbf_s: joint_mtbf_s(&t.fatigue, t.spec.motor.dims()),
-        physical_joint_mtbf_s: joint_mtbf_s(&t.physical, t.spec.motor.dims()),
-        physical_window_reengagements: t
-            .physical
-            .joints()
-            .iter()
-            .filter_map(|j| j.window_reengagements())
-            .sum(),
-        window_reengagements: t
-            .fatigue
-            .joints()
-            .iter()
-            .filter_map(|j| j.window_reengagements())
-            .sum(),
         learning_steps: t.learning_steps,
         test_steps: t.test_steps,
         learning_falls: t.learning_falls,
         learning_episodes: t.episodes,
-        test_falls: t.curve.iter().filter(|p| p.fell).count() as u32,
-        end_walked_m,
-        end_speed_m_s,
-        saturations: stats.saturations,
-        trace_drops: stats.trace_drops,
+        stats: t.agent.stats(),
         table: pada_core::weights::WeightStore::occupancy(t.agent.weights()),
-        governor: t.governor.as_ref().map(|g| g.finish(mtbf_s, physical_mtbf_s)),
-        curve: t.curve,
+        governor,
     };
+    let dims = t.spec.motor.dims();
+    let result = TrialResult::measured(counts, t.curve, &t.fatigue, &t.physical, dims);
     Ok((result, t.agent, switched, t.books))
 }
 

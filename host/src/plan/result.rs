@@ -72,12 +72,16 @@ struct Body {
     plan: String,
     index: u32,
     spec: TrialSpec,
-    result: StoredTrial,
+    #[serde(with = "StoredTrial")]
+    result: TrialResult,
     timing: TrialTiming,
 }
 
-/// [`TrialResult`] with its curve and exact floats.
+/// How a [`TrialResult`] is stored: with its curve and exact floats
+/// (serde's remote derive, so the fields are checked against
+/// [`TrialResult`]'s by the compiler and no copy is written by hand).
 #[derive(Serialize, Deserialize)]
+#[serde(remote = "TrialResult")]
 struct StoredTrial {
     trial: u32,
     seed: u64,
@@ -117,15 +121,17 @@ struct StoredTrial {
     trace_drops: u32,
     #[serde(default)]
     table: Option<pada_core::claim_table::Occupancy>,
-    curve: Vec<StoredPoint>,
+    #[serde(with = "stored_curve")]
+    curve: Vec<TestPoint>,
 }
 
 fn nan() -> f64 {
     f64::NAN
 }
 
-/// [`TestPoint`] with exact floats.
+/// How a [`TestPoint`] is stored: with exact floats.
 #[derive(Serialize, Deserialize)]
+#[serde(remote = "TestPoint")]
 struct StoredPoint {
     #[serde(with = "super::exact::f64")]
     learning_time_s: f64,
@@ -141,87 +147,22 @@ struct StoredPoint {
     claimed_slots: Option<u32>,
 }
 
-impl From<&TrialResult> for StoredTrial {
-    fn from(r: &TrialResult) -> Self {
-        StoredTrial {
-            trial: r.trial,
-            seed: r.seed,
-            end_performance: r.end_performance,
-            rise_time_s: r.rise_time_s,
-            mtbf_s: r.mtbf_s,
-            window_reengagements: r.window_reengagements,
-            physical_mtbf_s: r.physical_mtbf_s,
-            physical_window_reengagements: r.physical_window_reengagements,
-            run_mtbf_s: r.run_mtbf_s,
-            joint_mtbf_s: r.joint_mtbf_s.clone(),
-            physical_joint_mtbf_s: r.physical_joint_mtbf_s.clone(),
-            governor: r.governor.clone(),
-            learning_steps: r.learning_steps,
-            test_steps: r.test_steps,
-            learning_falls: r.learning_falls,
-            learning_episodes: r.learning_episodes,
-            test_falls: r.test_falls,
-            end_walked_m: r.end_walked_m,
-            end_speed_m_s: r.end_speed_m_s,
-            saturations: r.saturations,
-            trace_drops: r.trace_drops,
-            table: r.table,
-            curve: r
-                .curve
-                .iter()
-                .map(|p| StoredPoint {
-                    learning_time_s: p.learning_time_s,
-                    learning_episodes: p.learning_episodes,
-                    test_return: p.test_return,
-                    walked_m: p.walked_m,
-                    fell: p.fell,
-                    duration_s: p.duration_s,
-                    claimed_slots: p.claimed_slots,
-                })
-                .collect(),
-        }
-    }
-}
+/// A learning curve as a list of [`StoredPoint`]s.
+mod stored_curve {
+    use super::{StoredPoint, TestPoint};
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
-impl From<StoredTrial> for TrialResult {
-    fn from(r: StoredTrial) -> Self {
-        TrialResult {
-            trial: r.trial,
-            seed: r.seed,
-            end_performance: r.end_performance,
-            rise_time_s: r.rise_time_s,
-            mtbf_s: r.mtbf_s,
-            window_reengagements: r.window_reengagements,
-            physical_mtbf_s: r.physical_mtbf_s,
-            physical_window_reengagements: r.physical_window_reengagements,
-            run_mtbf_s: r.run_mtbf_s,
-            joint_mtbf_s: r.joint_mtbf_s,
-            physical_joint_mtbf_s: r.physical_joint_mtbf_s,
-            governor: r.governor.clone(),
-            learning_steps: r.learning_steps,
-            test_steps: r.test_steps,
-            learning_falls: r.learning_falls,
-            learning_episodes: r.learning_episodes,
-            test_falls: r.test_falls,
-            end_walked_m: r.end_walked_m,
-            end_speed_m_s: r.end_speed_m_s,
-            saturations: r.saturations,
-            trace_drops: r.trace_drops,
-            table: r.table,
-            curve: r
-                .curve
-                .into_iter()
-                .map(|p| TestPoint {
-                    learning_time_s: p.learning_time_s,
-                    learning_episodes: p.learning_episodes,
-                    test_return: p.test_return,
-                    walked_m: p.walked_m,
-                    fell: p.fell,
-                    duration_s: p.duration_s,
-                    claimed_slots: p.claimed_slots,
-                })
-                .collect(),
-        }
+    /// One point, stored as [`StoredPoint`] says.
+    #[derive(Serialize, Deserialize)]
+    #[serde(transparent)]
+    struct Point(#[serde(with = "StoredPoint")] TestPoint);
+
+    pub fn serialize<S: Serializer>(curve: &[TestPoint], s: S) -> Result<S::Ok, S::Error> {
+        s.collect_seq(curve.iter().map(|&p| Point(p)))
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<TestPoint>, D::Error> {
+        Ok(Vec::<Point>::deserialize(d)?.into_iter().map(|p| p.0).collect())
     }
 }
 
@@ -264,7 +205,7 @@ pub fn write(
         plan: plan.hash.clone(),
         index: spec.index,
         spec: spec.clone(),
-        result: StoredTrial::from(result),
+        result: result.clone(),
         timing: timing.clone(),
     };
     let json = serde_json::to_string_pretty(&body)? + "\n";
@@ -351,7 +292,7 @@ fn verify(bytes: &[u8], plan: &Plan, index: u32) -> Result<StoredResult, String>
             spec.describe()
         ));
     }
-    let result = TrialResult::from(body.result);
+    let result = body.result;
     if result.trial != spec.trial || result.seed != spec.trial_seed {
         return Err(format!(
             "its trial {} with seed {} is not the plan's trial {} with seed {}",
@@ -533,3 +474,4 @@ mod tests {
         assert_eq!(left, [".000000-def.partial", "000000.json"]);
     }
 }
+

@@ -3,7 +3,7 @@
 //! the reference's touchdowns marked.
 
 use super::{plot_err, Figure, FONT};
-use crate::leo::compare::{Comparison, ANGLE_NAMES};
+use crate::leo::compare::{Comparison, StepComparison, ANGLE_NAMES};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -87,23 +87,20 @@ impl Figure for ComparisonFigure<'_> {
                     )))
                     .map_err(plot_err)?;
             }
+            // Angle k of one simulator against time.
+            let trajectory = |angles: fn(&StepComparison) -> &[f32]| {
+                steps.iter().map(move |s| (s.time_s as f64, angles(s)[k] as f64))
+            };
             chart
                 .draw_series(DashedLineSeries::new(
-                    steps
-                        .iter()
-                        .map(|s| (s.time_s as f64, s.reference_angles[k] as f64)),
+                    trajectory(|s| &s.reference_angles),
                     6,
                     4,
                     REFERENCE.stroke_width(2),
                 ))
                 .map_err(plot_err)?;
             chart
-                .draw_series(LineSeries::new(
-                    steps
-                        .iter()
-                        .map(|s| (s.time_s as f64, s.pada_angles[k] as f64)),
-                    PADA.stroke_width(2),
-                ))
+                .draw_series(LineSeries::new(trajectory(|s| &s.pada_angles), PADA.stroke_width(2)))
                 .map_err(plot_err)?;
         }
         Ok(())

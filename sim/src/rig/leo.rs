@@ -35,16 +35,20 @@
 //! - **Torque off** (a fault, Stop): modelled as 0 V, the motor shorted,
 //!   which brakes the joint a little more than the RX-28's open winding.
 
-use super::{joint_volts, servo_reading, JointState, Rig, TEMPERATURE_C};
+use super::periodic::{PeriodBody, Periodic};
+use super::JointState;
 use crate::leo::model::{InitialPose, LeoModel, ModelOptions, Snapshot, NUM_JOINTS};
-use pada_core::dynamixel::table::PresentState;
 use pada_core::robot::leo::{ankle_x, Leg, StanceTracker, CONTROL_PERIOD_US, JOINTS};
 use pada_core::robot::{EncoderSpec, RobotSpec};
 use pada_core::rx28::Rx28;
 use pada_core::robot::leo::contact;
 
 /// LEO on its boom, behind seven emulated RX-28s.
-pub struct LeoRig {
+pub type LeoRig = Periodic<LeoOnBoom>;
+
+/// LEO's physics on its boom: the model, its start pose, the boom's
+/// encoder and the footsteps ([`LeoRig`]'s body).
+pub struct LeoOnBoom {
     model: LeoModel,
     /// The start of every episode: the reference pose after its first
     /// control period at 0 V.
@@ -54,21 +58,8 @@ pub struct LeoRig {
     hw: &'static RobotSpec,
     /// The boom's encoder of that definition.
     encoder: EncoderSpec,
-    /// Servo ID of each joint ([`pada_core::robot::leo::Joint`] order).
-    ids: [u8; NUM_JOINTS],
-    /// Voltage and torque enable per joint.
-    volts: [f32; NUM_JOINTS],
-    torque: [bool; NUM_JOINTS],
-    /// The next period boundary \[µs\].
-    next_step_us: u64,
-    /// Whether the operator holds LEO at the start pose.
-    held: bool,
     /// Mean gear torque of each joint over the last simulated period.
     torques: [f32; NUM_JOINTS],
-    /// Simulated periods, and those that blew up (then the operator
-    /// resets LEO as after a fall).
-    periods: u64,
-    blow_ups: u64,
     /// Footsteps since the operator let go.
     stance: StanceTracker,
 }
@@ -96,64 +87,17 @@ impl LeoRig {
         model.set_voltages([0.0; NUM_JOINTS]);
         model.control_step().map_err(|b| anyhow::anyhow!("the LEO model blew up settling into its start pose: {b:?}"))?;
         let start = model.snapshot();
-        let mut ids = [0; NUM_JOINTS];
-        for (id, servo) in ids.iter_mut().zip(hw.joints) {
-            *id = servo.id;
-        }
-        Ok(LeoRig {
-            model,
-            start,
-            hw,
-            encoder,
-            ids,
-            volts: [0.0; NUM_JOINTS],
-            torque: [false; NUM_JOINTS],
-            next_step_us: CONTROL_PERIOD_US as u64,
-            held: true,
-            torques: [0.0; NUM_JOINTS],
-            periods: 0,
-            blow_ups: 0,
-            stance: StanceTracker::new(),
-        })
+        let body = LeoOnBoom { model, start, hw, encoder, torques: [0.0; NUM_JOINTS], stance: StanceTracker::new() };
+        Ok(Periodic::of_body(body, CONTROL_PERIOD_US as u64))
     }
 
     /// The model (for inspection).
     pub fn model(&self) -> &LeoModel {
-        &self.model
+        &self.body.model
     }
+}
 
-    /// Control periods simulated, and how many of them blew up.
-    pub fn periods(&self) -> (u64, u64) {
-        (self.periods, self.blow_ups)
-    }
-
-    fn joint_of(&self, id: u8) -> Option<usize> {
-        self.ids.iter().position(|&i| i == id)
-    }
-
-    /// One control period with the voltages in force.
-    fn step(&mut self) {
-        let mut u = self.volts;
-        for (v, on) in u.iter_mut().zip(self.torque) {
-            if !on {
-                *v = 0.0;
-            }
-        }
-        self.model.set_voltages(u);
-        self.periods += 1;
-        match self.model.control_step() {
-            Ok(t) => self.torques = t,
-            Err(_) => {
-                // The simulation broke (NaN, a body far away): LEO is put
-                // back as after a fall; the firmware sees the jump.
-                self.blow_ups += 1;
-                self.model.restore(&self.start);
-                self.torques = [0.0; NUM_JOINTS];
-            }
-        }
-        self.track_stance();
-    }
-
+impl LeoOnBoom {
     /// The stance tracker sees the state at this boundary (§3.3, as
     /// `crate::leo::LeoEnv` does).
     fn track_stance(&mut self) {
@@ -162,8 +106,34 @@ impl LeoRig {
         let ankle = |leg: Leg| ankle_x(phi, s.angles[leg.hip() as usize], s.angles[leg.knee() as usize]);
         self.stance.update(s.contacts[0] || s.contacts[1], s.contacts[2] || s.contacts[3], ankle(Leg::Left), ankle(Leg::Right));
     }
+}
 
-    /// Joint `k` as its servo senses it now.
+impl PeriodBody for LeoOnBoom {
+    fn hw(&self) -> &'static RobotSpec {
+        self.hw
+    }
+
+    fn step_period(&mut self, volts: &[f32]) -> bool {
+        let mut u = [0.0; NUM_JOINTS];
+        u.copy_from_slice(volts);
+        self.model.set_voltages(u);
+        let ok = match self.model.control_step() {
+            Ok(t) => {
+                self.torques = t;
+                true
+            }
+            Err(_) => {
+                // The simulation broke (NaN, a body far away): LEO is put
+                // back as after a fall; the firmware sees the jump.
+                self.model.restore(&self.start);
+                self.torques = [0.0; NUM_JOINTS];
+                false
+            }
+        };
+        self.track_stance();
+        ok
+    }
+
     fn sensed(&self, k: usize) -> JointState {
         let (q, qd) = self.model.joint_state();
         let stall = Rx28::LEO.estimate_joint_torque(self.hw.supply_nominal_v, 0.0);
@@ -171,80 +141,27 @@ impl LeoRig {
         JointState { angle: q[k] as f64, rate: qd[k] as f64, load }
     }
 
-    /// Servo `k`'s reading now.
-    fn reading(&self, k: usize) -> PresentState {
-        let s = self.sensed(k);
-        servo_reading(&self.hw.joints[k], s.angle, s.rate, s.load, self.supply_v())
-    }
-
     /// The boom's encoder and the foot switches now.
-    fn sensor_reading(&self) -> (u16, u8) {
+    fn sensors(&self) -> (u16, u8) {
         let s = self.model.state();
         let bits = [contact::TOE_L, contact::HEEL_L, contact::TOE_R, contact::HEEL_R];
         let contacts = s.contacts.iter().zip(bits).filter(|(on, _)| **on).fold(0, |b, (_, bit)| b | bit);
         (self.encoder.count_of(s.torso_pitch as f64), contacts)
     }
 
-    /// Whether the state at `t_us` is the state now: no period boundary
-    /// to simulate before it (or the operator holds LEO still).
-    fn settled_until(&self, t_us: u64) -> bool {
-        self.held || t_us < self.next_step_us
-    }
-}
-
-impl Rig for LeoRig {
-    fn servo_ids(&self) -> &[u8] {
-        &self.ids
+    fn put_back(&mut self) {
+        self.model.restore(&self.start);
+        self.torques = [0.0; NUM_JOINTS];
     }
 
-    fn advance_to(&mut self, t_us: u64) {
-        while self.next_step_us <= t_us {
-            if !self.held {
-                self.step();
-            }
-            self.next_step_us += CONTROL_PERIOD_US as u64;
-        }
+    /// The walked distance counts from the start pose.
+    fn let_go(&mut self) {
+        self.stance = StanceTracker::new();
+        self.track_stance();
     }
 
-    fn drive(&mut self, t_us: u64, id: u8, torque: bool, volts: f64) {
-        self.advance_to(t_us);
-        if let Some(k) = self.joint_of(id) {
-            self.torque[k] = torque;
-            self.volts[k] = joint_volts(&self.hw.joints[k], volts) as f32;
-        }
-    }
-
-    fn present(&mut self, t_us: u64, id: u8) -> PresentState {
-        self.advance_to(t_us);
-        match self.joint_of(id) {
-            Some(k) => self.reading(k),
-            None => PresentState { position: 0, speed: 0, load: 0, voltage: 0, temperature: TEMPERATURE_C },
-        }
-    }
-
-    fn joint_state(&mut self, t_us: u64, id: u8) -> JointState {
-        self.advance_to(t_us);
-        self.joint_of(id).map_or_else(JointState::default, |k| self.sensed(k))
-    }
-
-    fn sensors(&mut self, t_us: u64) -> (u16, u8) {
-        self.advance_to(t_us);
-        self.sensor_reading()
-    }
-
-    fn peek_present(&self, t_us: u64, id: u8) -> Option<PresentState> {
-        let k = self.joint_of(id)?;
-        self.settled_until(t_us).then(|| self.reading(k))
-    }
-
-    fn peek_sensors(&self, t_us: u64) -> Option<(u16, u8)> {
-        self.settled_until(t_us).then(|| self.sensor_reading())
-    }
-
-    /// The nominal supply of the hardware definition (LEO's battery,
-    /// docs/reference/grl.md §2.2).
-    fn supply_v(&self) -> f64 {
-        self.hw.supply_nominal_v as f64
+    fn gear_torque(&self, k: usize) -> f32 {
+        self.torques[k]
     }
 
     fn walked_m(&self) -> Option<f64> {
@@ -258,24 +175,6 @@ impl Rig for LeoRig {
             self.encoder.counts_per_rev
         )
     }
-
-    fn episode_ended(&mut self, _t_us: u64) {
-        self.model.restore(&self.start);
-        self.torques = [0.0; NUM_JOINTS];
-        self.held = true;
-    }
-
-    /// From the next period boundary on, LEO moves; the walked distance
-    /// counts from the start pose.
-    fn episode_started(&mut self, _t_us: u64) {
-        self.held = false;
-        self.stance = StanceTracker::new();
-        self.track_stance();
-    }
-
-    fn gear_torque(&self, id: u8) -> f32 {
-        self.joint_of(id).map_or(0.0, |k| self.torques[k])
-    }
 }
 
 const _: () = assert!(JOINTS.len() == NUM_JOINTS);
@@ -283,6 +182,7 @@ const _: () = assert!(JOINTS.len() == NUM_JOINTS);
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::rig::Rig;
     use pada_core::dynamixel::table;
     use pada_core::robot::leo::{Joint, START_JOINT_ANGLES, START_PHI};
 
@@ -299,7 +199,7 @@ mod tests {
         assert!((before.0 as f64 - (512.0 + START_JOINT_ANGLES[Joint::HipRight as usize] as f64 / unit)).abs() <= 1.5);
         assert!((before.1 as f64 - (512.0 + START_JOINT_ANGLES[Joint::KneeRight as usize] as f64 / unit)).abs() <= 1.5);
         // (The first control period at 0 V tips the torso by a few mrad.)
-        let pitch = before.2 .0 as i32 - rig.encoder.count_of(-START_PHI as f64) as i32;
+        let pitch = before.2 .0 as i32 - rig.body.encoder.count_of(-START_PHI as f64) as i32;
         assert!(pitch.abs() <= 5, "{pitch} counts from the start pitch");
         assert_ne!(before.2 .1 & contact::LEFT, 0);
         // Held: a second passes, nothing moves, whatever is commanded.

@@ -18,8 +18,9 @@
 
 pub mod leo;
 pub mod pendulum;
+pub mod periodic;
 
-pub use leo::LeoRig;
+pub use leo::{LeoOnBoom, LeoRig};
 pub use pendulum::PendulumRig;
 
 use pada_core::dynamixel::control_table::{self, x_series};

@@ -12,4 +12,4 @@ mod tests;
 
 pub use body::{BlowUp, UrdfBody, UrdfModel, GRAVITY};
 pub use plant::{RulesPlant, UrdfTask};
-pub use rig::UrdfRig;
+pub use rig::{UrdfOnRig, UrdfRig};

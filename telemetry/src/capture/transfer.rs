@@ -78,7 +78,9 @@ impl Direction {
     }
 }
 
-/// One save or restore of a checkpoint the host keeps.
+/// One save or restore of a checkpoint the host keeps. Its JSON is a
+/// recording's `/checkpoint` message, without the recorder's clock (which
+/// stays out of a recording: it reads back as 0).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Transfer {
     /// A save or a restore.
@@ -121,8 +123,10 @@ pub struct Transfer {
     /// Chunks the board said it sent (a save's `Streamed` report).
     pub reported_chunks: Option<u32>,
     /// When its first frame came \[s\] (the recorder's clock).
+    #[serde(skip)]
     pub started_s: f64,
     /// When its last frame came \[s\].
+    #[serde(skip)]
     pub ended_s: f64,
 }
 

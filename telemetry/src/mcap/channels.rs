@@ -26,7 +26,7 @@
 //! (the claim table's occupancy, from `Health`) shows.
 
 use super::scene::SceneBuilder;
-use crate::capture::transfer::{Direction, Transfer, Transfers};
+use crate::capture::transfer::{Transfer, Transfers};
 use crate::capture::{describe, loss_name, mode_name, step_kind_name};
 use pada_core::wire::{Decoded, FrameError, Hello, LinkStats, SeqGap, ToHost, MAX_GEARBOXES};
 use serde::{Deserialize, Serialize};
@@ -293,54 +293,6 @@ pub struct EventView {
     pub detail: String,
 }
 
-/// `/checkpoint`: one save or restore of a checkpoint the host keeps
-/// ([`Transfer`] without the host's clock, which stays out of a recording).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CheckpointView {
-    /// `save` or `restore`.
-    pub direction: Direction,
-    /// The checkpoint's generation (null: a restore that loaded none).
-    pub generation: Option<u32>,
-    /// Bytes of the image.
-    pub bytes: u32,
-    /// A save's chunks received; a restore's chunks loaded (or sent).
-    pub chunks: u32,
-    /// A restore's requests.
-    pub requests: u32,
-    /// Frame bytes from the board.
-    pub board_bytes: u64,
-    /// Frame bytes of the host's answers to a restore (0 when the
-    /// recorder did not answer).
-    pub host_bytes: u64,
-    /// Seconds on the telemetry link.
-    pub link_s: f64,
-    /// How it ended (`telemetry.csv`'s `outcome`).
-    pub outcome: String,
-    /// The board's closing report came.
-    pub reported: bool,
-    /// Chunks the board said it sent (a save's report).
-    pub reported_chunks: Option<u32>,
-}
-
-impl CheckpointView {
-    /// The view of `t`.
-    pub fn of(t: &Transfer) -> CheckpointView {
-        CheckpointView {
-            direction: t.direction,
-            generation: t.generation,
-            bytes: t.bytes,
-            chunks: t.chunks,
-            requests: t.requests,
-            board_bytes: t.board_bytes,
-            host_bytes: t.host_bytes,
-            link_s: t.link_s,
-            outcome: t.outcome.clone(),
-            reported: t.reported,
-            reported_chunks: t.reported_chunks,
-        }
-    }
-}
-
 /// `/link`: the link's counters after an event.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LinkView {
@@ -562,7 +514,7 @@ impl Channelizer {
 
     /// The `/checkpoint` message of a save or restore that ended.
     pub fn transfer(&mut self, t: &Transfer) -> ChannelMessage {
-        ChannelMessage { topic: Topic::Checkpoint, log_time: self.clock.now(), sequence: 0, data: json(&CheckpointView::of(t)) }
+        ChannelMessage { topic: Topic::Checkpoint, log_time: self.clock.now(), sequence: 0, data: json(t) }
     }
 
     /// The `/link` message of a lost frame.
@@ -609,7 +561,7 @@ mod checkpoint_view_tests {
     #[test]
     fn the_checkpoint_view_has_exactly_its_schemas_fields() {
         let t = crate::capture::transfer::Transfer {
-            direction: Direction::Restore,
+            direction: crate::capture::transfer::Direction::Restore,
             generation: None,
             bytes: 1,
             chunks: 2,
@@ -623,7 +575,7 @@ mod checkpoint_view_tests {
             started_s: 1.0,
             ended_s: 2.0,
         };
-        let view: serde_json::Value = serde_json::from_slice(&json(&CheckpointView::of(&t))).unwrap();
+        let view: serde_json::Value = serde_json::from_slice(&json(&t)).unwrap();
         let (_, schema) = super::super::schemas::of(Topic::Checkpoint);
         let schema: serde_json::Value = serde_json::from_str(schema).unwrap();
         let mut fields: Vec<&str> = view.as_object().unwrap().keys().map(|k| k.as_str()).collect();

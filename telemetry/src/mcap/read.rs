@@ -102,7 +102,7 @@ pub fn replay(bytes: &[u8]) -> Result<Replayed, String> {
             Some(Topic::Checkpoint) => {
                 // One message for a save's chunks or a restore's requests,
                 // and the board's report that closed it.
-                let t: super::channels::CheckpointView = parse(name, data)?;
+                let t: crate::capture::transfer::Transfer = parse(name, data)?;
                 match t.direction {
                     crate::capture::transfer::Direction::Save => messages.checkpoint_chunk += t.chunks as u64,
                     crate::capture::transfer::Direction::Restore => messages.restore_wanted += t.requests as u64,

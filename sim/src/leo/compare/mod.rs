@@ -49,17 +49,17 @@ impl Drive {
 pub const TOUCHDOWN_MATCH_STEPS: i64 = 3;
 
 /// The angles compared, in the order of [`StepComparison::angle_error`]:
-/// the torso, then the joints in [`Joint`] order.
-pub const ANGLE_NAMES: [&str; NUM_JOINTS + 1] = [
-    "torso",
-    "shoulder",
-    "hip_left",
-    "hip_right",
-    "knee_left",
-    "knee_right",
-    "ankle_left",
-    "ankle_right",
-];
+/// the torso, then the joints in [`Joint`] order (their names in LEO's
+/// hardware definition).
+pub const ANGLE_NAMES: [&str; NUM_JOINTS + 1] = {
+    let mut names = ["torso"; NUM_JOINTS + 1];
+    let mut k = 0;
+    while k < NUM_JOINTS {
+        names[k + 1] = pada_core::robot::leo::JOINT_SPECS[k].name;
+        k += 1;
+    }
+    names
+};
 
 /// One control step of both simulators.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

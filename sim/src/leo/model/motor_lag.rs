@@ -1,5 +1,6 @@
 //! The step-size correction of the servos' first-order response.
 
+use super::step::inverse_column;
 use super::{LeoModel, ANGULAR_X, NUM_JOINTS};
 
 impl LeoModel {
@@ -29,6 +30,8 @@ impl LeoModel {
         let dofs = self.dofs;
         let links = self.links;
         let stepped = self.stepped;
+        // Not `multibody_mut`: the multibody and the rigid bodies are
+        // borrowed together below.
         let Some(mb) = self
             .world
             .multibody_joints
@@ -43,19 +46,11 @@ impl LeoModel {
         // 1/(M⁻¹)_dd (a Schur complement), so the DoF's own damping and
         // spring terms are taken off again below; the other DoFs' stay in,
         // so a neighbour held by its friction tie moves with this DoF.
-        let n = mb.ndofs();
         let mut inv = [0.0f32; NUM_JOINTS];
         let mut own = [0.0f32; NUM_JOINTS];
         if stepped {
-            let mut e = rapier3d::na::DVector::<f32>::zeros(n);
             for (i, &k) in dofs.iter().enumerate() {
-                e.fill(0.0);
-                e[k] = 1.0;
-                inv[i] = if mb.inv_augmented_mass().solve_mut(&mut e) {
-                    e[k]
-                } else {
-                    f32::NAN
-                };
+                inv[i] = inverse_column(mb, k).map_or(f32::NAN, |e| e[k]);
             }
             for (i, &k) in dofs.iter().enumerate() {
                 let spring = mb

@@ -165,11 +165,7 @@ impl LeoModel {
     pub fn set_velocities(&mut self, joint_rates: [f32; NUM_JOINTS], root: [f32; 3]) {
         let dofs = self.dofs;
         let root_dof = self.root_dof;
-        if let Some(mb) = self
-            .world
-            .multibody_joints
-            .get_multibody_mut(self.multibody)
-        {
+        if let Some(mb) = self.multibody_mut() {
             let mut v = mb.generalized_velocity_mut();
             for k in 0..NUM_JOINTS {
                 v[dofs[k]] = joint_rates[k];

@@ -176,6 +176,11 @@ impl LeoModel {
         }
     }
 
+    /// The robot's multibody (every joint's DoFs), mutable.
+    pub(super) fn multibody_mut(&mut self) -> Option<&mut Multibody> {
+        self.world.multibody_joints.get_multibody_mut(self.multibody)
+    }
+
     /// Sets the rates of the `stopped` joints to 0 with the generalized
     /// impulse λ on those DoFs alone that does it: v + A⁻¹·E·λ has zero
     /// entries there, (A⁻¹)_SS·λ = −v_S, with A the matrix rapier just
@@ -185,23 +190,16 @@ impl LeoModel {
     fn stop_joints(&mut self, stopped: &[bool; NUM_JOINTS]) {
         use rapier3d::na::{DMatrix, DVector};
         let dofs = self.dofs;
-        let Some(mb) = self
-            .world
-            .multibody_joints
-            .get_multibody_mut(self.multibody)
-        else {
+        let Some(mb) = self.multibody_mut() else {
             return;
         };
-        let n = mb.ndofs();
         let set: Vec<usize> = (0..NUM_JOINTS).filter(|&k| stopped[k]).collect();
         // Columns of A⁻¹ for the stopped DoFs.
         let mut columns = Vec::with_capacity(set.len());
         for &k in &set {
-            let mut e = DVector::<f32>::zeros(n);
-            e[dofs[k]] = 1.0;
-            if !mb.inv_augmented_mass().solve_mut(&mut e) {
+            let Some(e) = inverse_column(mb, dofs[k]) else {
                 return;
-            }
+            };
             columns.push(e);
         }
         let m = set.len();
@@ -246,4 +244,13 @@ impl LeoModel {
         }
         Ok(torque)
     }
+}
+
+/// Column `dof` of A⁻¹, with A the matrix rapier factorised in its last
+/// step (mass, armature, h·damping, h²·springs); `None` where the
+/// factorisation cannot solve.
+pub(super) fn inverse_column(mb: &Multibody, dof: usize) -> Option<rapier3d::na::DVector<f32>> {
+    let mut e = rapier3d::na::DVector::<f32>::zeros(mb.ndofs());
+    e[dof] = 1.0;
+    mb.inv_augmented_mass().solve_mut(&mut e).then_some(e)
 }
