@@ -21,7 +21,7 @@
 //!   ([`Plant::gearbox_torques`]).
 
 use super::agent_setup::{build_agent, HostAgent};
-use super::governed::{GovernorTrial, TrialGovernor};
+use super::governed::TrialGovernor;
 use super::measured::{robot_mtbf_s, TrialCounts};
 use super::config::RunConfig;
 use crate::board::fault_line::{fault_explained, Faulted};
@@ -37,93 +37,9 @@ use pada_core::fatigue::{FatigueCounter, PAPER_WINDOW_STEPS};
 use pada_core::tile_coding::MAX_STATE_DIMS;
 use pada_core::wire::{self, RunMode, StepKind, ToHost};
 use rand_pcg::Pcg64;
-use serde::Serialize;
 
-/// One point of a learning curve.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct TestPoint {
-    /// Learning time before this test run \[s of simulated time\].
-    pub learning_time_s: f64,
-    /// Learning episodes before this test run.
-    pub learning_episodes: u32,
-    /// Sum of the rewards of the greedy test run.
-    pub test_return: f64,
-    /// Distance walked in the test run \[m\] (walking tasks only).
-    pub walked_m: Option<f64>,
-    /// Whether the test run ended in an absorbing state (a fall).
-    pub fell: bool,
-    /// Duration of the test run \[s\].
-    pub duration_s: f64,
-    /// Slots of the claim table claimed before this test run (claim
-    /// tables only: what the learning so far has written).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub claimed_slots: Option<u32>,
-}
-
-/// Everything measured in one trial.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct TrialResult {
-    /// Trial index within the run.
-    pub trial: u32,
-    /// The trial's seed (derived from the master seed).
-    pub seed: u64,
-    /// End performance: mean return of the last 10% of test runs.
-    pub end_performance: f64,
-    /// Rise time \[s of learning time\].
-    pub rise_time_s: f64,
-    /// Predicted MTBF from the first 1200 learning actions \[s\], the
-    /// paper's definition: torques from the commanded action (infinite when
-    /// nothing re-engaged).
-    pub mtbf_s: f64,
-    /// Backlash re-engagements within those actions (all gearboxes), the
-    /// paper's definition.
-    pub window_reengagements: u64,
-    /// Predicted MTBF over all learning actions of the trial \[s\], the
-    /// paper's torques: how the learner wears the gearbox once it knows
-    /// more (the window's MTBF is its first minute).
-    pub run_mtbf_s: f64,
-    /// Predicted MTBF from the first 1200 learning actions \[s\], from the
-    /// simulated gear torques.
-    pub physical_mtbf_s: f64,
-    /// Re-engagements of the simulated gear torques within those actions.
-    pub physical_window_reengagements: u64,
-    /// Each counted gearbox's `mtbf_s`, in the robot's counted-joint order
-    /// (the robot's is the smallest); empty where not measured (results
-    /// stored by a plan).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub joint_mtbf_s: Vec<f64>,
-    /// Each counted gearbox's `physical_mtbf_s`, as `joint_mtbf_s`.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub physical_joint_mtbf_s: Vec<f64>,
-    /// Learning steps taken.
-    pub learning_steps: u64,
-    /// Test-run steps taken.
-    pub test_steps: u64,
-    /// Learning episodes that ended in an absorbing state (falls).
-    pub learning_falls: u64,
-    /// Learning episodes.
-    pub learning_episodes: u32,
-    /// Test runs that ended in an absorbing state (falls).
-    pub test_falls: u32,
-    /// Mean distance walked in the last 10% of the test runs \[m\]
-    /// (walking tasks only).
-    pub end_walked_m: Option<f64>,
-    /// Mean speed of the last 10% of the test runs, distance over duration
-    /// \[m/s\] (walking tasks only).
-    pub end_speed_m_s: Option<f64>,
-    /// Weight writes that saturated the fixed-point range (should be 0).
-    pub saturations: u32,
-    /// Trace entries dropped for capacity (should be 0).
-    pub trace_drops: u32,
-    /// The claim table's occupancy at the end (claim tables only).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub table: Option<pada_core::claim_table::Occupancy>,
-    /// What the wear governor did, when one ran (`--mtbf-budget`).
-    pub governor: Option<GovernorTrial>,
-    /// The learning curve.
-    #[serde(skip)]
-    pub curve: Vec<TestPoint>,
-}
+/// The result types, with their one constructor ([`TrialResult::measured`]).
+pub use super::measured::{TestPoint, TrialResult};
 
 /// Receives the trial as telemetry: a `Step` for every agent call and an
 /// `Episode` for every episode, as the firmware reports them
