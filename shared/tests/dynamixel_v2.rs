@@ -326,6 +326,31 @@ fn accounting_holds(stats: &DecoderStats, fed: usize, accepted: usize, buffered:
     assert_eq!(counted as usize, errs, "{stats:?}");
 }
 
+/// A decoder's results counted: `(packets, errors, bytes of the packets)`.
+/// Each packet, encoded again by `reencode`, must stand in `bytes` as it
+/// was, and pass `check`.
+fn tally<P, E>(
+    results: impl Iterator<Item = Result<P, E>>,
+    bytes: &[u8],
+    reencode: impl Fn(&P) -> Vec<u8>,
+    mut check: impl FnMut(&P) -> Result<(), TestCaseError>,
+) -> Result<(usize, usize, usize), TestCaseError> {
+    let (mut oks, mut errs, mut accepted) = (0, 0, 0);
+    for r in results {
+        match r {
+            Ok(p) => {
+                oks += 1;
+                let enc = reencode(&p);
+                prop_assert!(bytes.windows(enc.len()).any(|w| w == enc));
+                accepted += enc.len();
+                check(&p)?;
+            }
+            Err(_) => errs += 1,
+        }
+    }
+    Ok((oks, errs, accepted))
+}
+
 fn status_strategy() -> impl Strategy<Value = Status> {
     let byte = prop_oneof![Just(0xFFu8), Just(0xFD), Just(0x00), any::<u8>()];
     (0u8..=252, any::<u8>(), proptest::collection::vec(byte, 0..40))
@@ -410,35 +435,17 @@ proptest! {
         }
         let mut dec = StatusDecoder::<64>::new();
         dec.expect(expect.map(|(id, params)| Reply::status(id, params)));
-        let (mut oks, mut errs, mut accepted) = (0, 0, 0);
-        for r in dec.feed(&bytes) {
-            match r {
-                Ok(p) => {
-                    oks += 1;
-                    let enc = p.encode(&mut buf).unwrap();
-                    prop_assert!(bytes.windows(enc.len()).any(|w| w == enc));
-                    accepted += enc.len();
-                    if let Some((id, params)) = expect {
-                        prop_assert_eq!((p.id, p.params.len()), (id, params as usize));
-                    }
-                }
-                Err(_) => errs += 1,
+        let reencode = |p: &StatusPacket<64>| p.encode(&mut [0u8; 300]).unwrap().to_vec();
+        let (oks, errs, accepted) = tally(dec.feed(&bytes), &bytes, reencode, |p| {
+            if let Some((id, params)) = expect {
+                prop_assert_eq!((p.id, p.params.len()), (id, params as usize));
             }
-        }
+            Ok(())
+        })?;
         accounting_holds(&dec.stats(), bytes.len(), accepted, dec.buffered(), oks, errs);
         let mut ins = InstructionDecoder::<64>::new();
-        let (mut oks, mut errs, mut accepted) = (0, 0, 0);
-        for r in ins.feed(&bytes) {
-            match r {
-                Ok(p) => {
-                    oks += 1;
-                    let enc = p.encode(&mut buf).unwrap();
-                    prop_assert!(bytes.windows(enc.len()).any(|w| w == enc));
-                    accepted += enc.len();
-                }
-                Err(_) => errs += 1,
-            }
-        }
+        let reencode = |p: &InstructionPacket<64>| p.encode(&mut [0u8; 300]).unwrap().to_vec();
+        let (oks, errs, accepted) = tally(ins.feed(&bytes), &bytes, reencode, |_| Ok(()))?;
         accounting_holds(&ins.stats(), bytes.len(), accepted, ins.buffered(), oks, errs);
     }
 

@@ -5,7 +5,6 @@
 
 use super::{MemoryFault, TableMemory};
 use embassy_stm32::peripherals::*;
-use embassy_stm32::time::Hertz;
 use embassy_stm32::{bind_interrupts, dma, usart, Config, Peri, Peripherals};
 
 /// Core clock: 8 MHz HSE → PLL → 168 MHz (APB1 42 MHz, APB2 84 MHz).
@@ -23,27 +22,11 @@ bind_interrupts!(pub struct Irqs {
 /// The timer that counts the encoder.
 pub type EncoderTimer = TIM3;
 
-/// The clocks.
+/// The clocks: 8 MHz / 4 = 2 MHz × 168 = 336 MHz VCO; /2 = 168 MHz; /7 =
+/// 48 MHz.
 pub fn clock_config() -> Config {
-    use embassy_stm32::rcc::{
-        AHBPrescaler, APBPrescaler, Hse, HseMode, Pll, PllMul, PllPDiv, PllPreDiv, PllQDiv, PllSource, Sysclk,
-    };
-    let mut config = Config::default();
-    config.rcc.hse = Some(Hse { freq: Hertz(8_000_000), mode: HseMode::Oscillator });
-    config.rcc.pll_src = PllSource::HSE;
-    // 8 MHz / 4 = 2 MHz × 168 = 336 MHz VCO; /2 = 168 MHz; /7 = 48 MHz.
-    config.rcc.pll = Some(Pll {
-        prediv: PllPreDiv::DIV4,
-        mul: PllMul::MUL168,
-        divp: Some(PllPDiv::DIV2),
-        divq: Some(PllQDiv::DIV7),
-        divr: None,
-    });
-    config.rcc.sys = Sysclk::PLL1_P;
-    config.rcc.ahb_pre = AHBPrescaler::DIV1;
-    config.rcc.apb1_pre = APBPrescaler::DIV4;
-    config.rcc.apb2_pre = APBPrescaler::DIV2;
-    config
+    use embassy_stm32::rcc::{PllMul, PllQDiv};
+    super::f4_clocks::hse_pll_config(PllMul::MUL168, Some(PllQDiv::DIV7))
 }
 
 /// Whether the LED lights on a high level.

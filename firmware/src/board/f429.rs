@@ -8,7 +8,6 @@ use super::sdram::{self, DiscSdram};
 use super::{MemoryFault, TableMemory};
 use embassy_stm32::fmc::Fmc;
 use embassy_stm32::peripherals::*;
-use embassy_stm32::time::Hertz;
 use embassy_stm32::{bind_interrupts, dma, usart, Config, Peri, Peripherals};
 use pada_core::profile::Memory;
 use stm32_fmc::devices::is42s16400j_7::Is42s16400j;
@@ -33,31 +32,13 @@ bind_interrupts!(pub struct Irqs {
 /// The timer that counts the encoder.
 pub type EncoderTimer = TIM2;
 
-/// The clocks.
+/// The clocks, from the DISC1's X2 crystal (UM1670; not the ST-LINK's
+/// MCO): 8 MHz / 4 = 2 MHz × 180 = 360 MHz VCO; /2 = 180 MHz. No USB, so
+/// no 48 MHz output (360 MHz has no integer divider to it). embassy-stm32
+/// switches the regulator to scale 1 and over-drive, which 180 MHz needs
+/// (RM0090 5.1.4), and sets five flash wait states.
 pub fn clock_config() -> Config {
-    use embassy_stm32::rcc::{
-        AHBPrescaler, APBPrescaler, Hse, HseMode, Pll, PllMul, PllPDiv, PllPreDiv, PllSource, Sysclk,
-    };
-    let mut config = Config::default();
-    // The DISC1's X2 crystal (UM1670); not the ST-LINK's MCO.
-    config.rcc.hse = Some(Hse { freq: Hertz(8_000_000), mode: HseMode::Oscillator });
-    config.rcc.pll_src = PllSource::HSE;
-    // 8 MHz / 4 = 2 MHz × 180 = 360 MHz VCO; /2 = 180 MHz. No USB, so no
-    // 48 MHz output (360 MHz has no integer divider to it). embassy-stm32
-    // switches the regulator to scale 1 and over-drive, which 180 MHz
-    // needs (RM0090 5.1.4), and sets five flash wait states.
-    config.rcc.pll = Some(Pll {
-        prediv: PllPreDiv::DIV4,
-        mul: PllMul::MUL180,
-        divp: Some(PllPDiv::DIV2),
-        divq: None,
-        divr: None,
-    });
-    config.rcc.sys = Sysclk::PLL1_P;
-    config.rcc.ahb_pre = AHBPrescaler::DIV1;
-    config.rcc.apb1_pre = APBPrescaler::DIV4;
-    config.rcc.apb2_pre = APBPrescaler::DIV2;
-    config
+    super::f4_clocks::hse_pll_config(embassy_stm32::rcc::PllMul::MUL180, None)
 }
 
 /// Whether the LED lights on a high level (LD3 between PG13 and ground).

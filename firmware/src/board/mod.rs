@@ -92,6 +92,10 @@ mod hw;
 #[cfg(not(emulated))]
 pub use hw::*;
 
+// The clock tree of both STM32F4 boards.
+#[cfg(not(emulated))]
+mod f4_clocks;
+
 #[cfg(any(feature = "stm32f405", feature = "stm32f407"))]
 mod f40x;
 #[cfg(any(feature = "stm32f405", feature = "stm32f407"))]

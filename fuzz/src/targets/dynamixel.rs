@@ -4,6 +4,7 @@
 //! them, in either instruction table that rides on Protocol 1.0's framing
 //! ([`Dialect`]: Dynamixel 1.0's, Feetech's).
 
+use super::tally::{accept, Tally};
 use super::{ensure, Outcome, Target};
 use crate::gen::{below, bytes, mutate};
 use pada_core::dynamixel::{
@@ -112,30 +113,10 @@ fn packets(
     out
 }
 
-/// Checks the counters against what the decoder returned and the bytes it
-/// was fed: every byte is in an accepted packet, skipped or buffered, and
-/// every refusal is counted once.
-fn check_counts(
-    s: &DecoderStats,
-    fed: usize,
-    accepted_bytes: usize,
-    buffered: usize,
-    oks: u32,
-    errs: [u32; 3],
-) -> Outcome {
-    ensure!(
-        s.packets == oks,
-        "packets {} counted, {oks} returned",
-        s.packets
-    );
-    let counted = [s.bad_checksums, s.bad_lengths, s.unexpected_ids];
-    ensure!(
-        counted == errs,
-        "refusals counted {counted:?}, returned {errs:?}"
-    );
-    let kept = s.skipped_bytes as usize + accepted_bytes + buffered;
-    ensure!(kept == fed, "{fed} bytes fed, {kept} accounted for (skipped {}, in packets {accepted_bytes}, buffered {buffered})", s.skipped_bytes);
-    Outcome::Ok
+/// Checks the decoder's counters against `tally` and the `fed` bytes.
+fn check_counts(s: &DecoderStats, fed: usize, buffered: usize, tally: &Tally<3>) -> Outcome {
+    let refusals = [s.bad_checksums, s.bad_lengths, s.unexpected_ids];
+    tally.check(s.packets, refusals, s.skipped_bytes, fed, buffered)
 }
 
 fn kind(e: &DecodeError) -> usize {
@@ -144,11 +125,6 @@ fn kind(e: &DecodeError) -> usize {
         DecodeError::BadLength { .. } => 1,
         DecodeError::UnexpectedId { .. } | DecodeError::BroadcastStatus => 2,
     }
-}
-
-/// Whether `needle` occurs in `hay`.
-fn contains(hay: &[u8], needle: &[u8]) -> bool {
-    hay.windows(needle.len()).any(|w| w == needle)
 }
 
 impl<const N: usize> Target for Status<N> {
@@ -182,25 +158,20 @@ impl<const N: usize> Target for Status<N> {
         let reply = (mode & 1 == 1).then_some(Reply { id, params });
         let mut dec = StatusDecoder::<N>::new();
         dec.expect(reply);
-        let (mut oks, mut errs, mut accepted) = (0u32, [0u32; 3], 0usize);
+        let mut tally = Tally::<3>::new();
         let mut buf = [0u8; 300];
         for (i, &b) in stream.iter().enumerate() {
             let mut next = dec.push(b);
             while let Some(r) = next {
                 match r {
                     Ok(p) => {
-                        oks += 1;
                         // Invariant 2: it re-encodes to bytes that were fed.
-                        let Ok(bytes) = p.encode(&mut buf) else {
-                            return Outcome::Failed(format!(
-                                "accepted packet at byte {i} does not encode"
-                            ));
-                        };
-                        ensure!(
-                            contains(&stream[..=i], bytes),
-                            "accepted packet at byte {i} was never fed"
+                        accept!(
+                            tally,
+                            p.encode(&mut buf),
+                            &stream[..=i],
+                            format_args!("at byte {i}")
                         );
-                        accepted += bytes.len();
                         if let Some(r) = reply {
                             ensure!(
                                 p.id == r.id && p.params.len() == r.params as usize,
@@ -208,19 +179,12 @@ impl<const N: usize> Target for Status<N> {
                             );
                         }
                     }
-                    Err(e) => errs[kind(&e)] += 1,
+                    Err(e) => tally.refuse(kind(&e)),
                 }
                 next = dec.poll();
             }
         }
-        check_counts(
-            &dec.stats(),
-            stream.len(),
-            accepted,
-            dec.buffered(),
-            oks,
-            errs,
-        )
+        check_counts(&dec.stats(), stream.len(), dec.buffered(), &tally)
     }
 }
 
@@ -260,17 +224,12 @@ impl<const N: usize> Target for Instructions<N> {
 
     fn check(&self, stream: &[u8]) -> Outcome {
         let mut dec = InstructionDecoder::<N>::new();
-        let (mut oks, mut errs, mut accepted) = (0u32, [0u32; 3], 0usize);
+        let mut tally = Tally::<3>::new();
         let (mut buf, mut again) = ([0u8; 300], [0u8; 300]);
         for (i, p) in dec.feed(stream).enumerate() {
             match p {
                 Ok(p) => {
-                    oks += 1;
-                    let Ok(bytes) = p.encode(&mut buf) else {
-                        return Outcome::Failed(format!("accepted packet {i} does not encode"));
-                    };
-                    ensure!(contains(stream, bytes), "accepted packet {i} was never fed");
-                    accepted += bytes.len();
+                    let bytes = accept!(tally, p.encode(&mut buf), stream, i);
                     // The encoder and the parser agree: what parses encodes
                     // back to the same packet.
                     let same = self.dialect.round_trip(p.id, p.code, &p.params, bytes, &mut again);
@@ -281,16 +240,9 @@ impl<const N: usize> Target for Instructions<N> {
                         p.params
                     );
                 }
-                Err(e) => errs[kind(&e)] += 1,
+                Err(e) => tally.refuse(kind(&e)),
             }
         }
-        check_counts(
-            &dec.stats(),
-            stream.len(),
-            accepted,
-            dec.buffered(),
-            oks,
-            errs,
-        )
+        check_counts(&dec.stats(), stream.len(), dec.buffered(), &tally)
     }
 }

@@ -6,6 +6,7 @@
 //! fast reply's blocks, the instructions, the control table's write
 //! checks).
 
+use super::tally::{accept, Tally};
 use super::{ensure, Outcome, Target};
 use crate::gen::{below, bytes, mutate};
 use pada_core::dynamixel::control_table::x_series::XM430_W350;
@@ -137,20 +138,10 @@ fn kind(e: &DecodeError) -> usize {
     }
 }
 
-/// Every byte fed is in an accepted packet, skipped or buffered, and every
-/// refusal is counted once, in its own counter.
-fn check_counts(s: &DecoderStats, fed: usize, accepted: usize, buffered: usize, oks: u32, errs: [u32; 5]) -> Outcome {
-    ensure!(s.packets == oks, "packets {} counted, {oks} returned", s.packets);
-    let counted = [s.bad_crcs, s.bad_lengths, s.unexpected_ids, s.not_status, s.bad_stuffing];
-    ensure!(counted == errs, "refusals counted {counted:?}, returned {errs:?}");
-    let kept = s.skipped_bytes as usize + accepted + buffered;
-    ensure!(kept == fed, "{fed} bytes fed, {kept} accounted for (skipped {}, in packets {accepted}, buffered {buffered})", s.skipped_bytes);
-    Outcome::Ok
-}
-
-/// Whether `needle` occurs in `hay`.
-fn contains(hay: &[u8], needle: &[u8]) -> bool {
-    hay.windows(needle.len()).any(|w| w == needle)
+/// Checks the decoder's counters against `tally` and the `fed` bytes.
+fn check_counts(s: &DecoderStats, fed: usize, buffered: usize, tally: &Tally<5>) -> Outcome {
+    let refusals = [s.bad_crcs, s.bad_lengths, s.unexpected_ids, s.not_status, s.bad_stuffing];
+    tally.check(s.packets, refusals, s.skipped_bytes, fed, buffered)
 }
 
 /// The status side: the first four input bytes say what the decoder
@@ -206,19 +197,14 @@ impl<const N: usize> Target for Status<N> {
         let fast_len = (mode as u16 >> 1) % 8 + 1;
         let mut dec = StatusDecoder::<N>::new();
         dec.expect(reply);
-        let (mut oks, mut errs, mut accepted) = (0u32, [0u32; 5], 0usize);
+        let mut tally = Tally::<5>::new();
         let mut buf = vec![0u8; N + 16];
         for (i, &b) in stream.iter().enumerate() {
             let mut next = dec.push(b);
             while let Some(r) = next {
                 match r {
                     Ok(p) => {
-                        oks += 1;
-                        let Ok(bytes) = p.encode(&mut buf) else {
-                            return Outcome::Failed(format!("accepted packet at byte {i} does not encode"));
-                        };
-                        ensure!(contains(&stream[..=i], bytes), "accepted packet at byte {i} was never fed");
-                        accepted += bytes.len();
+                        accept!(tally, p.encode(&mut buf), &stream[..=i], format_args!("at byte {i}"));
                         if let Some(r) = reply {
                             ensure!(p.id == r.id && p.params.len() == r.params as usize, "accepted {p:?}, expected {r:?}");
                         }
@@ -232,12 +218,12 @@ impl<const N: usize> Target for Status<N> {
                             }
                         }
                     }
-                    Err(e) => errs[kind(&e)] += 1,
+                    Err(e) => tally.refuse(kind(&e)),
                 }
                 next = dec.poll();
             }
         }
-        check_counts(&dec.stats(), stream.len(), accepted, dec.buffered(), oks, errs)
+        check_counts(&dec.stats(), stream.len(), dec.buffered(), &tally)
     }
 }
 
@@ -276,7 +262,7 @@ impl<const N: usize> Target for Instructions<N> {
 
     fn check(&self, stream: &[u8]) -> Outcome {
         let mut dec = InstructionDecoder::<N>::new();
-        let (mut oks, mut errs, mut accepted) = (0u32, [0u32; 5], 0usize);
+        let mut tally = Tally::<5>::new();
         let (mut buf, mut again) = (vec![0u8; N + 16], vec![0u8; N + 16]);
         // A servo's table image for the write checks (XM430-W350 defaults
         // of the limits that matter).
@@ -286,12 +272,7 @@ impl<const N: usize> Target for Instructions<N> {
         for (i, p) in dec.feed(stream).enumerate() {
             match p {
                 Ok(p) => {
-                    oks += 1;
-                    let Ok(bytes) = p.encode(&mut buf) else {
-                        return Outcome::Failed(format!("accepted packet {i} does not encode"));
-                    };
-                    ensure!(contains(stream, bytes), "accepted packet {i} was never fed");
-                    accepted += bytes.len();
+                    let bytes = accept!(tally, p.encode(&mut buf), stream, i);
                     // What parses encodes back to the same packet.
                     if let Ok(ins) = p.instruction() {
                         let enc = ins.encode(p.id, &mut again);
@@ -306,9 +287,9 @@ impl<const N: usize> Target for Instructions<N> {
                         }
                     }
                 }
-                Err(e) => errs[kind(&e)] += 1,
+                Err(e) => tally.refuse(kind(&e)),
             }
         }
-        check_counts(&dec.stats(), stream.len(), accepted, dec.buffered(), oks, errs)
+        check_counts(&dec.stats(), stream.len(), dec.buffered(), &tally)
     }
 }

@@ -6,6 +6,7 @@ mod claim_table;
 mod dynamixel;
 mod dynamixel_v2;
 mod stream;
+mod tally;
 mod wire;
 
 use crate::gen::Corpus;

@@ -40,6 +40,7 @@
 pub mod control_table;
 pub mod decoder;
 pub mod packet;
+pub mod status_packet;
 pub mod table;
 pub mod v2;
 

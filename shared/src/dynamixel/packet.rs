@@ -474,32 +474,16 @@ pub fn sync_write_u16<'b>(addr: u8, entries: &[(u8, u16)], out: &'b mut [u8]) ->
     Ok(&out[..total])
 }
 
-/// A status packet (the servo's answer), owning up to `N` parameter bytes.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct StatusPacket<const N: usize = DEFAULT_PACKET_LEN> {
-    /// The answering servo.
-    pub id: u8,
-    /// The error bits.
-    pub error: ErrorFlags,
-    /// The data read (empty for answers to PING and WRITE).
-    pub params: Vec<u8, N>,
-}
+/// A status packet (the servo's answer), owning up to `N` parameter bytes:
+/// the two protocols' [`super::status_packet::StatusPacket`] with Protocol
+/// 1.0's error byte.
+pub type StatusPacket<const N: usize = DEFAULT_PACKET_LEN> = super::status_packet::StatusPacket<ErrorFlags, N>;
 
 impl<const N: usize> StatusPacket<N> {
     /// A status packet with `params` (which must fit `N`).
     pub fn new(id: u8, error: ErrorFlags, params: &[u8]) -> Result<Self, EncodeError> {
         let params = Vec::from_slice(params).map_err(|_| EncodeError::TooManyParams { params: params.len() })?;
         Ok(StatusPacket { id, error, params })
-    }
-
-    /// Parameter byte `i`.
-    pub fn u8_at(&self, i: usize) -> Option<u8> {
-        self.params.get(i).copied()
-    }
-
-    /// Little-endian 16-bit value at parameter bytes `i, i+1`.
-    pub fn u16_at(&self, i: usize) -> Option<u16> {
-        Some(u16::from_le_bytes([*self.params.get(i)?, *self.params.get(i + 1)?]))
     }
 
     /// Encodes the packet (bus-emulator side) into `out`.

@@ -15,67 +15,116 @@
 
 use crate::error::{check_range, ConfigError};
 
-/// The policies by name, without their parameters.
-///
-/// The discriminant is the checkpoint code and the variant index on the
-/// wire, so the order is a stored format: append, never reorder.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-#[derive(serde::Serialize, serde::Deserialize)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[repr(u8)]
-pub enum PolicyName {
+/// The one table of the policies: per row, the variant (of [`PolicyName`]
+/// and [`PolicyKind`] alike), its code, the name the command line spells,
+/// the title of figures and reports, and the parameters (the
+/// [`PolicyKind`] variant's fields, in the order of
+/// [`PolicyName::parameter_names`]). It defines [`PolicyName`] and what
+/// of both types follows from the table alone.
+macro_rules! policy_table {
+    ($($(#[$doc:meta])* $variant:ident = $code:literal, $name:literal, $title:literal, [$($param:ident),*];)+) => {
+        /// The policies by name, without their parameters.
+        ///
+        /// The discriminant is the checkpoint code and the variant index on the
+        /// wire, so the order is a stored format: append, never reorder.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+        #[derive(serde::Serialize, serde::Deserialize)]
+        #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+        #[repr(u8)]
+        pub enum PolicyName {
+            $($(#[$doc])* #[serde(rename = $name)] $variant = $code,)+
+        }
+
+        impl PolicyName {
+            /// Every policy, in code order: Section V's six, then the four gentle
+            /// explorations.
+            pub const ALL: [PolicyName; POLICY_COUNT] = [$(PolicyName::$variant),+];
+
+            /// The name of `kind`.
+            pub const fn of(kind: &PolicyKind) -> PolicyName {
+                match kind {
+                    $(PolicyKind::$variant { .. } => PolicyName::$variant,)+
+                }
+            }
+
+            /// The kind of this name with `parameters` (in the order of
+            /// [`parameter_names`](Self::parameter_names); extra entries ignored).
+            /// The parameters are not checked here ([`PolicyKind::validate`]).
+            pub const fn with_parameters(self, parameters: [f32; 2]) -> PolicyKind {
+                match self {
+                    $(PolicyName::$variant => policy_table!(@kind $variant [$($param),*] parameters),)+
+                }
+            }
+
+            /// The names of the kind's parameters, as the command line spells its
+            /// flags (`--alpha`, `--delta`, `--theta`, `--sigma`, `--weight`).
+            pub const fn parameter_names(self) -> &'static [&'static str] {
+                match self {
+                    $(PolicyName::$variant => &[$(stringify!($param)),*],)+
+                }
+            }
+
+            /// The name as the command line spells it.
+            pub const fn name(self) -> &'static str {
+                match self {
+                    $(PolicyName::$variant => $name,)+
+                }
+            }
+
+            /// The name used in figures and reports.
+            pub const fn title(self) -> &'static str {
+                match self {
+                    $(PolicyName::$variant => $title,)+
+                }
+            }
+        }
+
+        impl PolicyKind {
+            /// Its parameters in the order of [`PolicyName::parameter_names`], 0
+            /// where it has none.
+            pub fn parameters(&self) -> [f32; 2] {
+                match *self {
+                    $(PolicyKind::$variant { $($param),* } => policy_table!(@pair [$($param),*]),)+
+                }
+            }
+        }
+    };
+    (@kind $variant:ident [] $p:ident) => { PolicyKind::$variant {} };
+    (@kind $variant:ident [$a:ident] $p:ident) => { PolicyKind::$variant { $a: $p[0] } };
+    (@kind $variant:ident [$a:ident, $b:ident] $p:ident) => { PolicyKind::$variant { $a: $p[0], $b: $p[1] } };
+    (@pair []) => { [0.0, 0.0] };
+    (@pair [$a:ident]) => { [$a, 0.0] };
+    (@pair [$a:ident, $b:ident]) => { [$a, $b] };
+}
+
+policy_table! {
     /// SARSA(λ): the chosen level is applied.
-    #[serde(rename = "sarsa")]
-    Sarsa = 0,
+    Sarsa = 0, "sarsa", "SARSA(λ)", [];
     /// Low-pass filtered actions (Eq. 8).
-    #[serde(rename = "lowpass")]
-    LowPass = 1,
+    LowPass = 1, "lowpass", "low-pass filter", [alpha];
     /// Low-pass filter with the previous output in the state.
-    #[serde(rename = "markov-lowpass")]
-    MarkovLowPass = 2,
+    MarkovLowPass = 2, "markov-lowpass", "Markov low-pass filter", [alpha];
     /// Integrating controller: the learner chooses −Δ, 0 or +Δ.
-    #[serde(rename = "integrator")]
-    Integrator = 3,
+    Integrator = 3, "integrator", "integrating controller", [delta];
     /// Integrating controller with the integrated command in the state.
-    #[serde(rename = "markov-integrator")]
-    MarkovIntegrator = 4,
+    MarkovIntegrator = 4, "markov-integrator", "Markov integrating controller", [delta];
     /// Previous-action-dependent actions (Eq. 9).
-    #[serde(rename = "pada")]
-    Pada = 5,
+    Pada = 5, "pada", "PADA", [delta];
     /// ε-PADA: only the exploratory draws stay within Δ of the previous
     /// action.
-    #[serde(rename = "epsilon-pada")]
-    EpsilonPada = 6,
+    EpsilonPada = 6, "epsilon-pada", "ε-PADA", [delta];
     /// Ornstein–Uhlenbeck noise on the greedy action's level.
-    #[serde(rename = "ou")]
-    OrnsteinUhlenbeck = 7,
+    OrnsteinUhlenbeck = 7, "ou", "Ornstein–Uhlenbeck noise", [theta, sigma];
     /// Pink (1/f) noise on the greedy action's level.
-    #[serde(rename = "pink")]
-    PinkNoise = 8,
+    PinkNoise = 8, "pink", "pink noise", [sigma];
     /// ε-greedy SARSA(λ) with an action-change penalty in its reward.
-    #[serde(rename = "action-penalty")]
-    ActionPenalty = 9,
+    ActionPenalty = 9, "action-penalty", "action-change penalty", [weight];
 }
 
 /// How many policies there are.
 pub const POLICY_COUNT: usize = 10;
 
 impl PolicyName {
-    /// Every policy, in code order: Section V's six, then the four gentle
-    /// explorations.
-    pub const ALL: [PolicyName; POLICY_COUNT] = [
-        PolicyName::Sarsa,
-        PolicyName::LowPass,
-        PolicyName::MarkovLowPass,
-        PolicyName::Integrator,
-        PolicyName::MarkovIntegrator,
-        PolicyName::Pada,
-        PolicyName::EpsilonPada,
-        PolicyName::OrnsteinUhlenbeck,
-        PolicyName::PinkNoise,
-        PolicyName::ActionPenalty,
-    ];
-
     /// The six policies of Section V.
     pub const PAPER: [PolicyName; 6] = [
         PolicyName::Sarsa,
@@ -86,60 +135,10 @@ impl PolicyName {
         PolicyName::Pada,
     ];
 
-    /// The name of `kind`.
-    pub const fn of(kind: &PolicyKind) -> PolicyName {
-        match kind {
-            PolicyKind::Sarsa => PolicyName::Sarsa,
-            PolicyKind::LowPass { .. } => PolicyName::LowPass,
-            PolicyKind::MarkovLowPass { .. } => PolicyName::MarkovLowPass,
-            PolicyKind::Integrator { .. } => PolicyName::Integrator,
-            PolicyKind::MarkovIntegrator { .. } => PolicyName::MarkovIntegrator,
-            PolicyKind::Pada { .. } => PolicyName::Pada,
-            PolicyKind::EpsilonPada { .. } => PolicyName::EpsilonPada,
-            PolicyKind::OrnsteinUhlenbeck { .. } => PolicyName::OrnsteinUhlenbeck,
-            PolicyKind::PinkNoise { .. } => PolicyName::PinkNoise,
-            PolicyKind::ActionPenalty { .. } => PolicyName::ActionPenalty,
-        }
-    }
-
-    /// The kind of this name with `parameters` (in the order of
-    /// [`parameter_names`](Self::parameter_names); extra entries ignored).
-    /// The parameters are not checked here ([`PolicyKind::validate`]).
-    pub const fn with_parameters(self, parameters: [f32; 2]) -> PolicyKind {
-        let [p, q] = parameters;
-        match self {
-            PolicyName::Sarsa => PolicyKind::Sarsa,
-            PolicyName::LowPass => PolicyKind::LowPass { alpha: p },
-            PolicyName::MarkovLowPass => PolicyKind::MarkovLowPass { alpha: p },
-            PolicyName::Integrator => PolicyKind::Integrator { delta: p },
-            PolicyName::MarkovIntegrator => PolicyKind::MarkovIntegrator { delta: p },
-            PolicyName::Pada => PolicyKind::Pada { delta: p },
-            PolicyName::EpsilonPada => PolicyKind::EpsilonPada { delta: p },
-            PolicyName::OrnsteinUhlenbeck => PolicyKind::OrnsteinUhlenbeck { theta: p, sigma: q },
-            PolicyName::PinkNoise => PolicyKind::PinkNoise { sigma: p },
-            PolicyName::ActionPenalty => PolicyKind::ActionPenalty { weight: p },
-        }
-    }
-
     /// The kind of this name with `parameter` as its only (or first)
     /// parameter ([`with_parameters`](Self::with_parameters)).
     pub const fn with_parameter(self, parameter: f32) -> PolicyKind {
         self.with_parameters([parameter, 0.0])
-    }
-
-    /// The names of the kind's parameters, as the command line spells its
-    /// flags (`--alpha`, `--delta`, `--theta`, `--sigma`, `--weight`).
-    pub const fn parameter_names(self) -> &'static [&'static str] {
-        match self {
-            PolicyName::Sarsa => &[],
-            PolicyName::LowPass | PolicyName::MarkovLowPass => &["alpha"],
-            PolicyName::Integrator | PolicyName::MarkovIntegrator | PolicyName::Pada | PolicyName::EpsilonPada => {
-                &["delta"]
-            }
-            PolicyName::OrnsteinUhlenbeck => &["theta", "sigma"],
-            PolicyName::PinkNoise => &["sigma"],
-            PolicyName::ActionPenalty => &["weight"],
-        }
     }
 
     /// The number that stands for the policy in a checkpoint (its
@@ -154,41 +153,9 @@ impl PolicyName {
         PolicyName::ALL.get(code as usize).copied()
     }
 
-    /// The name as the command line spells it.
-    pub const fn name(self) -> &'static str {
-        match self {
-            PolicyName::Sarsa => "sarsa",
-            PolicyName::LowPass => "lowpass",
-            PolicyName::MarkovLowPass => "markov-lowpass",
-            PolicyName::Integrator => "integrator",
-            PolicyName::MarkovIntegrator => "markov-integrator",
-            PolicyName::Pada => "pada",
-            PolicyName::EpsilonPada => "epsilon-pada",
-            PolicyName::OrnsteinUhlenbeck => "ou",
-            PolicyName::PinkNoise => "pink",
-            PolicyName::ActionPenalty => "action-penalty",
-        }
-    }
-
     /// The policy of a command-line name.
     pub fn from_name(name: &str) -> Option<PolicyName> {
         PolicyName::ALL.into_iter().find(|n| n.name() == name)
-    }
-
-    /// The name used in figures and reports.
-    pub const fn title(self) -> &'static str {
-        match self {
-            PolicyName::Sarsa => "SARSA(λ)",
-            PolicyName::LowPass => "low-pass filter",
-            PolicyName::MarkovLowPass => "Markov low-pass filter",
-            PolicyName::Integrator => "integrating controller",
-            PolicyName::MarkovIntegrator => "Markov integrating controller",
-            PolicyName::Pada => "PADA",
-            PolicyName::EpsilonPada => "ε-PADA",
-            PolicyName::OrnsteinUhlenbeck => "Ornstein–Uhlenbeck noise",
-            PolicyName::PinkNoise => "pink noise",
-            PolicyName::ActionPenalty => "action-change penalty",
-        }
     }
 
     /// Whether the policy takes α (the low-pass filters, Eq. 8).
@@ -334,22 +301,6 @@ impl PolicyKind {
         match *self {
             PolicyKind::Sarsa => None,
             _ => Some(self.parameters()[0]),
-        }
-    }
-
-    /// Its parameters in the order of [`PolicyName::parameter_names`], 0
-    /// where it has none.
-    pub fn parameters(&self) -> [f32; 2] {
-        match *self {
-            PolicyKind::Sarsa => [0.0, 0.0],
-            PolicyKind::LowPass { alpha } | PolicyKind::MarkovLowPass { alpha } => [alpha, 0.0],
-            PolicyKind::Integrator { delta }
-            | PolicyKind::MarkovIntegrator { delta }
-            | PolicyKind::Pada { delta }
-            | PolicyKind::EpsilonPada { delta } => [delta, 0.0],
-            PolicyKind::OrnsteinUhlenbeck { theta, sigma } => [theta, sigma],
-            PolicyKind::PinkNoise { sigma } => [sigma, 0.0],
-            PolicyKind::ActionPenalty { weight } => [weight, 0.0],
         }
     }
 

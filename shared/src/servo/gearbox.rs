@@ -115,153 +115,98 @@ pub const MX28_GEARBOX: Gearbox = Gearbox {
            the paper's MTBF was computed with for this gear train.",
 };
 
-/// The XM430-W350's last gear: an estimate (metal).
-pub const XM430_W350_GEARBOX: Gearbox = Gearbox {
-    name: "XM430-W350",
-    params: GearboxParams {
-        // 15 arcmin, the e-Manual's backlash: 15/60·π/180 rad.
-        theta_bl_rad: 0.004363323129985824,
-        // LEO's coupling (Table I): the robot's, not the servo's.
-        k_nm_per_rad: 106.0,
-        // Full metal gear: Table I's material assumed.
-        d: -0.262,
-        sigma_f_mpa: 4402.0,
-        // Table I's 4 mm, 0.4 mm, 18.5 mm × 28.5/35.6 (case width), 3 s.f.
-        b_mm: 3.2,
-        m_n_mm: 0.32,
-        d_w_mm: 14.8,
-        // Table I's: the same 45-tooth profile assumed.
-        y_fa: 2.15,
-        y_sa: 2.0,
-        y_epsilon: 1.22,
-        y_beta: 1.0,
-        teeth: 45,
-    },
-    sources: GearboxSources {
-        theta_bl: "e-Manual, XM430-W350: backlash 15 arcmin",
-        k: COUPLING,
-        fatigue: "estimate: Table I's (full metal gear; same material assumed)",
-        geometry: SCALED,
-        y_factors: AS_TABLE_I,
-        teeth: AS_TABLE_I,
-    },
-    estimate: true,
-    note: "Full metal gears (e-Manual). No module, width or tooth count of its \
-           last gear is published: Table I's gear scaled with the case width \
-           (28.5/35.6), Table I's material, the e-Manual's 15 arcmin backlash.",
-};
+/// Table I's gear with a model's own backlash `theta_bl_rad`, fatigue
+/// coefficient `sigma_f_mpa` and geometry `[b, m_n, d_w]` (mm), the rest
+/// Table I's: LEO's coupling k (the robot's, not the servo's), the exponent
+/// d, and the Y factors of the same 45-tooth profile. The estimates scale
+/// the geometry with the case width (the module docs), to three
+/// significant figures.
+const fn table_i_with(theta_bl_rad: f64, sigma_f_mpa: f64, geometry: [f64; 3]) -> GearboxParams {
+    let [b_mm, m_n_mm, d_w_mm] = geometry;
+    GearboxParams { theta_bl_rad, sigma_f_mpa, b_mm, m_n_mm, d_w_mm, ..GearboxParams::TABLE_I }
+}
+
+/// σ'_f of the plastic gears: 19 MPa·(2·10⁷)^0.262 (nylon 6, Toray), on
+/// Table I's exponent.
+const PLASTIC_SIGMA_F_MPA: f64 = 1555.0;
+
+/// The sources of a geometry scaled with the case width.
+const fn scaled_sources(theta_bl: &'static str, fatigue: &'static str) -> GearboxSources {
+    GearboxSources { theta_bl, k: COUPLING, fatigue, geometry: SCALED, y_factors: AS_TABLE_I, teeth: AS_TABLE_I }
+}
+
+/// A plastic X-series gear (an estimate): its case is `$width` mm wide,
+/// so its geometry `[b, m_n, d_w]` is Table I's scaled by `$width`/35.6;
+/// the e-Manual gives no backlash ("N/A"), so Table I's; σ'_f
+/// [`PLASTIC_SIGMA_F_MPA`].
+macro_rules! plastic_x_gearbox {
+    ($name:literal, width: $width:literal, $geometry:expr) => {
+        Gearbox {
+            name: $name,
+            params: table_i_with(0.01, PLASTIC_SIGMA_F_MPA, $geometry),
+            sources: scaled_sources("estimate: Table I's (the e-Manual gives none)", PLASTIC),
+            estimate: true,
+            note: concat!(
+                "Engineering-plastic gears (e-Manual); the plastic is not named. \
+           Table I's gear scaled with the case width (",
+                $width,
+                "/35.6); fatigue \
+           curve with Table I's slope through nylon 6's 19 MPa at 1e7 cycles; \
+           Table I's backlash."
+            ),
+        }
+    };
+}
+
+/// A metal gear scaled with the case width (an estimate): Table I's
+/// material, so Table I's σ'_f; its own backlash `theta_bl_rad` (with its
+/// source `theta_bl`), geometry `[b, m_n, d_w]` (mm), the source of its
+/// fatigue constants `fatigue`, and `note`.
+const fn metal_scaled_gearbox(
+    name: &'static str,
+    theta_bl_rad: f64,
+    geometry: [f64; 3],
+    [theta_bl, fatigue]: [&'static str; 2],
+    note: &'static str,
+) -> Gearbox {
+    let params = table_i_with(theta_bl_rad, GearboxParams::TABLE_I.sigma_f_mpa, geometry);
+    Gearbox { name, params, sources: scaled_sources(theta_bl, fatigue), estimate: true, note }
+}
+
+/// The XM430-W350's last gear: an estimate (metal). The e-Manual's
+/// backlash, 15 arcmin = 15/60·π/180 rad; 28.5/35.6 of Table I's geometry.
+pub const XM430_W350_GEARBOX: Gearbox = metal_scaled_gearbox(
+    "XM430-W350",
+    0.004363323129985824,
+    [3.2, 0.32, 14.8],
+    ["e-Manual, XM430-W350: backlash 15 arcmin", "estimate: Table I's (full metal gear; same material assumed)"],
+    "Full metal gears (e-Manual). No module, width or tooth count of its \
+     last gear is published: Table I's gear scaled with the case width \
+     (28.5/35.6), Table I's material, the e-Manual's 15 arcmin backlash.",
+);
 
 /// The XL430-W250's last gear: an estimate (engineering plastic).
-pub const XL430_W250_GEARBOX: Gearbox = Gearbox {
-    name: "XL430-W250",
-    params: GearboxParams {
-        // The e-Manual gives no backlash ("N/A"): Table I's.
-        theta_bl_rad: 0.01,
-        // LEO's coupling (Table I): the robot's, not the servo's.
-        k_nm_per_rad: 106.0,
-        // Table I's exponent; σ'_f = 19 MPa·(2·10⁷)^0.262 (nylon 6, Toray).
-        d: -0.262,
-        sigma_f_mpa: 1555.0,
-        // Table I's 4 mm, 0.4 mm, 18.5 mm × 28.5/35.6 (case width), 3 s.f.
-        b_mm: 3.2,
-        m_n_mm: 0.32,
-        d_w_mm: 14.8,
-        // Table I's: the same 45-tooth profile assumed.
-        y_fa: 2.15,
-        y_sa: 2.0,
-        y_epsilon: 1.22,
-        y_beta: 1.0,
-        teeth: 45,
-    },
-    sources: GearboxSources {
-        theta_bl: "estimate: Table I's (the e-Manual gives none)",
-        k: COUPLING,
-        fatigue: PLASTIC,
-        geometry: SCALED,
-        y_factors: AS_TABLE_I,
-        teeth: AS_TABLE_I,
-    },
-    estimate: true,
-    note: "Engineering-plastic gears (e-Manual); the plastic is not named. \
-           Table I's gear scaled with the case width (28.5/35.6); fatigue \
-           curve with Table I's slope through nylon 6's 19 MPa at 1e7 cycles; \
-           Table I's backlash.",
-};
+pub const XL430_W250_GEARBOX: Gearbox = plastic_x_gearbox!("XL430-W250", width: "28.5", [3.2, 0.32, 14.8]);
 
 /// The XL330-M288's last gear: an estimate (engineering plastic).
-pub const XL330_M288_GEARBOX: Gearbox = Gearbox {
-    name: "XL330-M288",
-    params: GearboxParams {
-        // The e-Manual gives no backlash ("N/A"): Table I's.
-        theta_bl_rad: 0.01,
-        // LEO's coupling (Table I): the robot's, not the servo's.
-        k_nm_per_rad: 106.0,
-        // Table I's exponent; σ'_f = 19 MPa·(2·10⁷)^0.262 (nylon 6, Toray).
-        d: -0.262,
-        sigma_f_mpa: 1555.0,
-        // Table I's 4 mm, 0.4 mm, 18.5 mm × 20.0/35.6 (case width), 3 s.f.
-        b_mm: 2.25,
-        m_n_mm: 0.225,
-        d_w_mm: 10.4,
-        // Table I's: the same 45-tooth profile assumed.
-        y_fa: 2.15,
-        y_sa: 2.0,
-        y_epsilon: 1.22,
-        y_beta: 1.0,
-        teeth: 45,
-    },
-    sources: GearboxSources {
-        theta_bl: "estimate: Table I's (the e-Manual gives none)",
-        k: COUPLING,
-        fatigue: PLASTIC,
-        geometry: SCALED,
-        y_factors: AS_TABLE_I,
-        teeth: AS_TABLE_I,
-    },
-    estimate: true,
-    note: "Engineering-plastic gears (e-Manual); the plastic is not named. \
-           Table I's gear scaled with the case width (20.0/35.6); fatigue \
-           curve with Table I's slope through nylon 6's 19 MPa at 1e7 cycles; \
-           Table I's backlash.",
-};
+pub const XL330_M288_GEARBOX: Gearbox = plastic_x_gearbox!("XL330-M288", width: "20.0", [2.25, 0.225, 10.4]);
 
 /// The Feetech STS3215's last gear: an estimate (metal gears, the metal
-/// not steel by the one listing that names it).
-pub const STS3215_GEARBOX: Gearbox = Gearbox {
-    name: "STS3215",
-    params: GearboxParams {
-        // "≤ 0.5°" (Feetech's datasheet as quoted): 0.5·π/180 rad.
-        theta_bl_rad: 0.008726646259971648,
-        // LEO's coupling (Table I): the robot's, not the servo's.
-        k_nm_per_rad: 106.0,
-        // Metal gears: Table I's material assumed (see the note).
-        d: -0.262,
-        sigma_f_mpa: 4402.0,
-        // Table I's 4 mm, 0.4 mm, 18.5 mm × 24.7/35.6 (case width), 3 s.f.
-        b_mm: 2.78,
-        m_n_mm: 0.278,
-        d_w_mm: 12.8,
-        // Table I's: the same 45-tooth profile assumed.
-        y_fa: 2.15,
-        y_sa: 2.0,
-        y_epsilon: 1.22,
-        y_beta: 1.0,
-        teeth: 45,
-    },
-    sources: GearboxSources {
-        theta_bl: "Feetech datasheet as quoted (SO-ARM100 issue 134, Robonine): backlash <= 0.5 deg",
-        k: COUPLING,
-        fatigue: "estimate: Table I's (metal gear; the listing's copper and aluminium may be weaker than the RX-28's steel)",
-        geometry: SCALED,
-        y_factors: AS_TABLE_I,
-        teeth: AS_TABLE_I,
-    },
-    estimate: true,
-    note: "Metal gears, 1/345 (Feetech's listing: \"metal tooth\"; DFRobot's: copper and \
-           aluminium). No module, width or tooth count is published: Table I's gear scaled \
-           with the case width (24.7/35.6), Table I's fatigue curve (a copper alloy's would \
-           lie lower, so the MTBF is optimistic), the datasheet's 0.5 deg backlash.",
-};
+/// not steel by the one listing that names it). "≤ 0.5°" (Feetech's
+/// datasheet as quoted): 0.5·π/180 rad; 24.7/35.6 of Table I's geometry.
+pub const STS3215_GEARBOX: Gearbox = metal_scaled_gearbox(
+    "STS3215",
+    0.008726646259971648,
+    [2.78, 0.278, 12.8],
+    [
+        "Feetech datasheet as quoted (SO-ARM100 issue 134, Robonine): backlash <= 0.5 deg",
+        "estimate: Table I's (metal gear; the listing's copper and aluminium may be weaker than the RX-28's steel)",
+    ],
+    "Metal gears, 1/345 (Feetech's listing: \"metal tooth\"; DFRobot's: copper and \
+     aluminium). No module, width or tooth count is published: Table I's gear scaled \
+     with the case width (24.7/35.6), Table I's fatigue curve (a copper alloy's would \
+     lie lower, so the MTBF is optimistic), the datasheet's 0.5 deg backlash.",
+);
 
 /// Every gearbox pada knows.
 pub static GEARBOXES: [Gearbox; 6] = [

@@ -13,7 +13,6 @@
 //! EEPROM is addresses 0–63, RAM from 64.
 
 use super::{ControlTable, Item, Limit};
-use crate::dynamixel::Protocol;
 
 /// Model Number (2, R, EEPROM).
 pub const MODEL_NUMBER: u16 = 0;
@@ -268,14 +267,16 @@ pub(super) const INDIRECT_56: [Item; 4] = [
     Item::ram("Indirect Data 29–56", 634, 1).times(28),
 ];
 
-const fn voltage_limits(min: i64, max: i64) -> [Item; 2] {
+/// Max and Min Voltage Limit, both within `min..=max` (0.1 V).
+pub(super) const fn voltage_limits(min: i64, max: i64) -> [Item; 2] {
     [
         Item::eeprom("Max Voltage Limit", MAX_VOLTAGE_LIMIT, 2).range(min, max).unit(0.1, "V"),
         Item::eeprom("Min Voltage Limit", MIN_VOLTAGE_LIMIT, 2).range(min, max).unit(0.1, "V"),
     ]
 }
 
-const fn velocity_items(max: i64) -> [Item; 2] {
+/// Velocity Limit up to `max` and Goal Velocity within ±`max`.
+pub(super) const fn velocity_items(max: i64) -> [Item; 2] {
     [
         Item::eeprom("Velocity Limit", VELOCITY_LIMIT, 4).range(0, max).unit(0.229, "rev/min"),
         Item::ram("Goal Velocity", GOAL_VELOCITY, 4)
@@ -296,160 +297,106 @@ const fn current_items(max: i64, ma: f32) -> [Item; 3] {
     ]
 }
 
-const XM430_VOLTS: [Item; 2] = voltage_limits(95, 160);
-const XM430_VELOCITY: [Item; 2] = velocity_items(1023);
-const XM430_CURRENT: [Item; 3] = current_items(1193, 2.69);
+/// A control table with the X series' layout (the X series and the
+/// MX(2.0)): the items every such model has, listed once by address; the
+/// arguments are what differs between models. `current: [limit, goal,
+/// present]` gives a current sensor's three items ([`current_items`]);
+/// `load` puts Present Load at 126 instead and no current items.
+macro_rules! x_layout_table {
+    (
+        $model:literal, $number:literal, baud: $baud_max:literal of $bauds:expr, drive_mask: $mask:literal,
+        modes: $modes:expr, volts: $volts:expr, velocity: $vel:expr, current: $cur:expr,
+        indirect: [$($ind:expr),+], end: $end:literal $(,)?
+    ) => {
+        x_layout_table!(@table $model, $number, $baud_max, $bauds, $mask, $modes, $volts, $vel,
+            [$cur[0],], [$cur[1],], $cur[2], [$($ind),+], $end)
+    };
+    (
+        $model:literal, $number:literal, baud: $baud_max:literal of $bauds:expr, drive_mask: $mask:literal,
+        modes: $modes:expr, volts: $volts:expr, velocity: $vel:expr, load,
+        indirect: [$($ind:expr),+], end: $end:literal $(,)?
+    ) => {
+        x_layout_table!(@table $model, $number, $baud_max, $bauds, $mask, $modes, $volts, $vel,
+            [], [], $crate::dynamixel::control_table::x_series::PRESENT_LOAD_ITEM, [$($ind),+], $end)
+    };
+    (
+        @table $model:literal, $number:literal, $baud_max:literal, $bauds:expr, $mask:literal, $modes:expr,
+        $volts:expr, $vel:expr, [$($cur_limit:expr,)?], [$($cur_goal:expr,)?], $present_126:expr,
+        [$($ind:expr),+], $end:literal
+    ) => {{
+        use $crate::dynamixel::control_table::{x_series as x, ControlTable, Item};
+        ControlTable {
+            model: $model,
+            model_number: $number,
+            protocol: $crate::dynamixel::Protocol::V2,
+            items: &[
+                x::MODEL,
+                x::FIRMWARE,
+                x::ID_ITEM,
+                Item::eeprom("Baud Rate", x::BAUD_RATE, 1).range(0, $baud_max),
+                x::RETURN_DELAY,
+                Item::eeprom("Drive Mode", x::DRIVE_MODE, 1).mask($mask),
+                Item::eeprom("Operating Mode", x::OPERATING_MODE, 1).one_of($modes),
+                x::HOMING,
+                x::TEMP_LIMIT,
+                $volts[0],
+                $volts[1],
+                x::PWM_LIMIT_ITEM,
+                $($cur_limit,)?
+                $vel[0],
+                x::MAX_POSITION,
+                x::MIN_POSITION,
+                x::SHUTDOWN_ITEM,
+                x::TORQUE,
+                x::LED_ITEM,
+                x::RETURN_LEVEL,
+                x::REGISTERED,
+                x::HW_ERROR,
+                x::WATCHDOG,
+                x::GOAL_PWM_ITEM,
+                $($cur_goal,)?
+                $vel[1],
+                x::GOAL_POSITION_ITEM,
+                x::PRESENT_PWM_ITEM,
+                $present_126,
+                x::PRESENT_VELOCITY_ITEM,
+                x::PRESENT_POSITION_ITEM,
+                x::PRESENT_VOLTAGE_ITEM,
+                x::PRESENT_TEMPERATURE_ITEM,
+                $($ind),+
+            ],
+            baud_rates: &$bauds,
+            end: $end,
+            torque_enable: x::TORQUE_ENABLE,
+            operating_mode: x::OPERATING_MODE,
+        }
+    }};
+}
+pub(super) use x_layout_table;
 
 /// XM430-W350 (model 1020): current sensor (2.69 mA units), 10–14.8 V.
-pub static XM430_W350: ControlTable = ControlTable {
-    model: "XM430-W350",
-    model_number: 1020,
-    protocol: Protocol::V2,
-    items: &[
-        MODEL,
-        FIRMWARE,
-        ID_ITEM,
-        Item::eeprom("Baud Rate", BAUD_RATE, 1).range(0, 7),
-        RETURN_DELAY,
-        Item::eeprom("Drive Mode", DRIVE_MODE, 1).mask(0x0D),
-        Item::eeprom("Operating Mode", OPERATING_MODE, 1).one_of(OPERATING_MODES_ALL),
-        HOMING,
-        TEMP_LIMIT,
-        XM430_VOLTS[0],
-        XM430_VOLTS[1],
-        PWM_LIMIT_ITEM,
-        XM430_CURRENT[0],
-        XM430_VELOCITY[0],
-        MAX_POSITION,
-        MIN_POSITION,
-        SHUTDOWN_ITEM,
-        TORQUE,
-        LED_ITEM,
-        RETURN_LEVEL,
-        REGISTERED,
-        HW_ERROR,
-        WATCHDOG,
-        GOAL_PWM_ITEM,
-        XM430_CURRENT[1],
-        XM430_VELOCITY[1],
-        GOAL_POSITION_ITEM,
-        PRESENT_PWM_ITEM,
-        XM430_CURRENT[2],
-        PRESENT_VELOCITY_ITEM,
-        PRESENT_POSITION_ITEM,
-        PRESENT_VOLTAGE_ITEM,
-        PRESENT_TEMPERATURE_ITEM,
-        INDIRECT_56[0],
-        INDIRECT_56[1],
-        INDIRECT_56[2],
-        INDIRECT_56[3],
-    ],
-    baud_rates: &BAUD_RATES_X430,
-    end: 662,
-    torque_enable: TORQUE_ENABLE,
-    operating_mode: OPERATING_MODE,
-};
-
-const XL430_VOLTS: [Item; 2] = voltage_limits(60, 140);
+pub static XM430_W350: ControlTable = x_layout_table!(
+    "XM430-W350", 1020, baud: 7 of BAUD_RATES_X430, drive_mask: 0x0D, modes: OPERATING_MODES_ALL,
+    volts: voltage_limits(95, 160), velocity: velocity_items(1023), current: current_items(1193, 2.69),
+    indirect: [INDIRECT_56[0], INDIRECT_56[1], INDIRECT_56[2], INDIRECT_56[3]], end: 662,
+);
 
 /// XL430-W250 (model 1060): no current sensor, so no Current Limit or Goal
 /// Current, and Present Load (0.1 %) at 126; 6.5–12 V.
-pub static XL430_W250: ControlTable = ControlTable {
-    model: "XL430-W250",
-    model_number: 1060,
-    protocol: Protocol::V2,
-    items: &[
-        MODEL,
-        FIRMWARE,
-        ID_ITEM,
-        Item::eeprom("Baud Rate", BAUD_RATE, 1).range(0, 7),
-        RETURN_DELAY,
-        Item::eeprom("Drive Mode", DRIVE_MODE, 1).mask(0x0D),
-        Item::eeprom("Operating Mode", OPERATING_MODE, 1).one_of(OPERATING_MODES_NO_CURRENT),
-        HOMING,
-        TEMP_LIMIT,
-        XL430_VOLTS[0],
-        XL430_VOLTS[1],
-        PWM_LIMIT_ITEM,
-        XM430_VELOCITY[0],
-        MAX_POSITION,
-        MIN_POSITION,
-        SHUTDOWN_ITEM,
-        TORQUE,
-        LED_ITEM,
-        RETURN_LEVEL,
-        REGISTERED,
-        HW_ERROR,
-        WATCHDOG,
-        GOAL_PWM_ITEM,
-        XM430_VELOCITY[1],
-        GOAL_POSITION_ITEM,
-        PRESENT_PWM_ITEM,
-        PRESENT_LOAD_ITEM,
-        PRESENT_VELOCITY_ITEM,
-        PRESENT_POSITION_ITEM,
-        PRESENT_VOLTAGE_ITEM,
-        PRESENT_TEMPERATURE_ITEM,
-        INDIRECT_56[0],
-        INDIRECT_56[1],
-        INDIRECT_56[2],
-        INDIRECT_56[3],
-    ],
-    baud_rates: &BAUD_RATES_X430,
-    end: 662,
-    torque_enable: TORQUE_ENABLE,
-    operating_mode: OPERATING_MODE,
-};
-
-const XL330_VOLTS: [Item; 2] = voltage_limits(31, 70);
-const XL330_VELOCITY: [Item; 2] = velocity_items(2047);
-const XL330_CURRENT: [Item; 3] = current_items(1750, 1.0);
+pub static XL430_W250: ControlTable = x_layout_table!(
+    "XL430-W250", 1060, baud: 7 of BAUD_RATES_X430, drive_mask: 0x0D, modes: OPERATING_MODES_NO_CURRENT,
+    volts: voltage_limits(60, 140), velocity: velocity_items(1023), load,
+    indirect: [INDIRECT_56[0], INDIRECT_56[1], INDIRECT_56[2], INDIRECT_56[3]], end: 662,
+);
 
 /// XL330-M288 (model 1200): current sensor (1 mA units), 3.7–6 V, baud
 /// rates to 4 Mbps, 20 indirect addresses.
-pub static XL330_M288: ControlTable = ControlTable {
-    model: "XL330-M288",
-    model_number: 1200,
-    protocol: Protocol::V2,
-    items: &[
-        MODEL,
-        FIRMWARE,
-        ID_ITEM,
-        Item::eeprom("Baud Rate", BAUD_RATE, 1).range(0, 6),
-        RETURN_DELAY,
-        Item::eeprom("Drive Mode", DRIVE_MODE, 1).mask(0x0D),
-        Item::eeprom("Operating Mode", OPERATING_MODE, 1).one_of(OPERATING_MODES_ALL),
-        HOMING,
-        TEMP_LIMIT,
-        XL330_VOLTS[0],
-        XL330_VOLTS[1],
-        PWM_LIMIT_ITEM,
-        XL330_CURRENT[0],
-        XL330_VELOCITY[0],
-        MAX_POSITION,
-        MIN_POSITION,
-        SHUTDOWN_ITEM,
-        TORQUE,
-        LED_ITEM,
-        RETURN_LEVEL,
-        REGISTERED,
-        HW_ERROR,
-        WATCHDOG,
-        GOAL_PWM_ITEM,
-        XL330_CURRENT[1],
-        XL330_VELOCITY[1],
-        GOAL_POSITION_ITEM,
-        PRESENT_PWM_ITEM,
-        XL330_CURRENT[2],
-        PRESENT_VELOCITY_ITEM,
-        PRESENT_POSITION_ITEM,
-        PRESENT_VOLTAGE_ITEM,
-        PRESENT_TEMPERATURE_ITEM,
+pub static XL330_M288: ControlTable = x_layout_table!(
+    "XL330-M288", 1200, baud: 6 of BAUD_RATES_XL330, drive_mask: 0x0D, modes: OPERATING_MODES_ALL,
+    volts: voltage_limits(31, 70), velocity: velocity_items(2047), current: current_items(1750, 1.0),
+    indirect: [
         Item::ram("Indirect Address 1–20", INDIRECT_ADDRESS_1, 2).range(64, 227).times(20),
-        Item::ram("Indirect Data 1–20", 208, 1).times(20),
+        Item::ram("Indirect Data 1–20", 208, 1).times(20)
     ],
-    baud_rates: &BAUD_RATES_XL330,
     end: 228,
-    torque_enable: TORQUE_ENABLE,
-    operating_mode: OPERATING_MODE,
-};
+);

@@ -132,42 +132,20 @@ where
 }
 
 /// A status packet (a servo's answer), owning up to `N` parameter bytes
-/// (unstuffed).
+/// (unstuffed): the two protocols' [`crate::dynamixel::status_packet::StatusPacket`]
+/// with Protocol 2.0's ERROR byte.
 ///
 /// A status packet from [`BROADCAST_ID`] is the one combined reply to Fast
 /// Sync Read or Fast Bulk Read: `error` is the first servo's ERROR and
 /// `params` the rest of the blocks (read them with
 /// [`StatusPacket::fast_blocks`]); it is encoded without stuffing.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct StatusPacket<const N: usize = DEFAULT_PACKET_LEN> {
-    /// The answering servo (or the broadcast ID for a fast reply).
-    pub id: u8,
-    /// The ERROR byte.
-    pub error: StatusError,
-    /// The parameters (the data read; model and firmware for PING).
-    pub params: Vec<u8, N>,
-}
+pub type StatusPacket<const N: usize = DEFAULT_PACKET_LEN> = crate::dynamixel::status_packet::StatusPacket<StatusError, N>;
 
 impl<const N: usize> StatusPacket<N> {
     /// A status packet with `params`, which must fit `N`.
     pub fn new(id: u8, error: StatusError, params: &[u8]) -> Result<Self, EncodeError> {
         let params = Vec::from_slice(params).map_err(|_| EncodeError::TooLong { bytes: params.len() })?;
         Ok(StatusPacket { id, error, params })
-    }
-
-    /// Parameter byte `i`.
-    pub fn u8_at(&self, i: usize) -> Option<u8> {
-        self.params.get(i).copied()
-    }
-
-    /// Little-endian 16-bit value at parameter bytes `i, i+1`.
-    pub fn u16_at(&self, i: usize) -> Option<u16> {
-        Some(u16::from_le_bytes(*self.params.get(i..)?.first_chunk()?))
-    }
-
-    /// Little-endian 32-bit value at parameter bytes `i..i+4`.
-    pub fn u32_at(&self, i: usize) -> Option<u32> {
-        Some(u32::from_le_bytes(*self.params.get(i..)?.first_chunk()?))
     }
 
     /// Whether this is the combined reply of a fast read.
