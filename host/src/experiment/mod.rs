@@ -34,6 +34,6 @@ pub use metrics::{end_performance, rise_time};
 pub use config::RunConfig;
 pub use runner::{run_configs, run_configs_keeping, run_trials, run_trials_observed, FinishedTrial};
 pub use trial::{
-    run_trial, run_trial_from, run_trial_keep, run_trial_observed, StartWith, TestBooks, TestPoint, TrialObserver, TrialResult,
+    run_trial, run_trial_from, run_trial_keep, StartWith, TestBooks, TestPoint, TrialObserver, TrialResult,
     TrialStart,
 };

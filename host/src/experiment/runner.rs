@@ -5,7 +5,7 @@
 use super::agent_setup::HostAgent;
 /// The run configuration, where the runner's users have found it.
 pub use super::config::RunConfig;
-use super::trial::{run_trial_keep, run_trial_observed, StartWith, TrialObserver, TrialResult};
+use super::trial::{run_trial_from, run_trial_keep, StartWith, TrialObserver, TrialResult, TrialStart};
 use crate::experiment::task::Task;
 use rayon::prelude::*;
 
@@ -30,11 +30,11 @@ pub fn run_trials_observed<T: Task>(
     start: Option<StartWith<'_>>,
 ) -> anyhow::Result<(Vec<TrialResult>, HostAgent, bool)> {
     let (first, rest) = rayon::join(
-        || run_trial_observed(task, cfg, 0, progress, observer, start),
+        || run_trial_from(task, cfg, 0, progress, observer, TrialStart::of(start)).map(|(r, a, s, _)| (r, a, s)),
         || {
             (1..cfg.trials)
                 .into_par_iter()
-                .map(|t| run_trial_observed(task, cfg, t, progress, None, start).map(|(r, _, _)| r))
+                .map(|t| run_trial_from(task, cfg, t, progress, None, TrialStart::of(start)).map(|(r, ..)| r))
                 .collect::<anyhow::Result<Vec<_>>>()
         },
     );

@@ -54,7 +54,7 @@ pub fn run_trial<T: Task>(
     trial: u32,
     progress: &(dyn Fn(u64) + Sync),
 ) -> anyhow::Result<TrialResult> {
-    run_trial_observed(task, cfg, trial, progress, None, None).map(|(r, _, _)| r)
+    run_trial_from(task, cfg, trial, progress, None, TrialStart::Nothing).map(|(r, ..)| r)
 }
 
 /// [`run_trial`], also returning the agent as learned at the end (for
@@ -65,26 +65,12 @@ pub fn run_trial_keep<T: Task>(
     trial: u32,
     progress: &(dyn Fn(u64) + Sync),
 ) -> anyhow::Result<(TrialResult, HostAgent, bool)> {
-    run_trial_observed(task, cfg, trial, progress, None, None)
+    run_trial_from(task, cfg, trial, progress, None, TrialStart::Nothing).map(|(r, a, s, _)| (r, a, s))
 }
 
 /// What replaces a trial's initial weights (`pada run --weights`:
 /// `crate::start_weights`), after they were drawn from the trial's seed.
 pub type StartWith<'s> = &'s (dyn Fn(&mut HostAgent) -> anyhow::Result<()> + Sync);
-
-/// [`run_trial_keep`], telling `observer` every agent call and episode,
-/// and starting from the weights `start` puts in, if given.
-pub fn run_trial_observed<T: Task>(
-    task: &T,
-    cfg: &RunConfig,
-    trial: u32,
-    progress: &(dyn Fn(u64) + Sync),
-    observer: Option<TrialObserver<'_>>,
-    start: Option<StartWith<'_>>,
-) -> anyhow::Result<(TrialResult, HostAgent, bool)> {
-    let start = start.map_or(TrialStart::Nothing, TrialStart::With);
-    run_trial_from(task, cfg, trial, progress, observer, start).map(|(r, a, s, _)| (r, a, s))
-}
 
 /// Where a trial's weights start.
 pub enum TrialStart<'w> {
@@ -96,6 +82,13 @@ pub enum TrialStart<'w> {
     /// A learned agent for the task with the run's policy (its weights and
     /// state are kept).
     Agent(HostAgent),
+}
+
+impl<'w> TrialStart<'w> {
+    /// From the weights `start` puts in, if given.
+    pub fn of(start: Option<StartWith<'w>>) -> Self {
+        start.map_or(TrialStart::Nothing, TrialStart::With)
+    }
 }
 
 /// The books of a trial at each of its test runs, in the order of
@@ -111,8 +104,9 @@ pub struct TestBooks {
     pub learning_falls: Vec<u64>,
 }
 
-/// [`run_trial_observed`], starting as `start` says, and returning the
-/// books at every test run ([`TestBooks`]).
+/// [`run_trial_keep`], telling `observer` every agent call and episode,
+/// starting as `start` says, and returning the books at every test run
+/// ([`TestBooks`]).
 pub fn run_trial_from<T: Task>(
     task: &T,
     cfg: &RunConfig,
