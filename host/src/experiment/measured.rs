@@ -155,7 +155,7 @@ impl TrialResult {
     ) -> TrialResult {
         let times: Vec<f64> = curve.iter().map(|p| p.learning_time_s).collect();
         let returns: Vec<f64> = curve.iter().map(|p| p.test_return).collect();
-        let tail_n = curve.len().div_ceil(10).max(1).min(curve.len().max(1));
+        let tail_n = curve.len().div_ceil(10).max(1);
         let tail = &curve[curve.len().saturating_sub(tail_n)..];
         let walked: Option<f64> = tail.iter().map(|p| p.walked_m).sum();
         TrialResult {

@@ -1,6 +1,6 @@
 //! The step-size correction of the servos' first-order response.
 
-use super::step::inverse_column;
+use super::step::solve_inverse_column;
 use super::{LeoModel, ANGULAR_X, NUM_JOINTS};
 
 impl LeoModel {
@@ -49,8 +49,10 @@ impl LeoModel {
         let mut inv = [0.0f32; NUM_JOINTS];
         let mut own = [0.0f32; NUM_JOINTS];
         if stepped {
+            // One vector for every DoF's solve: this runs every step.
+            let mut e = rapier3d::na::DVector::<f32>::zeros(mb.ndofs());
             for (i, &k) in dofs.iter().enumerate() {
-                inv[i] = inverse_column(mb, k).map_or(f32::NAN, |e| e[k]);
+                inv[i] = if solve_inverse_column(mb, k, &mut e) { e[k] } else { f32::NAN };
             }
             for (i, &k) in dofs.iter().enumerate() {
                 let spring = mb

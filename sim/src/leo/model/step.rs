@@ -197,9 +197,10 @@ impl LeoModel {
         // Columns of A⁻¹ for the stopped DoFs.
         let mut columns = Vec::with_capacity(set.len());
         for &k in &set {
-            let Some(e) = inverse_column(mb, dofs[k]) else {
+            let mut e = DVector::<f32>::zeros(mb.ndofs());
+            if !solve_inverse_column(mb, dofs[k], &mut e) {
                 return;
-            };
+            }
             columns.push(e);
         }
         let m = set.len();
@@ -246,11 +247,12 @@ impl LeoModel {
     }
 }
 
-/// Column `dof` of A⁻¹, with A the matrix rapier factorised in its last
-/// step (mass, armature, h·damping, h²·springs); `None` where the
-/// factorisation cannot solve.
-pub(super) fn inverse_column(mb: &Multibody, dof: usize) -> Option<rapier3d::na::DVector<f32>> {
-    let mut e = rapier3d::na::DVector::<f32>::zeros(mb.ndofs());
+/// Puts column `dof` of A⁻¹ into `e` (of the multibody's DoFs; the caller
+/// keeps it, so a loop of solves allocates once), with A the matrix rapier
+/// factorised in its last step (mass, armature, h·damping, h²·springs);
+/// `false` where the factorisation cannot solve.
+pub(super) fn solve_inverse_column(mb: &Multibody, dof: usize, e: &mut rapier3d::na::DVector<f32>) -> bool {
+    e.fill(0.0);
     e[dof] = 1.0;
-    mb.inv_augmented_mass().solve_mut(&mut e).then_some(e)
+    mb.inv_augmented_mass().solve_mut(e)
 }
